@@ -1,0 +1,241 @@
+"""Lagrange's equations derived symbolically from a mechanism description (monograph §9.1,
+eq. 97).
+
+Route 1 (used for motion): positions of every body from the joints, velocities by
+Jacobians, T = sum(m v^2/2 + I w^2/2), generalized forces from gravity and from every
+force element by virtual power (eq. 95):
+
+    M(q) q'' + h(q, q') = Q(q, q', t),   h = d/dt(dT/dq') - dT/dq - M q''.
+
+Route 2 (energy functions, used to cross-check the linearization, monograph eq. 107-109
+and Italian notes §5.3.3-5.3.4): T, V and Rayleigh's D, whose Hessians at an equilibrium
+are M, K and C.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy as sp
+
+from ..systems import System, coordinate_symbols, get_system
+from ..systems.model import (
+    COORD,
+    COORD_RATE,
+    LENGTH,
+    LENGTH_RATE,
+    TIME,
+    WORLD,
+    CoordinateForce,
+    Mechanism,
+    PointToPoint,
+    Prismatic,
+    Revolute,
+    as_column,
+    rotation,
+)
+
+
+@dataclass
+class Pose:
+    position: sp.Matrix  # 2x1, centre of mass in world axes
+    angle: sp.Expr
+
+
+class Derivation:
+    """Symbolic model of a mechanism (parameters stay symbols)."""
+
+    def __init__(self, mechanism: Mechanism):
+        self.mechanism = mechanism
+        names = mechanism.coordinates
+        syms = [coordinate_symbols(n) for n in names]
+        self.q = sp.Matrix([s[0] for s in syms])
+        self.qd = sp.Matrix([s[1] for s in syms])
+        self.qdd = sp.Matrix([s[2] for s in syms])
+        self.n = len(names)
+        self.poses = self._poses()
+        self.joint_values = self._joint_values()
+        self._energies()
+        self._forces()
+        self.residual = (self.M * self.qdd + self.h - self.Q).applyfunc(sp.expand)
+
+    # --- kinematics ----------------------------------------------------------------------
+    def _poses(self) -> dict[str, Pose]:
+        poses = {WORLD: Pose(sp.zeros(2, 1), sp.Integer(0))}
+        mech = self.mechanism
+        for j, qj in zip(mech.joints, self.q):
+            parent = poses[j.parent]
+            Rp = rotation(parent.angle)
+            if isinstance(j, Revolute):
+                base = 0 if j.absolute else parent.angle
+                angle = base + qj + j.angle_offset
+                anchor = parent.position + Rp * as_column(j.parent_anchor)
+            elif isinstance(j, Prismatic):
+                angle = parent.angle + j.angle_offset
+                anchor = parent.position + Rp * (as_column(j.parent_anchor) + qj * as_column(j.axis))
+            else:  # pragma: no cover - the Joint union is closed
+                raise TypeError(j)
+            position = anchor - rotation(angle) * as_column(j.child_anchor)
+            poses[j.child] = Pose(position.applyfunc(sp.simplify), sp.simplify(angle))
+        return poses
+
+    def _joint_values(self) -> sp.Matrix:
+        """The engines' relative joint values as (linear) functions of the coordinates."""
+        vals = []
+        for j, qj in zip(self.mechanism.joints, self.q):
+            if isinstance(j, Revolute) and j.absolute:
+                vals.append(qj - self.poses[j.parent].angle)
+            else:
+                vals.append(qj)
+        return sp.Matrix(vals)
+
+    def point(self, body: str, local) -> sp.Matrix:
+        pose = self.poses[body]
+        return pose.position + rotation(pose.angle) * as_column(local)
+
+    def velocity(self, expr: sp.Matrix) -> sp.Matrix:
+        return expr.jacobian(self.q) * self.qd
+
+    def acceleration(self, expr: sp.Matrix) -> sp.Matrix:
+        v = self.velocity(expr)
+        return expr.jacobian(self.q) * self.qdd + v.jacobian(self.q) * self.qd
+
+    # --- energies ------------------------------------------------------------------------
+    def _energies(self) -> None:
+        mech = self.mechanism
+        M = sp.zeros(self.n, self.n)
+        V = sp.Integer(0)
+        for b in mech.bodies:
+            pose = self.poses[b.name]
+            Jv = pose.position.jacobian(self.q)
+            Jw = sp.Matrix([[sp.diff(pose.angle, qi) for qi in self.q]])
+            M += b.mass * (Jv.T * Jv) + b.inertia * (Jw.T * Jw)
+            V += b.mass * mech.gravity * pose.position[1]
+        self.M = M.applyfunc(sp.simplify)
+        self.T = sp.expand((self.qd.T * self.M * self.qd)[0] / 2)
+        # h = (dM/dt) q' - dT/dq
+        Mdot = sp.zeros(self.n, self.n)
+        for k in range(self.n):
+            Mdot += self.M.diff(self.q[k]) * self.qd[k]
+        dT_dq = sp.Matrix([sp.diff(self.T, qi) for qi in self.q])
+        self.h = (Mdot * self.qd - dT_dq).applyfunc(sp.simplify)
+        self.V_gravity = V
+
+    # --- forces --------------------------------------------------------------------------
+    def element_length(self, f: PointToPoint) -> tuple[sp.Expr, sp.Matrix]:
+        d = self.point(f.body_b, f.point_b) - self.point(f.body_a, f.point_a)
+        length = sp.sqrt(sp.simplify((d.T * d)[0]))
+        return length, d
+
+    def _forces(self) -> None:
+        mech = self.mechanism
+        g_vec = sp.Matrix([0, -mech.gravity])
+        Q = sp.zeros(self.n, 1)
+        for b in mech.bodies:
+            Jv = self.poses[b.name].position.jacobian(self.q)
+            Q += Jv.T * (b.mass * g_vec)
+        Q_autonomous = Q.copy()
+        V = self.V_gravity
+        D = sp.Integer(0)
+        energy_route = True
+        for f in mech.forces:
+            Qf, Vf, Df = self.element_generalized_force(f)
+            Q += Qf
+            time_dependent = TIME in sp.sympify(Qf).free_symbols
+            if not time_dependent:
+                Q_autonomous += Qf
+            if time_dependent:
+                continue
+            if Vf is None and Df is None:
+                energy_route = False
+                continue
+            V += Vf if Vf is not None else 0
+            D += Df if Df is not None else 0
+        self.Q = Q.applyfunc(sp.simplify)
+        #: generalized forces without the explicitly time-dependent elements e(t) (the
+        #: system whose equilibria are studied, monograph §8, eq. 78)
+        self.Q_autonomous = Q_autonomous.applyfunc(sp.simplify)
+        self.V = sp.simplify(V)
+        self.D = sp.simplify(D)
+        self.energy_route = energy_route and self._energy_route_consistent()
+        self.conservative = self.energy_route and self.D == 0 and not any(
+            TIME in sp.sympify(e).free_symbols for e in self.Q)
+
+    def element_generalized_force(self, f):
+        """(Q contribution, potential or None, dissipation or None) of a force element."""
+        if isinstance(f, PointToPoint):
+            length, _ = self.element_length(f)
+            rate = (sp.Matrix([length]).jacobian(self.q) * self.qd)[0]
+            subs = {LENGTH: length, LENGTH_RATE: rate}
+            tension = sp.sympify(f.tension).xreplace(subs)
+            dl_dq = sp.Matrix([sp.diff(length, qi) for qi in self.q])
+            Q = -tension * dl_dq
+            V = sp.sympify(f.potential).xreplace(subs) if f.potential is not None else None
+            D = sp.sympify(f.dissipation).xreplace(subs) if f.dissipation is not None else None
+            return Q, V, D
+        if isinstance(f, CoordinateForce):
+            i = self.mechanism.coordinates.index(f.coordinate)
+            subs = {COORD: self.q[i], COORD_RATE: self.qd[i]}
+            Q = sp.zeros(self.n, 1)
+            Q[i] = sp.sympify(f.force).xreplace(subs)
+            V = sp.sympify(f.potential).xreplace(subs) if f.potential is not None else None
+            D = sp.sympify(f.dissipation).xreplace(subs) if f.dissipation is not None else None
+            return Q, V, D
+        raise TypeError(f"unsupported force element {f!r}")
+
+    def _energy_route_consistent(self) -> bool:
+        """Q_autonomous must equal -dV/dq - dD/dq' for the energy route to apply."""
+        grad = sp.Matrix([sp.diff(self.V, qi) for qi in self.q])
+        dgrad = sp.Matrix([sp.diff(self.D, v) for v in self.qd])
+        diff = (self.Q_autonomous + grad + dgrad).applyfunc(sp.simplify)
+        return all(e == 0 for e in diff)
+
+    # --- reactions -----------------------------------------------------------------------
+    def reaction(self, joint_name: str) -> sp.Matrix:
+        """Force (world x, y) that the parent exerts on the child through the joint, from
+        Newton's law on the child's subtree: sum(m a) = R + gravity + element forces from
+        outside the subtree. Expression of q, q', q'', t."""
+        mech = self.mechanism
+        joint = mech.joint(joint_name)
+        subtree = set(mech.subtree(joint.child))
+        g_vec = sp.Matrix([0, -mech.gravity])
+        total = sp.zeros(2, 1)
+        for name in subtree:
+            b = mech.body(name)
+            if b.mass != 0:
+                total += b.mass * (self.acceleration(self.poses[name].position) - g_vec)
+        for f in mech.forces:
+            total -= self._external_force_on(f, subtree, joint)
+        return total.applyfunc(sp.simplify)
+
+    def _external_force_on(self, f, subtree: set[str], joint) -> sp.Matrix:
+        if isinstance(f, PointToPoint):
+            in_a, in_b = f.body_a in subtree, f.body_b in subtree
+            if in_a == in_b:
+                return sp.zeros(2, 1)
+            length, d = self.element_length(f)
+            rate = (sp.Matrix([length]).jacobian(self.q) * self.qd)[0]
+            tension = sp.sympify(f.tension).xreplace({LENGTH: length, LENGTH_RATE: rate})
+            unit = d / length  # from a to b
+            return tension * unit if in_a else -tension * unit
+        if isinstance(f, CoordinateForce):
+            owner = self.mechanism.joints[self.mechanism.coordinates.index(f.coordinate)]
+            if owner is not joint:
+                return sp.zeros(2, 1)  # internal to the subtree or a torque only
+            if isinstance(owner, Revolute):
+                return sp.zeros(2, 1)
+            i = self.mechanism.coordinates.index(f.coordinate)
+            force = sp.sympify(f.force).xreplace({COORD: self.q[i], COORD_RATE: self.qd[i]})
+            axis_world = rotation(self.poses[owner.parent].angle) * as_column(owner.axis)
+            return force * axis_world
+        raise TypeError(f)
+
+
+@lru_cache(maxsize=None)
+def derivation_of(system_id: str) -> Derivation:
+    """The (cached) symbolic derivation of a catalog system."""
+    return Derivation(get_system(system_id).mechanism)
+
+
+def derive(system: System) -> Derivation:
+    return derivation_of(system.id)

@@ -1,0 +1,194 @@
+"""The mechanism catalog: one module per mechanism, discovered automatically.
+
+Each module defines ``SYSTEM = System(...)``. Adding a mechanism means adding a module
+here and nothing else (the pattern of dm_control's suite).
+"""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from dataclasses import dataclass, field
+from functools import cached_property
+from types import SimpleNamespace
+from typing import Callable, Mapping
+
+import sympy as sp
+
+from .model import (
+    GRAVITY,
+    STANDARD_GRAVITY,
+    Expr,
+    Mechanism,
+    Parameter,
+    Scenario,
+)
+
+#: checks as MECHANISMS.md names them
+CHECK_KINDS = ("trajectory", "reaction", "frequency")
+
+
+def coordinate_symbols(name: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+    """(q, q_dot, q_ddot) symbols of a coordinate, as used in printed formulas."""
+    return (
+        sp.Symbol(name, real=True),
+        sp.Symbol(f"{name}_dot", real=True),
+        sp.Symbol(f"{name}_ddot", real=True),
+    )
+
+
+@dataclass(frozen=True)
+class PrintedFormula:
+    """A formula as the monograph prints it, coded as printed (with its equation number).
+
+    kind:
+      "eom"               residuals (one per printed equation) in q, q_dot, q_ddot
+      "kinetic_energy"    expression in q, q_dot
+      "potential_energy"  expression in q (compared up to a constant)
+      "M", "K", "C"       matrix at the operating point (coordinates in system order)
+      "equilibrium"       mapping coordinate -> printed equilibrium value
+      "frequency"         natural angular frequency (rad/s) at the operating point
+      "damping_ratio"     damping ratio at the operating point
+    """
+
+    label: str
+    kind: str
+    expr: object
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Expectation:
+    """An exception as data (scikit-learn's common-check pattern).
+
+    kind "xfail": the metric is expected to fail its gate (strict: a pass is reported);
+    kind "unsupported": the engine cannot express the mechanism (or scenario) at all.
+    `simulator` and `metric` are fnmatch patterns ("*" matches all)."""
+
+    simulator: str
+    metric: str
+    kind: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class System:
+    id: str
+    title: str
+    source: str
+    parameters: tuple[Parameter, ...]
+    build: Callable[[SimpleNamespace], Mechanism]
+    operating_point: Callable[[SimpleNamespace], Mapping[str, Expr]]
+    scenarios: tuple[Scenario, ...]
+    #: the monograph's printed formulas, as a function of the parameter symbols
+    printed: Callable[[SimpleNamespace], tuple[PrintedFormula, ...]] = lambda P: ()
+    reaction_joints: tuple[str, ...] = ()
+    expectations: tuple[Expectation, ...] = ()
+    #: name of an exact solution in mbfidelity.analytic.closed_forms, if one exists
+    exact_solution: str | None = None
+    notes: str = ""
+    module_doc: str = field(default="", compare=False)
+
+    @cached_property
+    def all_parameters(self) -> tuple[Parameter, ...]:
+        names = {p.name for p in self.parameters}
+        extra = () if "g" in names else (
+            Parameter("g", STANDARD_GRAVITY, "m/s^2", "gravitational acceleration (along -y)"),
+        )
+        return tuple(self.parameters) + extra
+
+    @cached_property
+    def symbols(self) -> SimpleNamespace:
+        return SimpleNamespace(**{p.name: p.symbol for p in self.all_parameters})
+
+    @cached_property
+    def mechanism(self) -> Mechanism:
+        """The symbolic mechanism (parameters as symbols)."""
+        mech = self.build(self.symbols)
+        if mech.gravity is not GRAVITY and sp.sympify(mech.gravity) != GRAVITY:
+            raise ValueError(f"{self.id}: gravity must be the parameter g")
+        return mech
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        return self.mechanism.coordinates
+
+    def parameter_values(self, overrides: Mapping[str, float] | None = None,
+                         scenario: Scenario | None = None) -> dict[str, float]:
+        """Defaults, then the scenario's values, then the user's overrides (validated)."""
+        known = {p.name: p for p in self.all_parameters}
+        values = {name: float(p.default) for name, p in known.items()}
+        if scenario is not None:
+            values.update({k: float(v) for k, v in scenario.overrides.items()})
+        for name, value in (overrides or {}).items():
+            if name not in known:
+                raise KeyError(
+                    f"unknown parameter {name!r} for {self.id}; valid: {', '.join(known)}"
+                )
+            known[name].validate(float(value))
+            values[name] = float(value)
+        return values
+
+    def subs(self, values: Mapping[str, float]) -> dict[sp.Symbol, float]:
+        return {getattr(self.symbols, k): v for k, v in values.items()}
+
+    def numeric_mechanism(self, values: Mapping[str, float]) -> Mechanism:
+        return self.mechanism.substitute(self.subs(values))
+
+    def scenario(self, name: str) -> Scenario:
+        for s in self.scenarios:
+            if s.name == name:
+                return s
+        raise KeyError(
+            f"unknown scenario {name!r} for {self.id}; valid: "
+            + ", ".join(s.name for s in self.scenarios)
+        )
+
+    def initial_state(self, scenario: Scenario, values: Mapping[str, float]):
+        import numpy as np
+
+        q0 = np.array([self.evaluate(scenario.q0.get(c, 0), values) for c in self.coordinates])
+        qd0 = np.array([self.evaluate(scenario.qd0.get(c, 0), values) for c in self.coordinates])
+        return q0, qd0
+
+    def evaluate(self, expr, values: Mapping[str, float]) -> float:
+        """A number, an expression of parameter symbols, or a string naming them."""
+        parsed = sp.sympify(expr, locals=vars(self.symbols)) if isinstance(expr, str) else expr
+        return float(sp.sympify(parsed).xreplace(self.subs(values)))
+
+    def operating_values(self, values: Mapping[str, float]):
+        import numpy as np
+
+        op = self.operating_point(self.symbols)
+        return np.array([self.evaluate(op.get(c, 0), values) for c in self.coordinates])
+
+
+def _discover() -> dict[str, System]:
+    found: dict[str, System] = {}
+    for info in pkgutil.iter_modules(__path__):
+        if info.name.startswith("_") or info.name == "model":
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        system = getattr(module, "SYSTEM", None)
+        if isinstance(system, System):
+            if system.id != info.name:
+                raise ValueError(f"module {info.name} defines system {system.id}")
+            object.__setattr__(system, "module_doc", module.__doc__ or "")
+            found[system.id] = system
+    return dict(sorted(found.items()))
+
+
+_REGISTRY: dict[str, System] | None = None
+
+
+def all_systems() -> dict[str, System]:
+    global _REGISTRY
+    if _REGISTRY is None:
+        _REGISTRY = _discover()
+    return _REGISTRY
+
+
+def get_system(system_id: str) -> System:
+    systems = all_systems()
+    if system_id not in systems:
+        raise KeyError(f"unknown system {system_id!r}; valid: {', '.join(systems)}")
+    return systems[system_id]

@@ -1,0 +1,331 @@
+"""The engine-neutral description of a planar mechanism.
+
+A mechanism is data: rigid bodies, the joints that give its generalized coordinates, force
+elements, applied loads, and (later mechanisms) closure constraints. The analytic layer
+derives the exact model from it; every simulator backend translates it.
+
+Conventions (all backends and the analytic layer honour them):
+
+1. World frame: x to the right, y up, motion in the x-y plane, gravity (0, -g).
+2. Every body has a frame whose origin is its centre of mass; `inertia` is the central
+   moment of inertia about the z axis. A body may be massless (mass 0, inertia 0): it is
+   then a kinematic link only (the arm of Fig. 12); backends that reject massless moving
+   bodies must fold its joints into its child.
+3. A body's pose is (x, y, theta); R(theta) rotates body-frame vectors to world axes.
+4. `Revolute(parent, child)`: the anchor points coincide,
+   ``p_parent + R(th_parent) parent_anchor = p_child + R(th_child) child_anchor``, and
+   ``th_child = th_parent + q + angle_offset`` (relative angle), or, with
+   ``absolute=True``, ``th_child = q + angle_offset`` (the monograph's absolute angles,
+   e.g. phi2 of Fig. 37). Engines with relative joint angles map through
+   `Mechanism.joint_map`.
+5. `Prismatic(parent, child)`: ``p_parent + R(th_parent)(parent_anchor + q axis) =
+   p_child + R(th_child) child_anchor`` and ``th_child = th_parent + angle_offset``.
+6. Reaction at a joint: the force the parent exerts on the child through the joint, in
+   world axes (x, y components), N.
+7. Force elements are written once as SymPy expressions of placeholder symbols
+   (`LENGTH`, `LENGTH_RATE` for point-to-point elements; `COORD`, `COORD_RATE` for
+   elements on one coordinate; `TIME` everywhere) and of parameter symbols. The same
+   expression feeds the derivation and, compiled with `compile_law`, every engine.
+8. Positive `tension` of a point-to-point element pulls its two points together.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Callable, Mapping, Sequence, Union
+
+import sympy as sp
+
+Expr = Union[sp.Expr, float, int]
+Vec = tuple[Expr, Expr]
+
+WORLD = "world"
+TIME = sp.Symbol("t", real=True)
+LENGTH = sp.Symbol("_length", positive=True)
+LENGTH_RATE = sp.Symbol("_length_rate", real=True)
+COORD = sp.Symbol("_coord", real=True)
+COORD_RATE = sp.Symbol("_coord_rate", real=True)
+GRAVITY = sp.Symbol("g", positive=True)
+STANDARD_GRAVITY = 9.81
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A named, overridable parameter (names as in MECHANISMS.md, ASCII spelling)."""
+
+    name: str
+    default: float
+    unit: str
+    meaning: str
+    source: str = "MECHANISMS.md"
+    #: "positive", "nonnegative" or "real": checked when a user overrides the value.
+    domain: str = "positive"
+
+    @property
+    def symbol(self) -> sp.Symbol:
+        if self.domain == "positive":
+            return sp.Symbol(self.name, positive=True)
+        if self.domain == "nonnegative":
+            return sp.Symbol(self.name, nonnegative=True)
+        return sp.Symbol(self.name, real=True)
+
+    def validate(self, value: float) -> None:
+        if self.domain == "positive" and not value > 0:
+            raise ValueError(f"parameter {self.name} must be > 0, got {value}")
+        if self.domain == "nonnegative" and not value >= 0:
+            raise ValueError(f"parameter {self.name} must be >= 0, got {value}")
+
+
+# --- drawing / contact geometry (body frame) -------------------------------------------
+
+
+@dataclass(frozen=True)
+class Segment:
+    a: Vec
+    b: Vec
+    width: Expr = 0.02
+
+
+@dataclass(frozen=True)
+class Circle:
+    center: Vec
+    radius: Expr
+
+
+@dataclass(frozen=True)
+class Rectangle:
+    center: Vec
+    width: Expr
+    height: Expr
+
+
+Shape = Union[Segment, Circle, Rectangle]
+
+
+@dataclass(frozen=True)
+class Body:
+    name: str
+    mass: Expr
+    inertia: Expr
+    shapes: tuple[Shape, ...] = ()
+
+    @property
+    def massless(self) -> bool:
+        return sp.sympify(self.mass) == 0 and sp.sympify(self.inertia) == 0
+
+
+@dataclass(frozen=True)
+class Revolute:
+    name: str
+    parent: str
+    child: str
+    coordinate: str
+    parent_anchor: Vec = (0, 0)
+    child_anchor: Vec = (0, 0)
+    angle_offset: Expr = 0
+    absolute: bool = False
+
+
+@dataclass(frozen=True)
+class Prismatic:
+    name: str
+    parent: str
+    child: str
+    coordinate: str
+    axis: Vec
+    parent_anchor: Vec = (0, 0)
+    child_anchor: Vec = (0, 0)
+    angle_offset: Expr = 0
+    #: open interval of admissible values (None = unbounded); the equilibrium search and
+    #: the backends respect it (e.g. a distance from a pivot is positive).
+    limits: tuple[Expr | None, Expr | None] = (None, None)
+
+
+Joint = Union[Revolute, Prismatic]
+
+
+@dataclass(frozen=True)
+class PointToPoint:
+    """Spring/damper/custom law acting along the line between two body points.
+
+    `tension` is an expression of LENGTH, LENGTH_RATE, TIME and parameters; positive
+    tension pulls the points together. `potential`, when the law is conservative, is the
+    stored energy as a function of LENGTH (used by the energy route of the linearization
+    and by energy-drift checks); `dissipation` is Rayleigh's function of LENGTH_RATE for
+    linear viscous parts.
+    """
+
+    name: str
+    body_a: str
+    point_a: Vec
+    body_b: str
+    point_b: Vec
+    tension: Expr
+    potential: Expr | None = None
+    dissipation: Expr | None = None
+
+
+@dataclass(frozen=True)
+class CoordinateForce:
+    """Generalized force on one coordinate (torsional/linear spring-damper, custom law,
+    applied load e(t)). `force` is an expression of COORD, COORD_RATE, TIME and
+    parameters, positive in the direction of increasing coordinate. It acts between the
+    parent and the child of the joint that owns the coordinate."""
+
+    name: str
+    coordinate: str
+    force: Expr
+    potential: Expr | None = None
+    dissipation: Expr | None = None
+
+    @property
+    def time_dependent(self) -> bool:
+        return TIME in sp.sympify(self.force).free_symbols
+
+
+ForceElement = Union[PointToPoint, CoordinateForce]
+
+
+def linear_spring_damper(k: Expr, l0: Expr, c: Expr = 0) -> dict:
+    """Tension, potential and dissipation of a linear spring (free length l0) with a
+    parallel viscous damper, for `PointToPoint(**...)`."""
+    return dict(
+        tension=k * (LENGTH - l0) + c * LENGTH_RATE,
+        potential=k * (LENGTH - l0) ** 2 / 2,
+        dissipation=c * LENGTH_RATE**2 / 2,
+    )
+
+
+def coordinate_spring_damper(k: Expr, q0: Expr, c: Expr = 0) -> dict:
+    """Linear spring with neutral position q0 plus damper on a coordinate."""
+    return dict(
+        force=-k * (COORD - q0) - c * COORD_RATE,
+        potential=k * (COORD - q0) ** 2 / 2,
+        dissipation=c * COORD_RATE**2 / 2,
+    )
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A planar mechanism (data only). Coordinates are the joints' coordinates in joint
+    order."""
+
+    bodies: tuple[Body, ...]
+    joints: tuple[Joint, ...]
+    forces: tuple[ForceElement, ...] = ()
+    gravity: Expr = GRAVITY
+
+    def __post_init__(self) -> None:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names) or WORLD in names:
+            raise ValueError(f"body names must be unique and not {WORLD!r}: {names}")
+        seen = {WORLD}
+        for j in self.joints:
+            if j.parent not in seen:
+                raise ValueError(f"joint {j.name}: parent {j.parent!r} must come before it")
+            if j.child in seen or j.child not in names:
+                raise ValueError(f"joint {j.name}: child {j.child!r} unknown or already placed")
+            seen.add(j.child)
+        if seen != {WORLD, *names}:
+            raise ValueError(f"bodies without a joint: {sorted(set(names) - seen)}")
+        coords = self.coordinates
+        if len(set(coords)) != len(coords):
+            raise ValueError(f"duplicate coordinate names: {coords}")
+        for f in self.forces:
+            if isinstance(f, CoordinateForce) and f.coordinate not in coords:
+                raise ValueError(f"force {f.name}: unknown coordinate {f.coordinate}")
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:
+        return tuple(j.coordinate for j in self.joints)
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def joint(self, name: str) -> Joint:
+        for j in self.joints:
+            if j.name == name:
+                return j
+        raise KeyError(name)
+
+    def joint_of_child(self, body: str) -> Joint:
+        for j in self.joints:
+            if j.child == body:
+                return j
+        raise KeyError(body)
+
+    def angular(self, coordinate: str) -> bool:
+        return isinstance(self.joints[self.coordinates.index(coordinate)], Revolute)
+
+    def subtree(self, body: str) -> list[str]:
+        """The body and everything hanging from it."""
+        out = [body]
+        for j in self.joints:
+            if j.parent in out:
+                out.append(j.child)
+        return out
+
+    def substitute(self, values: Mapping[sp.Symbol, float]) -> "Mechanism":
+        """The same mechanism with parameter symbols replaced by numbers (placeholders
+        and TIME stay symbolic)."""
+        subs = dict(values)
+
+        def ev(x):
+            if isinstance(x, tuple):
+                return tuple(ev(v) for v in x)
+            if x is None or isinstance(x, (str, bool)):
+                return x
+            return sp.sympify(x).xreplace(subs)
+
+        def ev_obj(obj):
+            changes = {}
+            for name in obj.__dataclass_fields__:
+                v = getattr(obj, name)
+                if name == "shapes":
+                    changes[name] = tuple(ev_obj(s) for s in v)
+                elif isinstance(v, (str, bool)):
+                    continue
+                else:
+                    changes[name] = ev(v)
+            return replace(obj, **changes)
+
+        return Mechanism(
+            bodies=tuple(ev_obj(b) for b in self.bodies),
+            joints=tuple(ev_obj(j) for j in self.joints),
+            forces=tuple(ev_obj(f) for f in self.forces),
+            gravity=ev(self.gravity),
+        )
+
+
+def compile_law(expr: Expr, args: Sequence[sp.Symbol]) -> Callable[..., float]:
+    """Compile a (numeric-parameter) law to a fast scalar function of `args`."""
+    expr = sp.sympify(expr)
+    extra = expr.free_symbols - set(args)
+    if extra:
+        raise ValueError(f"law {expr} still has free symbols {sorted(map(str, extra))}")
+    return sp.lambdify(args, expr, modules="math")
+
+
+def rotation(theta: Expr) -> sp.Matrix:
+    return sp.Matrix([[sp.cos(theta), -sp.sin(theta)], [sp.sin(theta), sp.cos(theta)]])
+
+
+def as_column(v: Vec) -> sp.Matrix:
+    return sp.Matrix([sp.sympify(v[0]), sp.sympify(v[1])])
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One run of a mechanism: initial state (expressions of parameters), duration,
+    parameter values it sets (the user's --param values win over them), and the checks
+    that apply to it."""
+
+    name: str
+    q0: Mapping[str, Expr]
+    qd0: Mapping[str, Expr] = field(default_factory=dict)
+    t_end: float = 10.0
+    overrides: Mapping[str, float] = field(default_factory=dict)
+    checks: tuple[str, ...] = ("trajectory",)
+    description: str = ""
