@@ -206,7 +206,7 @@ class Derivation:
                 total += b.mass * (self.acceleration(self.poses[name].position) - g_vec)
         for f in mech.forces:
             total -= self._external_force_on(f, subtree, joint)
-        return total.applyfunc(sp.simplify)
+        return total
 
     def _external_force_on(self, f, subtree: set[str], joint) -> sp.Matrix:
         if isinstance(f, PointToPoint):

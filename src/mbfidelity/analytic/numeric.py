@@ -35,7 +35,7 @@ class NumericModel:
         if self.n <= 3:
             # explicit q'' keeps the reference solver's right-hand side cheap
             acc = M.LUsolve(rhs)
-            self._acc_explicit = _lambdify(self._args, acc, modules="math")
+            self._acc_explicit = _lambdify(self._args, list(acc), modules="math")
         else:
             self._acc_explicit = None
         self._residual = _lambdify(q + qd + qdd + [TIME], d.residual.xreplace(self.subs))

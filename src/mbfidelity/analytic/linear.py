@@ -1,0 +1,173 @@
+"""Equilibria, their stability, the linearized M, C, K and the modes (DESIGN.md):
+
+eigenvalues s of M s^2 + C s + K = 0;
+frequency_hz = |s|/(2 pi), damping_ratio = -Re(s)/|s|, damped_frequency_hz = |Im s|/(2 pi).
+One mode per complex-conjugate pair (the member with Im s > 0), one per real eigenvalue.
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+
+from ..systems import System
+from ..systems.model import Prismatic
+from .numeric import NumericModel, numeric_model
+
+#: relative size below which the real part of an eigenvalue counts as zero (conservative
+#: systems have purely imaginary s; round-off leaves ~1e-15 |s|)
+ZERO_REAL_PART = 1e-9
+
+
+@dataclass
+class Mode:
+    frequency_hz: float
+    damping_ratio: float
+    damped_frequency_hz: float
+    eigenvalue: complex
+
+    def as_dict(self) -> dict:
+        return {
+            "frequency_hz": self.frequency_hz,
+            "damping_ratio": self.damping_ratio,
+            "damped_frequency_hz": self.damped_frequency_hz,
+            "eigenvalue": [self.eigenvalue.real, self.eigenvalue.imag],
+        }
+
+
+@dataclass
+class Equilibrium:
+    q: np.ndarray
+    stable: bool
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    eigenvalues: np.ndarray
+    modes: list[Mode] = field(default_factory=list)
+
+
+def quadratic_eigenvalues(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """All 2n roots s of det(M s^2 + C s + K) = 0 (first-order companion form)."""
+    n = M.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)],
+                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    return scipy.linalg.eigvals(A)
+
+
+def modes_from_eigenvalues(eigenvalues: np.ndarray) -> list[Mode]:
+    s_all = np.asarray(eigenvalues, dtype=complex)
+    scale = max(np.max(np.abs(s_all)), 1e-300)
+    modes = []
+    for s in s_all:
+        if abs(s.imag) <= ZERO_REAL_PART * scale:
+            s = complex(s.real, 0.0)
+        elif s.imag < 0:
+            continue  # the conjugate partner carries the mode
+        mag = abs(s)
+        modes.append(Mode(
+            frequency_hz=mag / (2 * np.pi),
+            damping_ratio=(-s.real / mag + 0.0) if mag > 0 else 0.0,
+            damped_frequency_hz=abs(s.imag) / (2 * np.pi),
+            eigenvalue=s,
+        ))
+    return sorted(modes, key=lambda m: (m.frequency_hz, m.damping_ratio))
+
+
+def is_stable(eigenvalues: np.ndarray) -> bool:
+    """Lyapunov stable in the linear sense: no eigenvalue with a positive real part and no
+    repeated zero eigenvalue (a rigid undamped drift, monograph §4.6)."""
+    s = np.asarray(eigenvalues, dtype=complex)
+    scale = max(np.max(np.abs(s)), 1.0)
+    if np.any(s.real > ZERO_REAL_PART * scale):
+        return False
+    return int(np.sum(np.abs(s) <= ZERO_REAL_PART * scale)) <= 1
+
+
+def linearize(model: NumericModel, q_eq: np.ndarray) -> Equilibrium:
+    M, C, K = model.linearization(q_eq)
+    s = quadratic_eigenvalues(M, C, K)
+    return Equilibrium(np.asarray(q_eq, float), is_stable(s), M, C, K, s,
+                       modes_from_eigenvalues(s))
+
+
+def _search_grid(system: System, values, op: np.ndarray) -> list[np.ndarray]:
+    """Starting points: 8 angles per period for angular coordinates; for linear ones the
+    operating value and points around it inside the coordinate's limits."""
+    mech = system.mechanism
+    axes = []
+    for i, j in enumerate(mech.joints):
+        if isinstance(j, Prismatic):
+            scale = max(abs(op[i]), 0.1)
+            pts = op[i] + scale * np.array([0.0, -0.5, 0.5, -0.9, 2.0])
+            lo, hi = (system.evaluate(b, values) if b is not None else None for b in j.limits)
+            pts = [p for p in pts if (lo is None or p > lo) and (hi is None or p < hi)]
+            axes.append(pts or [op[i]])
+        else:
+            axes.append(op[i] + np.linspace(-np.pi, np.pi, 8, endpoint=False))
+    return [np.array(p) for p in itertools.product(*axes)]
+
+
+def _admissible(system: System, values, q: np.ndarray) -> bool:
+    for i, j in enumerate(system.mechanism.joints):
+        if isinstance(j, Prismatic):
+            lo, hi = (system.evaluate(b, values) if b is not None else None for b in j.limits)
+            # open interval with a margin: a coordinate singularity on the boundary (the
+            # polar origin s = 0) is not an admissible configuration
+            margin = 1e-9 * max(1.0, abs(q[i]))
+            if (lo is not None and not q[i] > lo + margin) or (
+                    hi is not None and not q[i] < hi - margin):
+                return False
+    return True
+
+
+def wrap_angles(system: System, q: np.ndarray, op: np.ndarray) -> np.ndarray:
+    """Angular coordinates into (op - pi, op + pi]."""
+    q = np.array(q, dtype=float)
+    for i, name in enumerate(system.coordinates):
+        if system.mechanism.angular(name):
+            q[i] = op[i] - ((op[i] - q[i] + np.pi) % (2 * np.pi) - np.pi)
+            if abs(q[i] - op[i] + np.pi) < 1e-12:
+                q[i] = op[i] + np.pi
+    return q
+
+
+def find_equilibria(system: System, values) -> list[Equilibrium]:
+    """Every equilibrium within one period of each angular coordinate (centred on the
+    operating point), each classified by its linearization. The operating point comes
+    first when it is an equilibrium."""
+    model = numeric_model(system.id, values)
+    op = system.operating_values(values)
+    found: list[np.ndarray] = []
+    for start in [op] + _search_grid(system, values, op):
+        sol = scipy.optimize.root(
+            model.static_residual, start,
+            jac=lambda q: model.linearization(q)[2], method="hybr", tol=1e-14)
+        if not sol.success:
+            continue
+        r = model.static_residual(sol.x)
+        scale = max(1.0, float(np.max(np.abs(model.linearization(sol.x)[2]))))
+        if np.max(np.abs(r)) > 1e-9 * scale:
+            continue
+        q = wrap_angles(system, sol.x, op)
+        if not _admissible(system, values, q):
+            continue
+        if any(np.allclose(q, f, atol=1e-7, rtol=0) for f in found):
+            continue
+        found.append(q)
+    return [linearize(model, q) for q in found]
+
+
+def operating_equilibrium(system: System, values) -> Equilibrium:
+    """The equilibrium the monograph studies (the system's operating point, refined)."""
+    model = numeric_model(system.id, values)
+    op = system.operating_values(values)
+    sol = scipy.optimize.root(model.static_residual, op,
+                              jac=lambda q: model.linearization(q)[2], method="hybr", tol=1e-14)
+    q = sol.x if sol.success else op
+    r = model.static_residual(q)
+    if np.max(np.abs(r)) > 1e-8 * max(1.0, float(np.max(np.abs(model.linearization(q)[2])))):
+        raise ValueError(f"{system.id}: no equilibrium near the operating point {op}")
+    return linearize(model, q)

@@ -1,0 +1,66 @@
+"""Distances between an engine run and the reference."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.optimize
+
+
+def amplitude(q_ref: np.ndarray, q_eq: np.ndarray) -> np.ndarray:
+    """Excursion of each coordinate from the equilibrium over the run (floored so a
+    coordinate that barely moves is judged against the others' scale)."""
+    a = np.max(np.abs(q_ref - q_eq), axis=0)
+    return np.maximum(a, 1e-3 * max(float(np.max(a)), 1e-12))
+
+
+def trajectory_errors(q: np.ndarray, q_ref: np.ndarray, scale: np.ndarray) -> tuple[float, float]:
+    """(max, rms) of |q - q_ref| / scale over time and coordinates."""
+    err = np.abs(q - q_ref) / scale
+    return float(np.max(err)), float(np.sqrt(np.mean(err**2)))
+
+
+def mean_period(t: np.ndarray, x: np.ndarray) -> float | None:
+    """Mean period from upward zero crossings (linear interpolation); None if fewer than
+    two crossings."""
+    s = np.signbit(x)
+    idx = np.nonzero(s[:-1] & ~s[1:])[0]
+    if len(idx) < 2:
+        return None
+    tc = t[idx] - x[idx] * (t[idx + 1] - t[idx]) / (x[idx + 1] - x[idx])
+    return float((tc[-1] - tc[0]) / (len(tc) - 1))
+
+
+def relative_vector_error(f: np.ndarray, f_ref: np.ndarray) -> float:
+    """max |f - f_ref| / max |f_ref| over samples (Euclidean norms), NaN samples ignored."""
+    ok = ~np.any(np.isnan(f), axis=1)
+    if not np.any(ok):
+        return float("nan")
+    num = np.max(np.linalg.norm(f[ok] - f_ref[ok], axis=1))
+    return float(num / max(np.max(np.linalg.norm(f_ref, axis=1)), 1e-300))
+
+
+def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess: float):
+    """Least-squares fit of x = A exp(-sigma t) cos(wd t + phase) + offset.
+    Returns (undamped angular frequency, damping ratio)."""
+    xs = x - np.mean(x[-len(x) // 5:]) if len(x) > 10 else x
+    wd0 = w_guess * np.sqrt(max(1 - zeta_guess**2, 1e-6))
+    sigma0 = zeta_guess * w_guess
+    a0 = float(np.max(np.abs(xs[: max(len(xs) // 20, 3)])))
+    # linear least squares for amplitude/phase given (wd, sigma) seeds the nonlinear fit
+    def model(tt, a, sigma, wd, ph, off):
+        return a * np.exp(-sigma * tt) * np.cos(wd * tt + ph) + off
+
+    best = None
+    for ph0 in (0.0, np.pi / 2, np.pi, -np.pi / 2):
+        try:
+            p, _ = scipy.optimize.curve_fit(model, t, x, p0=[a0, sigma0, wd0, ph0, 0.0],
+                                            maxfev=20000, xtol=1e-14, ftol=1e-14)
+        except RuntimeError:
+            continue
+        res = float(np.sum((model(t, *p) - x) ** 2))
+        if best is None or res < best[0]:
+            best = (res, p)
+    if best is None:
+        raise RuntimeError("free-vibration fit did not converge")
+    _, (a, sigma, wd, ph, off) = best
+    w0 = float(np.hypot(abs(wd), sigma))
+    return w0, float(sigma / w0)

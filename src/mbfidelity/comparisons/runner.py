@@ -1,0 +1,266 @@
+"""One comparison (system x simulator x settings) and the runner over the matrix."""
+from __future__ import annotations
+
+import datetime
+import fnmatch
+import platform
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Mapping
+
+import numpy as np
+import scipy.linalg
+
+from .. import __version__
+from ..analytic.linear import operating_equilibrium
+from ..analytic.reference import reference
+from ..simulators import get_backend
+from ..systems import System, get_system
+from . import metrics, tolerances
+
+DEFAULT_DT = 1e-3
+
+
+@dataclass
+class Metric:
+    name: str
+    value: float
+    tolerance: float
+    passed: bool
+    status: str  # pass | fail | xfail | xpass | unsupported
+    reason: str = ""
+    unit: str = "relative"
+
+    def as_dict(self) -> dict:
+        d = {"name": self.name, "value": self.value, "tolerance": self.tolerance,
+             "passed": self.passed, "status": self.status, "unit": self.unit}
+        if self.reason:
+            d["reason"] = self.reason
+        return d
+
+
+@dataclass
+class Comparison:
+    system: str
+    simulator: str
+    engine_version: str
+    settings: dict
+    parameters: dict
+    dt: float
+    metrics: list[Metric] = field(default_factory=list)
+    supported: bool = True
+    reason: str = ""
+    wall_time: float = 0.0
+    simulated_time: float = 0.0
+    #: sampled series for the report: scenario -> dict of arrays
+    series: dict = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return self.supported and all(m.status in ("pass", "xfail") for m in self.metrics)
+
+    def as_dict(self) -> dict:
+        return {
+            "system": self.system, "simulator": self.simulator,
+            "engine_version": self.engine_version, "settings": self.settings,
+            "parameters": self.parameters, "dt": self.dt, "supported": self.supported,
+            "reason": self.reason, "metrics": [m.as_dict() for m in self.metrics],
+            "passed": self.passed, "wall_time_s": self.wall_time,
+            "simulated_time_s": self.simulated_time,
+        }
+
+
+def expectation_for(system: System, simulator: str, metric: str):
+    for e in system.expectations:
+        if fnmatch.fnmatch(simulator, e.simulator) and fnmatch.fnmatch(metric, e.metric):
+            return e
+    return None
+
+
+def _judge(system: System, simulator: str, name: str, value: float, tol: float,
+           unit: str = "relative") -> Metric:
+    ok = bool(np.isfinite(value) and value <= tol)
+    exp = expectation_for(system, simulator, name)
+    if exp is not None and exp.kind == "xfail":
+        return Metric(name, value, tol, ok, "xpass" if ok else "xfail", exp.reason, unit)
+    return Metric(name, value, tol, ok, "pass" if ok else "fail", "", unit)
+
+
+def characteristic_frequency(eq_modes, ref_q, ref_qd, q_eq) -> float:
+    """Fastest angular frequency of the motion (rad/s): see `tolerances`."""
+    w_lin = max((abs(m.eigenvalue) for m in eq_modes), default=0.0)
+    amp = metrics.amplitude(ref_q, q_eq)
+    w_traj = float(np.max(np.max(np.abs(ref_qd), axis=0) / amp))
+    return max(w_lin, w_traj)
+
+
+def _coordinate_scales(system: System, q_eq: np.ndarray) -> np.ndarray:
+    return np.array([1.0 if system.mechanism.angular(c) else max(abs(q), 0.1)
+                     for c, q in zip(system.coordinates, q_eq)])
+
+
+def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None,
+            dt: float = DEFAULT_DT, t_end: float | None = None,
+            settings: Mapping | None = None, scenarios: Iterable[str] | None = None,
+            keep_series: bool = False) -> Comparison:
+    system = get_system(system_id)
+    backend = get_backend(simulator)
+    base_values = system.parameter_values(params)
+    ok, why = backend.available()
+    if not ok:
+        return Comparison(system.id, simulator, "", {}, base_values, dt, supported=False,
+                          reason=f"engine not available: {why}")
+    merged = backend.resolve_settings(settings)
+    result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt)
+    mech = system.numeric_mechanism(base_values)
+    support = backend.support(mech)
+    unsupported = expectation_for(system, simulator, "*")
+    if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
+        result.supported = False
+        result.reason = support.reason if not support.ok else unsupported.reason
+        return result
+    chosen = [system.scenario(s) for s in scenarios] if scenarios else list(system.scenarios)
+    for sc in chosen:
+        _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series)
+    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series)
+    return result
+
+
+def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series):
+    values = system.parameter_values(params, scenario=sc)
+    mech = system.numeric_mechanism(values)
+    T = sc.t_end if t_end is None else t_end
+    ref = reference(system, sc, values, dt, T)
+    q0, qd0 = ref.q[0], ref.qd[0]
+    joints = system.reaction_joints if "reaction" in sc.checks else ()
+    run = backend.simulate(mech, q0, qd0, T, dt, settings, joints)
+    result.wall_time += run.wall_time
+    result.simulated_time += T
+    eq = operating_equilibrium(system, values)
+    w = characteristic_frequency(eq.modes, ref.q, ref.qd, eq.q)
+    order = run.integrator_order
+    scale = metrics.amplitude(ref.q, eq.q)
+    ref_err = float(np.max(ref.error_estimate / scale))
+    tol = tolerances.trajectory_tolerance(w, dt, order, T) + ref_err
+    n = min(len(run.t), len(ref.t))
+    emax, erms = metrics.trajectory_errors(run.q[:n], ref.q[:n], scale)
+    name = sc.name
+    result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_max", emax, tol))
+    result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
+    if len(system.coordinates) == 1:
+        p_ref = metrics.mean_period(ref.t, ref.q[:, 0] - eq.q[0])
+        p_run = metrics.mean_period(run.t[:n], run.q[:n, 0] - eq.q[0])
+        if p_ref is not None:
+            value = abs(p_run - p_ref) / p_ref if p_run is not None else float("inf")
+            result.metrics.append(_judge(system, backend.id, f"{name}.period", value,
+                                         tolerances.period_tolerance(w, dt, order, p_ref)))
+    if ref.energy is not None:
+        model_energy = _energy_of(system, values, run.q[:n], run.qd[:n])
+        e_scale = max(_kinetic_amplitude(system, values, ref.q, ref.qd), 1e-300)
+        drift = float(np.max(np.abs(model_energy - model_energy[0])) / e_scale)
+        result.metrics.append(_judge(system, backend.id, f"{name}.energy_drift", drift, tol))
+    for j in joints:
+        r_run = run.reactions.get(j)
+        if r_run is None:
+            continue
+        value = metrics.relative_vector_error(r_run[:n], ref.reactions[j][:n])
+        result.metrics.append(_judge(system, backend.id, f"{name}.reaction_{j}", value, tol))
+    if keep_series:
+        result.series[name] = {
+            "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
+            "reactions": {j: (ref.reactions[j][:n], run.reactions[j][:n])
+                          for j in joints if j in run.reactions},
+            "tolerance": tol, "scale": scale,
+        }
+
+
+def _energy_of(system, values, q, qd):
+    from ..analytic.numeric import numeric_model
+
+    return numeric_model(system.id, values).energy(q, qd)
+
+
+def _kinetic_amplitude(system, values, q, qd) -> float:
+    from ..analytic.numeric import numeric_model
+
+    model = numeric_model(system.id, values)
+    T = np.array([0.5 * v @ model.mass_matrix(x) @ v for x, v in zip(q[::10], qd[::10])])
+    return float(np.max(T))
+
+
+def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series):
+    """Modes of the operating equilibrium: the engine's own linearization, and a
+    free-vibration fit of each modal coordinate after a small modal release."""
+    eq = operating_equilibrium(system, values)
+    if not eq.stable:
+        return
+    mech = system.numeric_mechanism(values)
+    modes = [m for m in eq.modes if m.frequency_hz > 0]
+    ref_w = np.array([abs(m.eigenvalue) for m in modes])
+    w_max = float(np.max(ref_w)) if len(ref_w) else 0.0
+    lin = backend.linearize(mech, eq.q, settings, dt)
+    if lin is not None:
+        from ..analytic.linear import modes_from_eigenvalues
+
+        got = [m for m in modes_from_eigenvalues(lin.eigenvalues) if m.frequency_hz > 0]
+        discrete_order = lin.extra.get("discrete_order")
+        tol = (tolerances.discrete_linearization_tolerance(w_max, dt, discrete_order)
+               if discrete_order else tolerances.FD_FREQUENCY)
+        for i, m in enumerate(modes):
+            if i < len(got):
+                value = abs(got[i].frequency_hz - m.frequency_hz) / m.frequency_hz
+                dz = abs(got[i].damping_ratio - m.damping_ratio)
+            else:
+                value = dz = float("inf")
+            result.metrics.append(_judge(system, backend.id,
+                                         f"frequency.linearization_mode{i + 1}", value, tol))
+            if m.damping_ratio > 0:
+                result.metrics.append(_judge(system, backend.id,
+                                             f"damping.linearization_mode{i + 1}", dz, tol,
+                                             unit="absolute"))
+    # free-vibration fit (every engine)
+    n = len(system.coordinates)
+    lam, shapes = scipy.linalg.eig(eq.K, eq.M)
+    order_idx = np.argsort(np.abs(lam))
+    shapes = np.real(shapes[:, order_idx])
+    keep = [k for k in range(n) if abs(lam[order_idx][k]) > 1e-12 * max(np.abs(lam))]
+    scales = _coordinate_scales(system, eq.q)
+    shapes_scaled = shapes / np.max(np.abs(shapes / scales[:, None]), axis=0)
+    amp = tolerances.FIT_AMPLITUDE
+    q0 = eq.q + amp * shapes_scaled[:, keep].sum(axis=1)
+    periods = 2 * np.pi / ref_w.min() if len(ref_w) else 1.0
+    T = max(min(t_end or 10.0, 40 * periods), 10 * periods)
+    run = backend.simulate(mech, q0, np.zeros(n), T, dt, settings, ())
+    result.wall_time += run.wall_time
+    result.simulated_time += T
+    eta = np.linalg.solve(shapes_scaled, (run.q - eq.q).T).T
+    order = run.integrator_order
+    tol = tolerances.fit_tolerance(w_max, dt, order)
+    for i, (k, m) in enumerate(zip(keep, modes)):
+        try:
+            w_fit, z_fit = metrics.fit_damped_sinusoid(run.t, eta[:, k], abs(m.eigenvalue),
+                                                       m.damping_ratio)
+            value = abs(w_fit - abs(m.eigenvalue)) / abs(m.eigenvalue)
+            dz = abs(z_fit - m.damping_ratio)
+        except RuntimeError:
+            value = dz = float("inf")
+        result.metrics.append(_judge(system, backend.id, f"frequency.fit_mode{i + 1}", value, tol))
+        result.metrics.append(_judge(system, backend.id, f"damping.fit_mode{i + 1}", dz, tol,
+                                     unit="absolute"))
+
+
+# --- provenance and the matrix ---------------------------------------------------------
+
+
+def provenance() -> dict:
+    try:
+        describe = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True,
+                                  text=True, cwd=Path(__file__).parent, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        describe = ""
+    return {
+        "mbfidelity": __version__, "git_describe": describe or "unknown",
+        "python": platform.python_version(), "platform": platform.platform(),
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    }
