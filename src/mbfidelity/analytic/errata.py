@@ -9,6 +9,7 @@ engines' trajectories are compared with the printed model and with the derived o
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Mapping
 
 import numpy as np
@@ -182,3 +183,45 @@ def printed_model_trajectory(system: System, pf: PrintedFormula, values: Mapping
     res = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0, qd0]), method="DOP853",
                     rtol=1e-12, atol=1e-12, t_eval=t)
     return res.y[:n].T if res.success else None
+
+
+@lru_cache(maxsize=None)
+def _witness_cached(system_id: str) -> dict:
+    from ..simulators import all_backends
+    from ..systems import get_system
+    from .reference import reference
+
+    system = get_system(system_id)
+    full = [pf for pf in system.printed(system.symbols) if pf.kind == "eom"]
+    if not full:
+        return {}
+    # the largest-amplitude scenario shows the difference best
+    scenario = system.scenarios[-1]
+    values = system.parameter_values(scenario=scenario)
+    dt = 1e-3
+    ref = reference(system, scenario, values, dt)
+    printed_q = printed_model_trajectory(system, full[0], values, ref.q[0], ref.qd[0], ref.t)
+    if printed_q is None:
+        return {}
+    mech = system.numeric_mechanism(values)
+    out = {}
+    for sim, backend in all_backends().items():
+        ok, why = backend.available()
+        if not ok or not backend.support(mech).ok:
+            continue
+        run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt)
+        n = min(len(run.t), len(ref.t))
+        to_derived = float(np.max(np.abs(run.q[:n] - ref.q[:n])))
+        to_printed = float(np.max(np.abs(run.q[:n] - printed_q[:n])))
+        side = "derivation" if to_derived < to_printed else "printed"
+        out[sim] = {"scenario": scenario.name, "max_error_to_derived": to_derived,
+                    "max_error_to_printed": to_printed,
+                    "verdict": f"sides with the {side} (max |dq| {to_derived:.2e} to the derived "
+                               f"model, {to_printed:.2e} to the printed one)"}
+    return out
+
+
+def witness(system: System) -> dict:
+    """Each engine run on the system's largest-amplitude scenario, measured against the
+    derived model and against the printed equations of motion integrated as printed."""
+    return _witness_cached(system.id)

@@ -1,0 +1,271 @@
+"""Command line (DESIGN.md): list, analyze, compare, run, errata."""
+from __future__ import annotations
+
+import json
+import sys
+import time
+from pathlib import Path
+from typing import List, Optional
+
+import numpy as np
+import typer
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="Cross-validate multibody simulators against exact models.")
+
+
+def _fail(message: str) -> None:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(2)
+
+
+def _parse_params(items: Optional[List[str]]) -> dict[str, float]:
+    out = {}
+    for item in items or []:
+        if "=" not in item:
+            _fail(f"--param expects NAME=VALUE, got {item!r}")
+        name, value = item.split("=", 1)
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            _fail(f"--param {name}: {value!r} is not a number")
+    return out
+
+
+def _system(system_id: str):
+    from .systems import get_system
+
+    try:
+        return get_system(system_id)
+    except KeyError as exc:
+        _fail(exc.args[0])
+
+
+def _values(system, params):
+    try:
+        return system.parameter_values(params)
+    except (KeyError, ValueError) as exc:
+        _fail(exc.args[0])
+
+
+def _json(doc) -> None:
+    typer.echo(json.dumps(doc, indent=1, default=_jsonable))
+
+
+def _jsonable(x):
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, complex):
+        return [x.real, x.imag]
+    raise TypeError(type(x))
+
+
+@app.command("list")
+def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> None:
+    """Systems, engines, and which engine supports which system."""
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    backends = all_backends()
+    rows = []
+    for s in all_systems().values():
+        mech = s.numeric_mechanism(s.parameter_values())
+        support = {}
+        for sid, b in backends.items():
+            ok, why = b.available()
+            sup = b.support(mech) if ok else None
+            support[sid] = {"supported": bool(ok and sup.ok),
+                            "reason": why if not ok else (sup.reason if not sup.ok else "")}
+        rows.append({"system": s.id, "title": s.title, "source": s.source,
+                     "coordinates": list(s.coordinates),
+                     "scenarios": [sc.name for sc in s.scenarios], "simulators": support})
+    if as_json:
+        _json({"systems": rows, "simulators": list(backends)})
+        return
+    typer.echo(f"{'system':26s} " + " ".join(f"{b:9s}" for b in backends) + " source")
+    for r in rows:
+        marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
+                         for b in backends)
+        typer.echo(f"{r['system']:26s} {marks} {r['source']}")
+
+
+def _modes(eq):
+    return [m.as_dict() for m in eq.modes]
+
+
+@app.command()
+def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
+            param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
+            as_json: bool = typer.Option(False, "--json")) -> None:
+    """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
+    from .analytic.errata import errata
+    from .analytic.linear import find_equilibria, operating_equilibrium
+
+    system = _system(system_id)
+    values = _values(system, _parse_params(param))
+    coords = list(system.coordinates)
+    eqs = find_equilibria(system, values)
+    op = operating_equilibrium(system, values)
+    equilibria = []
+    for e in eqs:
+        item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
+        if e.stable:
+            item["modes"] = _modes(e)
+        else:
+            item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
+        equilibria.append(item)
+    doc = {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": coords, "parameters": values,
+        "equilibria": equilibria,
+        "operating_point": dict(zip(coords, op.q.tolist())),
+        "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C, "K": op.K},
+        "stable": op.stable,
+        "modes": _modes(op),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
+    if as_json:
+        _json(doc)
+        return
+    typer.echo(f"{system.id}: {system.title} ({system.source})")
+    typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in values.items()))
+    for e in equilibria:
+        typer.echo(f"equilibrium {e['q']}: {'stable' if e['stable'] else 'unstable'}")
+    typer.echo(f"at {doc['operating_point']}:")
+    for key in ("M", "C", "K"):
+        typer.echo(f"  {key} = {np.array2string(getattr(op, key), precision=6)}")
+    for m in op.modes:
+        typer.echo(f"  mode: f = {m.frequency_hz:.9g} Hz, zeta = {m.damping_ratio:.6g}, "
+                   f"f_d = {m.damped_frequency_hz:.9g} Hz")
+    for e in doc["printed_vs_derived"]:
+        typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
+
+
+def _settings(items: Optional[List[str]]) -> dict:
+    out = {}
+    for item in items or []:
+        if "=" not in item:
+            _fail(f"--setting expects KEY=VALUE, got {item!r}")
+        k, v = item.split("=", 1)
+        try:
+            out[k] = json.loads(v)
+        except json.JSONDecodeError:
+            out[k] = v
+    return out
+
+
+@app.command("compare")
+def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
+                sim: str = typer.Option(..., "--sim", help="mujoco | pybullet | exudyn | pymunk"),
+                param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
+                dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+                t_end: Optional[float] = typer.Option(None, "--t-end", help="simulated time, s"),
+                setting: Optional[List[str]] = typer.Option(
+                    None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
+                as_json: bool = typer.Option(False, "--json")) -> None:
+    """One comparison: metrics, tolerances, pass/fail."""
+    from .comparisons.runner import compare
+    from .simulators import get_backend
+
+    system = _system(system_id)
+    params = _parse_params(param)
+    _values(system, params)
+    try:
+        get_backend(sim)
+    except KeyError as exc:
+        _fail(exc.args[0])
+    if not dt > 0 or (t_end is not None and not t_end > 0):
+        _fail("--dt and --t-end must be positive")
+    try:
+        result = compare(system.id, sim, params, dt=dt, t_end=t_end, settings=_settings(setting))
+    except ValueError as exc:
+        _fail(str(exc))
+    doc = result.as_dict()
+    if as_json:
+        _json(doc)
+    else:
+        typer.echo(f"{result.system} on {result.simulator} {result.engine_version}, dt={dt:g}")
+        if not result.supported:
+            typer.echo(f"  unsupported: {result.reason}")
+        for m in result.metrics:
+            extra = f"  ({m.reason})" if m.reason else ""
+            typer.echo(f"  {m.name:34s} {m.value:10.3e} <= {m.tolerance:9.3e}  {m.status}{extra}")
+        typer.echo("PASSED" if result.passed else "FAILED")
+    raise typer.Exit(0 if result.passed else 1)
+
+
+@app.command()
+def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
+        sims: Optional[List[str]] = typer.Option(None, "--sims", help="simulator ids"),
+        out: Path = typer.Option(Path("results"), "--out", help="output folder"),
+        dt: float = typer.Option(1e-3, "--dt")) -> None:
+    """The whole matrix: results (CSV, JSON) and the HTML report."""
+    from rich.progress import Progress
+
+    from .comparisons.matrix import run_matrix, write_results
+    from .reports.html import write_report
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = _split(systems) or list(all_systems())
+    sim_ids = _split(sims) or list(all_backends())
+    for s in sys_ids:
+        _system(s)
+    for e in sim_ids:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    start = time.perf_counter()
+    with Progress(transient=False, disable=not sys.stderr.isatty()) as progress:
+        task = progress.add_task("comparisons", total=len(sys_ids) * len(sim_ids))
+
+        def tick(c):
+            progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
+        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick)
+    doc = write_results(results, out)
+    index = write_report(results, doc["provenance"], out)
+    elapsed = time.perf_counter() - start
+    failed = [f"{c.system}/{c.simulator}" for c in results if c.supported and not c.passed]
+    typer.echo(f"{len(results)} comparisons in {elapsed:.1f} s; "
+               f"{sum(c.passed for c in results)} passed, {len(failed)} failed")
+    typer.echo(f"results: {out.resolve()}")
+    typer.echo(f"report:  {index.resolve()}")
+
+
+def _split(items):
+    return [x for item in items or [] for x in item.split(",") if x]
+
+
+@app.command("errata")
+def errata_cmd(as_json: bool = typer.Option(False, "--json"),
+               witnesses: bool = typer.Option(True, "--witnesses/--no-witnesses",
+                                              help="run the engines on misprinted equations")
+               ) -> None:
+    """Every printed formula coded, compared with the derivation; engines as witnesses."""
+    from .analytic.errata import errata, witness
+    from .systems import all_systems
+
+    entries = []
+    for system in all_systems().values():
+        for e in errata(system):
+            if witnesses and e.verdict != "agrees" and e.kind == "eom":
+                e.witnesses = witness(system)
+            entries.append(e.as_dict())
+    if as_json:
+        _json({"errata": entries})
+        return
+    for e in entries:
+        typer.echo(f"{e['system']:24s} {e['label']:58s} {e['verdict']}")
+        if e["verdict"] != "agrees":
+            typer.echo(f"    printed: {e['printed']}\n    derived: {e['derived']}")
+            for sim, w in e.get("witnesses", {}).items():
+                typer.echo(f"    {sim}: {w['verdict']}")
+
+
+def main() -> None:
+    app()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,71 @@
+"""The runner over the matrix system x simulator: tidy results (one row per system x
+engine x settings x metric, with provenance) written to a folder."""
+from __future__ import annotations
+
+import csv
+import json
+import os
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Callable, Iterable
+
+from .runner import DEFAULT_DT, Comparison, compare, provenance
+
+ROW_FIELDS = ("system", "simulator", "engine_version", "metric", "value", "tolerance", "unit",
+              "status", "passed", "reason", "dt", "settings", "git_describe", "date",
+              "python", "platform")
+
+
+def _one(args) -> Comparison:
+    system, sim, dt = args
+    return compare(system, sim, dt=dt, keep_series=True)
+
+
+def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
+               workers: int | None = None,
+               progress: Callable[[Comparison], None] | None = None) -> list[Comparison]:
+    jobs = [(s, e, dt) for s in systems for e in simulators]
+    workers = workers or min(2, os.cpu_count() or 1)
+    results: list[Comparison] = []
+    if workers <= 1:
+        for job in jobs:
+            results.append(_one(job))
+            if progress:
+                progress(results[-1])
+        return results
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        for res in pool.map(_one, jobs):
+            results.append(res)
+            if progress:
+                progress(res)
+    return results
+
+
+def tidy_rows(results: list[Comparison], prov: dict) -> list[dict]:
+    rows = []
+    for c in results:
+        common = {"system": c.system, "simulator": c.simulator,
+                  "engine_version": c.engine_version, "dt": c.dt,
+                  "settings": json.dumps(c.settings, sort_keys=True),
+                  **{k: prov[k] for k in ("git_describe", "date", "python", "platform")}}
+        if not c.supported:
+            rows.append({**common, "metric": "*", "value": "", "tolerance": "", "unit": "",
+                         "status": "unsupported", "passed": "", "reason": c.reason})
+        for m in c.metrics:
+            rows.append({**common, "metric": m.name, "value": m.value, "tolerance": m.tolerance,
+                         "unit": m.unit, "status": m.status, "passed": m.passed,
+                         "reason": m.reason})
+    return rows
+
+
+def write_results(results: list[Comparison], out: Path) -> dict:
+    out.mkdir(parents=True, exist_ok=True)
+    prov = provenance()
+    rows = tidy_rows(results, prov)
+    with open(out / "results.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=ROW_FIELDS)
+        writer.writeheader()
+        writer.writerows(rows)
+    doc = {"provenance": prov, "comparisons": [c.as_dict() for c in results]}
+    (out / "results.json").write_text(json.dumps(doc, indent=1, default=float))
+    return doc

@@ -1,0 +1,154 @@
+"""HTML report rendered from saved comparison results: summary table, trajectory overlays,
+error-against-time figures, frequency table, errata."""
+from __future__ import annotations
+
+import html
+from collections import defaultdict
+from pathlib import Path
+
+import jinja2
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..systems import get_system  # noqa: E402
+
+#: why an engine deviates, in words a student can follow (SIMULATORS.md)
+EXPLANATIONS = {
+    "mujoco": "Reduced coordinates; RK4 by default here (its Euler is semi-implicit, with an "
+              "O(h) phase offset). Massless links are folded into their child body.",
+    "pybullet": "Reduced coordinates (Featherstone) with semi-implicit Euler: first order. "
+                "Hidden joint motors and 0.04 link damping are switched off here; left on they "
+                "stop or slow a pendulum.",
+    "exudyn": "Minimal coordinates (kinematic tree) with an explicit RK4: fourth order.",
+    "pymunk": "Maximal coordinates: every body free, joints enforced by iterated impulses at "
+              "the velocity level; semi-implicit Euler (first order). Error correction "
+              "(error_bias) is off here; its default bleeds energy out of a pendulum.",
+}
+
+TEMPLATE = jinja2.Template("""<!doctype html>
+<html><head><meta charset="utf-8"><title>mbfidelity report</title>
+<style>
+body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}
+table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
+th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.xfail{background:#fbeec8}
+.xpass{background:#f8d0d0}.unsupported{background:#e6e6e6}img{max-width:100%}
+code{font-size:12px}
+</style></head><body>
+<h1>mbfidelity: simulators against exact models</h1>
+<p>git {{ prov.git_describe }} · {{ prov.date }} · Python {{ prov.python }} · {{ prov.platform }}</p>
+<p>Engines: {% for sim, v in versions.items() %}{{ sim }} {{ v }}{% if not loop.last %}, {% endif %}{% endfor %}.
+Errors are relative to each coordinate's amplitude; each tolerance follows from the integrator's
+order p, the step h, the simulated time T and the fastest frequency w of the motion:
+(w h)^p (1 + w T) for trajectories (see <code>comparisons/tolerances.py</code>).</p>
+<h2>Summary</h2>
+<table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}</th>{% endfor %}</tr>
+{% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
+{% for sim in sims %}{% set c = cells[sys][sim] %}<td class="{{ c.cls }}">{{ c.text }}</td>{% endfor %}</tr>{% endfor %}
+</table>
+<h2>Why the engines deviate</h2><ul>{% for sim in sims %}<li><b>{{ sim }}</b>: {{ explanations.get(sim, "") }}</li>{% endfor %}</ul>
+{% for sys in systems %}
+<h2 id="{{ sys }}">{{ sys }}</h2><p>{{ titles[sys] }}</p>
+<table><tr><th>metric</th>{% for sim in sims %}<th>{{ sim }}</th>{% endfor %}</tr>
+{% for name in metric_names[sys] %}<tr><td>{{ name }}</td>
+{% for sim in sims %}{% set m = metrics[sys][sim].get(name) %}
+{% if m %}<td class="{{ m.status }}" title="{{ m.reason }}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ unsupported[sys].get(sim, "-") }}</td>{% endif %}
+{% endfor %}</tr>{% endfor %}</table>
+{% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
+{% endfor %}
+{% if errata %}<h2>Errata: printed formulas against the derivation</h2>
+<table><tr><th>system</th><th>formula</th><th>verdict</th><th>printed</th><th>derived</th></tr>
+{% for e in errata %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{{ e.system }}</td><td>{{ e.label }}</td><td>{{ e.verdict }}</td>
+<td><code>{{ e.printed }}</code></td><td><code>{{ e.derived }}</code></td></tr>{% endfor %}</table>{% endif %}
+</body></html>""")
+
+
+def _cell(c) -> dict:
+    if not c.supported:
+        return {"cls": "unsupported", "text": "cannot express: " + html.escape(c.reason)}
+    statuses = [m.status for m in c.metrics]
+    worst = next((s for s in ("fail", "xpass", "xfail") if s in statuses), "pass")
+    counts = ", ".join(f"{statuses.count(s)} {s}" for s in ("pass", "fail", "xfail", "xpass")
+                       if statuses.count(s))
+    return {"cls": worst, "text": counts}
+
+
+def _figures(system_id: str, comps, out: Path) -> list[str]:
+    names = []
+    scenarios = {name for c in comps for name in c.series}
+    coords = get_system(system_id).coordinates
+    for scenario in sorted(scenarios):
+        fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+        drawn_ref = False
+        for c in comps:
+            s = c.series.get(scenario)
+            if s is None:
+                continue
+            t = s["t"]
+            if not drawn_ref:
+                for i, name in enumerate(coords):
+                    axes[0].plot(t, s["q_ref"][:, i], "k-", lw=2.5, alpha=0.35,
+                                 label=f"reference {name}")
+                drawn_ref = True
+            for i, name in enumerate(coords):
+                axes[0].plot(t, s["q"][:, i], lw=0.8, label=f"{c.simulator} {name}")
+            err = np.max(np.abs(s["q"] - s["q_ref"]) / s["scale"], axis=1)
+            axes[1].semilogy(t, np.maximum(err, 1e-16), lw=0.8, label=c.simulator)
+            axes[1].axhline(s["tolerance"], ls="--", lw=0.6, color=axes[1].lines[-1].get_color())
+        axes[0].set_ylabel("coordinates")
+        axes[0].legend(fontsize=7, ncol=4)
+        axes[1].set_ylabel("|q - q_ref| / amplitude")
+        axes[1].set_xlabel("t [s]")
+        axes[1].legend(fontsize=7)
+        fig.suptitle(f"{system_id}, scenario {scenario} (dashed: tolerances)")
+        fig.tight_layout()
+        name = f"{system_id}-{scenario}.png"
+        fig.savefig(out / name, dpi=80)
+        plt.close(fig)
+        names.append(name)
+    return names
+
+
+def write_report(results, prov: dict, out: Path, errata: list[dict] | None = None) -> Path:
+    out.mkdir(parents=True, exist_ok=True)
+    by_system = defaultdict(list)
+    for c in results:
+        by_system[c.system].append(c)
+    sims = list(dict.fromkeys(c.simulator for c in results))
+    systems = list(by_system)
+    cells = {s: {c.simulator: _cell(c) for c in comps} for s, comps in by_system.items()}
+    metrics = {s: {c.simulator: {m.name: m for m in c.metrics} for c in comps}
+               for s, comps in by_system.items()}
+    metric_names = {s: list(dict.fromkeys(m.name for c in comps for m in c.metrics))
+                    for s, comps in by_system.items()}
+    unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
+                   for s, comps in by_system.items()}
+    figures = {s: _figures(s, comps, out) for s, comps in by_system.items()}
+    if errata is None:
+        from ..analytic.errata import errata as compute
+
+        errata = [e.as_dict() for s in systems for e in compute(get_system(s))]
+    versions = {c.simulator: c.engine_version for c in results if c.engine_version}
+    page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
+                           metric_names=metric_names, unsupported=unsupported, figures=figures,
+                           titles={s: get_system(s).title for s in systems}, versions=versions,
+                           explanations=EXPLANATIONS, errata=errata)
+    index = out / "index.html"
+    index.write_text(page)
+    (out / "summary.md").write_text(_markdown(results, prov))
+    return index
+
+
+def _markdown(results, prov: dict) -> str:
+    lines = [f"# mbfidelity summary ({prov['git_describe']}, {prov['date']})", "",
+             "| system | simulator | metric | value | tolerance | status |",
+             "|---|---|---|---|---|---|"]
+    for c in results:
+        if not c.supported:
+            lines.append(f"| {c.system} | {c.simulator} | * | | | unsupported: {c.reason} |")
+        for m in c.metrics:
+            lines.append(f"| {c.system} | {c.simulator} | {m.name} | {m.value:.3e} | "
+                         f"{m.tolerance:.3e} | {m.status} |")
+    return "\n".join(lines) + "\n"

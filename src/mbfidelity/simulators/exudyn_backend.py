@@ -1,0 +1,553 @@
+"""Exudyn backend: the minimal-coordinate route (`ObjectKinematicTree`).
+
+Translation (generic over the description, conventions 1-8 of `systems.model`):
+
+- every joint becomes one link of one kinematic tree, in joint order (parents come first);
+  `Revolute` -> ``RevoluteZ``, `Prismatic` -> ``PrismaticX`` with the joint frame turned so
+  that its x axis is the prismatic axis. Each link frame sits at the joint point of its
+  body with orientation ``theta_body + beta`` (beta = 0 for revolute children, the axis
+  angle minus the angle offset for prismatic children); the centre of mass is placed in
+  that frame, so the description's body frames are reproduced exactly;
+- the engine's joint values ``u`` are relative; description coordinates are the affine map
+  ``q = T u + c`` (absolute revolute angles add the parent's angle, a non-unit prismatic
+  axis scales the slide), generalized forces map with ``T^T``;
+- massless link bodies are kept as zero-mass links (the tree accepts them while the
+  mass matrix stays regular, i.e. while a massive descendant carries the coordinates);
+- gravity is the tree's own gravity vector; a `CoordinateForce` whose law is affine in
+  COORD/COORD_RATE and free of TIME uses the tree's PD terms (C++), any other law is a
+  Python ``forceUserFunction`` of the tree (called at every integrator stage with the
+  stage time); a `PointToPoint` element is an ``ObjectConnectorSpringDamper`` between
+  markers (native stiffness/damping/force when the law is affine in LENGTH/LENGTH_RATE,
+  a ``springForceUserFunction`` otherwise);
+- every step is sampled by internally stored sensors (write period = dt), so Exudyn's C++
+  loop runs without Python stepping;
+- reactions: the tree has no joint-force output, so the force parent -> child is Newton's
+  law on the child's subtree, with the engine's centre-of-mass accelerations (kinematic
+  tree sensors, end-of-step accelerations), minus gravity and minus the element forces
+  that enter the subtree from outside (the engine's connector force, or the law on the
+  owning prismatic joint).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+import sympy as sp
+
+from ..systems.model import (
+    COORD,
+    COORD_RATE,
+    LENGTH,
+    LENGTH_RATE,
+    TIME,
+    WORLD,
+    CoordinateForce,
+    Mechanism,
+    PointToPoint,
+    Prismatic,
+    Revolute,
+    compile_law,
+)
+from .base import Backend, Linearization, RunResult, Support
+
+#: order of accuracy of the fixed-step solvers offered through the "solver" setting
+_SOLVER_ORDER = {
+    "RK44": 4,
+    "RK67": 6,
+    "RK33": 3,
+    "ExplicitMidpoint": 2,
+    "ExplicitEuler": 1,
+    "VelocityVerlet": 2,
+    "GeneralizedAlpha": 2,
+    "TrapezoidalIndex2": 2,
+}
+_IMPLICIT = ("GeneralizedAlpha", "TrapezoidalIndex2")
+
+
+def _num(x) -> float:
+    value = sp.sympify(x)
+    if value.free_symbols:
+        raise ValueError(f"expression {value} still has free symbols")
+    return float(value)
+
+
+def _rot2(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def _rot3(angle: float) -> np.ndarray:
+    out = np.eye(3)
+    out[:2, :2] = _rot2(angle)
+    return out
+
+
+def _affine(expr, x: sp.Symbol, v: sp.Symbol) -> tuple[float, float, float] | None:
+    """(a0, ax, av) when expr == a0 + ax x + av v with numbers only (no TIME), else None."""
+    expr = sp.sympify(expr)
+    if TIME in expr.free_symbols:
+        return None
+    ax, av = sp.diff(expr, x), sp.diff(expr, v)
+    if ax.free_symbols or av.free_symbols:
+        return None
+    a0 = expr.xreplace({x: 0, v: 0})
+    if a0.free_symbols:
+        return None
+    return float(a0), float(ax), float(av)
+
+
+@dataclass
+class _Geometry:
+    """Numeric tree data derived from a (numeric) mechanism."""
+
+    n: int
+    link_of: dict[str, int]          # body name -> link index
+    parents: list[int]
+    types: list[str]                 # "R" or "P"
+    offsets: list[np.ndarray]        # joint offsets (parent link frame), 2-vectors
+    rotations: list[float]           # joint frame rotation against the parent link frame
+    beta: dict[str, float]           # link frame orientation minus body angle
+    com: dict[str, np.ndarray]       # centre of mass in the link frame
+    mass: dict[str, float]
+    inertia: dict[str, float]
+    T: np.ndarray                    # q = T u + c
+    c: np.ndarray
+    angle_rows: dict[str, tuple[np.ndarray, float]]  # body angle = row . u + const
+    gravity: float
+    axis_world_rows: dict[int, np.ndarray] = field(default_factory=dict)
+
+    def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
+        """A description body-frame point expressed in the body's link frame."""
+        return self.com[body] + _rot2(-self.beta[body]) @ np.asarray(point, dtype=float)
+
+
+def _geometry(mech: Mechanism) -> _Geometry:
+    n = len(mech.joints)
+    link_of: dict[str, int] = {}
+    parents: list[int] = []
+    types: list[str] = []
+    offsets: list[np.ndarray] = []
+    rotations: list[float] = []
+    beta: dict[str, float] = {WORLD: 0.0}
+    com: dict[str, np.ndarray] = {WORLD: np.zeros(2)}
+    angle_rows: dict[str, tuple[np.ndarray, float]] = {WORLD: (np.zeros(n), 0.0)}
+    T = np.zeros((n, n))
+    c = np.zeros(n)
+    for i, j in enumerate(mech.joints):
+        p = j.parent
+        parents.append(link_of[p] if p != WORLD else -1)
+        link_of[j.child] = i
+        parent_anchor = np.array([_num(v) for v in j.parent_anchor])
+        child_anchor = np.array([_num(v) for v in j.child_anchor])
+        offset = _num(j.angle_offset)
+        row_p, const_p = angle_rows[p]
+        # the joint point in the parent's link frame
+        offsets.append(com[p] + _rot2(-beta[p]) @ parent_anchor)
+        e_i = np.zeros(n)
+        e_i[i] = 1.0
+        if isinstance(j, Revolute):
+            types.append("R")
+            rotations.append(offset - beta[p])
+            beta[j.child] = 0.0
+            angle_rows[j.child] = (row_p + e_i, const_p + offset)
+            if j.absolute:  # q = theta_child - offset = theta_parent + u
+                T[i] = row_p + e_i
+                c[i] = const_p
+            else:
+                T[i] = e_i
+        elif isinstance(j, Prismatic):
+            types.append("P")
+            axis = np.array([_num(v) for v in j.axis])
+            length = float(np.hypot(*axis))
+            alpha = math.atan2(axis[1], axis[0])
+            rotations.append(alpha - beta[p])
+            beta[j.child] = alpha - offset
+            angle_rows[j.child] = (row_p.copy(), const_p + offset)
+            T[i] = e_i / length  # the engine slides by u = |axis| q
+        else:  # pragma: no cover - the Joint union is closed
+            raise TypeError(j)
+        com[j.child] = -_rot2(-beta[j.child]) @ child_anchor
+    mass = {b.name: _num(b.mass) for b in mech.bodies}
+    inertia = {b.name: _num(b.inertia) for b in mech.bodies}
+    return _Geometry(n, link_of, parents, types, offsets, rotations, beta, com, mass, inertia,
+                     T, c, angle_rows, _num(mech.gravity))
+
+
+class ExudynBackend(Backend):
+    id = "exudyn"
+
+    # --- identity --------------------------------------------------------------------------
+    def available(self) -> tuple[bool, str]:
+        try:
+            import exudyn  # noqa: F401
+            import exudyn.utilities  # noqa: F401
+        except Exception as exc:  # noqa: BLE001 - any import failure is a visible skip
+            return False, f"exudyn not importable: {exc}"
+        return True, ""
+
+    def version(self) -> str:
+        import exudyn
+
+        return str(exudyn.GetVersionString() if hasattr(exudyn, "GetVersionString")
+                   else exudyn.__version__)
+
+    def default_settings(self) -> dict:
+        return {
+            "solver": "RK44",
+            "automatic_step_size": False,
+            "ga_spectral_radius": 1.0,
+            "ga_adaptive_step": False,
+            "newton_relative_tolerance": 1e-13,
+            "newton_absolute_tolerance": 1e-14,
+            "modified_newton": False,
+            "end_of_step_accelerations": True,
+            "native_linear_laws": True,
+            "write_solution_file": False,
+            "linearization_relative_epsilon": 1e-7,
+        }
+
+    def setting_notes(self) -> dict[str, str]:
+        return {
+            "solver": "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 "
+                      "(classical Runge-Kutta, order 4) works on the kinematic tree without "
+                      "Newton iterations; also offered: " + ", ".join(_SOLVER_ORDER)
+                      + " (integrator_order reports the order of the one used).",
+            "automatic_step_size": "Exudyn default True lets error-controlled explicit "
+                                   "solvers change the step; False keeps the fixed step dt "
+                                   "the contract asks for.",
+            "ga_spectral_radius": "GeneralizedAlpha only. Exudyn default 0.9 adds numerical "
+                                  "damping (energy decays); 1.0 removes it (no constraints "
+                                  "here, so rho = 1 is stable).",
+            "ga_adaptive_step": "Implicit solvers only. Exudyn default True silently reduces "
+                                "the step after a failed Newton solve; False keeps dt fixed "
+                                "(a failure is raised instead).",
+            "newton_relative_tolerance": "Implicit solvers only. Exudyn default 1e-8 limits "
+                                         "the accuracy of small motions; tightened.",
+            "newton_absolute_tolerance": "Implicit solvers only. Exudyn default 1e-10; "
+                                         "tightened for small amplitudes.",
+            "modified_newton": "Implicit solvers only. Exudyn default True reuses an old "
+                               "Jacobian; full Newton converges to the tight tolerances.",
+            "end_of_step_accelerations": "Exudyn default True (kept): explicit solvers "
+                                         "recompute the accelerations at the end of each "
+                                         "step, so the sampled centre-of-mass accelerations "
+                                         "(used for reactions) belong to the sampled state; "
+                                         "False leaves last-stage accelerations.",
+            "native_linear_laws": "Backend choice: laws affine in the length/coordinate and "
+                                  "its rate (no TIME) use Exudyn's built-in spring-damper and "
+                                  "the tree's PD terms (C++); False sends every law through "
+                                  "Python user functions (same model, slower).",
+            "write_solution_file": "Exudyn default True writes coordinatesSolution.txt every "
+                                   "0.01 s (disk I/O inside the timed loop); the backend "
+                                   "samples with in-memory sensors at every step instead "
+                                   "(sensor write period dt replaces the 0.01 s default).",
+            "linearization_relative_epsilon": "linearize(): relative step of Exudyn's "
+                                              "numerical Jacobian (static solver) for K and "
+                                              "D; Exudyn default 1e-7 kept.",
+        }
+
+    # --- support ---------------------------------------------------------------------------
+    def support(self, mechanism: Mechanism) -> Support:
+        try:
+            _num(mechanism.gravity)
+            for b in mechanism.bodies:
+                _num(b.mass), _num(b.inertia)
+            for j in mechanism.joints:
+                if not isinstance(j, (Revolute, Prismatic)):
+                    return Support(False, f"joint {j.name}: type {type(j).__name__} not mapped")
+                for v in (*j.parent_anchor, *j.child_anchor, j.angle_offset):
+                    _num(v)
+                if isinstance(j, Prismatic) and np.hypot(*[_num(v) for v in j.axis]) == 0:
+                    return Support(False, f"joint {j.name}: zero prismatic axis")
+        except ValueError as exc:
+            return Support(False, f"mechanism is not numeric: {exc}")
+        for f in mechanism.forces:
+            if not isinstance(f, (PointToPoint, CoordinateForce)):
+                return Support(False, f"force {f.name}: type {type(f).__name__} not mapped")
+        # a massless body with nothing massive below it makes the tree's mass matrix singular
+        for b in mechanism.bodies:
+            if b.massless and all(mechanism.body(x).massless for x in mechanism.subtree(b.name)):
+                return Support(False, f"massless body {b.name} carries no mass: the kinematic "
+                                      "tree's mass matrix would be singular")
+        return Support(True)
+
+    # --- model building --------------------------------------------------------------------
+    def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict,
+               include_time_loads: bool = True):
+        import exudyn as exu
+        from exudyn.itemInterface import (MarkerBodyPosition, MarkerKinematicTreeRigid,
+                                          NodeGenericODE2, ObjectConnectorSpringDamper,
+                                          ObjectGround, ObjectKinematicTree)
+
+        geo = _geometry(mech)
+        n = geo.n
+        Tinv = np.linalg.inv(geo.T)
+        u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.c)
+        ud0 = Tinv @ np.asarray(qd0, dtype=float)
+
+        SC = exu.SystemContainer()
+        mbs = SC.AddSystem()
+        node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * n,
+                                           initialCoordinates=u0.tolist(),
+                                           initialCoordinates_t=ud0.tolist(),
+                                           numberOfODE2Coordinates=n))
+        bodies = [j.child for j in mech.joints]
+        joint_types = [exu.JointType.RevoluteZ if t == "R" else exu.JointType.PrismaticX
+                       for t in geo.types]
+        inertias = [np.diag([0.0, 0.0, geo.inertia[b]]) for b in bodies]
+        coms = [[*geo.com[b], 0.0] for b in bodies]
+
+        # coordinate forces: native PD terms where the law is affine and maps to one
+        # engine coordinate, the rest through one Python user function of the tree
+        P = np.zeros(n)
+        D = np.zeros(n)
+        f_const = np.zeros(n)
+        python_laws: list[tuple[int, Callable[..., float]]] = []
+        for f in mech.forces:
+            if not isinstance(f, CoordinateForce):
+                continue
+            if f.time_dependent and not include_time_loads:
+                continue
+            i = mech.coordinates.index(f.coordinate)
+            row = geo.T[i]
+            single = np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0
+            aff = _affine(f.force, COORD, COORD_RATE) if settings["native_linear_laws"] else None
+            if aff is not None and single:
+                s = row[i]  # q_i = s u_i, so Q_u = s F(s u, s u_t)
+                a0, ax, av = aff
+                f_const[i] += s * a0
+                P[i] += -s * s * ax
+                D[i] += -s * s * av
+            else:
+                python_laws.append((i, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+
+        tree_args = dict(
+            nodeNumber=node, gravity=[0.0, -geo.gravity, 0.0], baseOffset=[0.0, 0.0, 0.0],
+            jointTypes=joint_types, linkParents=geo.parents,
+            jointTransformations=exu.Matrix3DList([_rot3(a) for a in geo.rotations]),
+            jointOffsets=exu.Vector3DList([[*o, 0.0] for o in geo.offsets]),
+            linkInertiasCOM=exu.Matrix3DList(inertias), linkCOMs=exu.Vector3DList(coms),
+            linkMasses=[geo.mass[b] for b in bodies],
+        )
+        if np.any(P) or np.any(D):
+            tree_args.update(jointPControlVector=P.tolist(), jointDControlVector=D.tolist(),
+                             jointPositionOffsetVector=[0.0] * n,
+                             jointVelocityOffsetVector=[0.0] * n)
+        if np.any(f_const):
+            tree_args.update(jointForceVector=f_const.tolist())
+        if python_laws:
+            tree_args.update(forceUserFunction=self._coordinate_user_function(geo, python_laws))
+        tree = mbs.AddObject(ObjectKinematicTree(**tree_args))
+
+        # point-to-point elements: spring-dampers between markers
+        ground = None
+        connectors: dict[str, object] = {}
+        for f in mech.forces:
+            if not isinstance(f, PointToPoint):
+                continue
+            if f.body_a == WORLD and f.body_b == WORLD:
+                continue  # acts on nothing
+            if TIME in sp.sympify(f.tension).free_symbols and not include_time_loads:
+                continue
+            markers = []
+            for body, point in ((f.body_a, f.point_a), (f.body_b, f.point_b)):
+                pt = [_num(v) for v in point]
+                if body == WORLD:
+                    if ground is None:
+                        ground = mbs.AddObject(ObjectGround())
+                    markers.append(mbs.AddMarker(MarkerBodyPosition(
+                        bodyNumber=ground, localPosition=[*pt, 0.0])))
+                else:
+                    markers.append(mbs.AddMarker(MarkerKinematicTreeRigid(
+                        objectNumber=tree, linkNumber=geo.link_of[body],
+                        localPosition=[*geo.local_point(body, pt), 0.0])))
+            aff = (_affine(f.tension, LENGTH, LENGTH_RATE)
+                   if settings["native_linear_laws"] else None)
+            if aff is not None:
+                b0, bl, bv = aff  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
+                conn = ObjectConnectorSpringDamper(markerNumbers=markers, referenceLength=0.0,
+                                                   stiffness=bl, damping=bv, force=b0)
+            else:
+                law = compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))
+                # referenceLength 0, so deltaL is the length itself
+                conn = ObjectConnectorSpringDamper(
+                    markerNumbers=markers, referenceLength=0.0,
+                    springForceUserFunction=self._tension_user_function(law))
+            connectors[f.name] = mbs.AddObject(conn)
+        return exu, mbs, SC, node, tree, geo, connectors
+
+    @staticmethod
+    def _tension_user_function(law: Callable[..., float]):
+        def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
+            return law(delta_l, delta_l_t, t)  # referenceLength 0: delta_l is the length
+        return uf
+
+    @staticmethod
+    def _coordinate_user_function(geo: _Geometry, laws: list[tuple[int, Callable[..., float]]]):
+        T, c, n = geo.T, geo.c, geo.n
+        if np.array_equal(T, np.eye(n)) and not np.any(c):
+            def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
+                out = [0.0] * n
+                for i, law in laws:
+                    out[i] += law(u[i], u_t[i], t)
+                return out
+            return uf
+
+        def uf_mapped(mbs, t, item, u, u_t):
+            q = T @ np.asarray(u) + c
+            qd = T @ np.asarray(u_t)
+            F = np.zeros(n)
+            for i, law in laws:
+                F[i] += law(q[i], qd[i], t)
+            return (T.T @ F).tolist()
+        return uf_mapped
+
+    def _simulation_settings(self, exu, settings: dict, t_end: float, steps: int):
+        s = exu.SimulationSettings()
+        ti = s.timeIntegration
+        ti.numberOfSteps = steps
+        ti.endTime = t_end
+        ti.verboseMode = 0
+        ti.automaticStepSize = bool(settings["automatic_step_size"])
+        ti.adaptiveStep = bool(settings["ga_adaptive_step"])
+        ti.explicit.computeEndOfStepAccelerations = bool(settings["end_of_step_accelerations"])
+        ti.generalizedAlpha.spectralRadius = float(settings["ga_spectral_radius"])
+        ti.generalizedAlpha.computeInitialAccelerations = True
+        ti.newton.relativeTolerance = float(settings["newton_relative_tolerance"])
+        ti.newton.absoluteTolerance = float(settings["newton_absolute_tolerance"])
+        ti.newton.useModifiedNewton = bool(settings["modified_newton"])
+        s.solution.file.write = bool(settings["write_solution_file"])
+        s.solution.file.writePeriod = t_end / steps
+        s.solution.sensors.writePeriod = t_end / steps
+        s.staticSolver.verboseMode = 0
+        s.staticSolver.newton.numericalDifferentiation.relativeEpsilon = float(
+            settings["linearization_relative_epsilon"])
+        s.linearSolver.ignoreSingularJacobian = False
+        return s
+
+    # --- simulation ------------------------------------------------------------------------
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        cfg = self.resolve_settings(settings)
+        solver = str(cfg["solver"])
+        if solver not in _SOLVER_ORDER:
+            raise ValueError(f"unknown exudyn solver {solver!r}; valid: {', '.join(_SOLVER_ORDER)}")
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
+        steps = int(round(t_end / dt))
+        t_run = steps * dt
+        exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
+        from exudyn.itemInterface import SensorKinematicTree, SensorNode, SensorObject
+
+        ovt = exu.OutputVariableType
+        sens = dict(storeInternal=True, writeToFile=False)
+        s_u = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates, **sens))
+        s_ut = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates_t,
+                                        **sens))
+        # centre-of-mass accelerations of every massive body below a requested joint
+        acc_bodies: set[str] = set()
+        for name in reaction_joints:
+            joint = mechanism.joint(name)
+            acc_bodies |= {b for b in mechanism.subtree(joint.child) if geo.mass[b] != 0}
+        s_acc = {b: mbs.AddSensor(SensorKinematicTree(
+            objectNumber=tree, linkNumber=geo.link_of[b], localPosition=[*geo.com[b], 0.0],
+            outputVariableType=ovt.Acceleration, **sens)) for b in sorted(acc_bodies)}
+        # engine force of every connector that can cross a requested joint
+        s_conn = {name: mbs.AddSensor(SensorObject(objectNumber=obj, outputVariableType=ovt.Force,
+                                                   **sens))
+                  for name, obj in connectors.items()} if reaction_joints else {}
+        mbs.Assemble()
+        sim = self._simulation_settings(exu, cfg, t_run, steps)
+        solver_type = getattr(exu.DynamicSolverType, solver)
+
+        start = time.perf_counter()
+        mbs.SolveDynamic(sim, solverType=solver_type)
+        wall = time.perf_counter() - start
+
+        U = np.asarray(mbs.GetSensorStoredData(s_u))
+        Ut = np.asarray(mbs.GetSensorStoredData(s_ut))
+        t = U[:, 0]
+        if len(t) != steps + 1 or abs(t[-1] - t_run) > 1e-9 * max(1.0, t_run):
+            raise RuntimeError(f"exudyn sensors returned {len(t)} samples, expected {steps + 1}")
+        u, ut = U[:, 1:], Ut[:, 1:]
+        q = u @ geo.T.T + geo.c
+        qd = ut @ geo.T.T
+
+        reactions: dict[str, np.ndarray] = {}
+        if reaction_joints:
+            acc = {b: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3] for b, s in s_acc.items()}
+            conn_force = {name: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3]
+                          for name, s in s_conn.items()}
+            for name in reaction_joints:
+                reactions[name] = self._reaction(mechanism, geo, name, t, q, qd, u, acc,
+                                                 conn_force)
+        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
+                         integrator_order=_SOLVER_ORDER[solver], settings=cfg, steps=steps)
+
+    @staticmethod
+    def _reaction(mech: Mechanism, geo: _Geometry, joint_name: str, t: np.ndarray,
+                  q: np.ndarray, qd: np.ndarray, u: np.ndarray,
+                  acc: dict[str, np.ndarray], conn_force: dict[str, np.ndarray]) -> np.ndarray:
+        """Force parent -> child (world x, y): sum m (a - g) over the child's subtree minus
+        the element forces entering the subtree from outside."""
+        joint = mech.joint(joint_name)
+        subtree = set(mech.subtree(joint.child))
+        g_vec = np.array([0.0, -geo.gravity])
+        total = np.zeros((len(t), 2))
+        for b in subtree:
+            if geo.mass[b] != 0:
+                total += geo.mass[b] * (acc[b] - g_vec)
+        for f in mech.forces:
+            if isinstance(f, PointToPoint):
+                in_a, in_b = f.body_a in subtree, f.body_b in subtree
+                if in_a == in_b or f.name not in conn_force:
+                    continue
+                # Exudyn's connector force is the force on marker 0 (body_a)
+                on_a = conn_force[f.name]
+                total -= on_a if in_a else -on_a
+            elif isinstance(f, CoordinateForce):
+                i = mech.coordinates.index(f.coordinate)
+                owner = mech.joints[i]
+                if owner is not joint or isinstance(owner, Revolute):
+                    continue
+                law = compile_law(f.force, (COORD, COORD_RATE, TIME))
+                force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])
+                row, const = geo.angle_rows[owner.parent]
+                th_parent = u @ row + const
+                axis = np.array([_num(v) for v in owner.axis])
+                ax_world = np.stack([np.cos(th_parent) * axis[0] - np.sin(th_parent) * axis[1],
+                                     np.sin(th_parent) * axis[0] + np.cos(th_parent) * axis[1]],
+                                    axis=1)
+                total -= force[:, None] * ax_world
+        return total
+
+    # --- linearization ---------------------------------------------------------------------
+    def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
+                  settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
+        cfg = self.resolve_settings(settings)
+        support = self.support(mechanism)
+        if not support.ok:
+            return None
+        q_eq = np.asarray(q_eq, dtype=float)
+        exu, mbs, SC, node, tree, geo, _ = self._build(
+            mechanism, q_eq, np.zeros_like(q_eq), cfg, include_time_loads=False)
+        mbs.Assemble()
+        sim = self._simulation_settings(exu, cfg, 1.0, 1)
+        eig, _ = mbs.ComputeODE2Eigenvalues(simulationSettings=sim,
+                                            computeComplexEigenvalues=True,
+                                            useAbsoluteValues=False)
+        eig = np.asarray(eig, dtype=complex)
+        return Linearization(
+            eigenvalues=eig[np.argsort(eig.imag)],
+            method="exudyn mbs.ComputeODE2Eigenvalues(computeComplexEigenvalues=True): "
+                   "numerical Jacobians of the kinematic tree (M, K, D), first-order "
+                   "eigenproblem",
+            extra={"coordinates": "engine relative joint values (eigenvalues are invariant)"},
+        )
+
+
+BACKEND = ExudynBackend()
