@@ -103,11 +103,11 @@ class NumericModel:
         if joint not in self._reactions:
             d = self.derivation
             expr = d.reaction(joint).xreplace(self.subs)
-            self._reactions[joint] = _lambdify(list(d.q) + list(d.qd) + list(d.qdd) + [TIME], expr)
-        out = self._reactions[joint](*q.T, *qd.T, *qdd.T, t)
-        out = np.array([np.broadcast_to(np.asarray(c, dtype=float).reshape(-1), (len(t),))
-                        for c in np.asarray(out, dtype=object).reshape(-1)])
-        return out.T
+            self._reactions[joint] = _lambdify(list(d.q) + list(d.qd) + list(d.qdd) + [TIME],
+                                               list(expr))
+        fx, fy = self._reactions[joint](*q.T, *qd.T, *qdd.T, t)
+        return np.column_stack([np.broadcast_to(np.asarray(f, dtype=float), (len(t),))
+                                for f in (fx, fy)])
 
     def accelerations(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
         return np.array([self.acceleration(a, b, c) for a, b, c in zip(q, qd, t)])

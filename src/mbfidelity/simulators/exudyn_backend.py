@@ -461,8 +461,10 @@ class ExudynBackend(Backend):
                                                    **sens))
                   for name, obj in connectors.items()} if reaction_joints else {}
         mbs.Assemble()
-        sim = self._simulation_settings(exu, cfg, t_run, steps)
         solver_type = getattr(exu.DynamicSolverType, solver)
+        sim = self._simulation_settings(exu, cfg, t_run, steps)
+        sim.timeIntegration.solverType = solver_type
+        acc0 = self._initial_accelerations(exu, mbs, cfg, s_acc) if s_acc else {}
 
         start = time.perf_counter()
         mbs.SolveDynamic(sim, solverType=solver_type)
@@ -480,6 +482,8 @@ class ExudynBackend(Backend):
         reactions: dict[str, np.ndarray] = {}
         if reaction_joints:
             acc = {b: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3] for b, s in s_acc.items()}
+            for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
+                acc[b][0] = a0
             conn_force = {name: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3]
                           for name, s in s_conn.items()}
             for name in reaction_joints:
@@ -487,6 +491,22 @@ class ExudynBackend(Backend):
                                                  conn_force)
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=_SOLVER_ORDER[solver], settings=cfg, steps=steps)
+
+    def _initial_accelerations(self, exu, mbs, cfg: dict, sensors: dict) -> dict[str, np.ndarray]:
+        """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
+        right-hand side (the solvers store zero accelerations for the first sample)."""
+        sim = self._simulation_settings(exu, cfg, 1.0, 1)
+        sim.timeIntegration.solverType = exu.DynamicSolverType.RK44
+        helper = exu.MainSolverExplicit()
+        helper.InitializeSolver(mbs, sim)
+        helper.ComputeMassMatrix(mbs)
+        mass = np.asarray(helper.GetSystemMassMatrix())
+        helper.ComputeODE2RHS(mbs)
+        rhs = np.asarray(helper.GetSystemResidual())[:len(mass)]
+        helper.FinalizeSolver(mbs, sim)
+        a0 = np.linalg.solve(mass, rhs)
+        mbs.systemData.SetODE2Coordinates_tt(a0.tolist(), configuration=exu.ConfigurationType.Current)
+        return {b: np.asarray(mbs.GetSensorValues(s))[:2] for b, s in sensors.items()}
 
     @staticmethod
     def _reaction(mech: Mechanism, geo: _Geometry, joint_name: str, t: np.ndarray,

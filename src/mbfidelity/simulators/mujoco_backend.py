@@ -1,0 +1,700 @@
+"""MuJoCo backend: the description is translated to MJCF text and integrated with RK4.
+
+Translation (generic over the description, see `to_mjcf`):
+
+- Every body with mass becomes an MJCF body whose frame is the description's
+  centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
+  from geom density). The planar inertia goes on z; x and y get the same value so the
+  inertia is valid (they cannot act in planar motion).
+- MuJoCo rejects massless moving bodies, so a massless body's joints are folded into its
+  single child: that MJCF body carries the chain of joints, which MuJoCo applies in order,
+  each with its anchor and axis expressed in the body frame at the reference
+  configuration. This is exact (no substitute mass).
+- ``Revolute`` -> hinge about z (relative angle); ``Prismatic`` -> slide in the x-y plane.
+  Engine joint values v relate to the description coordinates q by a constant affine map
+  ``v = A q + b`` (A unit lower triangular up to axis lengths): absolute angles become
+  ``q - theta_parent``. The reference configuration of the MJCF (qpos0) is v = 0.
+- ``PointToPoint`` -> a spatial tendon between two sites. A law linear in LENGTH and
+  LENGTH_RATE uses the tendon's own stiffness/springlength/damping (exact, including free
+  length 0); any other law applies ``-T dL/dq`` from the passive callback.
+- ``CoordinateForce`` -> joint stiffness/springref/damping when the law is linear, has no
+  TIME and its coordinate is one engine joint; otherwise the passive callback
+  (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with ``d.time`` set to
+  the stage time, so time loads are evaluated at stage times.
+- Prismatic ``limits`` are admissible intervals of the description, not stops; they are
+  not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
+  outside the interval).
+
+Reactions: ``mj_forward`` + ``mj_rnePostConstraint`` at each sampled state (after the
+stepping, outside the timed loop); ``cfrc_int[body, 3:6]`` is the force the parent exerts
+on the body (world axes). Forces MuJoCo books as joint-space passive forces (tendons,
+joint springs, callback) are inside that number, so the force-element contributions from
+outside the child's subtree are subtracted to give the description's joint reaction.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+import sympy as sp
+
+from ..systems.model import (
+    COORD,
+    COORD_RATE,
+    LENGTH,
+    LENGTH_RATE,
+    TIME,
+    WORLD,
+    Circle,
+    CoordinateForce,
+    Mechanism,
+    PointToPoint,
+    Prismatic,
+    Rectangle,
+    Revolute,
+    Segment,
+    compile_law,
+)
+from .base import Backend, Linearization, RunResult, Support
+
+_INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
+_LINEARIZATIONS = ("inverseFD", "transitionFD")
+
+
+def _num(x) -> float:
+    return float(sp.sympify(x))
+
+
+def _fmt(*xs: float) -> str:
+    return " ".join(format(float(x), ".17g") for x in xs)
+
+
+def _rot(th: float) -> np.ndarray:
+    c, s = math.cos(th), math.sin(th)
+    return np.array([[c, -s], [s, c]])
+
+
+def _linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
+    """(a, b, c) with law = a + b x + c xd, or None when the law is not of that form."""
+    expr = sp.sympify(expr)
+    if not expr.free_symbols <= {x, xd} or not expr.is_polynomial(x, xd):
+        return None
+    if expr.free_symbols and sp.Poly(expr, x, xd).total_degree() > 1:
+        return None
+    a = float(expr.xreplace({x: 0, xd: 0}))
+    return a, float(sp.diff(expr, x)), float(sp.diff(expr, xd))
+
+
+def _vector_law(expr, args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
+    """A law evaluated on arrays (post-processing of reactions)."""
+    fn = sp.lambdify(args, sp.sympify(expr), modules="numpy")
+
+    def call(*arrays: np.ndarray) -> np.ndarray:
+        out = np.asarray(fn(*arrays), dtype=float)
+        return np.broadcast_to(out, np.shape(arrays[0])).astype(float)
+
+    return call
+
+
+@dataclass
+class _P2P:
+    element: PointToPoint
+    tendon: str
+    native: tuple[float, float, float] | None  # (stiffness, springlength, damping)
+    law: Callable[..., float]
+
+
+@dataclass
+class _Coord:
+    element: CoordinateForce
+    j: int  # description joint index
+    native: tuple[float, float, float] | None  # (a, b, c) in engine units of joint j
+    law: Callable[..., float]
+
+
+@dataclass
+class _Plan:
+    """A numeric mechanism translated to MuJoCo terms."""
+
+    mech: Mechanism
+    n: int
+    A: np.ndarray
+    Ainv: np.ndarray
+    b: np.ndarray
+    angle_c: dict[str, np.ndarray]
+    angle_d: dict[str, float]
+    carrier: dict[str, str]  # description body -> MJCF body carrying it
+    chains: dict[str, list[int]]  # MJCF body -> description joint indices, in order
+    mj_parent: dict[str, str]
+    p2p: list[_P2P] = field(default_factory=list)
+    coord: list[_Coord] = field(default_factory=list)
+    xml: str = ""
+
+    def engine_values(self, q: np.ndarray) -> np.ndarray:
+        return self.A @ np.asarray(q, dtype=float) + self.b
+
+
+def _check(mech: Mechanism) -> str:
+    """Empty string when the mechanism can be translated, else the reason."""
+    for b in mech.bodies:
+        for x in (b.mass, b.inertia):
+            if sp.sympify(x).free_symbols:
+                return f"body {b.name}: parameters are not numeric (use numeric_mechanism)"
+        m, inertia = _num(b.mass), _num(b.inertia)
+        if b.massless:
+            children = [j for j in mech.joints if j.parent == b.name]
+            if len(children) != 1:
+                return (f"massless body {b.name} has {len(children)} child joints; MuJoCo "
+                        "rejects massless moving bodies and its joints can only be folded "
+                        "into exactly one child")
+        elif m <= 0 or inertia <= 0:
+            return (f"body {b.name}: mass {m} and inertia {inertia} must both be > 0 "
+                    "(MuJoCo rejects moving bodies with zero mass or inertia)")
+    if sp.sympify(mech.gravity).free_symbols:
+        return "gravity is not numeric"
+    massless = {b.name for b in mech.bodies if b.massless}
+    placeholders = {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}
+    for f in mech.forces:
+        if not isinstance(f, (PointToPoint, CoordinateForce)):
+            return f"force element {f!r} is not supported"
+        law = f.tension if isinstance(f, PointToPoint) else f.force
+        if sp.sympify(law).free_symbols - placeholders:
+            return f"force element {f.name}: law has non-numeric parameters"
+        if isinstance(f, PointToPoint):
+            for body in (f.body_a, f.body_b):
+                if body in massless:
+                    return (f"force element {f.name} is attached to massless body {body}, "
+                            "which has no MJCF body of its own after folding")
+    for j in mech.joints:
+        if isinstance(j, Prismatic) and math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0:
+            return f"joint {j.name}: zero axis"
+    return ""
+
+
+def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
+    n = len(mech.joints)
+    idx = {j.name: i for i, j in enumerate(mech.joints)}
+    # body angle = angle_c . q + angle_d (affine in the description coordinates)
+    angle_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
+    angle_d: dict[str, float] = {WORLD: 0.0}
+    A = np.zeros((n, n))
+    b = np.zeros(n)
+    for i, j in enumerate(mech.joints):
+        cp, dp = angle_c[j.parent], angle_d[j.parent]
+        off = _num(j.angle_offset)
+        if isinstance(j, Revolute):
+            if j.absolute:
+                angle_c[j.child] = np.eye(n)[i]
+                angle_d[j.child] = off
+                A[i] = np.eye(n)[i] - cp  # v = q - theta_parent
+                b[i] = -dp
+            else:
+                angle_c[j.child] = cp + np.eye(n)[i]
+                angle_d[j.child] = dp + off
+                A[i, i] = 1.0
+        else:
+            angle_c[j.child] = cp.copy()
+            angle_d[j.child] = dp + off
+            A[i, i] = math.hypot(_num(j.axis[0]), _num(j.axis[1]))  # MuJoCo normalizes axes
+    Ainv = np.linalg.inv(A)
+
+    carrier: dict[str, str] = {}
+    for body in reversed([j.child for j in mech.joints]):
+        if mech.body(body).massless:
+            child = next(j.child for j in mech.joints if j.parent == body)
+            carrier[body] = carrier[child]
+        else:
+            carrier[body] = body
+    chains: dict[str, list[int]] = {}
+    mj_parent: dict[str, str] = {}
+    for i, j in enumerate(mech.joints):
+        chains.setdefault(carrier[j.child], []).append(i)
+    for name, chain in chains.items():
+        parent = mech.joints[chain[0]].parent
+        mj_parent[name] = WORLD if parent == WORLD else carrier[parent]
+
+    plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
+    joint_native: dict[int, list[float]] = {}
+    for f in mech.forces:
+        if isinstance(f, PointToPoint):
+            if autonomous and TIME in sp.sympify(f.tension).free_symbols:
+                continue
+            lin = _linear_law(f.tension, LENGTH, LENGTH_RATE) if native else None
+            spec = None
+            if lin is not None:
+                a, k, c = lin
+                if k > 0 and -a / k >= 0 and c >= 0:
+                    spec = (k, -a / k, c)
+                elif k == 0 and a == 0 and c >= 0:
+                    spec = (0.0, 0.0, c)
+            plan.p2p.append(_P2P(f, f.name, spec,
+                                 compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))))
+        else:
+            if autonomous and f.time_dependent:
+                continue
+            i = mech.coordinates.index(f.coordinate)
+            lin = _linear_law(f.force, COORD, COORD_RATE) if native else None
+            spec = None
+            single = np.count_nonzero(A[i]) == 1 and b[i] == 0
+            if lin is not None and single:
+                s = A[i, i]  # v = s q: force F on q is F/s on v
+                a, kq, cq = lin
+                spec = (a / s, kq / s**2, cq / s**2)
+                acc = joint_native.setdefault(i, [0.0, 0.0, 0.0])
+                acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
+            plan.coord.append(_Coord(f, i, spec, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+    # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
+    # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
+    for i, (a, k, c) in joint_native.items():
+        ok = c <= 0 and (k < 0 or (k == 0 and a == 0))
+        if not ok:
+            for e in plan.coord:
+                if e.j == i:
+                    e.native = None
+    plan.xml = _mjcf(plan, joint_native)
+    return plan
+
+
+def _poses(plan: _Plan, q: np.ndarray) -> tuple[dict, dict]:
+    """World poses (x, y, theta) of bodies and world anchors/axes of joints at q."""
+    mech = plan.mech
+    poses = {WORLD: (np.zeros(2), 0.0)}
+    joints = {}
+    for i, j in enumerate(mech.joints):
+        pp, thp = poses[j.parent]
+        Rp = _rot(thp)
+        th = float(plan.angle_c[j.child] @ q + plan.angle_d[j.child])
+        pa = np.array([_num(j.parent_anchor[0]), _num(j.parent_anchor[1])])
+        ca = np.array([_num(j.child_anchor[0]), _num(j.child_anchor[1])])
+        if isinstance(j, Revolute):
+            anchor = pp + Rp @ pa
+            joints[j.name] = (anchor, None)
+        else:
+            axis = np.array([_num(j.axis[0]), _num(j.axis[1])])
+            anchor = pp + Rp @ (pa + q[i] * axis)
+            joints[j.name] = (anchor, Rp @ axis)
+        poses[j.child] = (anchor - _rot(th) @ ca, th)
+    return poses, joints
+
+
+def _shape_geoms(shape) -> str:
+    if isinstance(shape, Segment):
+        a = [_num(v) for v in shape.a]
+        b = [_num(v) for v in shape.b]
+        r = _num(shape.width) / 2
+        if a == b:
+            return f'<geom type="sphere" size="{_fmt(r)}" pos="{_fmt(a[0], a[1], 0)}"/>'
+        return f'<geom type="capsule" size="{_fmt(r)}" fromto="{_fmt(a[0], a[1], 0, b[0], b[1], 0)}"/>'
+    if isinstance(shape, Circle):
+        c = [_num(v) for v in shape.center]
+        return f'<geom type="sphere" size="{_fmt(_num(shape.radius))}" pos="{_fmt(c[0], c[1], 0)}"/>'
+    if isinstance(shape, Rectangle):
+        c = [_num(v) for v in shape.center]
+        w, h = _num(shape.width), _num(shape.height)
+        return (f'<geom type="box" size="{_fmt(w / 2, h / 2, min(w, h) / 4)}" '
+                f'pos="{_fmt(c[0], c[1], 0)}"/>')
+    return ""
+
+
+def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
+    mech = plan.mech
+    q_ref = plan.Ainv @ (-plan.b)  # the configuration with every engine value 0
+    poses, janchor = _poses(plan, q_ref)
+    native_joint = {e.j for e in plan.coord if e.native is not None}
+    sites: dict[str, list[str]] = {}
+    for e in plan.p2p:
+        f = e.element
+        for tag, body, pt in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
+            sites.setdefault(body, []).append(
+                f'<site name="{f.name}:{tag}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+
+    def body_xml(name: str, depth: int) -> list[str]:
+        ind = "  " * depth
+        p, th = poses[name]
+        pp, thp = poses[plan.mj_parent[name]]
+        rel = _rot(thp).T @ (p - pp)
+        ang = th - thp
+        body = mech.body(name)
+        lines = [f'{ind}<body name="{name}" pos="{_fmt(rel[0], rel[1], 0)}" '
+                 f'quat="{_fmt(math.cos(ang / 2), 0, 0, math.sin(ang / 2))}">']
+        RbT = _rot(th).T
+        for i in plan.chains[name]:
+            j = mech.joints[i]
+            anchor, axis = janchor[j.name]
+            extra = ""
+            if i in native_joint:
+                a, k, c = joint_native[i]
+                ref = -a / k if k != 0 else 0.0
+                extra = f' stiffness="{_fmt(-k)}" springref="{_fmt(ref)}" damping="{_fmt(-c)}"'
+            if isinstance(j, Revolute):
+                loc = RbT @ (anchor - p)
+                lines.append(f'{ind}  <joint name="{j.name}" type="hinge" axis="0 0 1" '
+                             f'pos="{_fmt(loc[0], loc[1], 0)}"{extra}/>')
+            else:
+                ax = RbT @ axis
+                lines.append(f'{ind}  <joint name="{j.name}" type="slide" '
+                             f'axis="{_fmt(ax[0], ax[1], 0)}"{extra}/>')
+        m, inertia = _num(body.mass), _num(body.inertia)
+        lines.append(f'{ind}  <inertial pos="0 0 0" mass="{_fmt(m)}" '
+                     f'diaginertia="{_fmt(inertia, inertia, inertia)}"/>')
+        lines += [f"{ind}  {g}" for g in map(_shape_geoms, body.shapes) if g]
+        lines += [f"{ind}  {s}" for s in sites.get(name, [])]
+        for child in plan.chains:
+            if plan.mj_parent[child] == name:
+                lines += body_xml(child, depth + 1)
+        lines.append(f"{ind}</body>")
+        return lines
+
+    g = _num(mech.gravity)
+    out = [
+        '<mujoco model="mbfidelity">',
+        '  <compiler angle="radian" inertiafromgeom="false"/>',
+        f'  <option gravity="{_fmt(0, -g, 0)}">',
+        '    <flag contact="disable"/>',
+        "  </option>",
+        '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
+        "  <worldbody>",
+    ]
+    out += [f"    {s}" for s in sites.get(WORLD, [])]
+    for name in plan.chains:
+        if plan.mj_parent[name] == WORLD:
+            out += body_xml(name, 2)
+    out.append("  </worldbody>")
+    if plan.p2p:
+        out.append("  <tendon>")
+        for e in plan.p2p:
+            k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
+            out.append(f'    <spatial name="{e.tendon}" stiffness="{_fmt(k)}" '
+                       f'springlength="{_fmt(l0, l0)}" damping="{_fmt(c)}">')
+            out.append(f'      <site site="{e.element.name}:a"/>')
+            out.append(f'      <site site="{e.element.name}:b"/>')
+            out.append("    </spatial>")
+        out.append("  </tendon>")
+    out.append("</mujoco>")
+    return "\n".join(out) + "\n"
+
+
+class _Compiled:
+    """A compiled MuJoCo model of a plan plus the index maps and the passive callback."""
+
+    def __init__(self, plan: _Plan, integrator: str, dt: float) -> None:
+        import mujoco
+
+        self.mujoco = mujoco
+        self.plan = plan
+        self.model = mujoco.MjModel.from_xml_string(plan.xml)
+        self.model.opt.timestep = dt
+        self.model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
+        self.data = mujoco.MjData(self.model)
+        names = [j.name for j in plan.mech.joints]
+        self.qadr = np.array([self.model.joint(nm).qposadr[0] for nm in names])
+        self.vadr = np.array([self.model.joint(nm).dofadr[0] for nm in names])
+        self.callback = self._make_callback()
+
+    def _make_callback(self):
+        plan, model = self.plan, self.model
+        coord_terms = []
+        for e in plan.coord:
+            if e.native is not None:
+                continue
+            row = plan.Ainv[e.j]
+            nz = np.flatnonzero(row)
+            ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
+            const = float(-row @ plan.b)
+            # generalized force on the engine dofs: A^-T e_j F (row j of A^-1)
+            outs = tuple((int(self.vadr[i]), float(row[i])) for i in nz)
+            coord_terms.append((e.law, ins, const, outs))
+        p2p_terms = []
+        for e in plan.p2p:
+            if e.native is not None:
+                continue
+            tid = model.tendon(e.tendon).id
+            adr, nnz = int(model.ten_J_rowadr[tid]), int(model.ten_J_rownnz[tid])
+            cols = np.array(model.ten_J_colind[adr:adr + nnz])
+            p2p_terms.append((e.law, tid, adr, adr + nnz, cols))
+        if not coord_terms and not p2p_terms:
+            return None
+
+        def passive(m, d) -> None:
+            if m is not model:  # the callback is global: act on our model only
+                return
+            t = d.time
+            qfrc = d.qfrc_passive
+            if coord_terms:
+                qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
+                for law, ins, const, outs in coord_terms:
+                    x, xd = const, 0.0
+                    for qa, va, c in ins:
+                        x += c * qpos[qa]
+                        xd += c * qvel[va]
+                    force = law(x, xd, t)
+                    for va, c in outs:
+                        qfrc[va] += c * force
+            for law, tid, a0, a1, cols in p2p_terms:
+                tension = law(d.ten_length[tid], d.ten_velocity[tid], t)
+                qfrc[cols] -= tension * d.ten_J[a0:a1]  # -T dL/dq
+
+        return passive
+
+    def set_state(self, q: np.ndarray, qd: np.ndarray, t: float = 0.0) -> None:
+        d = self.data
+        d.qpos[self.qadr] = self.plan.engine_values(q)
+        d.qvel[self.vadr] = self.plan.A @ np.asarray(qd, dtype=float)
+        d.time = t
+
+
+class _PassiveInstalled:
+    """Installs a passive callback for a block and restores the previous one after."""
+
+    def __init__(self, callback) -> None:
+        import mujoco
+
+        self.mujoco, self.callback, self.previous = mujoco, callback, None
+
+    def __enter__(self) -> None:
+        if self.callback is not None:
+            self.previous = self.mujoco.get_mjcb_passive()
+            self.mujoco.set_mjcb_passive(self.callback)
+
+    def __exit__(self, *exc) -> None:
+        if self.callback is not None:
+            self.mujoco.set_mjcb_passive(self.previous)
+
+
+class MujocoBackend(Backend):
+    id = "mujoco"
+
+    def available(self) -> tuple[bool, str]:
+        try:
+            import mujoco  # noqa: F401
+        except ImportError as exc:  # pragma: no cover - depends on the environment
+            return False, f"mujoco is not importable: {exc}"
+        return True, ""
+
+    def version(self) -> str:
+        import mujoco
+
+        return mujoco.__version__
+
+    def default_settings(self) -> dict:
+        return {
+            "integrator": "RK4",
+            "native_springs": True,
+            "linearization": "inverseFD",
+            "fd_eps": 1e-6,
+        }
+
+    def setting_notes(self) -> dict[str, str]:
+        return {
+            "integrator": (
+                "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) "
+                "phase error on a pendulum) by 'RK4' (fourth order; the passive callback, "
+                "hence every custom and time-dependent force, is evaluated at each stage at "
+                "the stage time). Also accepted: Euler, implicit, implicitfast (order 1). "
+                "With Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
+            "native_springs": (
+                "true: force laws linear in length/coordinate and rate (no time) use "
+                "MuJoCo's own tendon stiffness/springlength/damping and joint "
+                "stiffness/springref/damping (exact for the description, free length 0 "
+                "included); false: every law goes through the passive callback. Only the "
+                "implicit integrators see the difference (they differentiate native "
+                "damping but not callback forces, mujoco #2433)."),
+            "linearization": (
+                "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD "
+                "(finite differences of mj_inverse), central differences by combining "
+                "+eps and -eps; eigenvalues of the first-order system. 'transitionFD': "
+                "mjd_transitionFD discrete A on a copy of the model with the Euler "
+                "integrator when the run uses RK4 (RK4 is not supported there), mapped "
+                "with ln(lambda)/dt; carries the step's own O(h) error."),
+            "fd_eps": "Finite-difference step of mjd_inverseFD / mjd_transitionFD.",
+        }
+
+    def support(self, mechanism: Mechanism) -> Support:
+        reason = _check(mechanism)
+        return Support(not reason, reason)
+
+    # --- translation ---------------------------------------------------------------------
+    def _resolve(self, settings: Mapping | None) -> dict:
+        s = self.resolve_settings(settings)
+        if s["integrator"] not in _INTEGRATORS:
+            raise ValueError(f"mujoco setting integrator must be one of {list(_INTEGRATORS)}, "
+                             f"got {s['integrator']!r}")
+        if s["linearization"] not in _LINEARIZATIONS:
+            raise ValueError(f"mujoco setting linearization must be one of {_LINEARIZATIONS}, "
+                             f"got {s['linearization']!r}")
+        return s
+
+    def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False) -> _Plan:
+        reason = _check(mechanism)
+        if reason:
+            raise ValueError(f"mujoco cannot express this mechanism: {reason}")
+        return _plan(mechanism, bool(settings["native_springs"]), autonomous)
+
+    def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
+                dt: float | None = None) -> str:
+        """The MJCF text of the translated mechanism (with the integrator setting and,
+        when given, the time step), to save and load with ``MjModel.from_xml_path``.
+        Laws that need the passive callback are not in the file."""
+        s = self._resolve(settings)
+        xml = self._plan(mechanism, s).xml
+        opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
+        return xml.replace("<option ", f"<option {opt} ", 1)
+
+    # --- simulation ----------------------------------------------------------------------
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        import mujoco
+
+        s = self._resolve(settings)
+        plan = self._plan(mechanism, s)
+        for name in reaction_joints:
+            mechanism.joint(name)  # KeyError for an unknown joint
+        comp = _Compiled(plan, s["integrator"], dt)
+        m, d = comp.model, comp.data
+        steps = int(round(t_end / dt))
+        comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
+        nq, nv = m.nq, m.nv
+        qpos = np.empty((steps + 1, nq))
+        qvel = np.empty((steps + 1, nv))
+        qpos[0], qvel[0] = d.qpos, d.qvel
+        step = mujoco.mj_step
+        with _PassiveInstalled(comp.callback):
+            start = time.perf_counter()
+            for k in range(1, steps + 1):
+                step(m, d)
+                qpos[k] = d.qpos
+                qvel[k] = d.qvel
+            wall = time.perf_counter() - start
+            t = dt * np.arange(steps + 1)
+            reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
+        V = qpos[:, comp.qadr]
+        VD = qvel[:, comp.vadr]
+        q = (V - plan.b) @ plan.Ainv.T
+        qd = VD @ plan.Ainv.T
+        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
+                         integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
+                         steps=steps)
+
+    def _reactions(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
+                   joints: Sequence[str]) -> dict[str, np.ndarray]:
+        """Force of the parent on the child at each joint, at each sampled state."""
+        if not joints:
+            return {}
+        import mujoco
+
+        plan, m, d = comp.plan, comp.model, comp.data
+        mech = plan.mech
+        bodies = sorted({plan.carrier[mech.joint(j).child] for j in joints})
+        bid = np.array([m.body(b).id for b in bodies])
+        tids = np.array([m.tendon(e.tendon).id for e in plan.p2p], dtype=int)
+        sid = np.array([[m.site(f"{e.element.name}:a").id, m.site(f"{e.element.name}:b").id]
+                        for e in plan.p2p], dtype=int).reshape(-1, 2)
+        N = len(t)
+        cf = np.empty((N, len(bodies), 2))
+        ten = np.empty((N, len(tids), 2))
+        spos = np.empty((N, len(tids), 2, 2))
+        for k in range(N):
+            d.qpos[:] = qpos[k]
+            d.qvel[:] = qvel[k]
+            d.time = t[k]
+            mujoco.mj_forward(m, d)
+            mujoco.mj_rnePostConstraint(m, d)
+            cf[k] = d.cfrc_int[bid, 3:5]
+            if len(tids):
+                ten[k, :, 0] = d.ten_length[tids]
+                ten[k, :, 1] = d.ten_velocity[tids]
+                spos[k] = d.site_xpos[sid][:, :, :2]
+        q = (qpos[:, comp.qadr] - plan.b) @ plan.Ainv.T
+        qd = qvel[:, comp.vadr] @ plan.Ainv.T
+        out: dict[str, np.ndarray] = {}
+        for name in joints:
+            joint = mech.joint(name)
+            inside = set(mech.subtree(joint.child))
+            r = cf[:, bodies.index(plan.carrier[joint.child])].copy()
+            # element forces from outside the subtree are booked by MuJoCo as joint-space
+            # forces, so they sit inside cfrc_int: take them out
+            for i, e in enumerate(plan.p2p):
+                f = e.element
+                in_a, in_b = f.body_a in inside, f.body_b in inside
+                if in_a == in_b:
+                    continue
+                tension = _vector_law(f.tension, (LENGTH, LENGTH_RATE, TIME))(
+                    ten[:, i, 0], ten[:, i, 1], t)
+                ab = spos[:, i, 1] - spos[:, i, 0]
+                unit = ab / np.linalg.norm(ab, axis=1)[:, None]
+                on_inside = tension[:, None] * unit * (1.0 if in_a else -1.0)
+                r -= on_inside
+            if isinstance(joint, Prismatic):
+                ji = mech.joints.index(joint)
+                axis = np.array([_num(joint.axis[0]), _num(joint.axis[1])])
+                th = q @ plan.angle_c[joint.parent] + plan.angle_d[joint.parent]
+                c, s_ = np.cos(th), np.sin(th)
+                axis_w = np.stack([c * axis[0] - s_ * axis[1], s_ * axis[0] + c * axis[1]], 1)
+                axis_w /= float(axis @ axis)  # force F on q is F axis/|axis|^2 in space
+                for e in plan.coord:
+                    if e.j == ji:
+                        F = _vector_law(e.element.force, (COORD, COORD_RATE, TIME))(
+                            q[:, ji], qd[:, ji], t)
+                        r -= F[:, None] * axis_w
+            out[name] = r
+        return out
+
+    # --- linearization -------------------------------------------------------------------
+    def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
+                  settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
+        import mujoco
+
+        s = self._resolve(settings)
+        plan = self._plan(mechanism, s, autonomous=True)
+        n, eps = plan.n, float(s["fd_eps"])
+        q_eq = np.asarray(q_eq, dtype=float)
+        # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the
+        # continuous-time inverse dynamics do not depend on the integrator)
+        integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
+        if s["linearization"] == "inverseFD":
+            comp = _Compiled(plan, integrator, dt)
+            m, d = comp.model, comp.data
+            mats = []
+            with _PassiveInstalled(comp.callback):
+                for h in (eps, -eps):  # forward and backward differences -> central
+                    comp.set_state(q_eq, np.zeros(n))
+                    d.qacc[:] = 0
+                    mujoco.mj_forward(m, d)
+                    d.qacc[:] = 0
+                    DfDq, DfDv, DfDa = (np.zeros((m.nv, m.nv)) for _ in range(3))
+                    mujoco.mjd_inverseFD(m, d, h, False, DfDq, DfDv, DfDa,
+                                         None, None, None, None)
+                    mats.append((DfDq, DfDv, DfDa))
+            # outputs are transposed (row i = derivative with respect to input i)
+            K, C, M = ((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
+            perm = comp.vadr
+            K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
+            Minv = np.linalg.inv(M)
+            system = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+            eig = np.linalg.eigvals(system).astype(complex)
+            A = plan.A  # v = A q + b: matrices in description coordinates are A^T X A
+            extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
+            method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central differences "
+                      f"of mj_inverse, eps={eps:g})")
+        else:
+            comp = _Compiled(plan, integrator, dt)
+            m, d = comp.model, comp.data
+            with _PassiveInstalled(comp.callback):
+                comp.set_state(q_eq, np.zeros(n))
+                mujoco.mj_forward(m, d)
+                Ad = np.zeros((2 * m.nv + m.na, 2 * m.nv + m.na))
+                mujoco.mjd_transitionFD(m, d, eps, True, Ad, None, None, None)
+            eig = np.log(np.linalg.eigvals(Ad).astype(complex)) / dt
+            extra = {"A_discrete": Ad, "integrator": integrator}
+            method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, centered, "
+                      f"eps={eps:g}), ln(lambda)/dt")
+        # order by imaginary then real part: real parts of undamped modes are FD noise
+        eig = eig[np.lexsort((eig.real, eig.imag))]
+        return Linearization(eigenvalues=eig, method=method, extra=extra)
+
+
+BACKEND = MujocoBackend()

@@ -1,0 +1,70 @@
+"""The command line as a user meets it (DESIGN.md): JSON contracts and clear errors."""
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from mbfidelity.cli import app
+
+runner = CliRunner()
+
+
+def _json(args):
+    res = runner.invoke(app, args)
+    assert res.exit_code in (0, 1), res.output
+    return json.loads(res.stdout)
+
+
+def test_list_json_names_every_system_and_engine():
+    doc = _json(["list", "--json"])
+    ids = {s["system"] for s in doc["systems"]}
+    assert {"compound_pendulum", "double_pendulum", "elastic_pendulum",
+            "pendulum_sliding_block", "mass_spring_damper"} <= ids
+    assert set(doc["simulators"]) <= {"mujoco", "pybullet", "exudyn", "pymunk"}
+
+
+def test_analyze_json_contract_and_param_override():
+    # Fig. 7, eq. 5 with L = 2: w0 = sqrt(3 g / (2 L))
+    doc = _json(["analyze", "compound_pendulum", "--param", "L=2", "--json"])
+    for key in ("system", "parameters", "equilibria", "linearization", "modes"):
+        assert key in doc
+    assert doc["parameters"]["L"] == 2
+    stable = [e for e in doc["equilibria"] if e["stable"]]
+    assert len(stable) == 1 and {"q", "stable", "modes"} <= set(stable[0])
+    f = doc["modes"][0]["frequency_hz"]
+    assert f == pytest.approx(np.sqrt(1.5 * 9.81 / 2) / (2 * np.pi), rel=1e-9)
+    assert np.array(doc["linearization"]["M"]).shape == (1, 1)
+    unstable = [e for e in doc["equilibria"] if not e["stable"]]
+    assert unstable and "eigenvalues" in unstable[0]
+
+
+def test_analyze_json_damped_modes():
+    doc = _json(["analyze", "mass_spring_damper", "--param", "c=4", "--json"])
+    (mode,) = doc["modes"]
+    assert mode["damping_ratio"] == pytest.approx(4 / (2 * np.sqrt(100)), rel=1e-9)
+    assert mode["damped_frequency_hz"] == pytest.approx(
+        np.sqrt(100) * np.sqrt(1 - 0.2**2) / (2 * np.pi), rel=1e-9)
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["analyze", "no_such_system"], "valid: compound_pendulum"),
+    (["analyze", "compound_pendulum", "--param", "mass=2"], "valid: m, L"),
+    (["analyze", "compound_pendulum", "--param", "L=-1"], "must be > 0"),
+    (["analyze", "compound_pendulum", "--param", "L"], "NAME=VALUE"),
+    (["compare", "compound_pendulum", "--sim", "gazebo"], "valid:"),
+])
+def test_bad_input_gets_one_line_error(args, needle):
+    res = runner.invoke(app, args)
+    assert res.exit_code == 2
+    assert needle in res.output
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def test_compare_json_contract():
+    doc = _json(["compare", "mass_spring_damper", "--sim", "mujoco", "--t-end", "2", "--json"])
+    for key in ("system", "simulator", "engine_version", "settings", "metrics", "passed"):
+        assert key in doc
+    assert doc["engine_version"]
+    for m in doc["metrics"]:
+        assert {"name", "value", "tolerance", "passed"} <= set(m)
