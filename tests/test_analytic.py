@@ -18,11 +18,25 @@ G = 9.81
 
 
 def _random_values(system_id, seed):
-    """Parameter values away from the defaults (any user value must work)."""
+    """Parameter values away from the defaults (any user value must work); draws that
+    leave the mechanism without an assembly or an equilibrium are redrawn."""
     s = get_system(system_id)
     rng = np.random.default_rng(seed)
-    return {p.name: p.default * rng.uniform(0.5, 2.0) if p.default else p.default
-            for p in s.all_parameters}
+    while True:
+        values = {p.name: p.default * rng.uniform(0.5, 2.0) if p.default else p.default
+                  for p in s.all_parameters}
+        if VALID.get(system_id, lambda v: True)(values):
+            return values
+
+
+def _yoke_third_equilibrium(v):
+    """eq. 50: sin(phi*) = (h - b - l*)/r with l* = (2 l0/pi) arccot(m g/F0)."""
+    l_star = 2 * v["l0"] / np.pi * (np.pi / 2 - np.arctan(v["m"] * v["g"] / v["F0"]))
+    return (v["h"] - v["b"] - l_star) / v["r"], l_star
+
+
+VALID = {"scotch_yoke": lambda v: abs(_yoke_third_equilibrium(v)[0]) < 0.9
+         and v["h"] - v["b"] + v["r"] < 2 * v["l0"] and v["h"] - v["b"] - v["r"] > 0}
 
 
 def _hand_frequencies(system_id, v):
@@ -46,6 +60,12 @@ def _hand_frequencies(system_id, v):
         A, B, C = a * c - b**2, -(a * k2 + c * k1), k1 * k2
         x = np.roots([A, B, C])
         return sorted(np.sqrt(x.real))
+    if system_id == "scotch_yoke":  # eq. 52 at the third equilibrium of eq. 50
+        sin_phi, l_star = _yoke_third_equilibrium(v)
+        cos2 = 1 - sin_phi**2
+        csc2 = 1 + (v["m"] * v["g"] / v["F0"]) ** 2  # csc^2 = 1 + cot^2, cot = m g / F0
+        k = v["F0"] * v["r"] ** 2 * cos2 * np.pi / (2 * v["l0"]) * csc2
+        return [np.sqrt(k / (v["I_O"] + v["m"] * v["r"] ** 2 * cos2))]
     raise KeyError(system_id)
 
 
@@ -76,6 +96,9 @@ HAND_EQUILIBRIA = {
     "elastic_pendulum": (1, 1),         # s = mg/k; phi = pi would need s < 0
     "pendulum_sliding_block": (2, 1),   # (0, rho0) stable; (pi, rho0 - 2mg/k) unstable
     "mass_spring_damper": (1, 1),
+    # phi = 0 and pi stable (same block height, pin on either side), +-pi/2 unstable:
+    # four, where the monograph (Fig. 16) counts three
+    "scotch_yoke": (4, 2),
 }
 
 
@@ -205,7 +228,10 @@ def test_double_pendulum_reactions_sum_to_total_momentum_rate():
 #    lacks the factor rho (not even dimensionally consistent).
 #  Fig. 12 row 2: along the arm gravity gives m g cos(phi), balanced by the preload m g at
 #    phi = 0: the printed equation drops m g (1 - cos phi) (harmless when linearized).
+#  eq. 51: with m(phi) = I_O + m r^2 cos^2(phi) (eq. 46), eq. 38's term m'(phi) phi'^2 / 2
+#    is -m r^2 sin(phi) cos(phi) phi'^2; the printed term carries a spurious 1/2.
 HAND_MISPRINTS = {
+    ("scotch_yoke", "Fig. 14, eq. 51"),
     ("elastic_pendulum", "Fig. 33, eq. 98, row 2"),
     ("pendulum_sliding_block", "Fig. 12, equations of motion (unnumbered, after eq. 15), row 1"),
     ("pendulum_sliding_block", "Fig. 12, equations of motion (unnumbered, after eq. 15), row 2"),

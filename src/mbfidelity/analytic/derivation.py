@@ -27,7 +27,10 @@ from ..systems.model import (
     TIME,
     WORLD,
     CoordinateForce,
+    LinearCoupling,
     Mechanism,
+    PointOnLine,
+    PointOnPoint,
     PointToPoint,
     Prismatic,
     Revolute,
@@ -57,6 +60,7 @@ class Derivation:
         self.joint_values = self._joint_values()
         self._energies()
         self._forces()
+        self._constraints()
         self.residual = (self.M * self.qdd + self.h - self.Q).applyfunc(sp.expand)
 
     # --- kinematics ----------------------------------------------------------------------
@@ -189,6 +193,53 @@ class Derivation:
         dgrad = sp.Matrix([sp.diff(self.D, v) for v in self.qd])
         diff = (self.Q_autonomous + grad + dgrad).applyfunc(sp.simplify)
         return all(e == 0 for e in diff)
+
+    # --- constraints ---------------------------------------------------------------------
+    def _constraints(self) -> None:
+        """Phi(q) = 0, its Jacobian, gamma = -(Phi_q q')_q q' (so that Phi_q q'' = gamma)
+        and the Hessian of each row (for the linearization on the constraint manifold)."""
+        rows = []
+        for c in self.mechanism.constraints:
+            rows += list(self.constraint_rows(c))
+        self.Phi = sp.Matrix(rows) if rows else sp.zeros(0, 1)
+        self.m = len(rows)
+        if self.m:
+            self.Phi_q = self.Phi.jacobian(self.q)
+            self.gamma = -(self.Phi_q * self.qd).jacobian(self.q) * self.qd
+            self.Phi_hessians = [sp.hessian(r, self.q) for r in rows]
+        else:
+            self.Phi_q = sp.zeros(0, self.n)
+            self.gamma = sp.zeros(0, 1)
+            self.Phi_hessians = []
+        names = self.mechanism.coordinates
+        self.independent = [names.index(c) for c in self.mechanism.independent_coordinates]
+        self.dependent = [i for i in range(self.n) if i not in self.independent]
+        if len(self.dependent) != self.m:
+            raise ValueError(
+                f"{self.m} constraint equations but {len(self.dependent)} dependent coordinates")
+
+    def constraint_rows(self, c) -> list[sp.Expr]:
+        if isinstance(c, PointOnPoint):
+            d = self.point(c.body_a, c.point_a) - self.point(c.body_b, c.point_b)
+            return [d[0], d[1]]
+        if isinstance(c, PointOnLine):
+            u = rotation(self.poses[c.line_body].angle) * as_column(c.direction)
+            normal = sp.Matrix([-u[1], u[0]]) / sp.sqrt(
+                sp.sympify(c.direction[0]) ** 2 + sp.sympify(c.direction[1]) ** 2)
+            d = self.point(c.body, c.point) - self.point(c.line_body, c.line_point)
+            return [sp.simplify((normal.T * d)[0])]
+        if isinstance(c, LinearCoupling):
+            names = self.mechanism.coordinates
+            return [sum(coef * self.q[names.index(n)] for n, coef in c.coefficients) - c.constant]
+        raise TypeError(f"unsupported constraint {c!r}")
+
+    def constraint_row_slices(self) -> dict[str, slice]:
+        out, k = {}, 0
+        for c in self.mechanism.constraints:
+            rows = 2 if isinstance(c, PointOnPoint) else 1
+            out[c.name] = slice(k, k + rows)
+            k += rows
+        return out
 
     # --- reactions -----------------------------------------------------------------------
     def reaction(self, joint_name: str) -> sp.Matrix:

@@ -19,7 +19,7 @@ from scipy.integrate import solve_ivp
 from ..systems import PrintedFormula, System, coordinate_symbols
 from ..systems.model import TIME, Prismatic
 from .derivation import derivation_of
-from .linear import operating_equilibrium
+from .linear import linearize, operating_equilibrium
 from .numeric import numeric_model
 
 AGREEMENT = 1e-9  # relative; round-off of the numeric comparison is ~1e-14
@@ -48,18 +48,38 @@ def _parameter_sets(system: System, rng) -> list[dict[str, float]]:
 
 
 def _random_states(system: System, values, rng, count: int = 25):
+    """Random consistent states: independent coordinates drawn around the operating point,
+    dependent ones from the constraints."""
     op = system.operating_values(values)
+    model = numeric_model(system.id, values)
+    independent = set(system.mechanism.independent_coordinates)
     out = []
-    for _ in range(count):
+    while len(out) < count:
         q = op.copy()
         for i, j in enumerate(system.mechanism.joints):
+            if j.coordinate not in independent:
+                continue
             if isinstance(j, Prismatic):
                 q[i] = op[i] * rng.uniform(0.6, 1.4) + (0 if op[i] else rng.uniform(-0.1, 0.1))
             else:
                 q[i] = op[i] + rng.uniform(-1.2, 1.2)
-        qd = rng.uniform(-1.5, 1.5, size=len(q))
+        try:
+            q = model.complete(q)
+        except (RuntimeError, np.linalg.LinAlgError):
+            continue
+        qd = model.velocity_basis(q) @ rng.uniform(-1.5, 1.5, size=len(model.independent))
         out.append((q, qd, rng.uniform(0, 10)))
     return out
+
+
+def _equilibrium_at(system: System, values, pf: PrintedFormula):
+    if pf.at is None:
+        return operating_equilibrium(system, values)
+    model = numeric_model(system.id, values)
+    guess = system.operating_values(values)
+    for name, value in pf.at.items():
+        guess[system.coordinates.index(name)] = system.evaluate(value, values)
+    return linearize(model, model.complete(guess))
 
 
 def _term_scale(expr: sp.Expr, env: dict) -> float:
@@ -76,16 +96,63 @@ def _env(system: System, values, q, qd, qdd, t) -> dict:
     return env
 
 
+def _with_relations(system: System, values: dict, pf: PrintedFormula) -> dict:
+    if not pf.relations:
+        return values
+    out = dict(values)
+    for name, expr in pf.relations.items():
+        out[name] = system.evaluate(expr, values)
+    return out
+
+
+def reduced_equations(system: System) -> list[sp.Expr] | None:
+    """Equations of motion in the independent coordinates, symbolically, when the
+    constraints can be solved for the dependent coordinates in closed form (else None):
+    T, V and the generalized forces are restricted to the manifold and Lagrange's
+    equations applied to them."""
+    d = derivation_of(system.id)
+    if not d.m:
+        return list(d.residual)
+    dep = [d.q[i] for i in d.dependent]
+    ind = [i for i in d.independent]
+    try:
+        sols = sp.solve(list(d.Phi), dep, dict=True)
+    except NotImplementedError:
+        return None
+    if len(sols) != 1:
+        return None
+    q_of = sols[0]
+    qi = [d.q[i] for i in ind]
+    qdi = [d.qd[i] for i in ind]
+    qddi = [d.qdd[i] for i in ind]
+    qd_of = {d.qd[i]: sum(sp.diff(q_of[d.q[i]], a) * b for a, b in zip(qi, qdi))
+             for i in d.dependent}
+    sub = {**q_of, **qd_of}
+    T = sp.simplify(d.T.xreplace(sub))
+    S = sp.Matrix([[sp.diff(q_of.get(d.q[k], d.q[k]), a) for a in qi] for k in range(d.n)])
+    Q = sp.simplify((S.T * d.Q).xreplace(sub))
+    eqs = []
+    for a, (x, v, acc) in enumerate(zip(qi, qdi, qddi)):
+        dT = sp.diff(T, v)
+        ddt = sum(sp.diff(dT, y) * w for y, w in zip(qi, qdi)) + sum(
+            sp.diff(dT, w) * z for w, z in zip(qdi, qddi))
+        eqs.append(sp.simplify(ddt - sp.diff(T, x) - Q[a]))
+    return eqs
+
+
 def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
     """(max relative difference, derived form as text)."""
     d = derivation_of(system.id)
     worst = 0.0
     derived_text = ""
     for values in _parameter_sets(system, rng):
+        values = _with_relations(system, values, pf)
         model = numeric_model(system.id, values)
-        eq = operating_equilibrium(system, values)
+        eq = _equilibrium_at(system, values, pf)
         if pf.kind == "eom":
-            derived_text = "; ".join(f"{sp.simplify(r)} = 0" for r in d.residual)
+            reduced = _reduced_cached(system.id)
+            derived_text = ("; ".join(f"{r} = 0" for r in reduced) if reduced is not None
+                            else "reduced numerically (constraints have no closed-form solution)")
             for q, qd, t in _random_states(system, values, rng):
                 qdd = model.acceleration(q, qd, t)
                 env = _env(system, values, q, qd, qdd, t)
@@ -102,8 +169,10 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
             qs = [coordinate_symbols(n)[0] for n in system.coordinates]
             for q, qd, t in _random_states(system, values, rng):
                 env = _env(system, values, q, qd, np.zeros_like(q), t)
-                gp = np.array([float(sp.diff(pf.expr, s).xreplace(env)) for s in qs])
-                gd = np.array([float(sp.diff(d.V, s).xreplace(env)) for s in qs])
+                # gradients along the constraint manifold: S^T grad V
+                S = model.velocity_basis(q)
+                gp = S.T @ np.array([float(sp.diff(pf.expr, s).xreplace(env)) for s in qs])
+                gd = S.T @ np.array([float(sp.diff(d.V, s).xreplace(env)) for s in qs])
                 worst = max(worst, np.max(np.abs(gp - gd)) / max(np.max(np.abs(gd)), 1e-12))
         elif pf.kind in ("M", "K", "C"):
             derived = {"M": eq.M, "K": eq.K, "C": eq.C}[pf.kind]
@@ -112,7 +181,10 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
             scale = max(np.max(np.abs(derived)), 1e-300)
             worst = max(worst, float(np.max(np.abs(printed - derived)) / scale))
         elif pf.kind == "equilibrium":
-            q = np.array([system.evaluate(pf.expr.get(c, 0), values) for c in system.coordinates])
+            q = system.operating_values(values)
+            for name, value in pf.expr.items():
+                q[system.coordinates.index(name)] = system.evaluate(value, values)
+            q = model.complete(q)
             scale = max(1.0, float(np.max(np.abs(eq.K))))
             worst = max(worst, float(np.max(np.abs(model.static_residual(q)))) / scale)
             derived_text = f"q_eq = {np.array2string(eq.q, precision=9)}"
@@ -129,6 +201,27 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
         else:
             raise ValueError(f"unknown printed-formula kind {pf.kind!r}")
     return worst, derived_text
+
+
+@lru_cache(maxsize=None)
+def _reduced_cached(system_id: str):
+    from ..systems import get_system
+
+    system = get_system(system_id)
+    eqs = reduced_equations(system)
+    if eqs is None:
+        return None
+    # lengths are sqrt(x^2) = |x|; x keeps one sign over the mechanism's range, so take it
+    # from the operating point (display only: the comparison is numeric)
+    values = system.parameter_values()
+    env = {**system.subs(values), **{coordinate_symbols(c)[0]: v for c, v in
+                                     zip(system.coordinates, system.operating_values(values))}}
+
+    def unsign(expr):
+        return expr.replace(lambda e: isinstance(e, sp.Abs),
+                            lambda e: e.args[0] * (1 if float(e.args[0].xreplace(env)) >= 0 else -1))
+    return [sp.simplify(unsign(sp.piecewise_fold(e)).rewrite(sp.Piecewise).args[-1][0]
+                        if isinstance(e, sp.Piecewise) else unsign(e)) for e in eqs]
 
 
 def _printed_text(pf: PrintedFormula) -> str:

@@ -94,11 +94,15 @@ def linearize(model: NumericModel, q_eq: np.ndarray) -> Equilibrium:
 
 
 def _search_grid(system: System, values, op: np.ndarray) -> list[np.ndarray]:
-    """Starting points: 8 angles per period for angular coordinates; for linear ones the
-    operating value and points around it inside the coordinate's limits."""
+    """Starting points over the independent coordinates: 8 angles per period for angular
+    ones; for linear ones the operating value and points around it inside the limits."""
     mech = system.mechanism
+    independent = set(mech.independent_coordinates)
     axes = []
     for i, j in enumerate(mech.joints):
+        if j.coordinate not in independent:
+            axes.append([op[i]])
+            continue
         if isinstance(j, Prismatic):
             scale = max(abs(op[i]), 0.1)
             pts = op[i] + scale * np.array([0.0, -0.5, 0.5, -0.9, 2.0])
@@ -134,6 +138,39 @@ def wrap_angles(system: System, q: np.ndarray, op: np.ndarray) -> np.ndarray:
     return q
 
 
+def _solve_static(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
+    """Newton-type search over the independent coordinates from a full start (the
+    dependent coordinates follow the constraints, warm-started from the start)."""
+    ind = model.independent
+    try:
+        base = model.complete(start)
+    except (RuntimeError, np.linalg.LinAlgError):
+        return None
+    state = {"q": base}
+
+    def full(qi):
+        guess = state["q"].copy()
+        guess[ind] = qi
+        state["q"] = model.complete(guess)
+        return state["q"]
+
+    def f(qi):
+        return model.static_residual(full(qi))
+
+    def jac(qi):
+        return model.linearization(full(qi))[2]
+
+    try:
+        sol = scipy.optimize.root(f, base[ind], jac=jac, method="hybr", tol=1e-14)
+        q = full(sol.x)
+    except (RuntimeError, np.linalg.LinAlgError):
+        return None
+    scale = max(1.0, float(np.max(np.abs(model.linearization(q)[2]))))
+    if not np.all(np.isfinite(q)) or np.max(np.abs(model.static_residual(q))) > 1e-9 * scale:
+        return None
+    return q
+
+
 def find_equilibria(system: System, values) -> list[Equilibrium]:
     """Every equilibrium within one period of each angular coordinate (centred on the
     operating point), each classified by its linearization. The operating point comes
@@ -142,16 +179,10 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     op = system.operating_values(values)
     found: list[np.ndarray] = []
     for start in [op] + _search_grid(system, values, op):
-        sol = scipy.optimize.root(
-            model.static_residual, start,
-            jac=lambda q: model.linearization(q)[2], method="hybr", tol=1e-14)
-        if not sol.success:
+        q = _solve_static(model, start)
+        if q is None:
             continue
-        r = model.static_residual(sol.x)
-        scale = max(1.0, float(np.max(np.abs(model.linearization(sol.x)[2]))))
-        if np.max(np.abs(r)) > 1e-9 * scale:
-            continue
-        q = wrap_angles(system, sol.x, op)
+        q = wrap_angles(system, q, op)
         if not _admissible(system, values, q):
             continue
         if any(np.allclose(q, f, atol=1e-7, rtol=0) for f in found):
@@ -164,10 +195,7 @@ def operating_equilibrium(system: System, values) -> Equilibrium:
     """The equilibrium the monograph studies (the system's operating point, refined)."""
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
-    sol = scipy.optimize.root(model.static_residual, op,
-                              jac=lambda q: model.linearization(q)[2], method="hybr", tol=1e-14)
-    q = sol.x if sol.success else op
-    r = model.static_residual(q)
-    if np.max(np.abs(r)) > 1e-8 * max(1.0, float(np.max(np.abs(model.linearization(q)[2])))):
+    q = _solve_static(model, op)
+    if q is None:
         raise ValueError(f"{system.id}: no equilibrium near the operating point {op}")
     return linearize(model, q)

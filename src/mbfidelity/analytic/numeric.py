@@ -1,4 +1,17 @@
-"""Numeric evaluation of a derived model for given parameter values."""
+"""Numeric evaluation of a derived model for given parameter values.
+
+Coordinates q are the joints' coordinates (redundant when the mechanism has closure
+constraints). Motion is integrated in the independent coordinates q_i; the dependent ones
+follow from Phi(q) = 0 by Newton's method, velocities from q' = S(q) q_i'. Accelerations
+and multipliers come from the augmented system (monograph §10)
+
+    [ M      Phi_q^T ] [ q'' ]   [ Q - h ]
+    [ Phi_q  0       ] [ lam ] = [ gamma ].
+
+The linearization at an equilibrium is taken on the constraint manifold:
+M_r = S^T M S, C_r = S^T C S, K_r = S^T (K + sum_k lam_k Hess(Phi_k)) S, with lam the
+static multipliers. Without constraints S = I and these reduce to eq. 104-109.
+"""
 from __future__ import annotations
 
 from functools import lru_cache
@@ -11,71 +24,134 @@ from ..systems import get_system
 from ..systems.model import TIME
 from .derivation import Derivation, derivation_of
 
+NEWTON_TOL = 1e-14
+NEWTON_MAX = 50
+
 
 def _lambdify(args, expr, modules="numpy") -> Callable:
     return sp.lambdify(args, expr, modules=modules, cse=True)
 
 
-class NumericModel:
-    """A derivation with parameter values substituted and compiled.
+def _matrix(fn, *args) -> np.ndarray:
+    return np.atleast_2d(np.array(fn(*args), dtype=float))
 
-    Vectors are numpy arrays in the system's coordinate order."""
+
+class NumericModel:
+    """A derivation with parameter values substituted and compiled."""
 
     def __init__(self, derivation: Derivation, subs: Mapping[sp.Symbol, float]):
         d = self.derivation = derivation
-        self.n = d.n
+        self.n, self.m = d.n, d.m
+        self.independent, self.dependent = list(d.independent), list(d.dependent)
+        self.constrained = self.m > 0
         self.subs = dict(subs)
         q, qd, qdd = list(d.q), list(d.qd), list(d.qdd)
         self._args = q + qd + [TIME]
-        sub = lambda e: e.xreplace(self.subs)  # noqa: E731
         M = d.M.xreplace(self.subs)
         rhs = (d.Q - d.h).xreplace(self.subs)
         self._M = _lambdify(q, M)
-        self._rhs = _lambdify(self._args, rhs)
-        if self.n <= 3:
+        self._rhs = _lambdify(self._args, list(rhs))
+        self._acc_explicit = None
+        if self.n <= 3 and not self.constrained:
             # explicit q'' keeps the reference solver's right-hand side cheap
-            acc = M.LUsolve(rhs)
-            self._acc_explicit = _lambdify(self._args, list(acc), modules="math")
-        else:
-            self._acc_explicit = None
-        self._residual = _lambdify(q + qd + qdd + [TIME], d.residual.xreplace(self.subs))
-        self._residual_autonomous = _lambdify(
-            q, (d.M * d.qdd + d.h - d.Q_autonomous).xreplace(
-                {**self.subs, **{v: 0 for v in qd + qdd}}))
-        self._energy = _lambdify(q + qd, sub(d.T + d.V)) if d.energy_route else None
+            self._acc_explicit = _lambdify(self._args, list(M.LUsolve(rhs)), modules="math")
+        self._residual = _lambdify(q + qd + qdd + [TIME], list(d.residual.xreplace(self.subs)))
+        zero_vel = {v: 0 for v in qd + qdd}
+        self._Q_static = _lambdify(q, list(d.Q_autonomous.xreplace({**self.subs, **zero_vel})))
+        self._energy = _lambdify(q + qd, (d.T + d.V).xreplace(self.subs)) if d.energy_route else None
+        self._V = _lambdify(q, d.V.xreplace(self.subs)) if d.energy_route else None
         # route 1 linearization: Jacobians of the autonomous residual (eq. 104-109)
         r_aut = (d.M * d.qdd + d.h - d.Q_autonomous).xreplace(self.subs)
-        zero_vel = {v: 0 for v in qd + qdd}
-        self._lin_M = _lambdify(q, r_aut.jacobian(d.qdd).xreplace(zero_vel))
         self._lin_C = _lambdify(q, r_aut.jacobian(d.qd).xreplace(zero_vel))
         self._lin_K = _lambdify(q, r_aut.jacobian(d.q).xreplace(zero_vel))
-        # route 2: Hessians of T, V and D
         if d.energy_route:
             self._hess_T = _lambdify(q, sp.hessian(d.T, qd).xreplace(self.subs))
             self._hess_V = _lambdify(q, sp.hessian(d.V, q).xreplace(self.subs))
-            self._hess_D = _lambdify(q, sp.hessian(d.D, qd).xreplace({**self.subs, **{v: 0 for v in qd}}))
+            self._hess_D = _lambdify(q, sp.hessian(d.D, qd).xreplace(
+                {**self.subs, **{v: 0 for v in qd}}))
+        if self.constrained:
+            self._Phi = _lambdify(q, list(d.Phi.xreplace(self.subs)))
+            self._Phi_q = _lambdify(q, d.Phi_q.xreplace(self.subs))
+            self._gamma = _lambdify(q + qd, list(d.gamma.xreplace(self.subs)))
+            self._Phi_hess = [_lambdify(q, H.xreplace(self.subs)) for H in d.Phi_hessians]
         self._reactions: dict[str, Callable] = {}
+        self._warm: np.ndarray | None = None
+
+    # --- constraint manifold -------------------------------------------------------------
+    def constraint_values(self, q) -> np.ndarray:
+        return np.array(self._Phi(*q), dtype=float) if self.constrained else np.zeros(0)
+
+    def constraint_jacobian(self, q) -> np.ndarray:
+        return _matrix(self._Phi_q, *q) if self.constrained else np.zeros((0, self.n))
+
+    def complete(self, q_guess) -> np.ndarray:
+        """Solve Phi(q) = 0 for the dependent coordinates, independent ones held."""
+        q = np.array(q_guess, dtype=float)
+        if not self.constrained:
+            return q
+        dep = self.dependent
+        for _ in range(NEWTON_MAX):
+            phi = self.constraint_values(q)
+            J = self.constraint_jacobian(q)[:, dep]
+            step = np.linalg.solve(J, phi)
+            q[dep] -= step
+            if np.max(np.abs(step)) <= NEWTON_TOL * max(1.0, np.max(np.abs(q[dep]))):
+                break
+        else:
+            raise RuntimeError("the constraint equations did not converge (assembly lost)")
+        if np.max(np.abs(self.constraint_values(q))) > 1e-10:
+            raise RuntimeError("the constraint equations have no solution here")
+        return q
+
+    def velocity_basis(self, q) -> np.ndarray:
+        """S with q' = S q_i' (n x n_independent)."""
+        n, ind, dep = self.n, self.independent, self.dependent
+        S = np.zeros((n, len(ind)))
+        S[ind, np.arange(len(ind))] = 1.0
+        if self.constrained:
+            J = self.constraint_jacobian(q)
+            S[dep, :] = -np.linalg.solve(J[:, dep], J[:, ind])
+        return S
+
+    def state_from_independent(self, qi, qdi, guess=None) -> tuple[np.ndarray, np.ndarray]:
+        if guess is None:
+            guess = self._warm if self._warm is not None else np.zeros(self.n)
+        q = np.array(guess, dtype=float)
+        q[self.independent] = qi
+        q = self.complete(q)
+        self._warm = q
+        return q, self.velocity_basis(q) @ np.asarray(qdi, dtype=float)
 
     # --- dynamics ------------------------------------------------------------------------
     def mass_matrix(self, q) -> np.ndarray:
-        return np.atleast_2d(np.array(self._M(*q), dtype=float))
+        return _matrix(self._M, *q)
+
+    def dynamics(self, q, qd, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q'', lam) at a consistent state."""
+        rhs = np.array(self._rhs(*q, *qd, t), dtype=float).reshape(-1)
+        if not self.constrained:
+            return np.linalg.solve(self.mass_matrix(q), rhs), np.zeros(0)
+        J = self.constraint_jacobian(q)
+        A = np.block([[self.mass_matrix(q), J.T], [J, np.zeros((self.m, self.m))]])
+        b = np.concatenate([rhs, np.array(self._gamma(*q, *qd), dtype=float).reshape(-1)])
+        sol = np.linalg.solve(A, b)
+        return sol[: self.n], sol[self.n:]
 
     def acceleration(self, q, qd, t: float) -> np.ndarray:
         if self._acc_explicit is not None:
             return np.array(self._acc_explicit(*q, *qd, t), dtype=float).reshape(-1)
-        rhs = np.array(self._rhs(*q, *qd, t), dtype=float).reshape(-1)
-        return np.linalg.solve(self.mass_matrix(q), rhs)
+        return self.dynamics(q, qd, t)[0]
 
     def ode_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        n = self.n
-        return np.concatenate([y[n:], self.acceleration(y[:n], y[n:], t)])
+        """Right-hand side in the independent coordinates, y = (q_i, q_i')."""
+        k = len(self.independent)
+        if not self.constrained:
+            return np.concatenate([y[k:], self.acceleration(y[:k], y[k:], t)])
+        q, qd = self.state_from_independent(y[:k], y[k:])
+        return np.concatenate([y[k:], self.dynamics(q, qd, t)[0][self.independent]])
 
     def residual(self, q, qd, qdd, t: float) -> np.ndarray:
         return np.array(self._residual(*q, *qd, *qdd, t), dtype=float).reshape(-1)
-
-    def static_residual(self, q) -> np.ndarray:
-        """Residual at rest without the time-dependent loads: zero at an equilibrium."""
-        return np.array(self._residual_autonomous(*q), dtype=float).reshape(-1)
 
     def energy(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """T + V along sampled states (arrays of shape (N, n))."""
@@ -83,23 +159,70 @@ class NumericModel:
             raise ValueError("this model has no potential for every force element")
         return np.asarray(self._energy(*q.T, *qd.T), dtype=float) * np.ones(len(q))
 
-    # --- linearization -------------------------------------------------------------------
-    def linearization(self, q_eq) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(M, C, K) from the Jacobians of the equations of motion (route 1)."""
-        f = lambda fn: np.atleast_2d(np.array(fn(*q_eq), dtype=float))  # noqa: E731
-        return f(self._lin_M), f(self._lin_C), f(self._lin_K)
+    # --- statics and linearization -------------------------------------------------------
+    def static_multipliers(self, q) -> np.ndarray:
+        if not self.constrained:
+            return np.zeros(0)
+        Q = np.array(self._Q_static(*q), dtype=float).reshape(-1)
+        lam, *_ = np.linalg.lstsq(self.constraint_jacobian(q).T, Q, rcond=None)
+        return lam
 
-    def energy_linearization(self, q_eq):
-        """(M, C, K) as Hessians of T, D, V (route 2), or None where it does not apply."""
+    def reduced_static_force(self, q) -> np.ndarray:
+        """S^T Q at rest without time loads (zero at an equilibrium), q consistent."""
+        Q = np.array(self._Q_static(*q), dtype=float).reshape(-1)
+        return self.velocity_basis(q).T @ Q
+
+    def static_residual(self, q) -> np.ndarray:
+        """Residual at rest without the time-dependent loads, in the independent
+        coordinates: zero at an equilibrium."""
+        return -self.reduced_static_force(q)
+
+    def linearization(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(M, C, K) in the independent coordinates at the consistent configuration q."""
+        S = self.velocity_basis(q)
+        M = self.mass_matrix(q)
+        C = _matrix(self._lin_C, *q)
+        K = _matrix(self._lin_K, *q)
+        if self.constrained:
+            lam = self.static_multipliers(q)
+            K = K + sum(l * _matrix(H, *q) for l, H in zip(lam, self._Phi_hess))
+        return S.T @ M @ S, S.T @ C @ S, S.T @ K @ S
+
+    def energy_linearization(self, q):
+        """(M, C, K) as Hessians of T, D, V (route 2), or None where it does not apply.
+        With constraints, K is the Hessian of the reduced potential V(q_i) by central
+        differences (an independent route, precise to ~1e-8 relative)."""
         if not self.derivation.energy_route:
             return None
-        f = lambda fn: np.atleast_2d(np.array(fn(*q_eq), dtype=float))  # noqa: E731
-        return f(self._hess_T), f(self._hess_D), f(self._hess_V)
+        S = self.velocity_basis(q)
+        M = S.T @ _matrix(self._hess_T, *q) @ S
+        C = S.T @ _matrix(self._hess_D, *q) @ S
+        if not self.constrained:
+            return M, C, _matrix(self._hess_V, *q)
+        k = len(self.independent)
+        h = 1e-4
+
+        def V(qi):
+            guess = np.array(q, dtype=float)
+            guess[self.independent] = qi
+            return float(self._V(*self.complete(guess)))
+
+        qi0 = np.asarray(q, dtype=float)[self.independent]
+        K = np.zeros((k, k))
+        for a in range(k):
+            for b in range(k):
+                ea, eb = np.eye(k)[a] * h, np.eye(k)[b] * h
+                K[a, b] = (V(qi0 + ea + eb) - V(qi0 + ea - eb) - V(qi0 - ea + eb)
+                           + V(qi0 - ea - eb)) / (4 * h * h)
+        return M, C, K
 
     # --- reactions -----------------------------------------------------------------------
     def reaction(self, joint: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
                  t: np.ndarray) -> np.ndarray:
         """(N, 2) reaction force on the child at `joint`, world axes."""
+        if self.constrained:
+            raise ValueError("tree-joint reactions of a constrained mechanism: use the "
+                             "constraint forces (multipliers)")
         if joint not in self._reactions:
             d = self.derivation
             expr = d.reaction(joint).xreplace(self.subs)
@@ -111,6 +234,10 @@ class NumericModel:
 
     def accelerations(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
         return np.array([self.acceleration(a, b, c) for a, b, c in zip(q, qd, t)])
+
+    def multipliers(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """(N, m) multipliers along a sampled motion."""
+        return np.array([self.dynamics(a, b, c)[1] for a, b, c in zip(q, qd, t)])
 
 
 @lru_cache(maxsize=64)

@@ -28,6 +28,8 @@ class Reference:
     #: max |error| estimate of q over the run (per coordinate)
     error_estimate: np.ndarray
     method: str
+    #: Lagrange multipliers (N, m) of the closure constraints (empty without)
+    multipliers: np.ndarray | None = None
 
 
 def _dop853(model, y0: np.ndarray, t: np.ndarray, tol: float) -> np.ndarray:
@@ -38,6 +40,30 @@ def _dop853(model, y0: np.ndarray, t: np.ndarray, tol: float) -> np.ndarray:
     return sol.y.T
 
 
+def consistent_initial_state(system: System, scenario: Scenario, values):
+    """The scenario's initial state on the constraint manifold: the independent
+    coordinates and velocities as given, the dependent ones solved (the scenario's values
+    for them are only Newton's starting guess)."""
+    q0, qd0 = system.initial_state(scenario, values)
+    model = numeric_model(system.id, values)
+    if not model.constrained:
+        return q0, qd0
+    q = model.complete(q0)
+    return q, model.velocity_basis(q) @ qd0[model.independent]
+
+
+def _full_states(model, y: np.ndarray, q0: np.ndarray):
+    k = len(model.independent)
+    if not model.constrained:
+        return y[:, :k], y[:, k:]
+    q, qd = np.empty((len(y), model.n)), np.empty((len(y), model.n))
+    guess = q0
+    for i, row in enumerate(y):
+        q[i], qd[i] = model.state_from_independent(row[:k], row[k:], guess)
+        guess = q[i]
+    return q, qd
+
+
 def reference(system: System, scenario: Scenario, values: Mapping[str, float],
               dt: float, t_end: float | None = None,
               q0: np.ndarray | None = None, qd0: np.ndarray | None = None) -> Reference:
@@ -46,23 +72,31 @@ def reference(system: System, scenario: Scenario, values: Mapping[str, float],
     steps = int(round(t_end / dt))
     t = np.arange(steps + 1) * dt
     if q0 is None:
-        q0, qd0 = system.initial_state(scenario, values)
-    n = len(q0)
+        q0, qd0 = consistent_initial_state(system, scenario, values)
     model = numeric_model(system.id, values)
-    y0 = np.concatenate([q0, qd0])
+    ind = model.independent
+    y0 = np.concatenate([q0[ind], qd0[ind]])
+    model._warm = np.array(q0, dtype=float)
     tight = _dop853(model, y0, t, TIGHT)
+    q, qd = _full_states(model, tight, q0)
     exact = SOLUTIONS.get(system.exact_solution or "")
     if exact is not None:
-        q, qd = exact(values, q0, qd0, t)
+        q_exact, qd_exact = exact(values, q0, qd0, t)
         # the closed form is exact to round-off; its distance to DOP853 bounds both
-        error = np.max(np.abs(q - tight[:, :n]), axis=0)
+        error = np.max(np.abs(q_exact - q), axis=0)
+        q, qd = q_exact, qd_exact
         method = f"closed form ({system.exact_solution}); DOP853 rtol=atol={TIGHT:g} agrees"
     else:
-        q, qd = tight[:, :n], tight[:, n:]
-        loose = _dop853(model, y0, t, LOOSE)
-        error = np.max(np.abs(loose[:, :n] - q), axis=0)
+        model._warm = np.array(q0, dtype=float)
+        loose_q, _ = _full_states(model, _dop853(model, y0, t, LOOSE), q0)
+        error = np.max(np.abs(loose_q - q), axis=0)
         method = f"DOP853 rtol=atol={TIGHT:g}; error estimated against rtol=atol={LOOSE:g}"
     qdd = model.accelerations(q, qd, t)
-    reactions = {j: model.reaction(j, q, qd, qdd, t) for j in system.reaction_joints}
+    if model.constrained:
+        lam = model.multipliers(q, qd, t)
+        reactions = {}
+    else:
+        lam = np.zeros((len(t), 0))
+        reactions = {j: model.reaction(j, q, qd, qdd, t) for j in system.reaction_joints}
     energy = model.energy(q, qd) if model.derivation.conservative else None
-    return Reference(t, q, qd, qdd, reactions, energy, error, method)
+    return Reference(t, q, qd, qdd, reactions, energy, error, method, lam)

@@ -227,7 +227,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
             if lin is not None:
                 a, k, c = lin
                 if k > 0 and -a / k >= 0 and c >= 0:
-                    spec = (k, -a / k, c)
+                    spec = (k, -a / k + 0.0, c)
                 elif k == 0 and a == 0 and c >= 0:
                     spec = (0.0, 0.0, c)
             plan.p2p.append(_P2P(f, f.name, spec,
@@ -615,12 +615,13 @@ class MujocoBackend(Backend):
             joint = mech.joint(name)
             inside = set(mech.subtree(joint.child))
             r = cf[:, bodies.index(plan.carrier[joint.child])].copy()
-            # element forces from outside the subtree are booked by MuJoCo as joint-space
-            # forces, so they sit inside cfrc_int: take them out
+            # callback forces are joint-space forces, so cfrc_int counts them as
+            # transmitted by the joint: take those from outside the subtree out. Native
+            # tendon forces are already external (MuJoCo 4.0 puts them in cfrc_ext).
             for i, e in enumerate(plan.p2p):
                 f = e.element
                 in_a, in_b = f.body_a in inside, f.body_b in inside
-                if in_a == in_b:
+                if in_a == in_b or e.native is not None:
                     continue
                 tension = _vector_law(f.tension, (LENGTH, LENGTH_RATE, TIME))(
                     ten[:, i, 0], ten[:, i, 1], t)

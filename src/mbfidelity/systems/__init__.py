@@ -48,12 +48,18 @@ class PrintedFormula:
       "equilibrium"       mapping coordinate -> printed equilibrium value
       "frequency"         natural angular frequency (rad/s) at the operating point
       "damping_ratio"     damping ratio at the operating point
+    Matrices, frequencies and damping ratios refer to the equilibrium `at` (independent
+    coordinate -> value) when given, otherwise to the operating point.
     """
 
     label: str
     kind: str
     expr: object
     note: str = ""
+    at: Mapping[str, Expr] | None = None
+    #: parameter relations under which the formula is printed (name -> expression of
+    #: other parameters); imposed on every parameter set it is compared at
+    relations: Mapping[str, Expr] | None = None
 
 
 @dataclass(frozen=True)

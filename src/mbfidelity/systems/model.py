@@ -185,6 +185,53 @@ class CoordinateForce:
 ForceElement = Union[PointToPoint, CoordinateForce]
 
 
+# --- closure constraints (loops, slots, couplings) -------------------------------------
+# Joints form a spanning tree; constraints close it. The analytic layer treats them with
+# Lagrange multipliers (monograph §10) and by reduction to the independent coordinates the
+# mechanism names. Sign convention: with Phi(q) = 0 and multipliers lam, the equations are
+# M q'' + h - Q + Phi_q^T lam = 0, so the constraint's generalized force is -Phi_q^T lam.
+
+
+@dataclass(frozen=True)
+class PointOnPoint:
+    """Loop closure: point_a of body_a coincides with point_b of body_b (2 equations,
+    Phi = p_a - p_b). Its force: -lam on body_a at the point, +lam on body_b."""
+
+    name: str
+    body_a: str
+    point_a: Vec
+    body_b: str
+    point_b: Vec
+
+
+@dataclass(frozen=True)
+class PointOnLine:
+    """Pin in slot: `point` of `body` stays on the line of `line_body` through
+    `line_point` along `direction` (body frames). One equation, Phi = n . (P - L) with n
+    the slot's unit normal (direction turned +90 degrees); the pin feels the force
+    -lam n, the slot body +lam n (frictionless slot)."""
+
+    name: str
+    body: str
+    point: Vec
+    line_body: str
+    line_point: Vec
+    direction: Vec
+
+
+@dataclass(frozen=True)
+class LinearCoupling:
+    """Sum of coefficient * coordinate = constant: belts, gears, rolling written on
+    relative angles. Its multiplier is a generalized force (N m for angles)."""
+
+    name: str
+    coefficients: tuple[tuple[str, Expr], ...]
+    constant: Expr = 0
+
+
+Constraint = Union[PointOnPoint, PointOnLine, LinearCoupling]
+
+
 def linear_spring_damper(k: Expr, l0: Expr, c: Expr = 0) -> dict:
     """Tension, potential and dissipation of a linear spring (free length l0) with a
     parallel viscous damper, for `PointToPoint(**...)`."""
@@ -213,6 +260,9 @@ class Mechanism:
     joints: tuple[Joint, ...]
     forces: tuple[ForceElement, ...] = ()
     gravity: Expr = GRAVITY
+    constraints: tuple[Constraint, ...] = ()
+    #: independent coordinates when constraints remove degrees of freedom (None: all)
+    independent: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         names = [b.name for b in self.bodies]
@@ -233,10 +283,32 @@ class Mechanism:
         for f in self.forces:
             if isinstance(f, CoordinateForce) and f.coordinate not in coords:
                 raise ValueError(f"force {f.name}: unknown coordinate {f.coordinate}")
+        for c in self.constraints:
+            used = ([name for name, _ in c.coefficients] if isinstance(c, LinearCoupling)
+                    else [])
+            bodies = {PointOnPoint: lambda c: (c.body_a, c.body_b),
+                      PointOnLine: lambda c: (c.body, c.line_body),
+                      LinearCoupling: lambda c: ()}[type(c)](c)
+            for b in bodies:
+                if b != WORLD and b not in names:
+                    raise ValueError(f"constraint {c.name}: unknown body {b!r}")
+            for name in used:
+                if name not in coords:
+                    raise ValueError(f"constraint {c.name}: unknown coordinate {name!r}")
+        if self.independent is not None:
+            unknown = set(self.independent) - set(coords)
+            if unknown:
+                raise ValueError(f"independent coordinates not in the mechanism: {unknown}")
+        elif self.constraints:
+            raise ValueError("a constrained mechanism must name its independent coordinates")
 
     @property
     def coordinates(self) -> tuple[str, ...]:
         return tuple(j.coordinate for j in self.joints)
+
+    @property
+    def independent_coordinates(self) -> tuple[str, ...]:
+        return self.independent if self.independent is not None else self.coordinates
 
     def body(self, name: str) -> Body:
         for b in self.bodies:
@@ -291,11 +363,19 @@ class Mechanism:
                     changes[name] = ev(v)
             return replace(obj, **changes)
 
+        def ev_constraint(c):
+            if isinstance(c, LinearCoupling):
+                return replace(c, coefficients=tuple((n, ev(v)) for n, v in c.coefficients),
+                               constant=ev(c.constant))
+            return ev_obj(c)
+
         return Mechanism(
             bodies=tuple(ev_obj(b) for b in self.bodies),
             joints=tuple(ev_obj(j) for j in self.joints),
             forces=tuple(ev_obj(f) for f in self.forces),
             gravity=ev(self.gravity),
+            constraints=tuple(ev_constraint(c) for c in self.constraints),
+            independent=self.independent,
         )
 
 
