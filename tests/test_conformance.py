@@ -15,6 +15,7 @@ CHECKS = {
     "trajectory": ("trajectory_max", "trajectory_rms", "period", "energy_drift"),
     "reaction": ("reaction_",),
     "frequency": ("frequency.", "damping."),
+    "constraint": ("constraint_",),
 }
 
 
@@ -22,6 +23,9 @@ def _applicable(system):
     checks = ["trajectory", "frequency"]
     if any("reaction" in sc.checks for sc in system.scenarios) and system.reaction_joints:
         checks.append("reaction")
+    if system.mechanism.constraints and any("constraint_force" in sc.checks
+                                            for sc in system.scenarios):
+        checks.append("constraint")
     return checks
 
 

@@ -218,6 +218,45 @@ class Derivation:
             raise ValueError(
                 f"{self.m} constraint equations but {len(self.dependent)} dependent coordinates")
 
+    @property
+    def explicit_dependent(self) -> dict | None:
+        """Dependent coordinates as closed-form functions of the independent ones, when
+        sympy solves the constraints uniquely (None otherwise). Cached."""
+        if not hasattr(self, "_explicit_dependent"):
+            self._explicit_dependent = None
+            if self.m:
+                dep = [self.q[i] for i in self.dependent]
+                try:
+                    sols = sp.solve(list(self.Phi), dep, dict=True)
+                except NotImplementedError:
+                    sols = []
+                if len(sols) == 1 and set(sols[0]) == set(dep):
+                    self._explicit_dependent = {k: sp.simplify(v) for k, v in sols[0].items()}
+        return self._explicit_dependent
+
+    def reduced_dynamics(self):
+        """(q(q_i), S, M_r, rhs_r) symbolically when `explicit_dependent` exists:
+        q'' = S q_i'' + Sdot q_i', M_r q_i'' = rhs_r = S^T (Q - h - M Sdot q_i')."""
+        if hasattr(self, "_reduced"):
+            return self._reduced
+        self._reduced = None
+        q_of = self.explicit_dependent
+        if q_of is None:
+            return None
+        qi = [self.q[i] for i in self.independent]
+        qdi = [self.qd[i] for i in self.independent]
+        q_full = sp.Matrix([q_of.get(x, x) for x in self.q])
+        S = q_full.jacobian(qi)
+        Sdot_qd = (S * sp.Matrix(qdi)).jacobian(qi) * sp.Matrix(qdi)
+        sub = {x: v for x, v in zip(self.q, q_full)}
+        sub.update({v: e for v, e in zip(self.qd, S * sp.Matrix(qdi))})
+        M = self.M.xreplace(sub)
+        rhs = (self.Q - self.h).xreplace(sub)
+        M_r = (S.T * M * S).applyfunc(sp.simplify)
+        rhs_r = (S.T * (rhs - M * Sdot_qd)).applyfunc(sp.simplify)
+        self._reduced = (q_full, S, M_r, rhs_r)
+        return self._reduced
+
     def constraint_rows(self, c) -> list[sp.Expr]:
         if isinstance(c, PointOnPoint):
             d = self.point(c.body_a, c.point_a) - self.point(c.body_b, c.point_b)
@@ -232,6 +271,21 @@ class Derivation:
             names = self.mechanism.coordinates
             return [sum(coef * self.q[names.index(n)] for n, coef in c.coefficients) - c.constant]
         raise TypeError(f"unsupported constraint {c!r}")
+
+    def constraint_force(self, c) -> sp.Matrix:
+        """Physical force of a constraint per its multipliers LAMBDA_k (see base.py point 6):
+        PointOnPoint: force on body_a; PointOnLine: slot force on the pin; LinearCoupling:
+        its generalized force."""
+        rows = self.constraint_row_slices()[c.name]
+        lam = [sp.Symbol(f"_lambda{k}") for k in range(rows.start, rows.stop)]
+        if isinstance(c, PointOnPoint):
+            return -sp.Matrix(lam)
+        if isinstance(c, PointOnLine):
+            u = rotation(self.poses[c.line_body].angle) * as_column(c.direction)
+            normal = sp.Matrix([-u[1], u[0]]) / sp.sqrt(
+                sp.sympify(c.direction[0]) ** 2 + sp.sympify(c.direction[1]) ** 2)
+            return -lam[0] * normal
+        return -sp.Matrix(lam)
 
     def constraint_row_slices(self) -> dict[str, slice]:
         out, k = {}, 0

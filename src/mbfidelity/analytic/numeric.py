@@ -76,6 +76,23 @@ class NumericModel:
             self._Phi_hess = [_lambdify(q, H.xreplace(self.subs)) for H in d.Phi_hessians]
         self._reactions: dict[str, Callable] = {}
         self._warm: np.ndarray | None = None
+        # closed-form reduction (constraints solved symbolically): a cheap explicit ODE
+        self._explicit = None
+        reduced = d.reduced_dynamics() if self.constrained else None
+        if reduced is not None and len(self.independent) <= 3:
+            q_full, S, M_r, rhs_r = (x.xreplace(self.subs) for x in reduced)
+            qi = [d.q[i] for i in self.independent]
+            qdi = [d.qd[i] for i in self.independent]
+            self._explicit = (
+                _lambdify(qi, list(q_full), modules="math"),
+                _lambdify(qi + qdi, list(S * sp.Matrix(qdi)), modules="math"),
+                _lambdify(qi + qdi + [TIME], list(M_r.LUsolve(rhs_r)), modules="math"),
+            )
+        dissipation = d.D.xreplace(self.subs)
+        q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
+        #: no dissipation and no time-dependent load at these parameter values
+        self.conservative = bool(d.energy_route and sp.simplify(dissipation) == 0
+                                 and not q_aut_t)
 
     # --- constraint manifold -------------------------------------------------------------
     def constraint_values(self, q) -> np.ndarray:
@@ -114,6 +131,9 @@ class NumericModel:
         return S
 
     def state_from_independent(self, qi, qdi, guess=None) -> tuple[np.ndarray, np.ndarray]:
+        if self._explicit is not None:
+            return (np.array(self._explicit[0](*qi), dtype=float),
+                    np.array(self._explicit[1](*qi, *qdi), dtype=float))
         if guess is None:
             guess = self._warm if self._warm is not None else np.zeros(self.n)
         q = np.array(guess, dtype=float)
@@ -132,7 +152,11 @@ class NumericModel:
         if not self.constrained:
             return np.linalg.solve(self.mass_matrix(q), rhs), np.zeros(0)
         J = self.constraint_jacobian(q)
-        A = np.block([[self.mass_matrix(q), J.T], [J, np.zeros((self.m, self.m))]])
+        n = self.n
+        A = np.zeros((n + self.m, n + self.m))
+        A[:n, :n] = self.mass_matrix(q)
+        A[:n, n:] = J.T
+        A[n:, :n] = J
         b = np.concatenate([rhs, np.array(self._gamma(*q, *qd), dtype=float).reshape(-1)])
         sol = np.linalg.solve(A, b)
         return sol[: self.n], sol[self.n:]
@@ -147,6 +171,8 @@ class NumericModel:
         k = len(self.independent)
         if not self.constrained:
             return np.concatenate([y[k:], self.acceleration(y[:k], y[k:], t)])
+        if self._explicit is not None:
+            return np.concatenate([y[k:], self._explicit[2](*y, t)])
         q, qd = self.state_from_independent(y[:k], y[k:])
         return np.concatenate([y[k:], self.dynamics(q, qd, t)[0][self.independent]])
 
@@ -235,9 +261,25 @@ class NumericModel:
     def accelerations(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
         return np.array([self.acceleration(a, b, c) for a, b, c in zip(q, qd, t)])
 
-    def multipliers(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """(N, m) multipliers along a sampled motion."""
-        return np.array([self.dynamics(a, b, c)[1] for a, b, c in zip(q, qd, t)])
+    def constraint_forces(self, q: np.ndarray, lam: np.ndarray) -> dict[str, np.ndarray]:
+        """Physical constraint forces along a sampled motion (see base.py point 6)."""
+        d = self.derivation
+        out = {}
+        for c in d.mechanism.constraints:
+            expr = d.constraint_force(c).xreplace(self.subs)
+            lam_syms = sorted((s for s in expr.free_symbols if s.name.startswith("_lambda")),
+                              key=lambda s: int(s.name[7:]))
+            fn = _lambdify(list(d.q) + lam_syms, list(expr))
+            cols = [int(s.name[7:]) for s in lam_syms]
+            vals = fn(*q.T, *lam[:, cols].T)
+            out[c.name] = np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), (len(q),))
+                                           for v in vals])
+        return out
+
+    def dynamics_along(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray):
+        """(q'' (N, n), multipliers (N, m)) along a sampled motion."""
+        out = [self.dynamics(a, b, c) for a, b, c in zip(q, qd, t)]
+        return np.array([o[0] for o in out]), np.array([o[1] for o in out]).reshape(len(t), self.m)
 
 
 @lru_cache(maxsize=64)

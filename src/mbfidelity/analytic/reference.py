@@ -30,6 +30,8 @@ class Reference:
     method: str
     #: Lagrange multipliers (N, m) of the closure constraints (empty without)
     multipliers: np.ndarray | None = None
+    #: physical constraint forces by constraint name (see simulators/base.py point 6)
+    constraint_forces: dict | None = None
 
 
 def _dop853(model, y0: np.ndarray, t: np.ndarray, tol: float) -> np.ndarray:
@@ -91,12 +93,14 @@ def reference(system: System, scenario: Scenario, values: Mapping[str, float],
         loose_q, _ = _full_states(model, _dop853(model, y0, t, LOOSE), q0)
         error = np.max(np.abs(loose_q - q), axis=0)
         method = f"DOP853 rtol=atol={TIGHT:g}; error estimated against rtol=atol={LOOSE:g}"
-    qdd = model.accelerations(q, qd, t)
     if model.constrained:
-        lam = model.multipliers(q, qd, t)
+        qdd, lam = model.dynamics_along(q, qd, t)
         reactions = {}
+        constraint_forces = model.constraint_forces(q, lam)
     else:
+        qdd = model.accelerations(q, qd, t)
         lam = np.zeros((len(t), 0))
+        constraint_forces = {}
         reactions = {j: model.reaction(j, q, qd, qdd, t) for j in system.reaction_joints}
-    energy = model.energy(q, qd) if model.derivation.conservative else None
-    return Reference(t, q, qd, qdd, reactions, energy, error, method, lam)
+    energy = model.energy(q, qd) if model.conservative else None
+    return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces)

@@ -162,10 +162,16 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
         result.metrics.append(_judge(system, backend.id, f"{name}.energy_drift", drift, tol))
     for j in joints:
         r_run = run.reactions.get(j)
-        if r_run is None:
-            continue
-        value = metrics.relative_vector_error(r_run[:n], ref.reactions[j][:n])
+        value = (metrics.relative_vector_error(r_run[:n], ref.reactions[j][:n])
+                 if r_run is not None else float("inf"))
         result.metrics.append(_judge(system, backend.id, f"{name}.reaction_{j}", value, tol))
+    if "constraint_force" in sc.checks:
+        for cname, f_ref in (ref.constraint_forces or {}).items():
+            f_run = run.constraint_forces.get(cname)
+            value = (metrics.relative_vector_error(f_run[:n], f_ref[:n])
+                     if f_run is not None else float("inf"))
+            result.metrics.append(_judge(system, backend.id, f"{name}.constraint_{cname}",
+                                         value, tol))
     if keep_series:
         result.series[name] = {
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
@@ -219,22 +225,28 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
                 result.metrics.append(_judge(system, backend.id,
                                              f"damping.linearization_mode{i + 1}", dz, tol,
                                              unit="absolute"))
-    # free-vibration fit (every engine)
-    n = len(system.coordinates)
+    # free-vibration fit (every engine), in the independent coordinates
+    from ..analytic.numeric import numeric_model
+
+    model = numeric_model(system.id, values)
+    ind = model.independent
+    k_dof = len(ind)
     lam, shapes = scipy.linalg.eig(eq.K, eq.M)
     order_idx = np.argsort(np.abs(lam))
     shapes = np.real(shapes[:, order_idx])
-    keep = [k for k in range(n) if abs(lam[order_idx][k]) > 1e-12 * max(np.abs(lam))]
-    scales = _coordinate_scales(system, eq.q)
+    keep = [k for k in range(k_dof) if abs(lam[order_idx][k]) > 1e-12 * max(np.abs(lam))]
+    scales = _coordinate_scales(system, eq.q)[ind]
     shapes_scaled = shapes / np.max(np.abs(shapes / scales[:, None]), axis=0)
     amp = tolerances.FIT_AMPLITUDE
-    q0 = eq.q + amp * shapes_scaled[:, keep].sum(axis=1)
+    guess = eq.q.copy()
+    guess[ind] += amp * shapes_scaled[:, keep].sum(axis=1)
+    q0 = model.complete(guess)
     periods = 2 * np.pi / ref_w.min() if len(ref_w) else 1.0
     T = max(min(t_end or 10.0, 40 * periods), 10 * periods)
-    run = backend.simulate(mech, q0, np.zeros(n), T, dt, settings, ())
+    run = backend.simulate(mech, q0, np.zeros(len(q0)), T, dt, settings, ())
     result.wall_time += run.wall_time
     result.simulated_time += T
-    eta = np.linalg.solve(shapes_scaled, (run.q - eq.q).T).T
+    eta = np.linalg.solve(shapes_scaled, (run.q[:, ind] - eq.q[ind]).T).T
     order = run.integrator_order
     tol = tolerances.fit_tolerance(w_max, dt, order)
     for i, (k, m) in enumerate(zip(keep, modes)):

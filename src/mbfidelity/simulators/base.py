@@ -25,6 +25,10 @@ conventions 1-8) into one engine and runs it. The contract:
    - ``reactions``: for each requested joint, shape (N+1, 2): the force the parent
      exerts on the child through the joint, world axes, belonging to the state at the
      same sample (NaN where the engine cannot give it for that sample);
+   - ``constraint_forces``: for each closure constraint of the mechanism, shape (N+1, k),
+     in physical terms at the same samples: PointOnPoint, the force on body_a from
+     body_b (world x, y); PointOnLine, the force of the slot on the pin (world x, y);
+     LinearCoupling, its generalized force (k = 1), with the sign of -multiplier;
    - ``wall_time``: seconds spent stepping only (build excluded);
    - ``integrator_order``: the order of the scheme actually used (tolerances use it).
    Applied loads that depend on time are evaluated at the time of each integrator stage
@@ -63,6 +67,7 @@ class RunResult:
     integrator_order: int
     settings: dict
     steps: int = 0
+    constraint_forces: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.q.shape != self.qd.shape or self.q.shape[0] != len(self.t):

@@ -74,9 +74,9 @@ class _Compiled:
     dynamic: list[str]
     folds: dict[str, _Fold]
     loaded: list[int]  # indices of engine bodies that receive element loads
-    loads_math: Callable | None  # (*P, *V, H, t) -> flat (fx, fy, tau) for `loaded`
-    external_np: dict[str, Callable]  # joint -> (*P, *V, H, t) -> (fx, fy) from elements
-    coords_np: Callable  # (*P, *V) -> (q..., qd...)
+    loads_math: Callable | None  # (*state, H, t) -> flat (fx, fy, tau) for `loaded`
+    external_np: dict[str, Callable]  # joint -> (*state, H, t) -> (fx, fy) from elements
+    coords_np: Callable  # (*state) -> (q..., qd...); state = per body x, y, th, vx, vy, w
     masses: dict[str, float]
 
 
@@ -160,8 +160,9 @@ class _Kinematics:
         self.V: list[sp.Symbol] = []
         self.sym: dict[str, tuple[sp.Matrix, sp.Expr]] = {}
         for k, name in enumerate(dynamic):
-            x, y, th = sp.symbols(f"x{k} y{k} th{k}", real=True)
-            vx, vy, w = sp.symbols(f"vx{k} vy{k} w{k}", real=True)
+            # names unlike lambdify's common-subexpression temporaries (x0, x1, ...)
+            x, y, th = sp.symbols(f"bx_{k} by_{k} bth_{k}", real=True)
+            vx, vy, w = sp.symbols(f"bvx_{k} bvy_{k} bw_{k}", real=True)
             self.P += [x, y, th]
             self.V += [vx, vy, w]
             self.sym[name] = (sp.Matrix([x, y]), th)
@@ -277,7 +278,9 @@ def _compile(mech: Mechanism, dynamic: list[str], folds: dict[str, _Fold]) -> _C
     H = sp.Symbol("H", real=True)
     # loads are evaluated at the position-updated state x + H v (H = dt or 0)
     predicted = {p: p + H * v for p, v in zip(kin.P, kin.V)}
-    args = [*kin.P, *kin.V, H, TIME]
+    # per body (x, y, theta, vx, vy, omega): the order the stepping loop reads them in
+    state = [s for k in range(len(dynamic)) for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
+    args = [*state, H, TIME]
     loads = _element_loads(mech, kin)
     per_body = _engine_loads(loads, kin, dynamic)
     loaded = sorted(per_body)
@@ -295,7 +298,7 @@ def _compile(mech: Mechanism, dynamic: list[str], folds: dict[str, _Fold]) -> _C
         external_np[j.name] = sp.lambdify(args, list(total.xreplace(predicted)),
                                           modules="numpy", cse=True)
     coords = [kin.coordinate(j) for j in mech.joints]
-    coords_np = sp.lambdify([*kin.P, *kin.V], coords + [kin.rate(c) for c in coords],
+    coords_np = sp.lambdify(state, coords + [kin.rate(c) for c in coords],
                             modules="numpy", cse=True)
     masses = {b.name: _num(b.mass) for b in mech.bodies}
     compiled = _Compiled(dynamic, folds, loaded, loads_math, external_np, coords_np, masses)
@@ -527,21 +530,18 @@ class PymunkBackend(Backend):
         wall = time.perf_counter() - start
 
         S = np.array(rows)
-        nb = len(bodies)
-        P = [S[:, 6 * k + i] for k in range(nb) for i in range(3)]
-        V = [S[:, 6 * k + 3 + i] for k in range(nb) for i in range(3)]
         n = len(mechanism.joints)
-        cq = comp.coords_np(*P, *V)
+        cq = comp.coords_np(*S.T)
         q = np.column_stack([np.broadcast_to(np.asarray(c, float), (n_steps + 1,)) for c in cq[:n]])
         qd = np.column_stack([np.broadcast_to(np.asarray(c, float), (n_steps + 1,)) for c in cq[n:]])
         t = np.arange(n_steps + 1) * h
-        reactions = {j: self._reaction(mechanism, comp, j, S, P, V, H, shift, h, t)
+        reactions = {j: self._reaction(mechanism, comp, j, S, H, shift, h, t)
                      for j in reaction_joints}
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=1, settings=cfg, steps=n_steps)
 
     @staticmethod
-    def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray, P, V,
+    def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
                   H: float, shift: int, h: float, t: np.ndarray) -> np.ndarray:
         """Force the parent exerts on the child, from Newton on the child's subtree:
         sum m (v(n+1) - v(n))/h - m g - element forces from outside, over step n -> n+1.
@@ -558,8 +558,7 @@ class PymunkBackend(Backend):
             m = comp.masses[name]
             total[:, 0] += m * np.diff(S[:, 6 * k + 3]) / h
             total[:, 1] += m * (np.diff(S[:, 6 * k + 4]) / h + g)
-        ext = comp.external_np[joint](*(p[:-1] for p in P), *(v[:-1] for v in V), H,
-                                      t[:-1] + shift * h)
+        ext = comp.external_np[joint](*S[:-1].T, H, t[:-1] + shift * h)
         for i in range(2):
             total[:, i] -= np.broadcast_to(np.asarray(ext[i], float), (len(t) - 1,))
         out[1:] = total
