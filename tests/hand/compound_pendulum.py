@@ -1,0 +1,9 @@
+"""Fig. 7, eq. 5: I_O phi'' + m g l phi = 0 with I_O = m L^2/3, l = L/2."""
+import numpy as np
+
+EQUILIBRIA = (2, 1)  # phi = 0 (stable), pi (unstable)
+MISPRINTS = set()
+
+
+def frequencies(v):
+    return [np.sqrt(v["m"] * v["g"] * v["L"] / 2 / (v["m"] * v["L"] ** 2 / 3))]
