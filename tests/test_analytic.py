@@ -10,7 +10,7 @@ from mbfidelity.analytic.derivation import derivation_of
 from mbfidelity.analytic.errata import errata
 from mbfidelity.analytic.linear import find_equilibria, operating_equilibrium
 from mbfidelity.analytic.numeric import numeric_model
-from mbfidelity.analytic.reference import reference
+from mbfidelity.analytic.reference import reference, sensitivity
 from mbfidelity.systems import all_systems, get_system
 
 from hand import facts
@@ -91,7 +91,7 @@ def test_two_routes_to_the_linearization_agree(system_id):
         np.testing.assert_allclose(C1, C2, atol=1e-12 * max(np.abs(C1).max(), 1.0))
 
 
-@pytest.mark.parametrize("system_id", [s for s in SYSTEMS if numeric_model(s, get_system(s).parameter_values()).conservative])
+@pytest.mark.parametrize("system_id", SYSTEMS)
 def test_reference_conserves_energy(system_id):
     s = get_system(system_id)
     checked = 0
@@ -105,7 +105,8 @@ def test_reference_conserves_energy(system_id):
         kinetic = max(0.5 * w @ model.mass_matrix(x) @ w for x, w in zip(ref.q, ref.qd))
         # DOP853 at rtol 1e-12: the energy error is round-off level relative to the motion
         assert np.ptp(ref.energy) / kinetic < 1e-8, sc.name
-    assert checked
+    if not checked:
+        pytest.skip("no conservative scenario (dissipation or excitation in every one)")
 
 @pytest.mark.parametrize("system_id", ["compound_pendulum", "mass_spring_damper"])
 def test_closed_form_solves_the_derived_equations(system_id):
@@ -193,3 +194,13 @@ def test_unknown_parameter_and_bad_values_are_rejected():
         s.parameter_values({"mass": 2.0})
     with pytest.raises(ValueError, match="must be > 0"):
         s.parameter_values({"L": -1.0})
+
+
+@pytest.mark.parametrize("system_id", SYSTEMS)
+def test_scenarios_are_not_chaotic(system_id):
+    """Trajectory gates assume errors grow linearly (tolerances.py); a scenario whose
+    small perturbations grow by orders of magnitude cannot be gated."""
+    s = get_system(system_id)
+    for sc in s.scenarios:
+        growth = sensitivity(s, sc, s.parameter_values(scenario=sc))
+        assert growth < 100, (sc.name, growth)

@@ -72,7 +72,7 @@ class Derivation:
             Rp = rotation(parent.angle)
             if isinstance(j, Revolute):
                 base = 0 if j.absolute else parent.angle
-                angle = base + qj + j.angle_offset
+                angle = base + (-qj if j.clockwise else qj) + j.angle_offset
                 anchor = parent.position + Rp * as_column(j.parent_anchor)
             elif isinstance(j, Prismatic):
                 angle = parent.angle + j.angle_offset
@@ -87,8 +87,9 @@ class Derivation:
         """The engines' relative joint values as (linear) functions of the coordinates."""
         vals = []
         for j, qj in zip(self.mechanism.joints, self.q):
-            if isinstance(j, Revolute) and j.absolute:
-                vals.append(qj - self.poses[j.parent].angle)
+            if isinstance(j, Revolute):
+                vals.append(sp.simplify(self.poses[j.child].angle - self.poses[j.parent].angle
+                                        - j.angle_offset))
             else:
                 vals.append(qj)
         return sp.Matrix(vals)
@@ -231,7 +232,7 @@ class Derivation:
                 except NotImplementedError:
                     sols = []
                 if len(sols) == 1 and set(sols[0]) == set(dep):
-                    self._explicit_dependent = {k: sp.simplify(v) for k, v in sols[0].items()}
+                    self._explicit_dependent = dict(sols[0])
         return self._explicit_dependent
 
     def reduced_dynamics(self):
@@ -252,8 +253,9 @@ class Derivation:
         sub.update({v: e for v, e in zip(self.qd, S * sp.Matrix(qdi))})
         M = self.M.xreplace(sub)
         rhs = (self.Q - self.h).xreplace(sub)
-        M_r = (S.T * M * S).applyfunc(sp.simplify)
-        rhs_r = (S.T * (rhs - M * Sdot_qd)).applyfunc(sp.simplify)
+        # no simplify: lambdify's common-subexpression elimination does the useful part
+        M_r = S.T * M * S
+        rhs_r = S.T * (rhs - M * Sdot_qd)
         self._reduced = (q_full, S, M_r, rhs_r)
         return self._reduced
 
@@ -331,8 +333,10 @@ class Derivation:
                 return sp.zeros(2, 1)
             i = self.mechanism.coordinates.index(f.coordinate)
             force = sp.sympify(f.force).xreplace({COORD: self.q[i], COORD_RATE: self.qd[i]})
-            axis_world = rotation(self.poses[owner.parent].angle) * as_column(owner.axis)
-            return force * axis_world
+            axis = as_column(owner.axis)
+            axis_world = rotation(self.poses[owner.parent].angle) * axis
+            # virtual power: F . (axis q') = Q q'  =>  F = Q axis / |axis|^2
+            return force * axis_world / (axis.T * axis)[0]
         raise TypeError(f)
 
 

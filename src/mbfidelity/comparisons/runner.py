@@ -201,7 +201,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     eq = operating_equilibrium(system, values)
     if not eq.stable:
         return
-    mech = system.numeric_mechanism(values)
+    # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
+    mech = system.numeric_mechanism(values).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
     ref_w = np.array([abs(m.eigenvalue) for m in modes])
     w_max = float(np.max(ref_w)) if len(ref_w) else 0.0

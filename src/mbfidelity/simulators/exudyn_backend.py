@@ -19,19 +19,23 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   stage time); a `PointToPoint` element is an ``ObjectConnectorSpringDamper`` between
   markers (native stiffness/damping/force when the law is affine in LENGTH/LENGTH_RATE,
   a ``springForceUserFunction`` otherwise);
-- every step is sampled by internally stored sensors (write period = dt), so Exudyn's C++
-  loop runs without Python stepping;
+- every step is sampled by in-memory sensors (write period dt/2, so each step is recorded
+  exactly once), and Exudyn's C++ loop runs without Python stepping;
 - reactions: the tree has no joint-force output, so the force parent -> child is Newton's
   law on the child's subtree, with the engine's centre-of-mass accelerations (kinematic
   tree sensors, end-of-step accelerations), minus gravity and minus the element forces
   that enter the subtree from outside (the engine's connector force, or the law on the
-  owning prismatic joint).
+  owning prismatic joint). The solvers record zero accelerations at t = 0, so that sample
+  uses the engine's mass matrix and right-hand side at the initial state;
+- linearization: `mbs.ComputeLinearizedSystem` (exact M; K and D from Exudyn's
+  forward-difference Jacobian, taken at two steps and Richardson-extrapolated), then the
+  first-order eigenproblem with damping (all 2n eigenvalues).
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -54,17 +58,17 @@ from ..systems.model import (
 from .base import Backend, Linearization, RunResult, Support
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
+#: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
+#: under development" and converged at first order)
 _SOLVER_ORDER = {
     "RK44": 4,
     "RK67": 6,
     "RK33": 3,
     "ExplicitMidpoint": 2,
     "ExplicitEuler": 1,
-    "VelocityVerlet": 2,
     "GeneralizedAlpha": 2,
     "TrapezoidalIndex2": 2,
 }
-_IMPLICIT = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
 def _num(x) -> float:
@@ -117,7 +121,6 @@ class _Geometry:
     c: np.ndarray
     angle_rows: dict[str, tuple[np.ndarray, float]]  # body angle = row . u + const
     gravity: float
-    axis_world_rows: dict[int, np.ndarray] = field(default_factory=dict)
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
@@ -153,11 +156,12 @@ def _geometry(mech: Mechanism) -> _Geometry:
             rotations.append(offset - beta[p])
             beta[j.child] = 0.0
             angle_rows[j.child] = (row_p + e_i, const_p + offset)
-            if j.absolute:  # q = theta_child - offset = theta_parent + u
-                T[i] = row_p + e_i
-                c[i] = const_p
+            sign = -1.0 if j.clockwise else 1.0  # clockwise: the coordinate is -angle
+            if j.absolute:  # sign q = theta_child - offset = theta_parent + u
+                T[i] = sign * (row_p + e_i)
+                c[i] = sign * const_p
             else:
-                T[i] = e_i
+                T[i] = sign * e_i
         elif isinstance(j, Prismatic):
             types.append("P")
             axis = np.array([_num(v) for v in j.axis])
@@ -191,8 +195,7 @@ class ExudynBackend(Backend):
     def version(self) -> str:
         import exudyn
 
-        return str(exudyn.GetVersionString() if hasattr(exudyn, "GetVersionString")
-                   else exudyn.__version__)
+        return str(exudyn.__version__)
 
     def default_settings(self) -> dict:
         return {
@@ -207,6 +210,7 @@ class ExudynBackend(Backend):
             "native_linear_laws": True,
             "write_solution_file": False,
             "linearization_relative_epsilon": 1e-4,
+            "linearization_richardson": True,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -244,10 +248,17 @@ class ExudynBackend(Backend):
                                    "samples with in-memory sensors at every step instead "
                                    "(sensor write period dt replaces the 0.01 s default).",
             "linearization_relative_epsilon": "linearize(): relative step of Exudyn's "
-                                              "numerical (central-difference) Jacobian that "
-                                              "gives K and D. Exudyn default 1e-7 is "
-                                              "round-off dominated (eigenvalue error up to "
-                                              "6e-10 relative here); 1e-4 gave <= 1.2e-12.",
+                                              "numerical Jacobian (K, D), a forward "
+                                              "difference. Exudyn default 1e-7 balances "
+                                              "truncation and round-off at ~1e-7..1e-6 "
+                                              "absolute error in K and D; with "
+                                              "linearization_richardson, 1e-4 gives ~1e-10 "
+                                              "relative.",
+            "linearization_richardson": "linearize(): True evaluates Exudyn's Jacobian at "
+                                        "eps and eps/2 and extrapolates (2 J(eps/2) - "
+                                        "J(eps), error O(eps^2)); False is Exudyn's single "
+                                        "forward difference (what ComputeODE2Eigenvalues "
+                                        "uses).",
         }
 
     # --- support ---------------------------------------------------------------------------
@@ -265,6 +276,10 @@ class ExudynBackend(Backend):
                     return Support(False, f"joint {j.name}: zero prismatic axis")
         except ValueError as exc:
             return Support(False, f"mechanism is not numeric: {exc}")
+        if getattr(mechanism, "constraints", ()):
+            names = ", ".join(f"{c.name} ({type(c).__name__})" for c in mechanism.constraints)
+            return Support(False, "closure constraints are not translated by this backend "
+                                  f"(kinematic tree, explicit solver): {names}")
         for f in mechanism.forces:
             if not isinstance(f, (PointToPoint, CoordinateForce)):
                 return Support(False, f"force {f.name}: type {type(f).__name__} not mapped")
@@ -276,8 +291,7 @@ class ExudynBackend(Backend):
         return Support(True)
 
     # --- model building --------------------------------------------------------------------
-    def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict,
-               include_time_loads: bool = True):
+    def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict):
         import exudyn as exu
         from exudyn.itemInterface import (MarkerBodyPosition, MarkerKinematicTreeRigid,
                                           NodeGenericODE2, ObjectConnectorSpringDamper,
@@ -309,8 +323,6 @@ class ExudynBackend(Backend):
         python_laws: list[tuple[int, Callable[..., float]]] = []
         for f in mech.forces:
             if not isinstance(f, CoordinateForce):
-                continue
-            if f.time_dependent and not include_time_loads:
                 continue
             i = mech.coordinates.index(f.coordinate)
             row = geo.T[i]
@@ -351,8 +363,6 @@ class ExudynBackend(Backend):
                 continue
             if f.body_a == WORLD and f.body_b == WORLD:
                 continue  # acts on nothing
-            if TIME in sp.sympify(f.tension).free_symbols and not include_time_loads:
-                continue
             markers = []
             for body, point in ((f.body_a, f.point_a), (f.body_b, f.point_b)):
                 pt = [_num(v) for v in point]
@@ -517,7 +527,8 @@ class ExudynBackend(Backend):
         rhs = np.asarray(helper.GetSystemResidual())[:len(mass)]
         helper.FinalizeSolver(mbs, sim)
         a0 = np.linalg.solve(mass, rhs)
-        mbs.systemData.SetODE2Coordinates_tt(a0.tolist(), configuration=exu.ConfigurationType.Current)
+        mbs.systemData.SetODE2Coordinates_tt(a0.tolist(),
+                                             configuration=exu.ConfigurationType.Current)
         return {b: np.asarray(mbs.GetSensorValues(s))[:2] for b, s in sensors.items()}
 
     @staticmethod
@@ -550,7 +561,9 @@ class ExudynBackend(Backend):
                 force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])
                 row, const = geo.angle_rows[owner.parent]
                 th_parent = u @ row + const
+                # virtual power: the physical force is F axis / |axis|^2 (along the slide)
                 axis = np.array([_num(v) for v in owner.axis])
+                axis = axis / float(axis @ axis)
                 ax_world = np.stack([np.cos(th_parent) * axis[0] - np.sin(th_parent) * axis[1],
                                      np.sin(th_parent) * axis[0] + np.cos(th_parent) * axis[1]],
                                     axis=1)
@@ -565,20 +578,35 @@ class ExudynBackend(Backend):
         if not support.ok:
             return None
         q_eq = np.asarray(q_eq, dtype=float)
+        # the autonomous system: the excitation e(t) does not belong to the equilibrium
         exu, mbs, SC, node, tree, geo, _ = self._build(
-            mechanism, q_eq, np.zeros_like(q_eq), cfg, include_time_loads=False)
+            mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
         mbs.Assemble()
-        sim = self._simulation_settings(exu, cfg, 1.0, 1)
-        eig, _ = mbs.ComputeODE2Eigenvalues(simulationSettings=sim,
-                                            computeComplexEigenvalues=True,
-                                            useAbsoluteValues=False)
-        eig = np.asarray(eig, dtype=complex)
+        eps = float(cfg["linearization_relative_epsilon"])
+
+        def engine_mkd(relative_epsilon: float):
+            sim = self._simulation_settings(exu, cfg, 1.0, 1)
+            sim.staticSolver.newton.numericalDifferentiation.relativeEpsilon = relative_epsilon
+            M, K, D = mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
+            return np.asarray(M), np.asarray(K), np.asarray(D)
+
+        M, K, D = engine_mkd(eps)
+        if cfg["linearization_richardson"]:
+            # Exudyn differentiates forward (error O(eps)); two steps cancel that term
+            _, K2, D2 = engine_mkd(eps / 2)
+            K, D = 2 * K2 - K, 2 * D2 - D
+        n = len(M)
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
+        eig = np.linalg.eigvals(A).astype(complex)
+        how = ("two forward-difference Jacobians (eps, eps/2) Richardson-extrapolated"
+               if cfg["linearization_richardson"] else "one forward-difference Jacobian")
         return Linearization(
             eigenvalues=eig[np.argsort(eig.imag)],
-            method="exudyn mbs.ComputeODE2Eigenvalues(computeComplexEigenvalues=True): "
-                   "numerical Jacobians of the kinematic tree (M, K, D), first-order "
-                   "eigenproblem",
-            extra={"coordinates": "engine relative joint values (eigenvalues are invariant)"},
+            method="exudyn mbs.ComputeLinearizedSystem (M exact; K, D from the kinematic "
+                   f"tree's numerical Jacobian: {how}), first-order eigenproblem",
+            extra={"coordinates": "engine relative joint values (eigenvalues are invariant)",
+                   "relative_epsilon": eps},
         )
 
 

@@ -66,7 +66,9 @@ SYSTEM = System(
     scenarios=(
         Scenario("small", {"phi": 0.05, "s": "m*g/k + 0.005"}, checks=("trajectory",),
                  description="near q_eq: 0.05 rad and 5 mm stretch beyond it"),
-        Scenario("large", {"phi": 0.8, "s": "m*g/k + 0.05"}, checks=("trajectory",),
-                 description="0.8 rad and 50 mm: swing and stretch exchange energy"),
+        Scenario("large", {"phi": 0.5, "s": "m*g/k + 0.03"}, checks=("trajectory",),
+                 description="0.5 rad and 30 mm: swing and stretch exchange energy (at 0.8 rad "
+                             "and 50 mm the motion is chaotic: a 1e-8 rad change grows 3e4-fold "
+                             "in 10 s, so no trajectory comparison is meaningful)"),
     ),
 )

@@ -16,8 +16,9 @@ Conventions (all backends and the analytic layer honour them):
    ``p_parent + R(th_parent) parent_anchor = p_child + R(th_child) child_anchor``, and
    ``th_child = th_parent + q + angle_offset`` (relative angle), or, with
    ``absolute=True``, ``th_child = q + angle_offset`` (the monograph's absolute angles,
-   e.g. phi2 of Fig. 37). Engines with relative joint angles map through
-   `Mechanism.joint_map`.
+   e.g. phi2 of Fig. 37); with ``clockwise=True`` the coordinate turns the other way
+   (q is replaced by -q, e.g. theta of Fig. 39). Engines with counter-clockwise relative
+   hinges use ``th_child - th_parent - angle_offset`` (`Derivation.joint_values`).
 5. `Prismatic(parent, child)`: ``p_parent + R(th_parent)(parent_anchor + q axis) =
    p_child + R(th_child) child_anchor`` and ``th_child = th_parent + angle_offset``.
 6. Reaction at a joint: the force the parent exerts on the child through the joint, in
@@ -123,6 +124,7 @@ class Revolute:
     child_anchor: Vec = (0, 0)
     angle_offset: Expr = 0
     absolute: bool = False
+    clockwise: bool = False
 
 
 @dataclass(frozen=True)
@@ -338,6 +340,15 @@ class Mechanism:
             if j.parent in out:
                 out.append(j.child)
         return out
+
+    def without_time_loads(self) -> "Mechanism":
+        """The autonomous mechanism: force elements that depend explicitly on time (the
+        excitation e(t), monograph eq. 78) removed. Equilibria, linearizations and
+        free-vibration tests use it."""
+        def timed(f):
+            law = f.tension if isinstance(f, PointToPoint) else f.force
+            return TIME in sp.sympify(law).free_symbols
+        return replace(self, forces=tuple(f for f in self.forces if not timed(f)))
 
     def substitute(self, values: Mapping[sp.Symbol, float]) -> "Mechanism":
         """The same mechanism with parameter symbols replaced by numbers (placeholders
