@@ -31,12 +31,16 @@ class Metric:
     status: str  # pass | fail | xfail | xpass | unsupported
     reason: str = ""
     unit: str = "relative"
+    #: the compared quantities themselves (e.g. reference and engine frequency in Hz)
+    detail: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         d = {"name": self.name, "value": self.value, "tolerance": self.tolerance,
              "passed": self.passed, "status": self.status, "unit": self.unit}
         if self.reason:
             d["reason"] = self.reason
+        if self.detail:
+            d["detail"] = self.detail
         return d
 
 
@@ -220,8 +224,10 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
                 dz = abs(got[i].damping_ratio - m.damping_ratio)
             else:
                 value = dz = float("inf")
-            result.metrics.append(_judge(system, backend.id,
-                                         f"frequency.linearization_mode{i + 1}", value, tol))
+            metric = _judge(system, backend.id, f"frequency.linearization_mode{i + 1}", value, tol)
+            metric.detail = {"reference_hz": m.frequency_hz, "method": lin.method,
+                             "engine_hz": got[i].frequency_hz if i < len(got) else None}
+            result.metrics.append(metric)
             if m.damping_ratio > 0:
                 result.metrics.append(_judge(system, backend.id,
                                              f"damping.linearization_mode{i + 1}", dz, tol,
@@ -257,8 +263,11 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
             value = abs(w_fit - abs(m.eigenvalue)) / abs(m.eigenvalue)
             dz = abs(z_fit - m.damping_ratio)
         except RuntimeError:
-            value = dz = float("inf")
-        result.metrics.append(_judge(system, backend.id, f"frequency.fit_mode{i + 1}", value, tol))
+            w_fit, value, dz = float("nan"), float("inf"), float("inf")
+        metric = _judge(system, backend.id, f"frequency.fit_mode{i + 1}", value, tol)
+        metric.detail = {"reference_hz": m.frequency_hz, "method": "free-vibration fit",
+                         "engine_hz": w_fit / (2 * np.pi) if np.isfinite(value) else None}
+        result.metrics.append(metric)
         result.metrics.append(_judge(system, backend.id, f"damping.fit_mode{i + 1}", dz, tol,
                                      unit="absolute"))
 

@@ -56,6 +56,10 @@ order p, the step h, the simulated time T and the fastest frequency w of the mot
 {% for sim in sims %}{% set m = metrics[sys][sim].get(name) %}
 {% if m %}<td class="{{ m.status }}" title="{{ m.reason }}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ unsupported[sys].get(sim, "-") }}</td>{% endif %}
 {% endfor %}</tr>{% endfor %}</table>
+{% if frequencies.get(sys) %}<h3>Frequencies (Hz) at the operating equilibrium</h3>
+<table><tr><th>mode</th><th>reference (linearized M, C, K)</th>{% for sim in sims %}<th>{{ sim }} linearization</th><th>{{ sim }} fit</th>{% endfor %}</tr>
+{% for mode, row in frequencies[sys].items() %}<tr><td>{{ mode }}</td><td>{{ "%.9f"|format(row.reference_hz) }}</td>
+{% for sim in sims %}{% set e = row.engines.get(sim, {}) %}<td>{{ "%.9f"|format(e.get("linearization")) if e.get("linearization") is not none else "-" }}</td><td>{{ "%.9f"|format(e.get("fit")) if e.get("fit") is not none else "-" }}</td>{% endfor %}</tr>{% endfor %}</table>{% endif %}
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
@@ -125,7 +129,9 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
                     for s, comps in by_system.items()}
     unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
                    for s, comps in by_system.items()}
-    figures = {s: _figures(s, comps, out) for s, comps in by_system.items()}
+    figures = {s: [draw_mechanism(s, out)] + _figures(s, comps, out)
+               for s, comps in by_system.items()}
+    frequencies = frequency_table(results)
     if errata is None:
         from ..analytic.errata import errata as compute
 
@@ -134,7 +140,7 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
                            metric_names=metric_names, unsupported=unsupported, figures=figures,
                            titles={s: get_system(s).title for s in systems}, versions=versions,
-                           explanations=EXPLANATIONS, errata=errata)
+                           explanations=EXPLANATIONS, errata=errata, frequencies=frequencies)
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
@@ -152,3 +158,70 @@ def _markdown(results, prov: dict) -> str:
             lines.append(f"| {c.system} | {c.simulator} | {m.name} | {m.value:.3e} | "
                          f"{m.tolerance:.3e} | {m.status} |")
     return "\n".join(lines) + "\n"
+
+
+def frequency_table(results) -> dict:
+    """system -> rows (mode, reference Hz, engine -> {method: Hz})."""
+    table: dict = {}
+    for c in results:
+        for m in c.metrics:
+            if not m.name.startswith("frequency.") or not m.detail:
+                continue
+            mode = m.name.split("mode")[-1]
+            rows = table.setdefault(c.system, {})
+            row = rows.setdefault(mode, {"reference_hz": m.detail["reference_hz"], "engines": {}})
+            kind = "linearization" if "linearization" in m.name else "fit"
+            row["engines"].setdefault(c.simulator, {})[kind] = m.detail.get("engine_hz")
+    return table
+
+
+def draw_mechanism(system_id: str, out: Path) -> str:
+    """The mechanism at its operating equilibrium, drawn from the description's shapes."""
+    import sympy as sp
+    from matplotlib.patches import Circle as CirclePatch
+    from matplotlib.patches import Polygon
+
+    from ..analytic.linear import operating_equilibrium
+    from ..analytic.numeric import numeric_model
+    from ..systems.model import WORLD, Circle, Rectangle, Segment
+
+    system = get_system(system_id)
+    values = system.parameter_values()
+    eq = operating_equilibrium(system, values)
+    model = numeric_model(system_id, values)
+    d = model.derivation
+    env = {**model.subs, **dict(zip(d.q, eq.q))}
+
+    def world(body: str, p) -> np.ndarray:
+        pt = sp.Matrix(p) if body == WORLD else d.point(body, p)
+        return np.array([float(sp.sympify(c).xreplace(env)) for c in pt])
+
+    fig, ax = plt.subplots(figsize=(4, 4))
+    mech = system.numeric_mechanism(values)
+    for b in mech.bodies:
+        for shape in b.shapes:
+            if isinstance(shape, Segment):
+                a, c = world(b.name, shape.a), world(b.name, shape.b)
+                ax.plot([a[0], c[0]], [a[1], c[1]], "-", lw=4, color="tab:blue", alpha=0.7)
+            elif isinstance(shape, Circle):
+                ax.add_patch(CirclePatch(world(b.name, shape.center), float(shape.radius),
+                                         fill=False, lw=2, color="tab:green"))
+            elif isinstance(shape, Rectangle):
+                cx, cy = (float(v) for v in shape.center)
+                w, h = float(shape.width) / 2, float(shape.height) / 2
+                corners = [world(b.name, (cx + sx * w, cy + sy * h))
+                           for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                ax.add_patch(Polygon(corners, closed=True, fill=False, lw=2, color="tab:orange"))
+        if float(b.mass) > 0:
+            ax.plot(*world(b.name, (0, 0)), "k+", ms=8)
+    for j in mech.joints:
+        ax.plot(*world(j.parent, j.parent_anchor), "o", color="k", ms=5, mfc="white")
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.margins(0.2)
+    at = ", ".join(f"{c} = {v:.4g}" for c, v in zip(system.coordinates, eq.q))
+    ax.set_title(f"{system_id} at {at}", fontsize=7)
+    name = f"{system_id}-drawing.png"
+    fig.savefig(out / name, dpi=80)
+    plt.close(fig)
+    return name

@@ -12,8 +12,9 @@ Translation (generic over the description, see `to_mjcf`):
   configuration. This is exact (no substitute mass).
 - ``Revolute`` -> hinge about z (relative angle); ``Prismatic`` -> slide in the x-y plane.
   Engine joint values v relate to the description coordinates q by a constant affine map
-  ``v = A q + b`` (A unit lower triangular up to axis lengths): absolute angles become
-  ``q - theta_parent``. The reference configuration of the MJCF (qpos0) is v = 0.
+  ``v = A q + b`` (A lower triangular, diagonal +-1 or the axis length): absolute angles
+  become ``q - theta_parent``, clockwise coordinates change sign. The reference
+  configuration of the MJCF (qpos0) is v = 0.
 - ``PointToPoint`` -> a spatial tendon between two sites. A law linear in LENGTH and
   LENGTH_RATE uses the tendon's own stiffness/springlength/damping (exact, including free
   length 0); any other law applies ``-T dL/dq`` from the passive callback.
@@ -21,15 +22,17 @@ Translation (generic over the description, see `to_mjcf`):
   TIME and its coordinate is one engine joint; otherwise the passive callback
   (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with ``d.time`` set to
   the stage time, so time loads are evaluated at stage times.
+- Closure constraints are not translated: `support` says so (MuJoCo equalities are soft).
 - Prismatic ``limits`` are admissible intervals of the description, not stops; they are
   not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
   outside the interval).
 
 Reactions: ``mj_forward`` + ``mj_rnePostConstraint`` at each sampled state (after the
 stepping, outside the timed loop); ``cfrc_int[body, 3:6]`` is the force the parent exerts
-on the body (world axes). Forces MuJoCo books as joint-space passive forces (tendons,
-joint springs, callback) are inside that number, so the force-element contributions from
-outside the child's subtree are subtracted to give the description's joint reaction.
+on the body (world axes). Forces MuJoCo books as joint-space passive forces (joint
+springs/dampers, the callback) are inside that number, so those acting on the child's
+subtree from outside are subtracted to give the description's joint reaction; native
+tendon forces are already outside it (MuJoCo 4.0 puts them in ``cfrc_ext``, measured).
 """
 from __future__ import annotations
 
@@ -139,6 +142,13 @@ class _Plan:
 
 def _check(mech: Mechanism) -> str:
     """Empty string when the mechanism can be translated, else the reason."""
+    why = {"PointOnPoint": "MuJoCo's connect equality is soft (solref/solimp)",
+           "PointOnLine": "MuJoCo has no point-on-line equality",
+           "LinearCoupling": "MuJoCo's joint/tendon equalities are soft"}
+    kinds = sorted({type(c).__name__ for c in getattr(mech, "constraints", ())})
+    if kinds:
+        return ("closure constraints are not translated by this backend: "
+                + "; ".join(f"{k}: {why.get(k, 'unknown constraint type')}" for k in kinds))
     for b in mech.bodies:
         for x in (b.mass, b.inertia):
             if sp.sympify(x).free_symbols:
@@ -186,15 +196,16 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
         cp, dp = angle_c[j.parent], angle_d[j.parent]
         off = _num(j.angle_offset)
         if isinstance(j, Revolute):
+            sign = -1.0 if getattr(j, "clockwise", False) else 1.0
             if j.absolute:
-                angle_c[j.child] = np.eye(n)[i]
+                angle_c[j.child] = sign * np.eye(n)[i]
                 angle_d[j.child] = off
-                A[i] = np.eye(n)[i] - cp  # v = q - theta_parent
+                A[i] = sign * np.eye(n)[i] - cp  # v = theta_child - theta_parent - offset
                 b[i] = -dp
             else:
-                angle_c[j.child] = cp + np.eye(n)[i]
+                angle_c[j.child] = cp + sign * np.eye(n)[i]
                 angle_d[j.child] = dp + off
-                A[i, i] = 1.0
+                A[i, i] = sign
         else:
             angle_c[j.child] = cp.copy()
             angle_d[j.child] = dp + off
@@ -380,7 +391,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
 class _Compiled:
     """A compiled MuJoCo model of a plan plus the index maps and the passive callback."""
 
-    def __init__(self, plan: _Plan, integrator: str, dt: float) -> None:
+    def __init__(self, plan: _Plan, integrator: str, dt: float, autoreset: bool = False) -> None:
         import mujoco
 
         self.mujoco = mujoco
@@ -388,6 +399,10 @@ class _Compiled:
         self.model = mujoco.MjModel.from_xml_string(plan.xml)
         self.model.opt.timestep = dt
         self.model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
+        if autoreset:
+            self.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        else:
+            self.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
         self.data = mujoco.MjData(self.model)
         names = [j.name for j in plan.mech.joints]
         self.qadr = np.array([self.model.joint(nm).qposadr[0] for nm in names])
@@ -485,6 +500,7 @@ class MujocoBackend(Backend):
             "native_springs": True,
             "linearization": "inverseFD",
             "fd_eps": 1e-6,
+            "autoreset": False,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -510,6 +526,10 @@ class MujocoBackend(Backend):
                 "integrator when the run uses RK4 (RK4 is not supported there), mapped "
                 "with ln(lambda)/dt; carries the step's own O(h) error."),
             "fd_eps": "Finite-difference step of mjd_inverseFD / mjd_transitionFD.",
+            "autoreset": (
+                "false replaces MuJoCo's default (autoreset on), which silently resets the "
+                "state to qpos0 when an acceleration is NaN or huge and would show a "
+                "divergence as a jump back to the start; off, it shows as NaN/inf."),
         }
 
     def support(self, mechanism: Mechanism) -> Support:
@@ -541,7 +561,11 @@ class MujocoBackend(Backend):
         s = self._resolve(settings)
         xml = self._plan(mechanism, s).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
-        return xml.replace("<option ", f"<option {opt} ", 1)
+        xml = xml.replace("<option ", f"<option {opt} ", 1)
+        if not s["autoreset"]:
+            xml = xml.replace('<flag contact="disable"/>',
+                              '<flag contact="disable" autoreset="disable"/>', 1)
+        return xml
 
     # --- simulation ----------------------------------------------------------------------
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
@@ -553,7 +577,7 @@ class MujocoBackend(Backend):
         plan = self._plan(mechanism, s)
         for name in reaction_joints:
             mechanism.joint(name)  # KeyError for an unknown joint
-        comp = _Compiled(plan, s["integrator"], dt)
+        comp = _Compiled(plan, s["integrator"], dt, bool(s["autoreset"]))
         m, d = comp.model, comp.data
         steps = int(round(t_end / dt))
         comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
@@ -690,7 +714,7 @@ class MujocoBackend(Backend):
                 Ad = np.zeros((2 * m.nv + m.na, 2 * m.nv + m.na))
                 mujoco.mjd_transitionFD(m, d, eps, True, Ad, None, None, None)
             eig = np.log(np.linalg.eigvals(Ad).astype(complex)) / dt
-            extra = {"A_discrete": Ad, "integrator": integrator}
+            extra = {"A_discrete": Ad, "integrator": integrator, "discrete_order": 1}
             method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, centered, "
                       f"eps={eps:g}), ln(lambda)/dt")
         # order by imaginary then real part: real parts of undamped modes are FD noise
