@@ -185,10 +185,26 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
         q = wrap_angles(system, q, op)
         if not _admissible(system, values, q):
             continue
-        if any(np.allclose(q, f, atol=1e-7, rtol=0) for f in found):
+        if any(_same_family(model, q, f) for f in found):
             continue
         found.append(q)
     return [linearize(model, q) for q in found]
+
+
+def _same_family(model: NumericModel, a: np.ndarray, b: np.ndarray) -> bool:
+    """Same equilibrium, or two members of one neutral family: their difference (in the
+    independent coordinates) lies in the null space of K, e.g. a free pulley angle
+    (one zero frequency, Fig. 38). A family is reported once, by its first member."""
+    diff = (a - b)[model.independent]
+    if np.allclose(diff, 0, atol=1e-7):
+        return True
+    K = model.linearization(b)[2]
+    u, sv, vt = np.linalg.svd(K)
+    null = vt[sv <= 1e-9 * max(sv.max(), 1.0)]
+    if len(null) == 0:
+        return False
+    residual = diff - null.T @ (null @ diff)
+    return bool(np.allclose(residual, 0, atol=1e-7))
 
 
 def operating_equilibrium(system: System, values) -> Equilibrium:

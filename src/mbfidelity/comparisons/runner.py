@@ -146,7 +146,8 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     order = run.integrator_order
     scale = metrics.amplitude(ref.q, eq.q)
     ref_err = float(np.max(ref.error_estimate / scale))
-    tol = tolerances.trajectory_tolerance(w, dt, order, T) + ref_err
+    zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
+    tol = tolerances.trajectory_tolerance(w, dt, order, T, zeta) + ref_err
     n = min(len(run.t), len(ref.t))
     emax, erms = metrics.trajectory_errors(run.q[:n], ref.q[:n], scale)
     name = sc.name
@@ -158,7 +159,7 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
         if p_ref is not None:
             value = abs(p_run - p_ref) / p_ref if p_run is not None else float("inf")
             result.metrics.append(_judge(system, backend.id, f"{name}.period", value,
-                                         tolerances.period_tolerance(w, dt, order, p_ref)))
+                                         tolerances.period_tolerance(w, dt, order, p_ref, zeta)))
     if ref.energy is not None:
         model_energy = _energy_of(system, values, run.q[:n], run.qd[:n])
         e_scale = max(_kinetic_amplitude(system, values, ref.q, ref.qd), 1e-300)

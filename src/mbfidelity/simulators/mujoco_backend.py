@@ -53,7 +53,10 @@ from ..systems.model import (
     WORLD,
     Circle,
     CoordinateForce,
+    LinearCoupling,
     Mechanism,
+    PointOnLine,
+    PointOnPoint,
     PointToPoint,
     Prismatic,
     Rectangle,
@@ -119,6 +122,30 @@ class _Coord:
 
 
 @dataclass
+class _Closure:
+    """A closure constraint and its MJCF equality: ``connect`` (PointOnPoint: site1 on
+    body_a, site2 on body_b), ``slider`` (PointOnLine: a connect between the pin's site1 and
+    the origin site2 of a slider body that slides along the slot on the slot body), or
+    ``tendon`` (LinearCoupling: a fixed tendon sum(w_j v_j) over the engine joint values,
+    w = A^-T c, held at ``offset`` = constant + c . A^-1 b by a tendon equality)."""
+
+    element: object
+    kind: str
+    site1: str = ""
+    site2: str = ""
+    slider: str = ""  # slider body (and its slide joint) name
+    parent: str = ""  # MJCF body carrying the slider (or the site bodies)
+    weights: dict[str, float] = field(default_factory=dict)
+    offset: float = 0.0
+    mass: float = 0.0
+    inertia: float = 0.0
+
+
+#: radius of gyration of the substitute bodies (their inertia is mass * GYRATION**2)
+GYRATION = 0.01
+
+
+@dataclass
 class _Plan:
     """A numeric mechanism translated to MuJoCo terms."""
 
@@ -134,38 +161,52 @@ class _Plan:
     mj_parent: dict[str, str]
     p2p: list[_P2P] = field(default_factory=list)
     coord: list[_Coord] = field(default_factory=list)
+    #: substitute (mass, inertia) of massless bodies that cannot be folded
+    substitutes: dict[str, tuple[float, float]] = field(default_factory=dict)
+    closures: list[_Closure] = field(default_factory=list)
+    opts: dict = field(default_factory=dict)
     xml: str = ""
 
     def engine_values(self, q: np.ndarray) -> np.ndarray:
         return self.A @ np.asarray(q, dtype=float) + self.b
 
 
+def _foldable(mech: Mechanism) -> set[str]:
+    """Massless bodies whose joints are folded into their single child (exact). A massless
+    body with another number of child joints, or that a constraint or a point-to-point
+    element refers to, has no such child frame: it becomes a substitute body of small mass
+    (setting ``massless_mass_ratio``)."""
+    used = set()
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            used |= {c.body_a, c.body_b}
+        elif isinstance(c, PointOnLine):
+            used |= {c.body, c.line_body}
+    for f in mech.forces:
+        if isinstance(f, PointToPoint):
+            used |= {f.body_a, f.body_b}
+    out = set()
+    for b in mech.bodies:
+        if b.massless and b.name not in used:
+            if sum(1 for j in mech.joints if j.parent == b.name) == 1:
+                out.add(b.name)
+    return out
+
+
 def _check(mech: Mechanism) -> str:
     """Empty string when the mechanism can be translated, else the reason."""
-    why = {"PointOnPoint": "MuJoCo's connect equality is soft (solref/solimp)",
-           "PointOnLine": "MuJoCo has no point-on-line equality",
-           "LinearCoupling": "MuJoCo's joint/tendon equalities are soft"}
-    kinds = sorted({type(c).__name__ for c in getattr(mech, "constraints", ())})
-    if kinds:
-        return ("closure constraints are not translated by this backend: "
-                + "; ".join(f"{k}: {why.get(k, 'unknown constraint type')}" for k in kinds))
     for b in mech.bodies:
         for x in (b.mass, b.inertia):
             if sp.sympify(x).free_symbols:
                 return f"body {b.name}: parameters are not numeric (use numeric_mechanism)"
         m, inertia = _num(b.mass), _num(b.inertia)
-        if b.massless:
-            children = [j for j in mech.joints if j.parent == b.name]
-            if len(children) != 1:
-                return (f"massless body {b.name} has {len(children)} child joints; MuJoCo "
-                        "rejects massless moving bodies and its joints can only be folded "
-                        "into exactly one child")
-        elif m <= 0 or inertia <= 0:
+        if not b.massless and (m <= 0 or inertia <= 0):
             return (f"body {b.name}: mass {m} and inertia {inertia} must both be > 0 "
                     "(MuJoCo rejects moving bodies with zero mass or inertia)")
+    if all(b.massless for b in mech.bodies):
+        return "every body is massless (no mass scale for the substitute bodies)"
     if sp.sympify(mech.gravity).free_symbols:
         return "gravity is not numeric"
-    massless = {b.name for b in mech.bodies if b.massless}
     placeholders = {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}
     for f in mech.forces:
         if not isinstance(f, (PointToPoint, CoordinateForce)):
@@ -173,18 +214,33 @@ def _check(mech: Mechanism) -> str:
         law = f.tension if isinstance(f, PointToPoint) else f.force
         if sp.sympify(law).free_symbols - placeholders:
             return f"force element {f.name}: law has non-numeric parameters"
-        if isinstance(f, PointToPoint):
-            for body in (f.body_a, f.body_b):
-                if body in massless:
-                    return (f"force element {f.name} is attached to massless body {body}, "
-                            "which has no MJCF body of its own after folding")
     for j in mech.joints:
         if isinstance(j, Prismatic) and math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0:
             return f"joint {j.name}: zero axis"
+    for c in mech.constraints:
+        if isinstance(c, LinearCoupling):
+            nums = [v for _, v in c.coefficients] + [c.constant]
+        elif isinstance(c, PointOnPoint):
+            nums = [*c.point_a, *c.point_b]
+        elif isinstance(c, PointOnLine):
+            nums = [*c.point, *c.line_point, *c.direction]
+        else:
+            return (f"constraint {c!r}: unknown constraint type (MuJoCo translates "
+                    "PointOnPoint, PointOnLine and LinearCoupling)")
+        if any(sp.sympify(x).free_symbols for x in nums):
+            return f"constraint {c.name}: parameters are not numeric (use numeric_mechanism)"
+        if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
+            return f"constraint {c.name}: zero slot direction"
+        if isinstance(c, LinearCoupling) and not any(_num(v) for _, v in c.coefficients):
+            return f"constraint {c.name}: every coefficient is zero"
     return ""
 
 
-def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
+def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
+          opts: Mapping | None = None) -> _Plan:
+    """``opts``: the constraint settings (slider_mass_ratio, massless_mass_ratio,
+    substitute_gravcomp, solref, solimp); defaults when None."""
+    opts = dict(opts or {})
     n = len(mech.joints)
     idx = {j.name: i for i, j in enumerate(mech.joints)}
     # body angle = angle_c . q + angle_d (affine in the description coordinates)
@@ -212,9 +268,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
             A[i, i] = math.hypot(_num(j.axis[0]), _num(j.axis[1]))  # MuJoCo normalizes axes
     Ainv = np.linalg.inv(A)
 
+    foldable = _foldable(mech)
     carrier: dict[str, str] = {}
     for body in reversed([j.child for j in mech.joints]):
-        if mech.body(body).massless:
+        if body in foldable:
             child = next(j.child for j in mech.joints if j.parent == body)
             carrier[body] = carrier[child]
         else:
@@ -228,6 +285,29 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False) -> _Plan:
         mj_parent[name] = WORLD if parent == WORLD else carrier[parent]
 
     plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
+    plan.opts = opts
+    m_min = min(_num(bd.mass) for bd in mech.bodies if not bd.massless)
+    sub_mass = float(opts.get("massless_mass_ratio", 1e-3)) * m_min
+    for bd in mech.bodies:
+        if bd.massless and bd.name not in foldable:
+            plan.substitutes[bd.name] = (sub_mass, sub_mass * GYRATION**2)
+    slider_mass = float(opts.get("slider_mass_ratio", 1e-3)) * m_min
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            plan.closures.append(_Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
+        elif isinstance(c, PointOnLine):
+            plan.closures.append(_Closure(
+                c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider",
+                WORLD if c.line_body == WORLD else carrier[c.line_body],
+                mass=slider_mass, inertia=slider_mass * GYRATION**2))
+        else:
+            coef = np.zeros(n)
+            for name, value in c.coefficients:
+                coef[mech.coordinates.index(name)] += _num(value)
+            w = Ainv.T @ coef  # c . q = c . A^-1 (v - b)
+            weights = {mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
+            plan.closures.append(_Closure(c, "tendon", weights=weights,
+                                          offset=_num(c.constant) + float(coef @ Ainv @ b)))
     joint_native: dict[int, list[float]] = {}
     for f in mech.forces:
         if isinstance(f, PointToPoint):
@@ -321,6 +401,28 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         for tag, body, pt in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
             sites.setdefault(body, []).append(
                 f'<site name="{f.name}:{tag}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+    gravcomp = ' gravcomp="1"' if plan.opts.get("substitute_gravcomp", True) else ""
+    sliders: dict[str, list[str]] = {}
+    for cl in plan.closures:
+        c = cl.element
+        if cl.kind == "connect":
+            for site, body, pt in ((cl.site1, c.body_a, c.point_a), (cl.site2, c.body_b, c.point_b)):
+                sites.setdefault(body, []).append(
+                    f'<site name="{site}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+        elif cl.kind == "slider":
+            sites.setdefault(c.body, []).append(
+                f'<site name="{cl.site1}" pos="{_fmt(_num(c.point[0]), _num(c.point[1]), 0)}"/>')
+            lp, dr = [_num(v) for v in c.line_point], [_num(v) for v in c.direction]
+            # the slot body's MJCF frame is its description frame (slot bodies are never
+            # folded): the slider starts at line_point, its joint value is the distance
+            # along the unit slot direction
+            sliders.setdefault(cl.parent, []).append("\n".join([
+                f'<body name="{cl.slider}" pos="{_fmt(lp[0], lp[1], 0)}"{gravcomp}>',
+                f'  <joint name="{cl.slider}" type="slide" axis="{_fmt(dr[0], dr[1], 0)}"/>',
+                f'  <inertial pos="0 0 0" mass="{_fmt(cl.mass)}" '
+                f'diaginertia="{_fmt(cl.inertia, cl.inertia, cl.inertia)}"/>',
+                f'  <site name="{cl.site2}"/>',
+                "</body>"]))
 
     def body_xml(name: str, depth: int) -> list[str]:
         ind = "  " * depth
@@ -349,6 +451,9 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
                 lines.append(f'{ind}  <joint name="{j.name}" type="slide" '
                              f'axis="{_fmt(ax[0], ax[1], 0)}"{extra}/>')
         m, inertia = _num(body.mass), _num(body.inertia)
+        if name in plan.substitutes:
+            m, inertia = plan.substitutes[name]
+            lines[0] = lines[0][:-1] + gravcomp + ">"
         lines.append(f'{ind}  <inertial pos="0 0 0" mass="{_fmt(m)}" '
                      f'diaginertia="{_fmt(inertia, inertia, inertia)}"/>')
         lines += [f"{ind}  {g}" for g in map(_shape_geoms, body.shapes) if g]
@@ -356,6 +461,8 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         for child in plan.chains:
             if plan.mj_parent[child] == name:
                 lines += body_xml(child, depth + 1)
+        for sl in sliders.get(name, []):
+            lines += [f"{ind}  {x}" for x in sl.split("\n")]
         lines.append(f"{ind}</body>")
         return lines
 
@@ -373,9 +480,16 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
     for name in plan.chains:
         if plan.mj_parent[name] == WORLD:
             out += body_xml(name, 2)
+    for sl in sliders.get(WORLD, []):
+        out += [f"    {x}" for x in sl.split("\n")]
     out.append("  </worldbody>")
-    if plan.p2p:
+    couplings = [cl for cl in plan.closures if cl.kind == "tendon"]
+    if plan.p2p or couplings:
         out.append("  <tendon>")
+        for cl in couplings:
+            out.append(f'    <fixed name="{cl.element.name}">')
+            out += [f'      <joint joint="{jn}" coef="{_fmt(w)}"/>' for jn, w in cl.weights.items()]
+            out.append("    </fixed>")
         for e in plan.p2p:
             k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
             out.append(f'    <spatial name="{e.tendon}" stiffness="{_fmt(k)}" '
@@ -384,6 +498,20 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
             out.append(f'      <site site="{e.element.name}:b"/>')
             out.append("    </spatial>")
         out.append("  </tendon>")
+    if plan.closures:
+        tau, zeta = plan.opts.get("solref", (0.02, 1.0))
+        soft = (f' solref="{_fmt(tau, zeta)}" '
+                f'solimp="{_fmt(*plan.opts.get("solimp", (0.9, 0.95, 0.001, 0.5, 2)))}"')
+        out.append("  <equality>")
+        for cl in plan.closures:
+            name = cl.element.name
+            if cl.kind == "tendon":
+                out.append(f'    <tendon name="{name}" tendon1="{name}" '
+                           f'polycoef="{_fmt(cl.offset, 0, 0, 0, 0)}"{soft}/>')
+            else:
+                out.append(f'    <connect name="{name}" site1="{cl.site1}" site2="{cl.site2}"'
+                           f'{soft}/>')
+        out.append("  </equality>")
     out.append("</mujoco>")
     return "\n".join(out) + "\n"
 
@@ -403,11 +531,62 @@ class _Compiled:
             self.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
         else:
             self.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        dis_refsafe = int(mujoco.mjtDisableBit.mjDSBL_REFSAFE)
+        if plan.opts.get("refsafe", True):
+            self.model.opt.disableflags &= ~dis_refsafe
+        else:
+            self.model.opt.disableflags |= dis_refsafe
+        diagexact = int(mujoco.mjtEnableBit.mjENBL_DIAGEXACT)
+        if plan.opts.get("diagexact", True):
+            self.model.opt.enableflags |= diagexact
+        else:
+            self.model.opt.enableflags &= ~diagexact
+        if plan.closures:
+            steps, zeta = plan.opts.get("timeconst_steps", 2.0), plan.opts.get("dampratio", 1.0)
+            self.model.eq_solref[:] = (float(steps) * dt, float(zeta))
+            self.model.eq_solimp[:] = plan.opts.get("solimp", (0.9, 0.95, 0.001, 0.5, 2))
         self.data = mujoco.MjData(self.model)
         names = [j.name for j in plan.mech.joints]
         self.qadr = np.array([self.model.joint(nm).qposadr[0] for nm in names])
         self.vadr = np.array([self.model.joint(nm).dofadr[0] for nm in names])
+        sliders = [cl for cl in plan.closures if cl.kind == "slider"]
+        self.slider_jnt = np.array([self.model.joint(cl.slider).id for cl in sliders], dtype=int)
+        self.slider_qadr = np.array([self.model.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_vadr = np.array([self.model.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_sites = [(self.model.site(cl.site1).id, self.model.site(cl.site2).id)
+                             for cl in sliders]
+        self.eq_id = [self.model.equality(cl.element.name).id for cl in plan.closures]
         self.callback = self._make_callback()
+
+    def closure_state(self) -> tuple[list[np.ndarray], np.ndarray]:
+        """After mj_forward: per closure, its force in the contract's physical terms, and
+        its violation (PointOnPoint: distance of the two points, m; PointOnLine: signed
+        distance of the pin from the slot line, m; LinearCoupling: Phi)."""
+        m, d = self.model, self.data
+        rows: dict[int, list[int]] = {}
+        eq_type = int(self.mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        for r in range(d.nefc):
+            if d.efc_type[r] == eq_type:
+                rows.setdefault(int(d.efc_id[r]), []).append(r)
+        forces, viol = [], np.empty(len(self.plan.closures))
+        k_slider = 0
+        for i, (cl, eid) in enumerate(zip(self.plan.closures, self.eq_id)):
+            rr = rows.get(eid, [])
+            f, pos = d.efc_force[rr], d.efc_pos[rr]
+            if cl.kind == "tendon":
+                # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
+                forces.append(np.array([f[0]]))
+                viol[i] = pos[0]
+            elif cl.kind == "connect":
+                # rows p1 - p2 (world), J = J1 - J2: f acts on body_a at site1
+                forces.append(np.array(f[:2]))
+                viol[i] = math.hypot(pos[0], pos[1])
+            else:
+                forces.append(np.array(f[:2]))  # on the pin (site1) from the slider
+                u = d.xaxis[self.slider_jnt[k_slider]]
+                viol[i] = -u[1] * pos[0] + u[0] * pos[1]  # slot normal . (P - L)
+                k_slider += 1
+        return forces, viol
 
     def _make_callback(self):
         plan, model = self.plan, self.model
@@ -455,10 +634,31 @@ class _Compiled:
         return passive
 
     def set_state(self, q: np.ndarray, qd: np.ndarray, t: float = 0.0) -> None:
-        d = self.data
+        """Description state -> MuJoCo state; the slider bodies of point-on-line
+        constraints are placed where the (consistent) state puts the pins: their slide
+        value is (P - L) . u and its rate (v_P - v_L) . u, with v_L the velocity of the
+        slot body's material point under the slider."""
+        mujoco, m, d = self.mujoco, self.model, self.data
         d.qpos[self.qadr] = self.plan.engine_values(q)
         d.qvel[self.vadr] = self.plan.A @ np.asarray(qd, dtype=float)
         d.time = t
+        if len(self.slider_jnt):
+            d.qpos[self.slider_qadr] = 0.0
+            d.qvel[self.slider_vadr] = 0.0
+            mujoco.mj_kinematics(m, d)
+            for k, (pin, sl) in enumerate(self.slider_sites):
+                u = d.xaxis[self.slider_jnt[k]]
+                d.qpos[self.slider_qadr[k]] = (d.site_xpos[pin] - d.site_xpos[sl]) @ u
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            jp, js = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+            rates = []
+            for k, (pin, sl) in enumerate(self.slider_sites):
+                mujoco.mj_jacSite(m, d, jp, None, pin)
+                mujoco.mj_jacSite(m, d, js, None, sl)
+                u = d.xaxis[self.slider_jnt[k]]
+                rates.append(((jp - js) @ d.qvel) @ u)
+            d.qvel[self.slider_vadr] = rates
 
 
 class _PassiveInstalled:
@@ -501,6 +701,14 @@ class MujocoBackend(Backend):
             "linearization": "inverseFD",
             "fd_eps": 1e-6,
             "autoreset": False,
+            "constraint_timeconst_steps": 2.0,
+            "constraint_dampratio": 1.0,
+            "constraint_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
+            "refsafe": True,
+            "diagexact": True,
+            "slider_mass_ratio": 1e-3,
+            "massless_mass_ratio": 1e-3,
+            "substitute_gravcomp": True,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -547,11 +755,25 @@ class MujocoBackend(Backend):
                              f"got {s['linearization']!r}")
         return s
 
-    def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False) -> _Plan:
+    def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
+              dt: float | None = None) -> _Plan:
         reason = _check(mechanism)
         if reason:
             raise ValueError(f"mujoco cannot express this mechanism: {reason}")
-        return _plan(mechanism, bool(settings["native_springs"]), autonomous)
+        steps = float(settings["constraint_timeconst_steps"])
+        opts = {
+            "slider_mass_ratio": float(settings["slider_mass_ratio"]),
+            "massless_mass_ratio": float(settings["massless_mass_ratio"]),
+            "substitute_gravcomp": bool(settings["substitute_gravcomp"]),
+            "timeconst_steps": steps,
+            "dampratio": float(settings["constraint_dampratio"]),
+            # the MJCF default timestep (0.002 s) when the file is written without one
+            "solref": (steps * (dt or 0.002), float(settings["constraint_dampratio"])),
+            "solimp": tuple(float(x) for x in settings["constraint_solimp"]),
+            "refsafe": bool(settings["refsafe"]),
+            "diagexact": bool(settings["diagexact"]),
+        }
+        return _plan(mechanism, bool(settings["native_springs"]), autonomous, opts)
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
                 dt: float | None = None) -> str:
@@ -559,12 +781,13 @@ class MujocoBackend(Backend):
         when given, the time step), to save and load with ``MjModel.from_xml_path``.
         Laws that need the passive callback are not in the file."""
         s = self._resolve(settings)
-        xml = self._plan(mechanism, s).xml
+        xml = self._plan(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
         if not s["autoreset"]:
-            xml = xml.replace('<flag contact="disable"/>',
-                              '<flag contact="disable" autoreset="disable"/>', 1)
+            xml = xml.replace('<flag contact="disable"', '<flag contact="disable" autoreset="disable"', 1)
+        if not s["refsafe"]:
+            xml = xml.replace('<flag contact="disable"', '<flag contact="disable" refsafe="disable"', 1)
         return xml
 
     # --- simulation ----------------------------------------------------------------------
@@ -574,7 +797,7 @@ class MujocoBackend(Backend):
         import mujoco
 
         s = self._resolve(settings)
-        plan = self._plan(mechanism, s)
+        plan = self._plan(mechanism, s, dt=dt)
         for name in reaction_joints:
             mechanism.joint(name)  # KeyError for an unknown joint
         comp = _Compiled(plan, s["integrator"], dt, bool(s["autoreset"]))
@@ -595,13 +818,41 @@ class MujocoBackend(Backend):
             wall = time.perf_counter() - start
             t = dt * np.arange(steps + 1)
             reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
+            forces, violation = self._closures(comp, qpos, qvel, t)
         V = qpos[:, comp.qadr]
         VD = qvel[:, comp.vadr]
         q = (V - plan.b) @ plan.Ainv.T
         qd = VD @ plan.Ainv.T
-        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                         integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
-                         steps=steps)
+        run = RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
+                        integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
+                        steps=steps, constraint_forces=forces)
+        # the substitute's own error: each closure's violation at every sample (not part
+        # of the contract; read by the reports when present)
+        run.constraint_violation = violation
+        return run
+
+    def _closures(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
+                  t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """Constraint forces (contract point 6) and violations at each sampled state."""
+        closures = comp.plan.closures
+        if not closures:
+            return {}, {}
+        import mujoco
+
+        m, d = comp.model, comp.data
+        N = len(t)
+        forces = [np.empty((N, 1 if cl.kind == "tendon" else 2)) for cl in closures]
+        viol = np.empty((N, len(closures)))
+        for k in range(N):
+            d.qpos[:] = qpos[k]
+            d.qvel[:] = qvel[k]
+            d.time = t[k]
+            mujoco.mj_forward(m, d)
+            f, viol[k] = comp.closure_state()
+            for i, fi in enumerate(f):
+                forces[i][k] = fi
+        names = [cl.element.name for cl in closures]
+        return dict(zip(names, forces)), {nm: viol[:, i] for i, nm in enumerate(names)}
 
     def _reactions(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
                    joints: Sequence[str]) -> dict[str, np.ndarray]:
@@ -674,7 +925,7 @@ class MujocoBackend(Backend):
         import mujoco
 
         s = self._resolve(settings)
-        plan = self._plan(mechanism, s, autonomous=True)
+        plan = self._plan(mechanism, s, autonomous=True, dt=dt)
         n, eps = plan.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the

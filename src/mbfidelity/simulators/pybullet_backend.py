@@ -8,14 +8,16 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   places it (the body's ``child_anchor``) with the body's orientation; the inertial frame
   is offset by ``-child_anchor`` so that it is the body frame (origin at the centre of
   mass). PyBullet's ``linkPositions`` are relative to the parent's link frame.
-- ``Revolute``: axis z; ``angle_offset`` is the joint frame's orientation. Absolute angles
-  (``absolute=True``) and non-unit prismatic axes make the engine's joint values an affine
-  map of the description coordinates, ``jv = A q + b``; states map back with ``A^-1`` and
-  generalized forces map as ``tau = A^-T Q``.
+- ``Revolute``: axis z; ``angle_offset`` is the joint frame's orientation. Absolute
+  angles (``absolute=True``), clockwise coordinates and non-unit prismatic axes make the
+  engine's joint values an affine map of the description coordinates, ``jv = A q + b``;
+  states map back with ``A^-1`` and generalized forces map as ``tau = A^-T Q``.
 - ``Prismatic``: axis in the x-y plane of the joint frame (the parent axis rotated by
   ``-angle_offset``), normalised (its length goes into ``A``).
 - Massless bodies are links of mass 0 and inertia 0: Featherstone's articulated-body
   algorithm only inverts the articulated inertia of each joint, which the child carries.
+- Closure constraints are not translated (PyBullet's ``createConstraint`` is a
+  velocity-level, drifting solver; see SIMULATORS.md): `support` says so.
 - ``CoordinateForce``: joint forces through ``setJointMotorControlArray(TORQUE_CONTROL)``
   every step. ``PointToPoint``: ``applyExternalForce`` (world frame) at both points every
   step, from the engine's own link states. Both are evaluated at the state and time at
@@ -132,13 +134,14 @@ class _Plan:
             axis_parent = np.zeros(2)
             if isinstance(j, Revolute):
                 axis = [0.0, 0.0, 1.0]
+                turn = -e_i if getattr(j, "clockwise", False) else e_i
                 if j.absolute:
-                    ang_c[j.child], ang_d[j.child] = e_i.copy(), off
-                    A[i] = e_i - ang_c[j.parent]
+                    ang_c[j.child], ang_d[j.child] = turn.copy(), off
+                    A[i] = turn - ang_c[j.parent]
                     b[i] = -ang_d[j.parent]
                 else:
-                    ang_c[j.child], ang_d[j.child] = ang_c[j.parent] + e_i, ang_d[j.parent] + off
-                    A[i] = e_i
+                    ang_c[j.child], ang_d[j.child] = ang_c[j.parent] + turn, ang_d[j.parent] + off
+                    A[i] = turn
             elif isinstance(j, Prismatic):
                 ax = np.array([_num(j.axis[0]), _num(j.axis[1])])
                 length = float(np.hypot(*ax))
@@ -282,7 +285,9 @@ class PyBulletBackend(Backend):
     def support(self, mechanism: Mechanism) -> Support:
         extra = getattr(mechanism, "constraints", ())
         if extra:
-            return Support(False, "closure constraints are not translated by this backend")
+            names = ", ".join(f"{c.name} ({type(c).__name__})" for c in extra)
+            return Support(False, "closure constraints are not translated by this backend "
+                                  f"(reduced-coordinate tree only): {names}")
         for j in mechanism.joints:
             if not isinstance(j, (Revolute, Prismatic)):
                 return Support(False, f"joint type {type(j).__name__} not supported")
@@ -626,9 +631,13 @@ class PyBulletBackend(Backend):
                                               (pf.link_a, pf.point_a, -1.0)):
                         if link < 0:
                             continue
+                        # calculateJacobian takes the point in the URDF link frame (the
+                        # joint frame), not about the centre of mass as its docstring says
+                        ip = plan.links[link].inertial_position
                         jac_t, _ = p.calculateJacobian(
-                            body, eidx[link], [point[0], point[1], 0.0], list(map(float, jv)),
-                            list(map(float, jvd)), zeros, physicsClientId=cid)
+                            body, eidx[link], [point[0] + ip[0], point[1] + ip[1], 0.0],
+                            list(map(float, jv)), list(map(float, jvd)), zeros,
+                            physicsClientId=cid)
                         J = np.asarray(jac_t)[:2]
                         tau = tau + sign * (J.T @ np.array([fx, fy]))
                 return tau

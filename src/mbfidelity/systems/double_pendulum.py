@@ -15,7 +15,7 @@ hinge angles use phi2 - phi1. The monograph prints T, V, M and K at q_eq = (0, 0
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 PARAMETERS = (
@@ -57,6 +57,15 @@ def printed(P):
     )
 
 
+_PYBULLET_REASON = (
+    "PyBullet integrates reduced coordinates with semi-implicit Euler; here the mass "
+    "matrix depends on the configuration (the coupling term 2 m l^2 cos(phi2 - phi1)), so"
+    " the scheme is not symplectic and the phase drifts at first order, (w h) w T, beyond"
+    " the semi-implicit-Euler gate (measured 2.3e-2 against a 1.1e-2 gate at dt = 1e-3, "
+    "converging at first order). Pymunk's maximal coordinates have a constant mass matrix"
+    " and stay within it."
+)
+
 SYSTEM = System(
     id="double_pendulum",
     title="Double pendulum of two equal bars",
@@ -72,4 +81,9 @@ SYSTEM = System(
                  description="0.6/0.3 rad from rest: nonlinear but not chaotic over 10 s"),
     ),
     reaction_joints=("pivot", "elbow"),
+    expectations=tuple(
+        Expectation("pybullet", f"moderate.{name}", "xfail",
+                    _PYBULLET_REASON)
+        for name in ["trajectory_max", "reaction_pivot", "reaction_elbow"]
+    ),
 )

@@ -14,7 +14,7 @@ between O and G with tension k s (free length 0). s > 0.
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (Body, Circle, Mechanism, Parameter, PointToPoint, Prismatic, Revolute,
                     Scenario, linear_spring_damper)
 
@@ -55,6 +55,15 @@ def printed(P):
     )
 
 
+_PYBULLET_REASON = (
+    "PyBullet integrates reduced coordinates with semi-implicit Euler; here the mass "
+    "matrix depends on the configuration (m s^2 + I_G and Coriolis terms), so the scheme "
+    "is not symplectic and the phase drifts at first order, (w h) w T, beyond the semi-"
+    "implicit-Euler gate (measured 2.2e-1 against a 2.7e-2 gate at dt = 1e-3, converging "
+    "at first order). Pymunk's maximal coordinates have a constant mass matrix and stay "
+    "within it."
+)
+
 SYSTEM = System(
     id="elastic_pendulum",
     title="Elastic pendulum (body on a zero-free-length spring)",
@@ -70,5 +79,10 @@ SYSTEM = System(
                  description="0.5 rad and 30 mm: swing and stretch exchange energy (at 0.8 rad "
                              "and 50 mm the motion is chaotic: a 1e-8 rad change grows 3e4-fold "
                              "in 10 s, so no trajectory comparison is meaningful)"),
+    ),
+    expectations=tuple(
+        Expectation("pybullet", f"large.{name}", "xfail",
+                    _PYBULLET_REASON)
+        for name in ["trajectory_max", "trajectory_rms", "energy_drift"]
     ),
 )

@@ -14,7 +14,7 @@ derivation by `mbfidelity errata`.
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (Body, CoordinateForce, Mechanism, Parameter, Prismatic, Rectangle,
                     Revolute, Scenario, coordinate_spring_damper)
 
@@ -56,6 +56,15 @@ def printed(P):
     )
 
 
+_PYBULLET_REASON = (
+    "PyBullet integrates reduced coordinates with semi-implicit Euler; here the mass "
+    "matrix depends on the configuration (m rho^2 + I_G and Coriolis terms), so the "
+    "scheme is not symplectic and the phase drifts at first order, (w h) w T, beyond the "
+    "semi-implicit-Euler gate (measured 3.4e-1 against a 4.3e-2 gate at dt = 1e-3, "
+    "converging at first order). Pymunk's maximal coordinates have a constant mass matrix"
+    " and stay within it."
+)
+
 SYSTEM = System(
     id="pendulum_sliding_block",
     title="Pendulum with a block sliding on a massless arm",
@@ -69,5 +78,10 @@ SYSTEM = System(
                  description="near the equilibrium (0, rho0)"),
         Scenario("large", {"phi": 1.5, "rho": "rho0"}, checks=("trajectory",),
                  description="1.5 rad: centrifugal and gravity terms along the arm matter"),
+    ),
+    expectations=tuple(
+        Expectation("pybullet", f"large.{name}", "xfail",
+                    _PYBULLET_REASON)
+        for name in ["trajectory_max", "trajectory_rms"]
     ),
 )
