@@ -86,8 +86,11 @@ def test_two_routes_to_the_linearization_agree(system_id):
         M1, C1, K1 = model.linearization(eq.q)
         M2, C2, K2 = model.energy_linearization(eq.q)
         scale = max(np.abs(K1).max(), 1.0)
+        # exact Hessians, except loops without a closed-form reduction, whose reduced
+        # potential is differentiated numerically (Richardson, ~1e-9)
+        numeric = model.constrained and model._hess_V_reduced is None
         np.testing.assert_allclose(M1, M2, atol=1e-12 * np.abs(M1).max())
-        np.testing.assert_allclose(K1, K2, atol=1e-12 * scale)
+        np.testing.assert_allclose(K1, K2, atol=(1e-6 if numeric else 1e-12) * scale)
         np.testing.assert_allclose(C1, C2, atol=1e-12 * max(np.abs(C1).max(), 1.0))
 
 

@@ -106,8 +106,12 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     system = _system(system_id)
     values = _values(system, _parse_params(param))
     coords = list(system.coordinates)
-    eqs = find_equilibria(system, values)
-    op = operating_equilibrium(system, values)
+    try:
+        eqs = find_equilibria(system, values)
+        op = operating_equilibrium(system, values)
+    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
+        _fail(f"{system.id} with these parameters has no assembled equilibrium near its "
+              f"operating point ({exc})")
     equilibria = []
     for e in eqs:
         item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}

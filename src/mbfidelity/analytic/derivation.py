@@ -227,8 +227,13 @@ class Derivation:
             self._explicit_dependent = None
             if self.m:
                 dep = [self.q[i] for i in self.dependent]
+                # sympy's solve does not return on trigonometric loops of several unknowns
+                # (the five-bar loop): try it only when it is a single unknown or linear
+                linear = all(sp.Poly(r, *dep).is_linear if r.is_polynomial(*dep) else False
+                             for r in self.Phi)
                 try:
-                    sols = sp.solve(list(self.Phi), dep, dict=True)
+                    sols = sp.solve(list(self.Phi), dep, dict=True) if (
+                        len(dep) == 1 or linear) else []
                 except NotImplementedError:
                     sols = []
                 if len(sols) == 1 and set(sols[0]) == set(dep):

@@ -42,9 +42,17 @@ class Erratum:
 
 
 def _parameter_sets(system: System, rng) -> list[dict[str, float]]:
+    """The defaults and one random perturbation (+-30 %) that keeps the mechanism
+    assembled with an equilibrium near its operating point (redrawn otherwise)."""
     base = system.parameter_values()
-    perturbed = {k: (v * rng.uniform(0.7, 1.3) if v != 0 else v) for k, v in base.items()}
-    return [base, perturbed]
+    for _ in range(50):
+        perturbed = {k: (v * rng.uniform(0.7, 1.3) if v != 0 else v) for k, v in base.items()}
+        try:
+            operating_equilibrium(system, perturbed)
+        except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError):
+            continue
+        return [base, perturbed]
+    return [base]
 
 
 def _random_states(system: System, values, rng, count: int = 25):
@@ -59,12 +67,17 @@ def _random_states(system: System, values, rng, count: int = 25):
         for i, j in enumerate(system.mechanism.joints):
             if j.coordinate not in independent:
                 continue
+            # closed loops: stay near the operating assembly branch (a large step may
+            # land on another branch or a singular pose, where printed formulas lapse)
+            spread = 0.3 if model.constrained else 1.2
             if isinstance(j, Prismatic):
-                q[i] = op[i] * rng.uniform(0.6, 1.4) + (0 if op[i] else rng.uniform(-0.1, 0.1))
+                q[i] = op[i] * rng.uniform(1 - spread / 3, 1 + spread / 3) + (
+                    0 if op[i] else rng.uniform(-0.1, 0.1))
             else:
-                q[i] = op[i] + rng.uniform(-1.2, 1.2)
+                q[i] = op[i] + rng.uniform(-spread, spread)
         try:
             q = model.complete(q)
+            model.velocity_basis(q)
         except (RuntimeError, np.linalg.LinAlgError):
             continue
         qd = model.velocity_basis(q) @ rng.uniform(-1.5, 1.5, size=len(model.independent))
@@ -198,6 +211,17 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
             worst = max(worst, abs(value - best) / max(abs(best), 1e-300))
             derived_text = f"{best:.12g} (closest derived mode, " + (
                 "|s| rad/s)" if pf.kind == "frequency" else "zeta)")
+        elif pf.kind == "constraint_force":
+            name, expr = pf.expr
+            derived_text = f"from the multipliers of constraint {name!r}"
+            exprs = list(expr) if isinstance(expr, (list, tuple, sp.MatrixBase)) else [expr]
+            for q, qd, t in _random_states(system, values, rng):
+                qdd, lam = model.dynamics(q, qd, t)
+                f = model.constraint_forces(q[None, :], lam[None, :])[name][0]
+                env = _env(system, values, q, qd, qdd, t)
+                printed = np.array([float(sp.sympify(e).xreplace(env)) for e in exprs])
+                worst = max(worst, float(np.max(np.abs(printed - f[:len(printed)])))
+                            / max(float(np.max(np.abs(f))), 1e-12))
         else:
             raise ValueError(f"unknown printed-formula kind {pf.kind!r}")
     return worst, derived_text

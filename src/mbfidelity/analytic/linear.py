@@ -14,7 +14,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..systems import System
-from ..systems.model import Prismatic
+from ..systems.model import PointOnLine, PointOnPoint, Prismatic
 from .numeric import NumericModel, numeric_model
 
 #: relative size below which the real part of an eigenvalue counts as zero (conservative
@@ -158,15 +158,64 @@ def _solve_static(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
         return model.static_residual(full(qi))
 
     def jac(qi):
-        return model.linearization(full(qi))[2]
+        return model.linearization(full(qi), chart=True)[2]
 
     try:
         sol = scipy.optimize.root(f, base[ind], jac=jac, method="hybr", tol=1e-14)
         q = full(sol.x)
-    except (RuntimeError, np.linalg.LinAlgError):
+    except (RuntimeError, ValueError, np.linalg.LinAlgError):
         return None
-    scale = max(1.0, float(np.max(np.abs(model.linearization(q)[2]))))
-    if not np.all(np.isfinite(q)) or np.max(np.abs(model.static_residual(q))) > 1e-9 * scale:
+    if not np.all(np.isfinite(q)) or not _regular(model, q, base):
+        return None
+    # residual judged on the scale of the stiffness where the search started: a
+    # coordinate singularity (slot parallel to its guide) has a huge K of its own
+    scale = max(1.0, float(np.max(np.abs(model.linearization(base, chart=True)[2]))))
+    if np.max(np.abs(model.static_residual(q))) > 1e-9 * scale:
+        return None
+    return q
+
+
+def _regular(model: NumericModel, q: np.ndarray, start: np.ndarray, chart: bool = True) -> bool:
+    """Not a coordinate singularity: the dependent coordinates stay finite and (in the
+    chart of the independent coordinates) the constraint Jacobian stays well
+    conditioned."""
+    if np.max(np.abs(q)) > 1e6 * max(1.0, float(np.max(np.abs(start)))):
+        return False
+    if model.constrained and chart:
+        J = model.constraint_jacobian(q)[:, model.dependent]
+        if np.linalg.cond(J) > 1e10:
+            return False
+    return True
+
+
+def _full_search_starts(system: System, values, op: np.ndarray) -> list[np.ndarray]:
+    """Starts over every angular coordinate (dependent ones included), 4 per period, for
+    closed loops whose other assembly branches no chart of independent coordinates
+    reaches."""
+    axes = []
+    for i, j in enumerate(system.mechanism.joints):
+        if isinstance(j, Prismatic):
+            axes.append([op[i]])
+        else:
+            axes.append(op[i] + np.linspace(-np.pi, np.pi, 4, endpoint=False))
+    return [np.array(p) for p in itertools.product(*axes)]
+
+
+def _solve_full(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
+    x0 = np.concatenate([start, np.zeros(model.m)])
+    try:
+        sol = scipy.optimize.root(model.static_equations, x0, jac=model.static_jacobian,
+                                  method="hybr", tol=1e-14)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    q = sol.x[: model.n]
+    if not sol.success or not np.all(np.isfinite(sol.x)):
+        return None
+    J = model.constraint_jacobian(q)
+    if np.linalg.matrix_rank(J, tol=1e-8 * max(1.0, np.abs(J).max())) < model.m:
+        return None  # a singular pose (e.g. two pins coinciding): not a regular equilibrium
+    scale = max(1.0, float(np.max(np.abs(model.static_jacobian(sol.x)))))
+    if np.max(np.abs(model.static_equations(sol.x))) > 1e-9 * scale:
         return None
     return q
 
@@ -174,15 +223,24 @@ def _solve_static(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
 def find_equilibria(system: System, values) -> list[Equilibrium]:
     """Every equilibrium within one period of each angular coordinate (centred on the
     operating point), each classified by its linearization. The operating point comes
-    first when it is an equilibrium."""
+    first when it is an equilibrium. Closed loops are also searched in all coordinates
+    and multipliers, so that equilibria on other assembly branches are found."""
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     found: list[np.ndarray] = []
-    for start in [op] + _search_grid(system, values, op):
-        q = _solve_static(model, start)
-        if q is None:
+    candidates = [_solve_static(model, s) for s in [op] + _search_grid(system, values, op)]
+    if model.constrained and any(
+            isinstance(c, (PointOnPoint, PointOnLine)) for c in system.mechanism.constraints):
+        candidates += [_solve_full(model, s) for s in _full_search_starts(system, values, op)]
+    for q in candidates:
+        if q is None or not _regular(model, q, op, chart=False):
             continue
-        q = wrap_angles(system, q, op)
+        try:
+            # dependent coordinates re-solved after wrapping: a 2 pi shift of one angle
+            # is no symmetry of a linear coupling (belt, rolling)
+            q = model.complete(wrap_angles(system, q, op))
+        except (RuntimeError, np.linalg.LinAlgError):
+            continue
         if not _admissible(system, values, q):
             continue
         if any(_same_family(model, q, f) for f in found):
@@ -192,12 +250,23 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
 
 
 def _same_family(model: NumericModel, a: np.ndarray, b: np.ndarray) -> bool:
-    """Same equilibrium, or two members of one neutral family: their difference (in the
-    independent coordinates) lies in the null space of K, e.g. a free pulley angle
-    (one zero frequency, Fig. 38). A family is reported once, by its first member."""
-    diff = (a - b)[model.independent]
-    if np.allclose(diff, 0, atol=1e-7):
+    """Same equilibrium, or two members of one neutral family: their difference lies in
+    the null space of K, e.g. a free pulley angle (one zero frequency, Fig. 38). A family
+    is reported once, by its first member."""
+    if np.allclose(a, b, atol=1e-7):
         return True
+    if model.constrained:
+        # same assembly branch: b's configuration carried to a's independent coordinates
+        # by Newton lands on a
+        guess = b.copy()
+        guess[model.independent] = a[model.independent]
+        try:
+            carried = model.complete(guess)
+        except (RuntimeError, np.linalg.LinAlgError):
+            return False
+        if not np.allclose(carried, a, atol=1e-6):
+            return False
+    diff = (a - b)[model.independent]
     K = model.linearization(b)[2]
     u, sv, vt = np.linalg.svd(K)
     null = vt[sv <= 1e-9 * max(sv.max(), 1.0)]

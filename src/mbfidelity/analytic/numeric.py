@@ -88,6 +88,12 @@ class NumericModel:
                 _lambdify(qi + qdi, list(S * sp.Matrix(qdi)), modules="math"),
                 _lambdify(qi + qdi + [TIME], list(M_r.LUsolve(rhs_r)), modules="math"),
             )
+        # route 2 with closed-form constraints: exact Hessian of V(q(q_i))
+        self._hess_V_reduced = None
+        if reduced is not None and d.energy_route:
+            qi = [d.q[i] for i in self.independent]
+            V_r = d.V.xreplace(dict(zip(d.q, reduced[0]))).xreplace(self.subs)
+            self._hess_V_reduced = _lambdify(qi, sp.hessian(V_r, qi))
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
         #: no dissipation and no time-dependent load at these parameter values
@@ -203,9 +209,37 @@ class NumericModel:
         coordinates: zero at an equilibrium."""
         return -self.reduced_static_force(q)
 
-    def linearization(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(M, C, K) in the independent coordinates at the consistent configuration q."""
-        S = self.velocity_basis(q)
+    def static_equations(self, x: np.ndarray) -> np.ndarray:
+        """Equilibrium in all coordinates and multipliers, x = (q, lam):
+        Q(q) - Phi_q^T lam = 0 and Phi(q) = 0 (no chart of independent coordinates)."""
+        q, lam = x[: self.n], x[self.n:]
+        Q = np.array(self._Q_static(*q), dtype=float).reshape(-1)
+        return np.concatenate([Q - self.constraint_jacobian(q).T @ lam,
+                               self.constraint_values(q)])
+
+    def static_jacobian(self, x: np.ndarray) -> np.ndarray:
+        q, lam = x[: self.n], x[self.n:]
+        J = self.constraint_jacobian(q)
+        K = _matrix(self._lin_K, *q) + sum(l * _matrix(H, *q) for l, H in zip(lam, self._Phi_hess))
+        return np.block([[-K, -J.T], [J, np.zeros((self.m, self.m))]])
+
+    def tangent_basis(self, q) -> np.ndarray:
+        """Velocities allowed by the constraints: the chart of the independent
+        coordinates where it is regular, an orthonormal null-space basis of Phi_q on
+        another assembly branch where that chart is singular."""
+        if not self.constrained:
+            return np.eye(self.n)
+        J = self.constraint_jacobian(q)
+        if np.linalg.cond(J[:, self.dependent]) < 1e8:
+            return self.velocity_basis(q)
+        _, sv, vt = np.linalg.svd(J)
+        return vt[len(sv[sv > 1e-10 * sv.max()]):].T
+
+    def linearization(self, q, chart: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(M, C, K) in the independent coordinates at the consistent configuration q
+        (in a null-space basis where that chart is singular, unless `chart`; eigenvalues
+        do not depend on the basis)."""
+        S = self.velocity_basis(q) if chart else self.tangent_basis(q)
         M = self.mass_matrix(q)
         C = _matrix(self._lin_C, *q)
         K = _matrix(self._lin_K, *q)
@@ -216,8 +250,9 @@ class NumericModel:
 
     def energy_linearization(self, q):
         """(M, C, K) as Hessians of T, D, V (route 2), or None where it does not apply.
-        With constraints, K is the Hessian of the reduced potential V(q_i) by central
-        differences (an independent route, precise to ~1e-8 relative)."""
+        With constraints, K is the Hessian of the reduced potential V(q(q_i)): exact when
+        the constraints solve in closed form, otherwise by Richardson-extrapolated central
+        differences (precise to ~1e-9 relative)."""
         if not self.derivation.energy_route:
             return None
         S = self.velocity_basis(q)
@@ -225,22 +260,28 @@ class NumericModel:
         C = S.T @ _matrix(self._hess_D, *q) @ S
         if not self.constrained:
             return M, C, _matrix(self._hess_V, *q)
+        if self._hess_V_reduced is not None:
+            return M, C, _matrix(self._hess_V_reduced, *np.asarray(q)[self.independent])
         k = len(self.independent)
-        h = 1e-4
 
         def V(qi):
             guess = np.array(q, dtype=float)
             guess[self.independent] = qi
-            return float(self._V(*self.complete(guess)))
+            return float(np.real(self._V(*self.complete(guess))))
 
         qi0 = np.asarray(q, dtype=float)[self.independent]
-        K = np.zeros((k, k))
-        for a in range(k):
-            for b in range(k):
-                ea, eb = np.eye(k)[a] * h, np.eye(k)[b] * h
-                K[a, b] = (V(qi0 + ea + eb) - V(qi0 + ea - eb) - V(qi0 - ea + eb)
-                           + V(qi0 - ea - eb)) / (4 * h * h)
-        return M, C, K
+
+        def hessian(h):
+            K = np.zeros((k, k))
+            for a in range(k):
+                for b in range(k):
+                    ea, eb = np.eye(k)[a] * h, np.eye(k)[b] * h
+                    K[a, b] = (V(qi0 + ea + eb) - V(qi0 + ea - eb) - V(qi0 - ea + eb)
+                               + V(qi0 - ea - eb)) / (4 * h * h)
+            return K
+
+        # Richardson extrapolation of the O(h^2) central difference
+        return M, C, (4 * hessian(5e-4) - hessian(1e-3)) / 3
 
     # --- reactions -----------------------------------------------------------------------
     def reaction(self, joint: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,

@@ -66,10 +66,25 @@ def _full_states(model, y: np.ndarray, q0: np.ndarray):
     return q, qd
 
 
+_CACHE: dict = {}
+_CACHE_SIZE = 64
+
+
 def reference(system: System, scenario: Scenario, values: Mapping[str, float],
               dt: float, t_end: float | None = None,
               q0: np.ndarray | None = None, qd0: np.ndarray | None = None) -> Reference:
-    """Sampled every dt from 0 to t_end (the scenario's by default)."""
+    """Sampled every dt from 0 to t_end (the scenario's by default). Cached: every engine
+    of a comparison matrix is measured against the same solve."""
+    key = (system.id, scenario.name, tuple(sorted(values.items())), dt, t_end,
+           None if q0 is None else (tuple(q0), tuple(qd0)))
+    if key not in _CACHE:
+        if len(_CACHE) >= _CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[key] = _reference(system, scenario, values, dt, t_end, q0, qd0)
+    return _CACHE[key]
+
+
+def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
     t_end = scenario.t_end if t_end is None else t_end
     steps = int(round(t_end / dt))
     t = np.arange(steps + 1) * dt

@@ -48,6 +48,8 @@ class PrintedFormula:
       "equilibrium"       mapping coordinate -> printed equilibrium value
       "frequency"         natural angular frequency (rad/s) at the operating point
       "damping_ratio"     damping ratio at the operating point
+      "constraint_force"  (constraint name, expression or list of expressions in q, q_dot,
+                          q_ddot): its physical force (simulators/base.py point 6)
     Matrices, frequencies and damping ratios refer to the equilibrium `at` (independent
     coordinate -> value) when given, otherwise to the operating point.
     """

@@ -137,5 +137,9 @@ SYSTEM = System(
         Scenario("damped", {"phi": 2.0}, overrides={"c": 5.0},
                  checks=("trajectory", "constraint_force"),
                  description="guide friction c = 5 (§4.2), from 2 rad"),
+        Scenario("rotating", {"phi": 0}, {"phi": 40.0}, checks=("trajectory", "constraint_force"),
+                 description="40 rad/s at phi = 0: the disc turns over; the contact force of "
+                             "the bilateral model goes negative past phi ~ 2.2 rad (from "
+                             "about 34 rad/s at the defaults): a real block would lift off"),
     ),
 )

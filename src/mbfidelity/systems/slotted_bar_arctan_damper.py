@@ -28,7 +28,7 @@ that the motion never reaches from phi = 0 (|phi| = pi/2 would need x infinite).
 import sympy as sp
 
 from . import PrintedFormula, System, coordinate_symbols
-from .model import (COORD, COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
+from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Rectangle, Revolute, Scenario, Segment,
                     coordinate_spring_damper)
 

@@ -110,7 +110,7 @@ def build(P) -> Mechanism:
 
 def printed(P):
     y, y_d, y_dd = coordinate_symbols("y")
-    x, x_d, x_dd = coordinate_symbols("x")
+    x, x_d, _ = coordinate_symbols("x")
     phi, phi_d, phi_dd = coordinate_symbols("phi")
     m, I_G, b, k, c, l0, l, g = P.m, P.I_G, P.b, P.k, P.c, P.l0, P.l, P.g
     sec = sp.sec(phi)
