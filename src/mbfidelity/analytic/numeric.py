@@ -93,6 +93,9 @@ class NumericModel:
         if reduced is not None and d.energy_route:
             qi = [d.q[i] for i in self.independent]
             V_r = d.V.xreplace(dict(zip(d.q, reduced[0]))).xreplace(self.subs)
+            # |x| from lengths as sqrt(x^2): smooth where the length is not zero (no
+            # DiracDelta in the second derivative)
+            V_r = V_r.replace(sp.Abs, lambda a: sp.sqrt(a**2))
             self._hess_V_reduced = _lambdify(qi, sp.hessian(V_r, qi))
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
