@@ -28,8 +28,13 @@ NEWTON_TOL = 1e-14
 NEWTON_MAX = 50
 
 
+#: derivatives of |length| carry DiracDelta(length): zero wherever the length is not
+#: zero, which is everywhere a mechanism can be
+_DELTA = {"DiracDelta": lambda *args: 0.0}
+
+
 def _lambdify(args, expr, modules="numpy") -> Callable:
-    return sp.lambdify(args, expr, modules=modules, cse=True)
+    return sp.lambdify(args, expr, modules=[_DELTA, modules], cse=True)
 
 
 def _matrix(fn, *args) -> np.ndarray:
@@ -93,9 +98,6 @@ class NumericModel:
         if reduced is not None and d.energy_route:
             qi = [d.q[i] for i in self.independent]
             V_r = d.V.xreplace(dict(zip(d.q, reduced[0]))).xreplace(self.subs)
-            # |x| from lengths as sqrt(x^2): smooth where the length is not zero (no
-            # DiracDelta in the second derivative)
-            V_r = V_r.replace(sp.Abs, lambda a: sp.sqrt(a**2))
             self._hess_V_reduced = _lambdify(qi, sp.hessian(V_r, qi))
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
