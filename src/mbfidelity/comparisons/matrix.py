@@ -16,28 +16,34 @@ ROW_FIELDS = ("system", "simulator", "engine_version", "metric", "value", "toler
               "python", "platform")
 
 
-def _one(args) -> Comparison:
-    system, sim, dt = args
-    return compare(system, sim, dt=dt, keep_series=True)
+def _one_system(args) -> list[Comparison]:
+    """Every engine on one system, in one process: the references are solved once
+    (cached) and shared by all engines."""
+    system, sims, dt = args
+    return [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
 
 
 def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
                workers: int | None = None,
                progress: Callable[[Comparison], None] | None = None) -> list[Comparison]:
-    jobs = [(s, e, dt) for s in systems for e in simulators]
+    sims = list(simulators)
+    jobs = [(s, sims, dt) for s in systems]
     workers = workers or min(2, os.cpu_count() or 1)
     results: list[Comparison] = []
-    if workers <= 1:
-        for job in jobs:
-            results.append(_one(job))
-            if progress:
-                progress(results[-1])
-        return results
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        for res in pool.map(_one, jobs):
+
+    def collect(batch):
+        for res in batch:
             results.append(res)
             if progress:
                 progress(res)
+
+    if workers <= 1:
+        for job in jobs:
+            collect(_one_system(job))
+        return results
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        for batch in pool.map(_one_system, jobs):
+            collect(batch)
     return results
 
 
