@@ -87,8 +87,22 @@ def _judge(system: System, simulator: str, name: str, value: float, tol: float,
     ok = bool(np.isfinite(value) and value <= tol)
     exp = expectation_for(system, simulator, name)
     if exp is not None and exp.kind == "xfail":
-        return Metric(name, value, tol, ok, "xpass" if ok else "xfail", exp.reason, unit)
+        return Metric(name, value, tol, ok, "pass" if ok else "xfail", exp.reason, unit)
     return Metric(name, value, tol, ok, "pass" if ok else "fail", "", unit)
+
+
+def _strict_expectations(system: System, result: "Comparison") -> None:
+    """An expected failure covers the metrics its pattern matches and is met when at
+    least one of them fails; when every one passes it is an unexpected pass (strict):
+    the problem was fixed and the declaration must go."""
+    for exp in system.expectations:
+        if exp.kind != "xfail" or not fnmatch.fnmatch(result.simulator, exp.simulator):
+            continue
+        covered = [m for m in result.metrics if fnmatch.fnmatch(m.name, exp.metric)
+                   and expectation_for(system, result.simulator, m.name) is exp]
+        if covered and all(m.passed for m in covered):
+            for m in covered:
+                m.status = "xpass"
 
 
 def characteristic_frequency(eq_modes, ref_q, ref_qd, q_eq) -> float:
@@ -128,6 +142,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     for sc in chosen:
         _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series)
     _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series)
+    _strict_expectations(system, result)
     return result
 
 

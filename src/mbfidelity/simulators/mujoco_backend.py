@@ -22,7 +22,26 @@ Translation (generic over the description, see `to_mjcf`):
   TIME and its coordinate is one engine joint; otherwise the passive callback
   (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with ``d.time`` set to
   the stage time, so time loads are evaluated at stage times.
-- Closure constraints are not translated: `support` says so (MuJoCo equalities are soft).
+- Closure constraints become MuJoCo equalities, which are SOFT (solref/solimp; MuJoCo
+  clamps the impedance at 0.9999, so each row transmits at most 99.99 % of the needed
+  force at once and a small violation makes up the rest):
+  ``PointOnPoint`` -> ``connect`` between two sites (site1 on body_a);
+  ``PointOnLine`` (MuJoCo has no point-on-line equality) -> a substitute slider body, child
+  of the slot body with a slide joint along the slot, ``connect``-ed to a site at the pin.
+  The slider follows the pin, so its mass (``slider_mass_ratio`` of the largest admissible
+  point mass) is taken out of the pin body: mass, centre of mass and inertia of the pin
+  body are adjusted so that pin body + slider have the description's mass, first and
+  second moments (exact while the constraint holds); on a fixed pin the slider does not
+  move and its weight is cancelled (gravcomp). A light slider would make MuJoCo's per-row
+  regularisation (relative to each world-axis row's diagonal) soften the row across a
+  rotating slot; ``LinearCoupling`` -> a fixed tendon ``sum(w_j v_j)`` over the engine joint
+  values (w = A^-T c, any number of coordinates) held by a tendon equality (exact linear
+  relation). With ``rolling="contact"`` a rolling coupling of a disc inside a ring is built
+  as friction contact instead (`_rolling_geometry`). Massless bodies that cannot be folded
+  (several child joints, or loaded by a constraint or a point force) become substitute
+  bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
+  Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
+  every sample; the violation is returned as ``RunResult.constraint_violation``.
 - Prismatic ``limits`` are admissible intervals of the description, not stops; they are
   not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
   outside the interval).
@@ -139,10 +158,15 @@ class _Closure:
     offset: float = 0.0
     mass: float = 0.0
     inertia: float = 0.0
+    gravcomp: bool = False
+    coef: np.ndarray | None = None  # LinearCoupling: coefficients over the coordinates
+    contact: dict = field(default_factory=dict)  # rolling='contact': see _rolling_geometry
 
 
 #: radius of gyration of the substitute bodies (their inertia is mass * GYRATION**2)
 GYRATION = 0.01
+#: the same for sliders: they turn with the slot body, whose inertia they add to
+SLIDER_GYRATION = 1e-5
 
 
 @dataclass
@@ -163,6 +187,8 @@ class _Plan:
     coord: list[_Coord] = field(default_factory=list)
     #: substitute (mass, inertia) of massless bodies that cannot be folded
     substitutes: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: (mass, centre of mass, inertia) of pin bodies that carry slider mass
+    inertials: dict[str, tuple[float, tuple[float, float], float]] = field(default_factory=dict)
     closures: list[_Closure] = field(default_factory=list)
     opts: dict = field(default_factory=dict)
     xml: str = ""
@@ -191,6 +217,49 @@ def _foldable(mech: Mechanism) -> set[str]:
             if sum(1 for j in mech.joints if j.parent == b.name) == 1:
                 out.add(b.name)
     return out
+
+
+def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCoupling,
+                      coef: np.ndarray) -> dict | str:
+    """The friction-contact variant of a rolling coupling: a disc (a body with a Circle
+    centred on its hinge, radius r) carried by a massless arm hinged at the centre of a
+    Circle of radius R on a track body, at distance R - r (rolling inside). The coupling
+    must be the no-slip condition of that geometry, (R - r) a_arm + r a_disc - R a_track
+    (absolute angles). Returns the geometry or the reason it does not apply."""
+    names = [nm for nm, _ in c.coefficients]
+    for jd in mech.joints:
+        if jd.coordinate not in names or not isinstance(jd, Revolute):
+            continue
+        disc = mech.body(jd.child)
+        ca = [_num(v) for v in jd.child_anchor]
+        circles = [sh for sh in disc.shapes if isinstance(sh, Circle)
+                   and [_num(v) for v in sh.center] == ca]
+        if not circles or jd.parent == WORLD:
+            continue
+        r = _num(circles[0].radius)
+        arm = jd.parent
+        ja = mech.joint_of_child(arm)
+        if not isinstance(ja, Revolute) or arm not in foldable or ja.parent == WORLD:
+            return (f"the disc {disc.name}'s arm {arm} must be a massless body hinged on "
+                    "the track")
+        track = mech.body(ja.parent)
+        centre = [_num(v) for v in ja.parent_anchor]
+        rings = [sh for sh in track.shapes if isinstance(sh, Circle)
+                 and [_num(v) for v in sh.center] == centre]
+        if not rings:
+            return f"no Circle on {track.name} centred at the arm's hinge"
+        R = _num(rings[0].radius)
+        arm_len = math.dist([_num(v) for v in ja.child_anchor], [_num(v) for v in jd.parent_anchor])
+        if not (R > r and abs(arm_len - (R - r)) <= 1e-9 * R):
+            return f"the arm length {arm_len} is not R - r = {R - r} (rolling inside the ring)"
+        g = (R - r) * angle_c[arm] + r * angle_c[disc.name] - R * angle_c[track.name]
+        cn, gn = coef / np.linalg.norm(coef), g / np.linalg.norm(g)
+        if min(np.linalg.norm(cn - gn), np.linalg.norm(cn + gn)) > 1e-9:
+            return "the coupling is not the no-slip condition of the disc in the ring"
+        return {"disc": disc.name, "arm_joint": ja.name, "disc_joint": jd.name,
+                "track": track.name, "centre": centre, "R": R, "r": r,
+                "j": mech.joints.index(jd)}
+    return "no disc (a body with a Circle centred on its hinge) among the coupled coordinates"
 
 
 def _check(mech: Mechanism) -> str:
@@ -287,27 +356,90 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
     plan.opts = opts
     m_min = min(_num(bd.mass) for bd in mech.bodies if not bd.massless)
-    sub_mass = float(opts.get("massless_mass_ratio", 1e-3)) * m_min
+    # massless bodies that cannot be folded: a pure kinematic link (several children, no
+    # constraint or point force on it) carries no load of its own and can be very light;
+    # a massless body that a constraint or a point force loads must be heavier, because
+    # MuJoCo's soft constraints scale their stiffness with the mass they move
+    loaded = set()
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            loaded |= {c.body_a, c.body_b}
+        elif isinstance(c, PointOnLine):
+            loaded |= {c.body, c.line_body}
+    for f in mech.forces:
+        if isinstance(f, PointToPoint):
+            loaded |= {f.body_a, f.body_b}
     for bd in mech.bodies:
         if bd.massless and bd.name not in foldable:
+            key = "massless_mass_ratio" if bd.name in loaded else "link_mass_ratio"
+            sub_mass = float(opts.get(key, 3e-4 if bd.name in loaded else 1e-9)) * m_min
             plan.substitutes[bd.name] = (sub_mass, sub_mass * GYRATION**2)
-    slider_mass = float(opts.get("slider_mass_ratio", 1e-3)) * m_min
+    # point-on-line sliders. The slider follows the pin point, so its mass is taken out
+    # of the pin body (mass, centre of mass and inertia adjusted so that body + slider
+    # have the description's mass, first and second moments: exact while the constraint
+    # holds); it can then be a sizeable fraction of the pin body's mass, which keeps the
+    # constraint's rows well conditioned (MuJoCo's regularisation is relative to each
+    # world-axis row's diagonal, and a tiny slider mass makes the row along the slot
+    # dominate and soften the row across it). A slider on a fixed pin does not move: its
+    # weight is cancelled (gravcomp) and its mass is a fraction of the slot body's.
+    ratio = float(opts.get("slider_mass_ratio", 0.3))
+    pins: dict[str, list] = {}
+    for c in mech.constraints:
+        if isinstance(c, PointOnLine):
+            pins.setdefault(c.body, []).append(c)
+    slider_mass: dict[str, float] = {}
+    for body, cons in pins.items():
+        pts = [np.array([_num(c.point[0]), _num(c.point[1])]) for c in cons]
+        if body == WORLD:
+            for c in cons:
+                lb = c.line_body
+                ml = m_min if lb == WORLD or mech.body(lb).massless else _num(mech.body(lb).mass)
+                slider_mass[c.name] = ratio * ml
+            continue
+        bd = mech.body(body)
+        if body in plan.substitutes:  # a massless pin: its substitute carries the slider
+            ms, _ = plan.substitutes[body]
+            for c in cons:
+                slider_mass[c.name] = ratio * ms
+            continue
+        mp, ip = _num(bd.mass), _num(bd.inertia)
+        # the largest point masses at the pins that leave a positive inertia
+        bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
+        masses = [ratio * bound for _ in cons]
+        for c, mc in zip(cons, masses):
+            slider_mass[c.name] = mc
+        rest = mp - sum(masses)
+        com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
+        inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
+                   - rest * float(com @ com))
+        plan.inertials[body] = (rest, (float(com[0]), float(com[1])), inertia)
     for c in mech.constraints:
         if isinstance(c, PointOnPoint):
             plan.closures.append(_Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
         elif isinstance(c, PointOnLine):
+            ms = slider_mass[c.name]
             plan.closures.append(_Closure(
                 c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider",
                 WORLD if c.line_body == WORLD else carrier[c.line_body],
-                mass=slider_mass, inertia=slider_mass * GYRATION**2))
+                mass=ms, inertia=ms * SLIDER_GYRATION**2,
+                gravcomp=c.body == WORLD or c.body in plan.substitutes))
         else:
             coef = np.zeros(n)
             for name, value in c.coefficients:
                 coef[mech.coordinates.index(name)] += _num(value)
             w = Ainv.T @ coef  # c . q = c . A^-1 (v - b)
             weights = {mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
-            plan.closures.append(_Closure(c, "tendon", weights=weights,
-                                          offset=_num(c.constant) + float(coef @ Ainv @ b)))
+            offset = _num(c.constant) + float(coef @ Ainv @ b)
+            if opts.get("rolling", "coupling") == "contact":
+                geo = _rolling_geometry(mech, angle_c, foldable, c, coef)
+                if isinstance(geo, str):
+                    raise ValueError(f"mujoco rolling='contact' cannot build {c.name}: {geo}")
+                plan.closures.append(_Closure(c, "contact", slider=f"{c.name}:radial",
+                                              weights=weights, offset=offset, contact=geo,
+                                              coef=coef))
+            else:
+                plan.closures.append(_Closure(c, "tendon", weights=weights, offset=offset,
+                                              coef=coef))
     joint_native: dict[int, list[float]] = {}
     for f in mech.forces:
         if isinstance(f, PointToPoint):
@@ -406,7 +538,8 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
     for cl in plan.closures:
         c = cl.element
         if cl.kind == "connect":
-            for site, body, pt in ((cl.site1, c.body_a, c.point_a), (cl.site2, c.body_b, c.point_b)):
+            for site, body, pt in ((cl.site1, c.body_a, c.point_a),
+                                   (cl.site2, c.body_b, c.point_b)):
                 sites.setdefault(body, []).append(
                     f'<site name="{site}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
         elif cl.kind == "slider":
@@ -417,12 +550,40 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
             # folded): the slider starts at line_point, its joint value is the distance
             # along the unit slot direction
             sliders.setdefault(cl.parent, []).append("\n".join([
-                f'<body name="{cl.slider}" pos="{_fmt(lp[0], lp[1], 0)}"{gravcomp}>',
+                f'<body name="{cl.slider}" pos="{_fmt(lp[0], lp[1], 0)}"'
+                + (' gravcomp="1">' if cl.gravcomp and gravcomp else ">"),
                 f'  <joint name="{cl.slider}" type="slide" axis="{_fmt(dr[0], dr[1], 0)}"/>',
                 f'  <inertial pos="0 0 0" mass="{_fmt(cl.mass)}" '
                 f'diaginertia="{_fmt(cl.inertia, cl.inertia, cl.inertia)}"/>',
                 f'  <site name="{cl.site2}"/>',
                 "</body>"]))
+
+    contact_geoms: dict[str, list[str]] = {}
+    cparams = ""
+    if any(cl.kind == "contact" for cl in plan.closures):
+        ctau, czeta = plan.opts.get("contact_solref", (0.002, 1.0))
+        cimp = plan.opts.get("contact_solimp", (0.9, 0.95, 0.001, 0.5, 2))
+        cparams = (f' condim="3" friction="{_fmt(plan.opts.get("contact_friction", 1.0), 0, 0)}"'
+                   f' solref="{_fmt(ctau, czeta)}" solimp="{_fmt(*cimp)}"')
+    for cl in plan.closures:
+        if cl.kind != "contact":
+            continue
+        geo = cl.contact
+        disc_c = [_num(v) for v in mech.joint(geo["disc_joint"]).child_anchor]
+        contact_geoms.setdefault(plan.carrier[geo["disc"]], []).append(
+            f'<geom name="{cl.element.name}:disc" type="sphere" size="{_fmt(geo["r"])}" '
+            f'pos="{_fmt(disc_c[0], disc_c[1], 0)}" contype="2" conaffinity="0"{cparams}/>')
+        nseg = int(plan.opts.get("ring_segments", 720))
+        R, (cx, cy) = geo["R"], geo["centre"]
+        t = 0.1 * R  # radial thickness of the ring's boxes; the inner faces lie at R
+        half = R * math.tan(math.pi / nseg)  # faces meet: a polygon circumscribing R
+        for k in range(nseg):
+            a = 2 * math.pi * k / nseg
+            x, y = cx + (R + t / 2) * math.cos(a), cy + (R + t / 2) * math.sin(a)
+            contact_geoms.setdefault(plan.carrier[geo["track"]], []).append(
+                f'<geom type="box" size="{_fmt(t / 2, half, 2 * geo["r"])}" '
+                f'pos="{_fmt(x, y, 0)}" quat="{_fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '
+                f'contype="0" conaffinity="2"{cparams}/>')
 
     def body_xml(name: str, depth: int) -> list[str]:
         ind = "  " * depth
@@ -450,13 +611,24 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
                 ax = RbT @ axis
                 lines.append(f'{ind}  <joint name="{j.name}" type="slide" '
                              f'axis="{_fmt(ax[0], ax[1], 0)}"{extra}/>')
+            for cl in plan.closures:
+                if cl.kind == "contact" and cl.contact["arm_joint"] == j.name:
+                    # the arm's length is freed: the contact's normal force replaces it
+                    hub = janchor[cl.contact["disc_joint"]][0]
+                    u = RbT @ ((hub - anchor) / np.linalg.norm(hub - anchor))
+                    lines.append(f'{ind}  <joint name="{cl.slider}" type="slide" '
+                                 f'axis="{_fmt(u[0], u[1], 0)}"/>')
         m, inertia = _num(body.mass), _num(body.inertia)
+        com = (0.0, 0.0)
         if name in plan.substitutes:
             m, inertia = plan.substitutes[name]
             lines[0] = lines[0][:-1] + gravcomp + ">"
-        lines.append(f'{ind}  <inertial pos="0 0 0" mass="{_fmt(m)}" '
+        if name in plan.inertials:
+            m, com, inertia = plan.inertials[name]
+        lines.append(f'{ind}  <inertial pos="{_fmt(com[0], com[1], 0)}" mass="{_fmt(m)}" '
                      f'diaginertia="{_fmt(inertia, inertia, inertia)}"/>')
         lines += [f"{ind}  {g}" for g in map(_shape_geoms, body.shapes) if g]
+        lines += [f"{ind}  {g}" for g in contact_geoms.get(name, [])]
         lines += [f"{ind}  {s}" for s in sites.get(name, [])]
         for child in plan.chains:
             if plan.mj_parent[child] == name:
@@ -471,7 +643,8 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
         f'  <option gravity="{_fmt(0, -g, 0)}">',
-        '    <flag contact="disable"/>',
+        ('    <flag contact="disable"/>' if not contact_geoms else
+         '    <flag contact="enable" filterparent="disable"/>'),
         "  </option>",
         '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
         "  <worldbody>",
@@ -483,7 +656,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
     for sl in sliders.get(WORLD, []):
         out += [f"    {x}" for x in sl.split("\n")]
     out.append("  </worldbody>")
-    couplings = [cl for cl in plan.closures if cl.kind == "tendon"]
+    couplings = [cl for cl in plan.closures if cl.kind in ("tendon", "contact")]
     if plan.p2p or couplings:
         out.append("  <tendon>")
         for cl in couplings:
@@ -498,13 +671,15 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
             out.append(f'      <site site="{e.element.name}:b"/>')
             out.append("    </spatial>")
         out.append("  </tendon>")
-    if plan.closures:
+    if any(cl.kind != "contact" for cl in plan.closures):
         tau, zeta = plan.opts.get("solref", (0.02, 1.0))
         soft = (f' solref="{_fmt(tau, zeta)}" '
                 f'solimp="{_fmt(*plan.opts.get("solimp", (0.9, 0.95, 0.001, 0.5, 2)))}"')
         out.append("  <equality>")
         for cl in plan.closures:
             name = cl.element.name
+            if cl.kind == "contact":
+                continue
             if cl.kind == "tendon":
                 out.append(f'    <tendon name="{name}" tendon1="{name}" '
                            f'polycoef="{_fmt(cl.offset, 0, 0, 0, 0)}"{soft}/>')
@@ -553,10 +728,46 @@ class _Compiled:
         self.slider_jnt = np.array([self.model.joint(cl.slider).id for cl in sliders], dtype=int)
         self.slider_qadr = np.array([self.model.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
         self.slider_vadr = np.array([self.model.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_body = np.array([self.model.body(cl.slider).id for cl in sliders], dtype=int)
         self.slider_sites = [(self.model.site(cl.site1).id, self.model.site(cl.site2).id)
                              for cl in sliders]
-        self.eq_id = [self.model.equality(cl.element.name).id for cl in plan.closures]
+        self.eq_id = [self.model.equality(cl.element.name).id if cl.kind != "contact" else -1
+                      for cl in plan.closures]
+        contacts = [cl for cl in plan.closures if cl.kind == "contact"]
+        self.radial_qadr = np.array([self.model.joint(cl.slider).qposadr[0] for cl in contacts],
+                                    dtype=int)
+        self.radial_vadr = np.array([self.model.joint(cl.slider).dofadr[0] for cl in contacts],
+                                    dtype=int)
+        self.disc_geom = [self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]
+        m = self.model
+        cone = plan.opts.get("contact_cone", "pyramidal").upper()
+        m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{cone}")
+        m.opt.impratio = float(plan.opts.get("impratio", 1.0))
+        m.opt.noslip_iterations = int(plan.opts.get("noslip_iterations", 0))
+        if contacts:  # the contacts' time constant follows the step like the equalities'
+            cs = float(plan.opts.get("contact_timeconst_steps", 2.0)) * dt
+            m.geom_solref[[self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]] = (
+                cs, float(plan.opts.get("contact_dampratio", 1.0)))
+            ring = np.flatnonzero(m.geom_conaffinity == 2)
+            m.geom_solref[ring] = (cs, float(plan.opts.get("contact_dampratio", 1.0)))
         self.callback = self._make_callback()
+
+    def _contact_qfrc(self, geom: int) -> np.ndarray:
+        """Joint-space force of the contacts of one geom (after mj_forward)."""
+        mujoco, m, d = self.mujoco, self.model, self.data
+        kinds = {int(mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS),
+                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_PYRAMIDAL),
+                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_ELLIPTIC)}
+        rows = [r for r in range(d.nefc) if int(d.efc_type[r]) in kinds
+                and geom in d.contact.geom[d.efc_id[r]]]
+        if not rows:
+            return np.zeros(m.nv)
+        if mujoco.mj_isSparse(m):
+            J = np.zeros((d.nefc, m.nv))
+            mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
+        else:
+            J = d.efc_J.reshape(d.nefc, m.nv)
+        return J[rows].T @ d.efc_force[rows]
 
     def closure_state(self) -> tuple[list[np.ndarray], np.ndarray]:
         """After mj_forward: per closure, its force in the contract's physical terms, and
@@ -569,11 +780,26 @@ class _Compiled:
             if d.efc_type[r] == eq_type:
                 rows.setdefault(int(d.efc_id[r]), []).append(r)
         forces, viol = [], np.empty(len(self.plan.closures))
-        k_slider = 0
+        k_slider = k_contact = 0
+        mujoco = self.mujoco
+        if len(self.slider_jnt):
+            mujoco.mj_rnePostConstraint(m, d)
+        obj_body, acc = int(mujoco.mjtObj.mjOBJ_BODY), np.zeros(6)
         for i, (cl, eid) in enumerate(zip(self.plan.closures, self.eq_id)):
             rr = rows.get(eid, [])
             f, pos = d.efc_force[rr], d.efc_pos[rr]
-            if cl.kind == "tendon":
+            if cl.kind == "contact":
+                # generalized force of the disc's contacts on the description coordinates
+                # (A^T qfrc); the coupling's value -lam is that on the disc's coordinate
+                # over its coefficient. Violation: the accumulated slip Phi = c.q - const
+                qfrc = self._contact_qfrc(self.disc_geom[k_contact])
+                Q = self.plan.A.T @ qfrc[self.vadr]
+                j = cl.contact["j"]
+                forces.append(np.array([Q[j] / cl.coef[j]]))
+                q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
+                viol[i] = cl.coef @ q - _num(cl.element.constant)
+                k_contact += 1
+            elif cl.kind == "tendon":
                 # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
                 forces.append(np.array([f[0]]))
                 viol[i] = pos[0]
@@ -582,7 +808,15 @@ class _Compiled:
                 forces.append(np.array(f[:2]))
                 viol[i] = math.hypot(pos[0], pos[1])
             else:
-                forces.append(np.array(f[:2]))  # on the pin (site1) from the slider
+                # the slider's mass belongs to the pin (see _plan): the slot's force on
+                # pin + slider is the slide joint's force on the slider,
+                # m_s a_s - (weight not cancelled) + (connect force on the pin); MuJoCo's
+                # body accelerations are proper accelerations a - g
+                bid = self.slider_body[k_slider]
+                mujoco.mj_objectAcceleration(m, d, obj_body, bid, acc, 0)
+                ms = m.body_mass[bid]
+                cancelled = ms * m.opt.gravity[:2] * m.body_gravcomp[bid]
+                forces.append(np.array(f[:2]) + ms * acc[3:5] + cancelled)
                 u = d.xaxis[self.slider_jnt[k_slider]]
                 viol[i] = -u[1] * pos[0] + u[0] * pos[1]  # slot normal . (P - L)
                 k_slider += 1
@@ -642,6 +876,8 @@ class _Compiled:
         d.qpos[self.qadr] = self.plan.engine_values(q)
         d.qvel[self.vadr] = self.plan.A @ np.asarray(qd, dtype=float)
         d.time = t
+        d.qpos[self.radial_qadr] = 0.0
+        d.qvel[self.radial_vadr] = 0.0
         if len(self.slider_jnt):
             d.qpos[self.slider_qadr] = 0.0
             d.qvel[self.slider_vadr] = 0.0
@@ -706,9 +942,19 @@ class MujocoBackend(Backend):
             "constraint_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
             "refsafe": True,
             "diagexact": True,
-            "slider_mass_ratio": 1e-3,
-            "massless_mass_ratio": 1e-3,
+            "slider_mass_ratio": 0.3,
+            "massless_mass_ratio": 3e-4,
+            "link_mass_ratio": 1e-9,
             "substitute_gravcomp": True,
+            "rolling": "coupling",
+            "contact_timeconst_steps": 2.0,
+            "contact_dampratio": 1.0,
+            "contact_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
+            "contact_friction": 1.0,
+            "contact_cone": "pyramidal",
+            "impratio": 1.0,
+            "noslip_iterations": 0,
+            "ring_segments": 720,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -738,6 +984,71 @@ class MujocoBackend(Backend):
                 "false replaces MuJoCo's default (autoreset on), which silently resets the "
                 "state to qpos0 when an acceleration is NaN or huge and would show a "
                 "divergence as a jump back to the start; off, it shows as NaN/inf."),
+            "constraint_timeconst_steps": (
+                "Closure equalities: solref time constant in time steps (solref[0] = "
+                "steps * dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. "
+                "MuJoCo clamps it to 2 dt unless refsafe is off; measured on the scotch "
+                "yoke with RK4: 2 is best (1: same trajectory, 20x the force error; 0.5: "
+                "15x worse; 0.3: unstable)."),
+            "constraint_dampratio": (
+                "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
+                "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
+            "constraint_solimp": (
+                "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
+                "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
+                "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
+                "trajectory error 10x larger."),
+            "refsafe": (
+                "MuJoCo's default (on): solref time constants below 2 dt are raised to "
+                "2 dt. Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
+            "diagexact": (
+                "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint "
+                "regularisation uses the exact diagonal of J M^-1 J^T instead of the "
+                "body_invweight0 estimate; with the estimate the scotch yoke's slot force "
+                "was 6 % low at t = 0 and its violation 3e-6 m (5e-9 m exact)."),
+            "slider_mass_ratio": (
+                "Mass of each point-on-line slider as a fraction of the largest point mass "
+                "its pin body can give up (the rest keeps a positive inertia); it is taken "
+                "out of the pin body (exact while the constraint holds). Lighter sliders "
+                "pass less inertial force through the soft connect but condition it worse "
+                "across rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
+            "massless_mass_ratio": (
+                "Substitute mass of a massless body that a constraint or point force "
+                "loads (e.g. a massless pin in a slot), times the lightest body's mass; "
+                "weight cancelled. Not compensated: it adds inertia, while a lighter one "
+                "softens the constraints through it (their stiffness scales with the mass "
+                "they move). Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give "
+                "similar trajectories (~5e-3), 1e-3 three times the frequency error "
+                "(6e-4), 1e-2 and 1e-4 2x-8x worse trajectories."),
+            "link_mass_ratio": (
+                "Substitute mass of a massless kinematic link that cannot be folded "
+                "(several child joints, no constraint on it), times the lightest body's "
+                "mass; its tree children carry the inertia, so it can be tiny (belt arm: "
+                "1e-3 gave 3e-6 trajectory error, 1e-9 gives 8e-10)."),
+            "substitute_gravcomp": (
+                "Cancel the weight of substitute bodies whose mass is not taken from a "
+                "body of the description (MuJoCo body gravcomp=1)."),
+            "rolling": (
+                "'coupling' (default): a rolling LinearCoupling is a tendon equality (an "
+                "exact linear relation, soft like every equality). 'contact': a disc "
+                "inside a ring is built as friction contact (sphere disc, ring of "
+                "ring_segments boxes, the arm's length freed by a radial slide so that "
+                "the contact's normal force holds the disc); the coupling's force is the "
+                "contacts' generalized force on the disc's coordinate over its "
+                "coefficient, its violation the accumulated slip c.q - const. "
+                "linearize always uses the coupling."),
+            "contact_timeconst_steps": "rolling='contact': solref[0] of the contacts in steps.",
+            "contact_dampratio": "rolling='contact': solref[1] of the contacts.",
+            "contact_solimp": (
+                "rolling='contact': solimp of the contacts (MuJoCo's default 0.9 0.95 "
+                "lost energy: 0.215 rad error in SIMULATORS.md)."),
+            "contact_friction": "rolling='contact': sliding friction coefficient of the disc.",
+            "contact_cone": "rolling='contact': MuJoCo friction cone, pyramidal or elliptic.",
+            "impratio": "rolling='contact': MuJoCo impratio (friction-to-normal impedance).",
+            "noslip_iterations": (
+                "rolling='contact': MuJoCo's noslip post-processing iterations (0 = off, "
+                "MuJoCo's default); they remove the regularised friction's creep."),
+            "ring_segments": "rolling='contact': number of boxes forming the ring.",
         }
 
     def support(self, mechanism: Mechanism) -> Support:
@@ -753,6 +1064,12 @@ class MujocoBackend(Backend):
         if s["linearization"] not in _LINEARIZATIONS:
             raise ValueError(f"mujoco setting linearization must be one of {_LINEARIZATIONS}, "
                              f"got {s['linearization']!r}")
+        if s["rolling"] not in ("coupling", "contact"):
+            raise ValueError(f"mujoco setting rolling must be 'coupling' or 'contact', "
+                             f"got {s['rolling']!r}")
+        if s["contact_cone"] not in ("pyramidal", "elliptic"):
+            raise ValueError(f"mujoco setting contact_cone must be 'pyramidal' or 'elliptic', "
+                             f"got {s['contact_cone']!r}")
         return s
 
     def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
@@ -764,6 +1081,7 @@ class MujocoBackend(Backend):
         opts = {
             "slider_mass_ratio": float(settings["slider_mass_ratio"]),
             "massless_mass_ratio": float(settings["massless_mass_ratio"]),
+            "link_mass_ratio": float(settings["link_mass_ratio"]),
             "substitute_gravcomp": bool(settings["substitute_gravcomp"]),
             "timeconst_steps": steps,
             "dampratio": float(settings["constraint_dampratio"]),
@@ -772,6 +1090,17 @@ class MujocoBackend(Backend):
             "solimp": tuple(float(x) for x in settings["constraint_solimp"]),
             "refsafe": bool(settings["refsafe"]),
             "diagexact": bool(settings["diagexact"]),
+            "rolling": settings["rolling"],
+            "contact_timeconst_steps": float(settings["contact_timeconst_steps"]),
+            "contact_dampratio": float(settings["contact_dampratio"]),
+            "contact_solref": (float(settings["contact_timeconst_steps"]) * (dt or 0.002),
+                               float(settings["contact_dampratio"])),
+            "contact_solimp": tuple(float(x) for x in settings["contact_solimp"]),
+            "contact_friction": float(settings["contact_friction"]),
+            "contact_cone": settings["contact_cone"],
+            "impratio": float(settings["impratio"]),
+            "noslip_iterations": int(settings["noslip_iterations"]),
+            "ring_segments": int(settings["ring_segments"]),
         }
         return _plan(mechanism, bool(settings["native_springs"]), autonomous, opts)
 
@@ -784,10 +1113,17 @@ class MujocoBackend(Backend):
         xml = self._plan(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
+        flags = []
         if not s["autoreset"]:
-            xml = xml.replace('<flag contact="disable"', '<flag contact="disable" autoreset="disable"', 1)
+            flags.append('autoreset="disable"')
         if not s["refsafe"]:
-            xml = xml.replace('<flag contact="disable"', '<flag contact="disable" refsafe="disable"', 1)
+            flags.append('refsafe="disable"')
+        if s["diagexact"] and "<equality>" in xml:
+            flags.append('diagexact="enable"')
+        if flags:
+            head, tail = xml.split("<flag ", 1)
+            attrs, rest = tail.split("/>", 1)
+            xml = f"{head}<flag {attrs} {' '.join(flags)}/>{rest}"
         return xml
 
     # --- simulation ----------------------------------------------------------------------
@@ -841,7 +1177,7 @@ class MujocoBackend(Backend):
 
         m, d = comp.model, comp.data
         N = len(t)
-        forces = [np.empty((N, 1 if cl.kind == "tendon" else 2)) for cl in closures]
+        forces = [np.empty((N, 1 if cl.kind in ("tendon", "contact") else 2)) for cl in closures]
         viol = np.empty((N, len(closures)))
         for k in range(N):
             d.qpos[:] = qpos[k]
@@ -920,18 +1256,105 @@ class MujocoBackend(Backend):
         return out
 
     # --- linearization -------------------------------------------------------------------
+    @staticmethod
+    def _constrained_modes(comp: _Compiled, q_eq: np.ndarray, eps: float):
+        """Eigenvalues of the engine's model with its closures as exact constraints:
+        with T a basis of the null space of the equality Jacobian J at q_eq and f the
+        closure forces that balance the tree there, the reduced matrices are T^T M T,
+        T^T C T and T^T (K - d(J^T f)/dq) T, where M, C, K come from mjd_inverseFD with the
+        equality constraints disabled."""
+        import mujoco
+
+        m, d = comp.model, comp.data
+        nv, n = m.nv, comp.plan.n
+        eq_type = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        dsbl_eq = int(mujoco.mjtDisableBit.mjDSBL_EQUALITY)
+
+        def jacobian() -> np.ndarray:
+            mujoco.mj_forward(m, d)
+            rows = [r for r in range(d.nefc) if d.efc_type[r] == eq_type]
+            J = np.zeros((len(rows), nv))
+            if not mujoco.mj_isSparse(m):
+                J[:] = d.efc_J.reshape(d.nefc, nv)[rows]
+            else:
+                dense = np.zeros((d.nefc, nv))
+                mujoco.mju_sparse2dense(dense, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr,
+                                        d.efc_J_colind)
+                J[:] = dense[rows]
+            return J
+
+        comp.set_state(q_eq, np.zeros(n))
+        qpos0 = d.qpos.copy()
+        d.qvel[:] = 0
+        J = jacobian()
+        # the static balance of the tree: J^T f = qfrc_bias - qfrc_passive (v = 0, a = 0)
+        rhs = d.qfrc_bias - d.qfrc_passive
+        load = np.linalg.norm(d.qfrc_bias) + np.linalg.norm(d.qfrc_passive)
+        f = np.linalg.lstsq(J.T, rhs, rcond=None)[0]
+        G = np.zeros((nv, nv))
+        for i in range(nv):
+            cols = []
+            for h in (eps, -eps):
+                dq = np.zeros(nv)
+                dq[i] = h
+                d.qpos[:] = qpos0
+                mujoco.mj_integratePos(m, d.qpos, dq, 1.0)
+                cols.append(jacobian().T @ f)
+            G[:, i] = (cols[0] - cols[1]) / (2 * eps)
+        d.qpos[:] = qpos0
+        m.opt.disableflags |= dsbl_eq
+        try:
+            mats = []
+            for h in (eps, -eps):
+                d.qpos[:] = qpos0
+                d.qvel[:] = 0
+                d.qacc[:] = 0
+                mujoco.mj_forward(m, d)
+                d.qacc[:] = 0
+                DfDq, DfDv, DfDa = (np.zeros((nv, nv)) for _ in range(3))
+                mujoco.mjd_inverseFD(m, d, h, False, DfDq, DfDv, DfDa, None, None, None, None)
+                mats.append((DfDq, DfDv, DfDa))
+        finally:
+            m.opt.disableflags &= ~dsbl_eq
+        K, C, M = ((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
+        K = K - G
+        U, sv, Vt = np.linalg.svd(J)
+        rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
+        T = Vt[rank:].T
+        Mr, Cr, Kr = (T.T @ X @ T for X in (M, C, K))
+        k = T.shape[1]
+        Minv = np.linalg.inv(Mr)
+        system = np.block([[np.zeros((k, k)), np.eye(k)], [-Minv @ Kr, -Minv @ Cr]])
+        eig = np.linalg.eigvals(system).astype(complex)
+        # rigid modes (a free pulley) come out as round-off: make them exact zeros
+        eig[np.abs(eig) < 1e-10 * max(np.max(np.abs(eig)), 1e-300)] = 0.0
+        residual = float(np.linalg.norm(J.T @ f - rhs) / max(load, 1e-300))
+        return eig, {"M_reduced": Mr, "C_reduced": Cr, "K_reduced": Kr, "basis": T,
+                     "closure_forces": f, "balance_residual": residual}
+
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         import mujoco
 
         s = self._resolve(settings)
+        s["rolling"] = "coupling"  # a contact has no linearization: the exact coupling
         plan = self._plan(mechanism, s, autonomous=True, dt=dt)
         n, eps = plan.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the
         # continuous-time inverse dynamics do not depend on the integrator)
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
-        if s["linearization"] == "inverseFD":
+        if s["linearization"] == "inverseFD" and plan.closures:
+            comp = _Compiled(plan, integrator, dt)
+            with _PassiveInstalled(comp.callback):
+                eig, extra = self._constrained_modes(comp, q_eq, eps)
+            method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "
+                      f"central differences, eps={eps:g}) plus the geometric stiffness of "
+                      "the closure forces (equality Jacobian efc_J differentiated, forces "
+                      "from the static balance J^T f = qfrc_bias - qfrc_passive), reduced "
+                      "to the null space of efc_J (exact constraints: MuJoCo's soft "
+                      "regularisation is left out)")
+        elif s["linearization"] == "inverseFD":
             comp = _Compiled(plan, integrator, dt)
             m, d = comp.model, comp.data
             mats = []
@@ -968,6 +1391,9 @@ class MujocoBackend(Backend):
             extra = {"A_discrete": Ad, "integrator": integrator, "discrete_order": 1}
             method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, centered, "
                       f"eps={eps:g}), ln(lambda)/dt")
+        if plan.closures and s["linearization"] == "transitionFD":
+            method += ("; soft closures: the spectrum includes the constraints' own fast "
+                       "modes (time constant solref) and the substitute bodies' dofs")
         # order by imaginary then real part: real parts of undamped modes are FD noise
         eig = eig[np.lexsort((eig.real, eig.imag))]
         return Linearization(eigenvalues=eig, method=method, extra=extra)
