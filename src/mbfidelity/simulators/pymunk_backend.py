@@ -2,29 +2,76 @@
 
 Translation of the description (conventions of `mbfidelity.systems.model`):
 
-* every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the centre
-  of mass (Chipmunk's centre of gravity left at the origin); the world is
-  ``space.static_body`` (at the origin, angle 0). No shapes are created, so nothing can
-  collide.
+* every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the
+  description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
+  substitute is compensated, below); the world is ``space.static_body`` (at the origin,
+  angle 0). No shapes are created (except for the optional contact variant of rolling),
+  so nothing can collide.
 * ``Revolute`` -> ``PivotJoint`` at the two local anchors.
 * ``Prismatic`` -> ``GrooveJoint`` whose slot is the path of the child's centre of mass
   in the parent's frame (pa - R(offset) ca + q axis, q between the limits, or
   +-``groove_half_length`` where a side is unbounded) with the pin at the child's centre
   of mass, plus a ``GearJoint`` (ratio 1, phase = angle_offset) that locks the relative
   rotation.
-* Chipmunk has no massless bodies. A massless link with one revolute and one prismatic
-  joint (a guide arm carrying a slider, or a slider carrying a pin) is folded: the link
-  turns with the body on the far side of its prismatic joint (its "partner") and its
-  revolute point (the "pin") is a point of the other body, so the pair of joints is one
-  ``GrooveJoint``: a slot in the partner's frame along which the pin slides. Loads on the
-  folded link are moved to the real bodies by virtual power (a force f at a link point W
-  = f at the pin on the pin's body + torque (W - pin) x f on the partner).
-* Chipmunk's groove impulse is exact only when the slot passes through the slot body's
-  centre of mass and the pin is the pin body's centre of mass (or either is the world):
-  it solves the full 2x2 point problem and projects the impulse on the slot normal.
-  Other geometries are reported as unsupported (see `_GROOVE_LIMIT`).
+* Chipmunk has no massless bodies. Massless bodies are eliminated:
+  - a link with one revolute and one prismatic joint (a guide arm carrying a slider, or a
+    slider carrying a pin) is folded: the link turns with the body on the far side of its
+    prismatic joint (its "partner") and its revolute point (the "pin") is a point of the
+    other body, so the pair of joints is one ``GrooveJoint``;
+  - a link with revolute joints only, at two distinct points of the link (an arm), is a
+    ``PinJoint`` (fixed distance) between the bodies at its two ends plus ``PivotJoint``s
+    between bodies hinged at the same point of it; its angle is the direction of the
+    line between its two points;
+  - massless bodies whose angles are fixed by prismatic joints and whose joints and
+    closure constraints leave the bodies around them free (three relative degrees of
+    freedom, e.g. two crossed carriages, or a pin running in two slots) impose no
+    Chipmunk constraint at all; their positions are solved from the joint equations.
+  Loads on eliminated links are moved to the real bodies by virtual power.
+* Closure constraints (model.py):
+  - ``PointOnPoint`` -> ``PivotJoint`` (exact).
+  - ``PointOnLine`` -> ``GrooveJoint``. Chipmunk's groove impulse is exact only when the
+    slot passes through the slot body's centre of mass and the pin is the pin body's
+    centre of mass (or either is the world, or a body whose rotation is fixed by
+    prismatic joints to the world, which then gets an infinite moment of inertia: its
+    moment enters no equation): it solves the full 2x2 point problem and projects the
+    impulse on the slot normal (`_GROOVE_LIMIT`). Otherwise a slider substitute is
+    inserted: a point-mass "pin slider" (infinite moment) pinned to the pin point by a
+    ``PivotJoint`` and running in the groove at its own centre of mass, and/or a "slot
+    carrier" glued to the slot body (``PivotJoint`` + ``GearJoint``) with its centre of
+    mass on the slot line. Its mass is ``slider_mass_fraction`` of the host's effective
+    mass at that point, and with ``slider_compensation`` that mass (and its moment) is
+    taken out of the host body (mass, centre of gravity, moment), so the composite host
+    + substitute has exactly the described inertia: the substitute is exact up to the
+    iterative solve.
+  - ``LinearCoupling``: written on absolute body angles, sum k_b theta_b = const. Two
+    bodies -> ``GearJoint`` (exact). Three bodies A, B, K with sum k = 0, A and B hinged
+    on the carrier K (belt pulleys on an arm, a disc rolling in a moving track): that is
+    an internal/external gear pair on the carrier, i.e. rolling of the pitch circles at
+    the pitch point C = a + lam (b - a), lam = k_A / (k_A + k_B), on the line of the hubs
+    a, b. It is a ``PivotJoint`` between A and B whose anchors are moved to C before every
+    solve (pre-solve callback, at the position-updated configuration): its tangential
+    row is the coupling, its normal row is implied by the carrier (redundant), and the
+    coupling's position error is put into the tangential anchor gap so that Chipmunk's
+    own error correction removes it. With ``rolling = "contact"`` the pitch circles,
+    when the description draws them as circle shapes, become colliding shapes instead (a
+    Circle in a ring of ``contact_segments`` Segments) with friction ``contact_friction``,
+    and the massless carrier arm is removed (the contact holds the disc).
+    Other couplings (three bodies without a common carrier, prismatic coordinates) are
+    refused with the reason.
 * Force elements are applied as body forces and torques, evaluated every step by one
-  compiled function of the body states (a Python call per step).
+  compiled function of the body states (a Python call per step). A CoordinateForce is
+  the generalized force Q on its coordinate: on a revolute joint the torque s Q on the
+  child (s = -1 for a clockwise coordinate) and -s Q on the parent unless the angle is
+  absolute (virtual power of Q q').
+* Constraint forces and reactions of constrained mechanisms: Chipmunk reports only the
+  magnitude of an impulse, so the forces are reconstructed from momentum balance of every
+  description body over each step, m (v(n+1) - v(n))/h - m g - applied loads, solved in
+  least squares for all joint reactions and closure multipliers at the configuration
+  where Chipmunk computed them (sample n+1). A start with velocity shows a transient at
+  sample 1: Chipmunk's velocity is staggered (v_n ~ v(t_n + h/2), whose constraint
+  component is -h times the curvature term), the exact initial velocity is not, and the
+  first impulse makes up the difference: 1.5 times the centripetal part (eccentric cam
+  spinning at 40 rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2).
 
 Chipmunk's step (cpSpaceStep): positions x += h v (old velocity); constraints pre-step at
 the new positions; v += h (g + F/m); warm-started Gauss-Seidel velocity iterations that
@@ -35,7 +82,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -48,8 +95,12 @@ from ..systems.model import (
     LENGTH_RATE,
     TIME,
     WORLD,
+    Circle,
     CoordinateForce,
+    LinearCoupling,
     Mechanism,
+    PointOnLine,
+    PointOnPoint,
     PointToPoint,
     Prismatic,
     Revolute,
@@ -60,6 +111,8 @@ from .base import Backend, Linearization, RunResult, Support
 
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
+#: how a rolling coupling with drawn pitch circles is built
+_ROLLING = ("coupling", "contact")
 
 
 @dataclass(frozen=True)
@@ -90,24 +143,104 @@ class _Groove:
 
 
 @dataclass(frozen=True)
+class _RevLink:
+    """A massless link with revolute joints only, at two distinct points alpha, beta of
+    the link. `at_alpha`/`at_beta`: (body, point of that body) hinged there; the first is
+    the representative (the world if it is one of them)."""
+
+    link: str
+    alpha: tuple[float, float]
+    beta: tuple[float, float]
+    at_alpha: tuple[tuple[str, tuple[float, float]], ...]
+    at_beta: tuple[tuple[str, tuple[float, float]], ...]
+
+
+@dataclass(frozen=True)
+class _Component:
+    """Massless bodies that impose no constraint on the real bodies around them: their
+    angles follow prismatic joints, their positions solve the (linear) joint equations."""
+
+    bodies: tuple[str, ...]
+    joints: tuple  # description joints with an end in `bodies`
+    closures: tuple  # PointOnPoint / PointOnLine with an end in `bodies`
+    angles: tuple[tuple[str, str, float], ...]  # (body, known body, offset): theta = theta_known + offset
+
+
+@dataclass(frozen=True)
+class _Carrier:
+    """Slider substitute: an engine body that belongs to description body `host`.
+    kind "pin": point mass (infinite moment) pinned at `point`; kind "slot": glued to the
+    host (pivot + gear), its centre of mass at `point` (host frame)."""
+
+    name: str
+    host: str
+    kind: str
+    point: tuple[float, float]
+    mass: float
+    moment: float
+    constraint: str
+
+
+@dataclass(frozen=True)
+class _Pitch:
+    """A LinearCoupling k_a th_a + k_b th_b + k_k th_k = const (sum k = 0) with a, b
+    hinged on the carrier k at hub points: a PivotJoint between a and b at the pitch point
+    (see the module docstring)."""
+
+    name: str
+    a: str
+    b: str
+    hub_a: tuple[float, float]  # local point of a (its hinge on the carrier)
+    hub_b: tuple[float, float]
+    d: float  # hub distance on the carrier
+    lam: float  # k_a / (k_a + k_b)
+    ksum: float  # k_a + k_b
+    wrap: float  # Phi jumps by this when a massless carrier's angle wraps (0: none)
+    carrier: str
+    contact: tuple | None  # (ring body, ring centre, ring radius, disc body, centre, radius, internal)
+
+
+@dataclass
 class _Layout:
-    dynamic: list[str]  # bodies with mass, in description order: the engine bodies
+    dynamic: list[str]  # bodies with mass, in description order
     folds: dict[str, _Fold]
     pivots: list[tuple[str, str, tuple[float, float], tuple[float, float]]]
     grooves: list[_Groove]
+    links: dict[str, _RevLink] = field(default_factory=dict)
+    components: list[_Component] = field(default_factory=list)
+    carriers: list[_Carrier] = field(default_factory=list)
+    #: engine centre of gravity (description frame) of compensated hosts
+    cog: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: engine (mass, moment) of every engine body
+    engine_mass: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: PinJoints (a, b, anchor a, anchor b, length, massless link)
+    pins: list[tuple] = field(default_factory=list)
+    #: GearJoints of couplings and glued carriers (a, b, phase, ratio)
+    gears: list[tuple[str, str, float, float]] = field(default_factory=list)
+    pitches: list[_Pitch] = field(default_factory=list)
+    infinite: set[str] = field(default_factory=set)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def engine(self) -> list[str]:
+        return self.dynamic + [c.name for c in self.carriers]
 
 
 @dataclass
 class _Compiled:
     """Everything derived once per mechanism (symbolic, then compiled). The engine state
-    is, per engine body, (x, y, theta, vx, vy, omega)."""
+    is, per engine body, (x, y, theta, vx, vy, omega) of its centre of mass."""
 
     layout: _Layout
+    kin: "_Kinematics"
+    loads: list  # element loads on description bodies (symbolic)
     loaded: list[int]  # indices of engine bodies that receive element loads
     loads_math: Callable | None  # (*state, H, t) -> flat (fx, fy, tau) for `loaded`
     external_np: dict[str, Callable]  # joint -> (*state, H, t) -> (fx, fy) from elements
     coords_np: Callable  # (*state) -> (q..., qd...)
     masses: dict[str, float]
+    pitch_phi: list[Callable]  # per pitch coupling: (*positions) -> Phi
+    balance: object = None  # lazily built momentum-balance solver
 
 
 def _num(x) -> float:
@@ -147,9 +280,11 @@ _GROOVE_LIMIT = (
     "drift, divergence for large offsets)")
 
 
-def _grooves(mech: Mechanism, folds: dict[str, _Fold]) -> list[_Groove] | str:
-    """The GrooveJoints of the prismatic joints and of the folded links, or why one of
-    them would not be exact in Chipmunk."""
+def _grooves(mech: Mechanism, folds: dict[str, _Fold],
+             skip: frozenset[int] = frozenset()) -> list[_Groove] | str:
+    """The GrooveJoints of the prismatic joints (except those in `skip`, joints of
+    eliminated massless groups) and of the folded links, or why one of them would not be
+    exact in Chipmunk."""
     out: list[_Groove] = []
 
     def ends(j: Prismatic) -> tuple[float | None, float | None]:
@@ -157,7 +292,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold]) -> list[_Groove] | str:
 
     folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
     for j in mech.joints:
-        if not isinstance(j, Prismatic) or id(j) in folded:
+        if not isinstance(j, Prismatic) or id(j) in folded or id(j) in skip:
             continue
         # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
         # with the rotation locked the pin can be the child's centre of mass
@@ -198,15 +333,195 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold]) -> list[_Groove] | str:
     return out
 
 
-def _plan(mech: Mechanism) -> _Layout | str:
-    """The engine layout (bodies, folded links, pivots, grooves), or the reason the
-    mechanism cannot be expressed exactly."""
+
+def _closure_bodies(c) -> tuple[str, ...]:
+    if isinstance(c, PointOnPoint):
+        return (c.body_a, c.body_b)
+    if isinstance(c, PointOnLine):
+        return (c.body, c.line_body)
+    return ()
+
+
+def _rotation_fixed(mech: Mechanism, body: str) -> bool:
+    """Whether the body's angle is constant: every joint from the world to it is
+    prismatic (its moment of inertia then enters no equation of motion)."""
+    while body != WORLD:
+        j = mech.joint_of_child(body)
+        if not isinstance(j, Prismatic):
+            return False
+        body = j.parent
+    return True
+
+
+def _effective_mass(m: float, inertia: float, d: float) -> float:
+    """Mass of a rigid body felt at a point at distance d from its centre of mass, across
+    the radius: m I / (I + m d^2)."""
+    return m * inertia / (inertia + m * d * d)
+
+
+def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink | str:
+    joints = [j for j in mech.joints if name in (j.parent, j.child)]
+    groups: list[tuple[np.ndarray, list[tuple[str, tuple[float, float]]]]] = []
+    for j in joints:
+        if j.parent == name:
+            own, other, at = _vec(j.parent_anchor), j.child, _vec(j.child_anchor)
+        else:
+            own, other, at = _vec(j.child_anchor), j.parent, _vec(j.parent_anchor)
+        if other in massless:
+            return f"massless body {name} is hinged to another massless body {other}"
+        for point, members in groups:
+            if np.allclose(point, own, rtol=0, atol=1e-12):
+                members.append((other, tuple(at)))
+                break
+        else:
+            groups.append((own, [(other, tuple(at))]))
+    if len(groups) != 2:
+        return (f"massless body {name} has revolute joints at {len(groups)} distinct points; "
+                "only a link with two (an arm, a PinJoint in Chipmunk) can be eliminated")
+    for _, members in groups:  # the world first: its point is exact
+        members.sort(key=lambda m: m[0] != WORLD)
+    seen = [m[0] for _, ms in groups for m in ms]
+    if len(set(seen)) != len(seen):
+        return f"massless body {name} is hinged twice to the same body"
+    (pa, ma), (pb, mb) = groups
+    return _RevLink(name, tuple(pa), tuple(pb), tuple(ma), tuple(mb))
+
+
+def _component(mech: Mechanism, group: set[str], real: set[str],
+               closures: list) -> _Component | str:
+    joints = tuple(j for j in mech.joints if j.parent in group or j.child in group)
+    mine = tuple(c for c in closures if set(_closure_bodies(c)) & group)
+    ends = ({b for j in joints for b in (j.parent, j.child)}
+            | {b for c in mine for b in _closure_bodies(c)}) - group
+    bad = [b for b in ends if b != WORLD and b not in real]
+    if bad:
+        return f"massless bodies {sorted(group)} are attached to other massless bodies {bad}"
+    known = set(ends) | {WORLD}
+    angles: list[tuple[str, str, float]] = []
+    changed = True
+    while changed:
+        changed = False
+        for j in joints:
+            if not isinstance(j, Prismatic):
+                continue
+            off = _num(j.angle_offset)
+            if j.parent in known and j.child not in known:
+                angles.append((j.child, j.parent, off))
+                known.add(j.child)
+                changed = True
+            elif j.child in known and j.parent not in known:
+                angles.append((j.parent, j.child, -off))
+                known.add(j.parent)
+                changed = True
+    loose = sorted(group - known)
+    if loose:
+        return (f"massless bodies {loose}: rotation not fixed by prismatic joints, and not a "
+                "foldable link or arm (Chipmunk has no massless bodies)")
+    unknowns = (2 * len(group) + sum(isinstance(j, Prismatic) for j in joints)
+                + sum(isinstance(c, PointOnLine) for c in mine))
+    equations = 2 * (len(joints) + len(mine))
+    if unknowns != equations:
+        return (f"massless bodies {sorted(group)}: their joints and constraints impose "
+                f"{equations - unknowns:+d} conditions on the bodies around them; only "
+                "massless groups that leave them free (or fold into one joint) can be "
+                "eliminated (Chipmunk has no massless bodies)")
+    return _Component(tuple(sorted(group)), joints, mine, tuple(angles))
+
+
+def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
+              massless: set[str]):
+    """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch), or why the coupling cannot
+    be expressed."""
+    k: dict[str, float] = {}
+    k0 = _num(c.constant)
+    for name, coef in c.coefficients:
+        j = mech.joints[mech.coordinates.index(name)]
+        if isinstance(j, Prismatic):
+            return (f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
+                    "only angles (GearJoint)")
+        s = -1.0 if j.clockwise else 1.0
+        coef = _num(coef)
+        k[j.child] = k.get(j.child, 0.0) + coef * s
+        if not j.absolute:
+            k[j.parent] = k.get(j.parent, 0.0) - coef * s
+        k0 += coef * s * _num(j.angle_offset)
+    scale = max((abs(v) for v in k.values()), default=0.0)
+    bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
+    if not bodies:
+        return f"coupling {c.name}: no body angle enters it"
+    if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
+        if len(bodies) == 1:
+            a = bodies[0]
+            return "gear", (a, WORLD, -k0 / k[a], 1.0)
+        a, b = bodies
+        return "gear", (a, b, -k0 / k[a], -k[b] / k[a])
+    for K in bodies:
+        others = [b for b in bodies if b != K]
+        hubs: dict[str, tuple[tuple, tuple]] = {}  # body -> (its hub point, K's hub point)
+        for j in mech.joints:
+            if isinstance(j, Revolute) and K in (j.parent, j.child):
+                if j.parent == K:
+                    hubs[j.child] = (tuple(_vec(j.child_anchor)), tuple(_vec(j.parent_anchor)))
+                else:
+                    hubs[j.parent] = (tuple(_vec(j.parent_anchor)), tuple(_vec(j.child_anchor)))
+        if not set(others) <= set(hubs):
+            continue
+        if len(others) == 2:
+            A, B = others
+            if abs(sum(k[b] for b in bodies)) > 1e-12 * scale:
+                continue
+            ka, kb = k[A], k[B]
+        elif len(others) == 1 and WORLD in hubs:
+            A, B = others[0], WORLD
+            ka = k[A]
+            kb = -(k[K] + ka)
+        else:
+            continue
+        if not (engine_ok(A) and engine_ok(B)):
+            continue
+        d = float(np.linalg.norm(np.subtract(hubs[B][1], hubs[A][1])))
+        if d == 0.0 or abs(ka + kb) <= 1e-12 * scale:
+            continue
+        lam = ka / (ka + kb)
+        wrap = 2 * math.pi * abs(k[K]) if K in massless else 0.0
+        contact = _pitch_circles(mech, A, hubs[A][0], abs(lam) * d, B, hubs[B][0],
+                                 abs(lam - 1) * d, not 0.0 < lam < 1.0)
+        if contact is not None and K not in massless:
+            contact = None  # the carrier's hinges would keep the distance: see _build
+        return "pitch", _Pitch(c.name, A, B, hubs[A][0], hubs[B][0], d, lam, ka + kb, wrap, K,
+                               contact)
+    return (f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
+            "couples the absolute angles of two bodies, and a coupling of three is "
+            "expressible here only as two bodies hinged on a common carrier (gear pair, "
+            "belt, rolling: a pivot at the pitch point)")
+
+
+def _pitch_circles(mech: Mechanism, a: str, hub_a, rho_a: float, b: str, hub_b, rho_b: float,
+                   internal: bool):
+    """The drawn circles of a and b that are the pitch circles (centred at the hubs, with
+    the pitch radii), or None."""
+    def find(body, hub, rho):
+        if body == WORLD:
+            return None
+        for s in mech.body(body).shapes:
+            if isinstance(s, Circle) and _is_number(s.radius):
+                centre = _vec(s.center)
+                if (np.allclose(centre, hub, rtol=0, atol=1e-9 * max(rho, 1.0))
+                        and abs(_num(s.radius) - rho) <= 1e-9 * max(rho, 1.0)):
+                    return True
+        return None
+
+    if find(a, hub_a, rho_a) and find(b, hub_b, rho_b):
+        return (a, hub_a, rho_a, b, hub_b, rho_b, internal)
+    return None
+
+
+def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
+    """The engine layout (bodies, folded links, pivots, grooves, substitutes), or the
+    reason the mechanism cannot be expressed."""
+    cfg = cfg or {}
     if not _is_number(mech.gravity):
         return "gravity is not numeric (pass a numeric mechanism)"
-    if getattr(mech, "constraints", ()):
-        names = ", ".join(f"{type(c).__name__} {c.name}" for c in mech.constraints)
-        return (f"closure constraints ({names}) are not translated by this backend; only "
-                "tree mechanisms (joints and folded massless links) are")
     dynamic: list[str] = []
     massless: list[str] = []
     for b in mech.bodies:
@@ -219,7 +534,7 @@ def _plan(mech: Mechanism) -> _Layout | str:
             dynamic.append(b.name)
         else:
             return (f"body {b.name}: mass {m} and inertia {i}; Chipmunk needs both > 0 "
-                    "(or both 0 for a foldable massless link)")
+                    "(or both 0 for a massless link that can be eliminated)")
     for j in mech.joints:
         if not isinstance(j, (Revolute, Prismatic)):
             return f"joint {j.name}: type {type(j).__name__} not supported"
@@ -230,24 +545,20 @@ def _plan(mech: Mechanism) -> _Layout | str:
             return f"joint {j.name}: geometry not numeric (pass a numeric mechanism)"
         if isinstance(j, Prismatic) and _num(j.axis[0]) ** 2 + _num(j.axis[1]) ** 2 == 0:
             return f"joint {j.name}: zero prismatic axis"
-    folds: dict[str, _Fold] = {}
-    for name in massless:
-        inner = mech.joint_of_child(name)
-        children = [j for j in mech.joints if j.parent == name]
-        if len(children) != 1:
-            return (f"massless body {name} has {len(children)} child joints; only a link with "
-                    "exactly one child can be folded (Chipmunk has no massless bodies)")
-        outer = children[0]
-        if {type(inner), type(outer)} != {Revolute, Prismatic}:
-            return (f"massless body {name}: joints {type(inner).__name__} + "
-                    f"{type(outer).__name__}; only a revolute + prismatic pair folds into a "
-                    "Chipmunk GrooveJoint")
-        if inner.parent in massless or outer.child in massless:
-            return f"massless body {name} is attached to another massless body"
-        if isinstance(inner, Revolute):
-            folds[name] = _Fold(name, inner, outer, partner=outer.child, pin_body=inner.parent)
+    constraints = tuple(getattr(mech, "constraints", ()))
+    for c in constraints:
+        if isinstance(c, LinearCoupling):
+            values = [v for _, v in c.coefficients] + [c.constant]
+        elif isinstance(c, PointOnPoint):
+            values = [*c.point_a, *c.point_b]
+        elif isinstance(c, PointOnLine):
+            values = [*c.point, *c.line_point, *c.direction]
         else:
-            folds[name] = _Fold(name, inner, outer, partner=inner.parent, pin_body=outer.child)
+            return f"constraint {getattr(c, 'name', c)}: type {type(c).__name__} not supported"
+        if not all(_is_number(v) for v in values):
+            return f"constraint {c.name}: geometry not numeric (pass a numeric mechanism)"
+        if isinstance(c, PointOnLine) and not _vec(c.direction).any():
+            return f"constraint {c.name}: zero slot direction"
     for f in mech.forces:
         if not isinstance(f, (PointToPoint, CoordinateForce)):
             return f"force element {f.name}: type {type(f).__name__} not supported"
@@ -257,48 +568,291 @@ def _plan(mech: Mechanism) -> _Layout | str:
         if isinstance(f, PointToPoint) and not all(
                 _is_number(v) for v in (*f.point_a, *f.point_b)):
             return f"force element {f.name}: points not numeric"
-    grooves = _grooves(mech, folds)
+
+    # --- massless bodies: fold (revolute + prismatic), arm (revolutes), free group ------
+    geometric = [c for c in constraints if isinstance(c, (PointOnPoint, PointOnLine))]
+    touched = {b for c in geometric for b in _closure_bodies(c)}
+    mset = set(massless)
+    folds: dict[str, _Fold] = {}
+    links: dict[str, _RevLink] = {}
+    for name in massless:
+        if name in touched:
+            continue
+        inner = mech.joint_of_child(name)
+        children = [j for j in mech.joints if j.parent == name]
+        if (len(children) == 1 and {type(inner), type(children[0])} == {Revolute, Prismatic}
+                and inner.parent not in mset and children[0].child not in mset):
+            outer = children[0]
+            if isinstance(inner, Revolute):
+                folds[name] = _Fold(name, inner, outer, partner=outer.child, pin_body=inner.parent)
+            else:
+                folds[name] = _Fold(name, inner, outer, partner=inner.parent, pin_body=outer.child)
+            continue
+        if all(isinstance(j, Revolute) for j in [inner, *children]):
+            link = _rev_link(mech, name, mset)
+            if isinstance(link, str):
+                return link
+            links[name] = link
+    rest = [n for n in massless if n not in folds and n not in links]
+    components: list[_Component] = []
+    remaining = set(rest)
+    while remaining:
+        group = {remaining.pop()}
+        grown = True
+        while grown:
+            grown = False
+            pairs = [(j.parent, j.child) for j in mech.joints] + [
+                _closure_bodies(c) for c in geometric]
+            for a, b in pairs:
+                for x, y in ((a, b), (b, a)):
+                    if x in group and y in remaining:
+                        group.add(y)
+                        remaining.discard(y)
+                        grown = True
+        comp = _component(mech, group, set(dynamic), geometric)
+        if isinstance(comp, str):
+            return comp
+        components.append(comp)
+    consumed = {id(c) for comp in components for c in comp.closures}
+    in_component = frozenset(id(j) for comp in components for j in comp.joints)
+    grooves = _grooves(mech, folds, in_component)
     if isinstance(grooves, str):
         return grooves
     folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
+    linked = {id(j) for j in mech.joints if j.parent in links or j.child in links}
     pivots = [(j.parent, j.child, tuple(_vec(j.parent_anchor)), tuple(_vec(j.child_anchor)))
-              for j in mech.joints if isinstance(j, Revolute) and id(j) not in folded]
-    return _Layout(dynamic, folds, pivots, grooves)
+              for j in mech.joints if isinstance(j, Revolute)
+              and id(j) not in folded and id(j) not in linked and id(j) not in in_component]
+    layout = _Layout(dynamic, folds, pivots, grooves, links, components)
+    for link in links.values():
+        (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
+        for other, point in link.at_alpha[1:]:
+            layout.pivots.append((ra, other, pa, point))
+        for other, point in link.at_beta[1:]:
+            layout.pivots.append((rb, other, pb, point))
+        length = float(np.linalg.norm(np.subtract(link.beta, link.alpha)))
+        layout.pins.append((ra, rb, pa, pb, length, link.link))
+
+    # --- closure constraints ------------------------------------------------------------
+    def engine_ok(b: str) -> bool:
+        return b == WORLD or b in dynamic
+
+    half = float(cfg.get("groove_half_length", 1000.0))
+    fraction = float(cfg.get("slider_mass_fraction", 0.5))
+    for c in constraints:
+        if id(c) in consumed:
+            continue
+        if isinstance(c, PointOnPoint):
+            bad = [b for b in (c.body_a, c.body_b) if not engine_ok(b)]
+            if bad:
+                return (f"constraint {c.name}: on massless body {bad[0]} that cannot be "
+                        "eliminated with it")
+            layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
+                                  tuple(_vec(c.point_b))))
+        elif isinstance(c, PointOnLine):
+            bad = [b for b in (c.body, c.line_body) if not engine_ok(b)]
+            if bad:
+                return (f"constraint {c.name}: on massless body {bad[0]} that cannot be "
+                        "eliminated with it")
+            point, base = _vec(c.point), _vec(c.line_point)
+            direction = _vec(c.direction) / float(np.linalg.norm(_vec(c.direction)))
+            slot, pin, anchor = c.line_body, c.body, point
+            if slot != WORLD and not _through_origin(base, direction):
+                if _rotation_fixed(mech, slot):
+                    layout.infinite.add(slot)
+                else:  # slot carrier glued to the slot body, its centre on the line
+                    foot = base - float(base @ direction) * direction
+                    host = mech.body(slot)
+                    m, inertia = _num(host.mass), _num(host.inertia)
+                    mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(foot)))
+                    name = f"_slot_carrier_{c.name}"
+                    layout.carriers.append(_Carrier(name, slot, "slot", tuple(foot), mass,
+                                                    mass * inertia / m, c.name))
+                    layout.pivots.append((slot, name, tuple(foot), (0.0, 0.0)))
+                    layout.gears.append((slot, name, 0.0, 1.0))
+                    slot, base = name, base - foot
+            if pin != WORLD and point.any():
+                if _rotation_fixed(mech, pin):
+                    layout.infinite.add(pin)
+                else:  # pin slider: a point mass pinned to the pin point
+                    host = mech.body(pin)
+                    m, inertia = _num(host.mass), _num(host.inertia)
+                    mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(point)))
+                    name = f"_pin_slider_{c.name}"
+                    layout.carriers.append(_Carrier(name, pin, "pin", tuple(point), mass,
+                                                    math.inf, c.name))
+                    layout.pivots.append((pin, name, tuple(point), (0.0, 0.0)))
+                    pin, anchor = name, np.zeros(2)
+            layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -half, half,
+                                          tuple(anchor), None))
+        else:
+            out = _coupling(mech, c, engine_ok, mset)
+            if isinstance(out, str):
+                return out
+            kind, value = out
+            if kind == "gear":
+                layout.gears.append(value)
+            else:
+                if cfg.get("rolling", "coupling") == "contact" and value.contact is None:
+                    return (f"rolling = 'contact': coupling {c.name} has no drawn pitch "
+                            "circles (Circle shapes centred at the hubs with the pitch radii) "
+                            "on a massless carrier (an arm the contact can replace) to "
+                            "collide; use rolling = 'coupling'")
+                layout.pitches.append(value)
+
+    # --- engine masses; compensation of the slider substitutes -------------------------
+    for name in dynamic:
+        b = mech.body(name)
+        layout.engine_mass[name] = (_num(b.mass),
+                                    math.inf if name in layout.infinite else _num(b.inertia))
+    for car in layout.carriers:
+        layout.engine_mass[car.name] = (car.mass, car.moment)
+    if layout.carriers and cfg.get("slider_compensation", True):
+        for host in dict.fromkeys(car.host for car in layout.carriers):
+            cars = [car for car in layout.carriers if car.host == host]
+            m, inertia = _num(mech.body(host).mass), _num(mech.body(host).inertia)
+            m1 = m - sum(car.mass for car in cars)
+            first = sum(car.mass * np.array(car.point) for car in cars)
+            c1 = -first / m1 if m1 > 0 else np.zeros(2)
+            i1 = inertia - sum((car.moment if car.kind == "slot" else 0.0)
+                               + car.mass * float(np.dot(car.point, car.point)) for car in cars
+                               ) - m1 * float(c1 @ c1)
+            if m1 <= 0 or i1 <= 0:
+                layout.notes.append(f"slider substitutes on {host} not compensated "
+                                    f"(mass {m1:.3g}, moment {i1:.3g} left)")
+                continue
+            layout.engine_mass[host] = (m1, i1)
+            layout.cog[host] = (float(c1[0]), float(c1[1]))
+    # every groove must stay exact with the engine centres of mass
+    for _ in range(2):
+        for g in layout.grooves:
+            for body, ok in ((g.slot, _slot_exact(layout, g)), (g.pin, _pin_exact(layout, g))):
+                if not ok and body in layout.cog:
+                    del layout.cog[body]
+                    b = mech.body(body)
+                    layout.engine_mass[body] = (_num(b.mass), _num(b.inertia))
+                    layout.notes.append(f"slider substitutes on {body} not compensated (its "
+                                        "centre of gravity must stay on a groove)")
+    for g in layout.grooves:
+        if not (_slot_exact(layout, g) and _pin_exact(layout, g)):
+            return f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}"
+    return layout
+
+
+def _slot_exact(layout: _Layout, g: _Groove) -> bool:
+    if g.slot == WORLD or g.slot in layout.infinite:
+        return True
+    return _through_origin(np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))),
+                           np.array(g.direction))
+
+
+def _pin_exact(layout: _Layout, g: _Groove) -> bool:
+    if g.pin == WORLD or g.pin in layout.infinite or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf:
+        return True
+    return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
 
 class _Kinematics:
-    """Description-level poses as expressions of the engine bodies' states."""
+    """Description-level poses as expressions of the engine bodies' states (centre of
+    mass position, angle, and their rates)."""
 
-    def __init__(self, mech: Mechanism, dynamic: list[str], folds: dict[str, _Fold]):
-        self.mech, self.folds = mech, folds
+    def __init__(self, mech: Mechanism, layout: _Layout):
+        self.mech, self.layout, self.folds = mech, layout, layout.folds
         self.P: list[sp.Symbol] = []
         self.V: list[sp.Symbol] = []
         self.sym: dict[str, tuple[sp.Matrix, sp.Expr]] = {}
-        for k, name in enumerate(dynamic):
+        self.com: dict[str, sp.Matrix] = {}
+        self.index: dict[str, int] = {}
+        for k, name in enumerate(layout.engine):
             # names unlike lambdify's common-subexpression temporaries (x0, x1, ...)
             x, y, th = sp.symbols(f"bx_{k} by_{k} bth_{k}", real=True)
             vx, vy, w = sp.symbols(f"bvx_{k} bvy_{k} bw_{k}", real=True)
             self.P += [x, y, th]
             self.V += [vx, vy, w]
-            self.sym[name] = (sp.Matrix([x, y]), th)
+            self.index[name] = k
+            self.com[name] = sp.Matrix([x, y])
+            if name in layout.dynamic:
+                cog = layout.cog.get(name)
+                p = self.com[name] - rotation(th) * sp.Matrix(cog) if cog else self.com[name]
+                self.sym[name] = (p, th)
         self.sym[WORLD] = (sp.zeros(2, 1), sp.Integer(0))
 
     def pose(self, name: str) -> tuple[sp.Matrix, sp.Expr]:
         if name in self.sym:
             return self.sym[name]
-        fold = self.folds[name]
-        if isinstance(fold.inner, Revolute):  # link turns with its child, pin on the parent
-            _, th_c = self.pose(fold.outer.child)
-            th = th_c - fold.outer.angle_offset
-            pin = self.point(fold.inner.parent, fold.inner.parent_anchor)
-            p = pin - rotation(th) * as_column(fold.inner.child_anchor)
-        else:  # link turns with its parent, pin on the child
-            _, th_p = self.pose(fold.inner.parent)
-            th = th_p + fold.inner.angle_offset
-            pin = self.point(fold.outer.child, fold.outer.child_anchor)
-            p = pin - rotation(th) * as_column(fold.outer.parent_anchor)
-        self.sym[name] = (p, th)
-        return p, th
+        if name in self.folds:
+            fold = self.folds[name]
+            if isinstance(fold.inner, Revolute):  # link turns with its child, pin on the parent
+                _, th_c = self.pose(fold.outer.child)
+                th = th_c - fold.outer.angle_offset
+                pin = self.point(fold.inner.parent, fold.inner.parent_anchor)
+                p = pin - rotation(th) * as_column(fold.inner.child_anchor)
+            else:  # link turns with its parent, pin on the child
+                _, th_p = self.pose(fold.inner.parent)
+                th = th_p + fold.inner.angle_offset
+                pin = self.point(fold.outer.child, fold.outer.child_anchor)
+                p = pin - rotation(th) * as_column(fold.outer.parent_anchor)
+            self.sym[name] = (p, th)
+        elif name in self.layout.links:
+            link = self.layout.links[name]
+            wa = self.point(*link.at_alpha[0])
+            wb = self.point(*link.at_beta[0])
+            ell = sp.Matrix(np.subtract(link.beta, link.alpha).tolist())
+            w = wb - wa
+            th = sp.atan2(ell[0] * w[1] - ell[1] * w[0], ell[0] * w[0] + ell[1] * w[1])
+            self.sym[name] = (wa - rotation(th) * sp.Matrix(link.alpha), th)
+        else:
+            for comp in self.layout.components:
+                if name in comp.bodies:
+                    self._solve(comp)
+                    break
+            else:
+                raise KeyError(name)
+        return self.sym[name]
+
+    def _solve(self, comp: _Component) -> None:
+        """Positions of a free massless group: the joint equations are linear in them
+        once the angles (fixed by prismatic joints) are known."""
+        theta: dict[str, sp.Expr] = {}
+        for body, known, off in comp.angles:
+            theta[body] = (theta[known] if known in theta else self.pose(known)[1]) + off
+        unknown: list[sp.Symbol] = []
+        pos: dict[str, sp.Matrix] = {}
+        for i, body in enumerate(comp.bodies):
+            px, py = sp.symbols(f"_mlx{i} _mly{i}", real=True)
+            unknown += [px, py]
+            pos[body] = sp.Matrix([px, py])
+
+        def angle(body):
+            return theta[body] if body in theta else self.pose(body)[1]
+
+        def point(body, local):
+            if body in pos:
+                return pos[body] + rotation(theta[body]) * as_column(local)
+            return self.point(body, local)
+
+        eqs: list[sp.Expr] = []
+        for n, j in enumerate(comp.joints):
+            gap = point(j.parent, j.parent_anchor) - point(j.child, j.child_anchor)
+            if isinstance(j, Prismatic):
+                q = sp.Symbol(f"_mlq{n}", real=True)
+                unknown.append(q)
+                gap += q * rotation(angle(j.parent)) * as_column(j.axis)
+            eqs += list(gap)
+        for n, c in enumerate(comp.closures):
+            if isinstance(c, PointOnPoint):
+                gap = point(c.body_a, c.point_a) - point(c.body_b, c.point_b)
+            else:
+                u = sp.Symbol(f"_mlu{n}", real=True)
+                unknown.append(u)
+                gap = (point(c.body, c.point) - point(c.line_body, c.line_point)
+                       - u * rotation(angle(c.line_body)) * as_column(c.direction))
+            eqs += list(gap)
+        A, rhs = sp.linear_eq_to_matrix(eqs, unknown)
+        sol = A.LUsolve(rhs)
+        values = dict(zip(unknown, sol))
+        for body in comp.bodies:
+            self.sym[body] = (pos[body].xreplace(values), theta[body])
 
     def point(self, body: str, local) -> sp.Matrix:
         p, th = self.pose(body)
@@ -316,11 +870,28 @@ class _Kinematics:
         p_p, th_p = self.pose(j.parent)
         p_c, th_c = self.pose(j.child)
         if isinstance(j, Revolute):
-            return th_c - (0 if j.absolute else th_p) - j.angle_offset
+            value = th_c - (0 if j.absolute else th_p) - j.angle_offset
+            return -value if j.clockwise else value
         axis = as_column(j.axis)
         d = p_c + rotation(th_c) * as_column(j.child_anchor) - p_p \
             - rotation(th_p) * as_column(j.parent_anchor)
         return (axis.T * rotation(th_p).T * d)[0] / (axis.T * axis)[0]
+
+
+def _coordinate_loads(j: Revolute | Prismatic, value: sp.Expr, kin: _Kinematics):
+    """Loads (body, force, point, torque) of a generalized force `value` on the
+    coordinate of joint j (virtual power)."""
+    if isinstance(j, Revolute):
+        s = -1 if j.clockwise else 1
+        out = [(j.child, None, None, s * value)]
+        if not j.absolute:
+            out.append((j.parent, None, None, -s * value))
+        return out
+    _, th_p = kin.pose(j.parent)
+    axis = as_column(j.axis)
+    force = value * rotation(th_p) * axis / (axis.T * axis)[0]
+    w = kin.point(j.child, j.child_anchor)
+    return [(j.child, force, w, 0), (j.parent, -force, w, 0)]
 
 
 def _element_loads(mech: Mechanism, kin: _Kinematics):
@@ -342,21 +913,12 @@ def _element_loads(mech: Mechanism, kin: _Kinematics):
             i = mech.coordinates.index(f.coordinate)
             j = mech.joints[i]
             value = sp.sympify(f.force).xreplace({COORD: coords[i], COORD_RATE: kin.rate(coords[i])})
-            if isinstance(j, Revolute):
-                loads.append((j.child, None, None, value))
-                loads.append((j.parent, None, None, -value))
-            else:
-                _, th_p = kin.pose(j.parent)
-                axis = as_column(j.axis)
-                force = value * rotation(th_p) * axis / (axis.T * axis)[0]
-                w = kin.point(j.child, j.child_anchor)
-                loads.append((j.child, force, w, 0))
-                loads.append((j.parent, -force, w, 0))
+            loads += _coordinate_loads(j, value, kin)
     return loads
 
 
 def _engine_loads(loads, kin: _Kinematics, dynamic: list[str]) -> dict[int, list[sp.Expr]]:
-    """Body loads (fx, fy, tau about the centre of mass) on the engine bodies."""
+    """Body loads (fx, fy at the centre of mass, tau about it) on the engine bodies."""
     out: dict[int, list[sp.Expr]] = {}
 
     def add(body: str, force, point, torque) -> None:
@@ -370,9 +932,23 @@ def _engine_loads(loads, kin: _Kinematics, dynamic: list[str]) -> dict[int, list
                 torque = torque + _cross(point - pin, force)
             add(fold.partner, None, None, torque)
             return
-        acc = out.setdefault(dynamic.index(body), [sp.Integer(0)] * 3)
+        if body not in kin.index:  # eliminated massless body: virtual power, J^T f
+            _, th = kin.pose(body)
+            for name, k in kin.index.items():
+                gen = []
+                for s in kin.P[3 * k:3 * k + 3]:
+                    g = sp.diff(th, s) * torque if torque != 0 else sp.Integer(0)
+                    if force is not None:
+                        g += force[0] * sp.diff(point[0], s) + force[1] * sp.diff(point[1], s)
+                    gen.append(g)
+                if any(g != 0 for g in gen):
+                    acc = out.setdefault(k, [sp.Integer(0)] * 3)
+                    for i in range(3):
+                        acc[i] += gen[i]
+            return
+        acc = out.setdefault(kin.index[body], [sp.Integer(0)] * 3)
         if force is not None:
-            p, _ = kin.pose(body)
+            p = kin.com[body]
             acc[0] += force[0]
             acc[1] += force[1]
             acc[2] += _cross(point - p, force)
@@ -383,50 +959,142 @@ def _engine_loads(loads, kin: _Kinematics, dynamic: list[str]) -> dict[int, list
     return out
 
 
-_CACHE: dict[Mechanism, _Compiled] = {}
+_CACHE: dict[tuple, _Compiled] = {}
+
+
+def _layout_key(layout: _Layout) -> tuple:
+    return (tuple(layout.engine), tuple(sorted(layout.cog.items())),
+            tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
 
 
 def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
-    if mech in _CACHE:
-        return _CACHE[mech]
-    dynamic = layout.dynamic
-    kin = _Kinematics(mech, dynamic, layout.folds)
+    key = (mech, _layout_key(layout))
+    if key in _CACHE:
+        return _CACHE[key]
+    kin = _Kinematics(mech, layout)
     H = sp.Symbol("H", real=True)
     # loads are evaluated at the position-updated state x + H v (H = dt or 0)
     predicted = {p: p + H * v for p, v in zip(kin.P, kin.V)}
-    state = [s for k in range(len(dynamic))
-             for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
+    n_engine = len(layout.engine)
+    state = [s for k in range(n_engine) for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
     args = [*state, H, TIME]
     loads = _element_loads(mech, kin)
-    per_body = _engine_loads(loads, kin, dynamic)
+    per_body = _engine_loads(loads, kin, layout.dynamic)
     loaded = sorted(per_body)
     loads_math = None
     if loaded:
         flat = [e.xreplace(predicted) for k in loaded for e in per_body[k]]
         loads_math = sp.lambdify(args, flat, modules="math", cse=True)
     external_np: dict[str, Callable] = {}
-    for j in mech.joints:
-        subtree = set(mech.subtree(j.child))
-        total = sp.zeros(2, 1)
-        for body, force, _, _ in loads:
-            if force is not None and body in subtree:
-                total += force
-        external_np[j.name] = sp.lambdify(args, list(total.xreplace(predicted)),
-                                          modules="numpy", cse=True)
+    if not mech.constraints:
+        for j in mech.joints:
+            subtree = set(mech.subtree(j.child))
+            total = sp.zeros(2, 1)
+            for body, force, _, _ in loads:
+                if force is not None and body in subtree:
+                    total += force
+            external_np[j.name] = sp.lambdify(args, list(total.xreplace(predicted)),
+                                              modules="numpy", cse=True)
     coords = [kin.coordinate(j) for j in mech.joints]
     coords_np = sp.lambdify(state, coords + [kin.rate(c) for c in coords],
                             modules="numpy", cse=True)
     masses = {b.name: _num(b.mass) for b in mech.bodies}
-    compiled = _Compiled(layout, loaded, loads_math, external_np, coords_np, masses)
+    pitch_phi = []
+    for pitch in layout.pitches:
+        c = next(c for c in mech.constraints if c.name == pitch.name)
+        phi = sum((_num(coef) * coords[mech.coordinates.index(name)]
+                   for name, coef in c.coefficients), sp.Integer(0)) - _num(c.constant)
+        pitch_phi.append(sp.lambdify(kin.P, phi, modules="math", cse=True))
+    compiled = _Compiled(layout, kin, loads, loaded, loads_math, external_np, coords_np, masses,
+                         pitch_phi)
     if len(_CACHE) > 64:
         _CACHE.clear()
-    _CACHE[mech] = compiled
+    _CACHE[key] = compiled
     return compiled
 
 
+class _Balance:
+    """Momentum balance of every description body over a step, solved in least squares
+    for the joint reactions and the closure multipliers (see `PymunkBackend._forces`)."""
+
+    def __init__(self, mech: Mechanism, comp: _Compiled):
+        kin = comp.kin
+        self.bodies = [b.name for b in mech.bodies]
+        self.columns: list[tuple[str, str]] = []  # (kind, name)
+        cols: list[dict[str, list]] = []
+        vectors: list[sp.Matrix] = []  # per column, the unit force direction (or zeros)
+
+        def add(col, body, force, point, torque):
+            if body == WORLD:
+                return
+            c, _ = kin.pose(body)
+            entry = col.setdefault(body, [sp.Integer(0)] * 3)
+            if force is not None:
+                entry[0] += force[0]
+                entry[1] += force[1]
+                entry[2] += _cross(point - c, force)
+            entry[2] += torque
+
+        def column(kind, name, pairs, vector):
+            col: dict[str, list] = {}
+            for body, force, point, torque in pairs:
+                add(col, body, force, point, torque)
+            cols.append(col)
+            self.columns.append((kind, name))
+            vectors.append(vector)
+
+        ex, ey, zero = sp.Matrix([1, 0]), sp.Matrix([0, 1]), sp.zeros(2, 1)
+        for j in mech.joints:
+            w = kin.point(j.child, j.child_anchor)
+            if isinstance(j, Revolute):
+                for e in (ex, ey):
+                    column("joint", j.name, [(j.child, e, w, 0), (j.parent, -e, w, 0)], e)
+            else:
+                _, th_p = kin.pose(j.parent)
+                axis = as_column(j.axis)
+                n = rotation(th_p) * sp.Matrix([-axis[1], axis[0]]) / sp.sqrt((axis.T * axis)[0])
+                column("joint", j.name, [(j.child, n, w, 0), (j.parent, -n, w, 0)], n)
+                column("moment", j.name, [(j.child, None, None, 1), (j.parent, None, None, -1)],
+                       zero)
+        for c in mech.constraints:
+            if isinstance(c, PointOnPoint):
+                w = kin.point(c.body_a, c.point_a)
+                for e in (ex, ey):
+                    column("closure", c.name, [(c.body_a, e, w, 0), (c.body_b, -e, w, 0)], e)
+            elif isinstance(c, PointOnLine):
+                _, th = kin.pose(c.line_body)
+                d = as_column(c.direction)
+                n = rotation(th) * sp.Matrix([-d[1], d[0]]) / sp.sqrt((d.T * d)[0])
+                w = kin.point(c.body, c.point)
+                column("closure", c.name, [(c.body, n, w, 0), (c.line_body, -n, w, 0)], n)
+            else:
+                pairs = []
+                for name, coef in c.coefficients:
+                    j = mech.joints[mech.coordinates.index(name)]
+                    pairs += _coordinate_loads(j, sp.sympify(coef), kin)
+                column("closure", c.name, pairs, zero)
+        entries = [col.get(b, [0, 0, 0])[r] for b in self.bodies for r in range(3) for col in cols]
+        self.shape = (3 * len(self.bodies), len(cols))
+        self.A = sp.lambdify(kin.P, entries, modules="numpy", cse=True)
+        self.vectors = sp.lambdify(kin.P, [e for v in vectors for e in v], modules="numpy",
+                                   cse=True)
+        self.centres = sp.lambdify(kin.P, [e for b in self.bodies for e in kin.pose(b)[0]],
+                                   modules="numpy", cse=True)
+        H = sp.Symbol("H", real=True)
+        predicted = {p: p + H * v for p, v in zip(kin.P, kin.V)}
+        ext: dict[str, list] = {}
+        for body, force, point, torque in comp.loads:
+            add(ext, body, force, point, torque)
+        flat = [sp.sympify(ext.get(b, [0, 0, 0])[r]).xreplace(predicted)
+                for b in self.bodies for r in range(3)]
+        state = [s for k in range(len(kin.index))
+                 for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
+        self.external = sp.lambdify([*state, H, TIME], flat, modules="numpy", cse=True)
+
+
 def _initial_states(mech: Mechanism, q0, qd0) -> dict[str, tuple[float, ...]]:
-    """(x, y, theta, vx, vy, omega) of every description body at (q0, qd0), by planar
-    forward kinematics in joint order (conventions 3-5)."""
+    """(x, y, theta, vx, vy, omega) of every description body's frame at (q0, qd0), by
+    planar forward kinematics in joint order (conventions 3-5)."""
     st: dict[str, tuple[float, ...]] = {WORLD: (0.0,) * 6}
 
     def rot(th: float, v) -> tuple[float, float]:
@@ -439,6 +1107,8 @@ def _initial_states(mech: Mechanism, q0, qd0) -> dict[str, tuple[float, ...]]:
         ca = (_num(j.child_anchor[0]), _num(j.child_anchor[1]))
         off = _num(j.angle_offset)
         if isinstance(j, Revolute):
+            if j.clockwise:
+                q, qd = -q, -qd
             th = (0.0 if j.absolute else th_p) + q + off
             w = (0.0 if j.absolute else w_p) + qd
             r = rot(th_p, pa)
@@ -455,8 +1125,20 @@ def _initial_states(mech: Mechanism, q0, qd0) -> dict[str, tuple[float, ...]]:
     return st
 
 
+def _point_state(st: tuple[float, ...], local) -> tuple[float, float, float, float]:
+    """World position and velocity of a body point, from the body frame's state."""
+    x, y, th, vx, vy, w = st
+    c, s = math.cos(th), math.sin(th)
+    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
+    return x + rx, y + ry, vx - w * ry, vy + w * rx
+
+
 class PymunkBackend(Backend):
     id = "pymunk"
+    #: of the last constrained run: relative residual of the momentum balance behind the
+    #: constraint forces (0 when the engine's constraints are exactly the description's),
+    #: and notes on substitutes that could not be compensated
+    diagnostics: dict = {}
 
     def available(self) -> tuple[bool, str]:
         try:
@@ -474,10 +1156,16 @@ class PymunkBackend(Backend):
         return {
             "error_bias": 0.0,
             "iterations": 50,
+            "start_iterations": 1000,
             "damping": 1.0,
             "sleep_time_threshold": None,
             "element_forces": "position_updated",
             "groove_half_length": 1000.0,
+            "slider_mass_fraction": 0.5,
+            "slider_compensation": True,
+            "rolling": "coupling",
+            "contact_friction": 10.0,
+            "contact_segments": 720,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -495,7 +1183,16 @@ class PymunkBackend(Backend):
                 "on the small double-pendulum swing the reaction error was 1.8e-3 "
                 "(relative) with 10 and 1.4e-4 with 20 or more (20, 30, 50, 100 identical; "
                 "trajectories identical from 10 on, reactions 65 % off with 1). 50 keeps a "
-                "margin at negligible cost."),
+                "margin at negligible cost. Closed loops with slider substitutes need it: "
+                "the scotch yoke diverged with 10 at slider_mass_fraction 0.1."),
+            "start_iterations": (
+                "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
+                "step from the previous step's impulses; the first step has none, and a "
+                "closed loop or a slider substitute then leaves it unconverged: with 50 "
+                "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
+                "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
+                "unchanged (they converge from the warm start). Tree mechanisms were already "
+                "converged (bit-identical results)."),
             "damping": (
                 "space.damping, the fraction of velocity kept after 1 s. Pymunk's default "
                 "is already 1 (no damping); stated explicitly so it is recorded."),
@@ -515,21 +1212,69 @@ class PymunkBackend(Backend):
                 "rate or time, so the backend applies body forces and torques."),
             "groove_half_length": (
                 "Chipmunk grooves are finite segments: a prismatic side without a limit "
-                "is given this extent in m (the groove ends act as stops). Finite limits "
-                "of the description are used as the groove ends."),
+                "(and every point-on-line slot) is given this extent in m (the groove ends "
+                "act as stops). Finite limits of the description are used as the groove "
+                "ends."),
+            "slider_mass_fraction": (
+                "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
+                "exact (pin off the pin body's centre of mass, or slot line off the slot "
+                "body's): a 'pin slider' (point mass pinned to the pin point) and/or a "
+                "'slot carrier' (glued to the slot body, centre on the slot line) runs in "
+                "an exact groove. Its mass is this fraction of the host body's effective "
+                "mass at that point, m I / (I + m d^2). Chipmunk has no such substitute and "
+                "no massless bodies. With compensation (below) the fraction does not enter "
+                "the dynamics (scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and "
+                "0.5), only the convergence of the Gauss-Seidel solve, since a light body "
+                "between heavy ones converges slowly: from the cold start (no cached "
+                "impulses) the slot force at samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at "
+                "0.5 with 50 iterations; the rhombus loop diverged at 0.05 with 50 "
+                "iterations (exact with 500). Must stay below 1 (the host keeps a positive "
+                "moment)."),
+            "slider_compensation": (
+                "true: the substitute's mass (and a slot carrier's moment) is taken out of "
+                "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
+                "host + substitute have exactly the described inertia; false: the "
+                "substitute adds its mass to the mechanism (teaching mode: shows the "
+                "dynamic effect of a slider mass; measured with fraction 0.05, 10 s: "
+                "trajectory error 0.33-1.9 of the amplitude on the scotch yoke, 0.37-140 on "
+                "the slotted link, against 3-10e-3 compensated)."),
+            "rolling": (
+                "'coupling' (default): a LinearCoupling of two bodies hinged on a carrier "
+                "(gear pair, belt, disc rolling in a moving track) is a PivotJoint between "
+                "them at the pitch point, re-anchored before every solve (exact rows, the "
+                "coupling's position error corrected by Chipmunk's own error correction). "
+                "'contact': where the description draws the pitch circles (Circle shapes), "
+                "they collide instead (a Circle inside a ring of Segments, or two Circles) "
+                "with Coulomb friction and the carrier arm removed (the contact holds the "
+                "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
+                "its friction, at zero): what a game-physics user would build. Measured on "
+                "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
+                "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
+                "the disc passes from one chord to the next (normal impulse 0, then twice), "
+                "3-6 s per 10 s run (coupling 0.4 s)."),
+            "contact_friction": (
+                "Friction coefficient of the rolling contact (rolling = 'contact'); "
+                "Chipmunk multiplies the two shapes' coefficients, this one goes on the "
+                "inner shape and 1 on the ring. Must exceed |friction| / normal force at all "
+                "times or the disc slides."),
+            "contact_segments": (
+                "Number of Segment shapes of a ring (rolling = 'contact'), inscribed in the "
+                "pitch circle; space.collision_slop is set to the chord's sagitta so that "
+                "the polygon's penetration is not 'corrected' against the carrier joint."),
         }
 
     def support(self, mechanism: Mechanism) -> Support:
-        plan = _plan(mechanism)
+        plan = _plan(mechanism, self.default_settings())
         if isinstance(plan, str):
             return Support(False, plan)
         return Support(True)
 
     # --- building ------------------------------------------------------------------------
     @staticmethod
-    def _build(mech: Mechanism, layout: _Layout, q0, qd0, cfg: dict):
+    def _build(mech: Mechanism, comp: _Compiled, q0, qd0, cfg: dict):
         import pymunk
 
+        layout = comp.layout
         space = pymunk.Space()
         space.gravity = (0.0, -_num(mech.gravity))
         space.damping = float(cfg["damping"])
@@ -538,20 +1283,42 @@ class PymunkBackend(Backend):
         space.sleep_time_threshold = math.inf if sleep is None else float(sleep)
         state = _initial_states(mech, q0, qd0)
         bodies: dict[str, pymunk.Body] = {WORLD: space.static_body}
-        for name in layout.dynamic:
-            b = mech.body(name)
-            body = pymunk.Body(_num(b.mass), _num(b.inertia))  # no shapes: nothing collides
-            x, y, th, vx, vy, w = state[name]
+        for name in layout.engine:
+            m, inertia = layout.engine_mass[name]
+            body = pymunk.Body(m, inertia)  # no shapes: nothing collides
+            if name in layout.dynamic:
+                x, y, th, vx, vy, w = state[name]
+                cog = layout.cog.get(name)
+            else:
+                car = next(c for c in layout.carriers if c.name == name)
+                x, y, vx, vy = _point_state(state[car.host], car.point)
+                th, w = (state[car.host][2], state[car.host][5]) if car.kind == "slot" else (0.0, 0.0)
+                cog = None
+            body.angle = th  # before the position: pymunk places the frame with the angle
+            if cog:
+                body.center_of_gravity = cog
+                _, _, vx, vy = _point_state((x, y, th, vx, vy, w), cog)
             body.position = (x, y)
-            body.angle = th
-            body.velocity = (vx, vy)
+            body.velocity = (vx, vy)  # of the centre of gravity
             body.angular_velocity = w
             space.add(body)
             bodies[name] = body
         half = float(cfg["groove_half_length"])
+
+        def spins(name: str) -> bool:
+            return name != WORLD and layout.engine_mass[name][1] != math.inf
+
         constraints: list = []
         for parent, child, pa, ca in layout.pivots:
             constraints.append(pymunk.PivotJoint(bodies[parent], bodies[child], pa, ca))
+        contact = cfg["rolling"] == "contact"
+        # a rolling contact holds the disc itself: the arm that stood for it goes (kept, the
+        # distance would be enforced twice and Gauss-Seidel may leave the contact's normal
+        # impulse, hence its friction, at zero)
+        replaced = {p.carrier for p in layout.pitches if contact and p.contact is not None}
+        for a, b, pa, pb, _, link in layout.pins:
+            if link not in replaced:
+                constraints.append(pymunk.PinJoint(bodies[a], bodies[b], pa, pb))
         for g in layout.grooves:
             base, direction = np.array(g.base), np.array(g.direction)
             lo = -half if g.lo is None else g.lo
@@ -559,12 +1326,102 @@ class PymunkBackend(Backend):
             a, b = bodies[g.slot], bodies[g.pin]
             constraints.append(pymunk.GrooveJoint(a, b, tuple(base + lo * direction),
                                                   tuple(base + hi * direction), g.anchor))
-            if g.phase is not None:
+            if g.phase is not None and (spins(g.slot) or spins(g.pin)):
                 constraints.append(pymunk.GearJoint(a, b, g.phase, 1.0))
+        for a, b, phase, ratio in layout.gears:
+            constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
+        for i, (pitch, phi) in enumerate(zip(layout.pitches, comp.pitch_phi)):
+            if contact and pitch.contact is not None:
+                PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
+            else:
+                constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch, phi))
         for c in constraints:
             c.error_bias = float(cfg["error_bias"])
         space.add(*constraints)
-        return space, [bodies[n] for n in layout.dynamic]
+        return space, [bodies[n] for n in layout.engine]
+
+    @staticmethod
+    def _pitch_pivot(pymunk, bodies, comp: _Compiled, pitch: _Pitch, phi_fn):
+        """PivotJoint between the two coupled bodies, moved to the pitch point at the
+        position-updated configuration before every solve; the coupling's position error
+        e (metres along the pitch tangent) is left as the tangential gap of the anchors so
+        that Chipmunk removes it like any joint error."""
+        a, b = bodies[pitch.a], bodies[pitch.b]
+        engine = [bodies[n] for n in comp.layout.engine]
+        cogs = [comp.layout.cog.get(n) for n in comp.layout.engine]
+        scale = pitch.d / pitch.ksum
+        last: list[float | None] = [None]
+
+        def anchors():
+            pos = []
+            for body, cog in zip(engine, cogs):
+                p = body.local_to_world(cog) if cog else body.position
+                pos += [p.x, p.y, body.angle]
+            value = phi_fn(*pos)
+            if pitch.wrap and last[0] is not None:  # a massless carrier's angle wrapped
+                value += pitch.wrap * round((last[0] - value) / pitch.wrap)
+            last[0] = value
+            ha, hb = a.local_to_world(pitch.hub_a), b.local_to_world(pitch.hub_b)
+            dx, dy = hb.x - ha.x, hb.y - ha.y
+            dist = math.hypot(dx, dy)
+            ux, uy = dx / dist, dy / dist
+            e = scale * value
+            ra, rb = pitch.lam * pitch.d, (pitch.lam - 1.0) * pitch.d
+            ca = (ha.x + ra * ux, ha.y + ra * uy)
+            cb = (hb.x + rb * ux + e * uy, hb.y + rb * uy - e * ux)
+            return a.world_to_local(ca), b.world_to_local(cb)
+
+        pa, pb = anchors()
+        joint = pymunk.PivotJoint(a, b, pa, pb)
+
+        def pre_solve(constraint, space):
+            constraint.anchor_a, constraint.anchor_b = anchors()
+
+        joint.pre_solve = pre_solve
+        return joint
+
+    @staticmethod
+    def _contact_shapes(space, bodies, pitch: _Pitch, index: int, cfg: dict) -> None:
+        """The pitch circles as colliding shapes with friction (rolling = 'contact')."""
+        import pymunk
+
+        a, hub_a, rho_a, b, hub_b, rho_b, internal = pitch.contact
+        flt = pymunk.ShapeFilter(categories=1 << (index % 32), mask=1 << (index % 32))
+        shapes = []
+        if internal:
+            (ring, centre, rho), (disc, dcentre, drho) = sorted(
+                [(a, hub_a, rho_a), (b, hub_b, rho_b)], key=lambda s: -s[2])
+            n = int(cfg["contact_segments"])
+            pts = [(centre[0] + rho * math.cos(2 * math.pi * i / n),
+                    centre[1] + rho * math.sin(2 * math.pi * i / n)) for i in range(n)]
+            # chords inscribed in the pitch circle, rounded with the sagitta: the disc on
+            # the pitch circle overlaps them by between 1 and 2 sagittas everywhere (at a
+            # vertex too), so the contact never opens; a slop of 3 sagittas keeps Chipmunk
+            # from pushing the disc out of that overlap
+            sagitta = rho * (1 - math.cos(math.pi / n))
+            segs = [pymunk.Segment(bodies[ring], pts[i], pts[(i + 1) % n], sagitta)
+                    for i in range(n)]
+            for i, seg in enumerate(segs):
+                seg.set_neighbors(pts[i - 1], pts[(i + 2) % n])
+                seg.friction = 1.0
+            shapes += segs
+            circle = pymunk.Circle(bodies[disc], drho, tuple(dcentre))
+            circle.friction = float(cfg["contact_friction"])
+            shapes.append(circle)
+            space.collision_slop = 3.0 * sagitta
+        else:
+            # two circles held at touching distance by the carrier: inflated by 1e-6 of
+            # their size so that they overlap (and stay in contact), slop above that
+            grow = 1e-6 * max(rho_a, rho_b)
+            for body, centre, rho in ((a, hub_a, rho_a), (b, hub_b, rho_b)):
+                circle = pymunk.Circle(bodies[body], rho + grow, tuple(centre))
+                circle.friction = float(cfg["contact_friction"]) if body == b else 1.0
+                shapes.append(circle)
+            space.collision_slop = 4.0 * grow
+        for s in shapes:
+            s.elasticity = 0.0
+            s.filter = flt
+        space.add(*shapes)
 
     # --- running -------------------------------------------------------------------------
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
@@ -573,21 +1430,24 @@ class PymunkBackend(Backend):
         cfg = self.resolve_settings(settings)
         if cfg["element_forces"] not in _FORCE_MODES:
             raise ValueError(f"element_forces must be one of {_FORCE_MODES}")
-        layout = _plan(mechanism)
+        if cfg["rolling"] not in _ROLLING:
+            raise ValueError(f"rolling must be one of {_ROLLING}")
+        layout = _plan(mechanism, cfg)
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
         comp = _compile(mechanism, layout)
-        space, bodies = self._build(mechanism, layout, np.asarray(q0, float),
-                                    np.asarray(qd0, float), cfg)
+        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
+        space, bodies = self._build(mechanism, comp, q0, qd0, cfg)
         n_steps = int(round(t_end / dt))
         h = float(dt)
         # loads at x + h v and t + h (see setting notes), or at the sampled state
         H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        cogs = [layout.cog.get(n) for n in layout.engine]
 
         def read() -> list[float]:
             row: list[float] = []
-            for b in bodies:
-                row.extend(b.position)
+            for b, cog in zip(bodies, cogs):
+                row.extend(b.local_to_world(cog) if cog else b.position)
                 row.append(b.angle)
                 row.extend(b.velocity)
                 row.append(b.angular_velocity)
@@ -597,11 +1457,16 @@ class PymunkBackend(Backend):
         step = space.step
         loads = comp.loads_math
         targets = [bodies[k] for k in comp.loaded]
+        iterations = int(cfg["iterations"])
+        # the first step has no cached impulses to start from (see start_iterations)
+        space.iterations = max(iterations, int(cfg["start_iterations"]))
         start = time.perf_counter()
         if loads is None:
-            for _ in range(n_steps):
+            for k in range(n_steps):
                 step(h)
                 rows.append(read())
+                if k == 0:
+                    space.iterations = iterations
         else:
             for k in range(n_steps):
                 out = loads(*rows[-1], H, (k + shift) * h)
@@ -610,6 +1475,8 @@ class PymunkBackend(Backend):
                     b.torque = out[3 * i + 2]
                 step(h)
                 rows.append(read())
+                if k == 0:
+                    space.iterations = iterations
         wall = time.perf_counter() - start
 
         S = np.array(rows)
@@ -617,10 +1484,20 @@ class PymunkBackend(Backend):
         t = np.arange(n_steps + 1) * h
         cols = [np.broadcast_to(np.asarray(c, float), t.shape) for c in comp.coords_np(*S.T)]
         q, qd = np.column_stack(cols[:n]), np.column_stack(cols[n:])
-        reactions = {j: self._reaction(mechanism, comp, j, S, H, shift, h, t)
-                     for j in reaction_joints}
+        for i, j in enumerate(mechanism.joints):
+            if isinstance(j, Revolute):  # angles of eliminated links come from atan2
+                col = np.unwrap(q[:, i])
+                q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
+        constraint_forces: dict[str, np.ndarray] = {}
+        if mechanism.constraints:
+            joint_forces, constraint_forces = self._forces(mechanism, comp, S, H, shift, h, t)
+            reactions = {j: joint_forces[j] for j in reaction_joints}
+        else:
+            reactions = {j: self._reaction(mechanism, comp, j, S, H, shift, h, t)
+                         for j in reaction_joints}
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                         integrator_order=1, settings=cfg, steps=n_steps)
+                         integrator_order=1, settings=cfg, steps=n_steps,
+                         constraint_forces=constraint_forces)
 
     @staticmethod
     def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
@@ -650,6 +1527,84 @@ class PymunkBackend(Backend):
         out = np.full((len(t), 2), np.nan)
         out[1:] = total
         return out
+
+    def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, H: float, shift: int,
+                h: float, t: np.ndarray):
+        """Joint reactions and closure-constraint forces of a constrained mechanism.
+
+        Chipmunk's `impulse` is a magnitude, and a closure may be a substitute (slider,
+        pitch pivot, contact), so the forces are taken from momentum balance: for every
+        description body, over the step n -> n+1, the engine parts that make it up give
+        sum m (a - g) and sum (I alpha + r x m (a - g)) about its centre of mass; minus the
+        element loads as applied in that step, that is the wrench of the unknown joint
+        reactions and closure multipliers, whose directions and points are those of the
+        description at the configuration x(n+1) where Chipmunk computed its impulses.
+        Solved in least squares (pseudo-inverse) per sample; the same sample convention
+        as the reactions (n+1; sample 0 NaN). Massless bodies enter with zero inertia, so
+        the force in a joint of an eliminated link is its static balance."""
+        layout = comp.layout
+        if comp.balance is None:
+            comp.balance = _Balance(mech, comp)
+        bal: _Balance = comp.balance
+        m_steps = len(t) - 1
+        nrow, ncol = bal.shape
+        pos = [S[1:, 6 * k + i] for k in range(len(layout.engine)) for i in range(3)]
+
+        def arrays(values) -> list[np.ndarray]:
+            return [np.broadcast_to(np.asarray(v, float), (m_steps,)) for v in values]
+
+        A = np.stack(arrays(bal.A(*pos)), axis=-1).reshape(m_steps, nrow, ncol)
+        centres = arrays(bal.centres(*pos))
+        rhs = np.zeros((m_steps, nrow))
+        g = _num(mech.gravity)
+        carriers = {c.name: c for c in layout.carriers}
+        for k, name in enumerate(layout.engine):
+            host = name if name in layout.dynamic else carriers[name].host
+            i = bal.bodies.index(host)
+            m, inertia = layout.engine_mass[name]
+            fx = m * np.diff(S[:, 6 * k + 3]) / h
+            fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
+            alpha = np.diff(S[:, 6 * k + 5]) / h
+            if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
+                inertia = _num(mech.body(name).inertia) if name in layout.dynamic else 0.0
+            rx, ry = S[1:, 6 * k] - centres[2 * i], S[1:, 6 * k + 1] - centres[2 * i + 1]
+            rhs[:, 3 * i] += fx
+            rhs[:, 3 * i + 1] += fy
+            rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
+        ext = arrays(bal.external(*S[:-1].T, H, t[:-1] + shift * h))
+        rhs -= np.column_stack(ext)
+        x = (np.linalg.pinv(A) @ rhs[..., None])[..., 0]
+        resid = np.linalg.norm(np.einsum("nij,nj->ni", A, x) - rhs, axis=1)
+        self.diagnostics = {
+            "balance_residual": float(np.max(resid) / max(float(np.max(np.abs(rhs))), 1e-300)),
+            "notes": list(layout.notes),
+        }
+        vec = arrays(bal.vectors(*pos))
+        joints: dict[str, list] = {}
+        closures: dict[str, list] = {}
+        for i, (kind, name) in enumerate(bal.columns):
+            if kind == "moment":
+                continue
+            target = joints if kind == "joint" else closures
+            target.setdefault(name, []).append(i)
+
+        def assemble(indices: list[int], scalar_vector: bool) -> np.ndarray:
+            if len(indices) == 2:
+                val = x[:, indices]
+            elif scalar_vector:  # force magnitude along its known direction
+                i = indices[0]
+                val = x[:, [i]] * np.column_stack([vec[2 * i], vec[2 * i + 1]])
+            else:
+                val = x[:, indices]
+            out = np.full((len(t), val.shape[1]), np.nan)
+            out[1:] = val
+            return out
+
+        joint_forces = {name: assemble(ix, True) for name, ix in joints.items()}
+        constraint_forces = {
+            c.name: assemble(closures[c.name], not isinstance(c, LinearCoupling))
+            for c in mech.constraints}
+        return joint_forces, constraint_forces
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
