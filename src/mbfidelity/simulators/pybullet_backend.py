@@ -16,8 +16,22 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   ``-angle_offset``), normalised (its length goes into ``A``).
 - Massless bodies are links of mass 0 and inertia 0: Featherstone's articulated-body
   algorithm only inverts the articulated inertia of each joint, which the child carries.
-- Closure constraints are not translated (PyBullet's ``createConstraint`` is a
-  velocity-level, drifting solver; see SIMULATORS.md): `support` says so.
+- Closure constraints (``createConstraint``, solved with the velocity-level projected
+  Gauss-Seidel of the multibody solver: J(q_k) v_{k+1} = -erp Phi(q_k)/dt, then
+  q_{k+1} = q_k + dt v_{k+1}; exact for linear constraints, first order otherwise):
+  ``PointOnPoint`` -> ``JOINT_POINT2POINT``; ``PointOnLine`` -> a rotor link on the pin
+  (revolute, no mass, tiny inertia) and ``JOINT_PRISMATIC`` rotor -> slot body, whose
+  child pivot is moved under the pin before each step (the engine evaluates the
+  constraint Jacobian at its pivot, a fixed body point); ``LinearCoupling`` -> written on
+  the engine joint values (``w = A^-T c``) and, when it involves exactly two of them,
+  ``JOINT_GEAR`` (jv_a + ratio jv_b = target). Couplings of one or of three or more joint
+  values are refused by `support`. Massless bodies that carry nothing but are held by a
+  constraint get a small substitute mass. Constraint frames are centre-of-mass frames
+  (= body frames). The violation of each closure is measured at every sample
+  (``RunResult.constraint_violation``). Settings "point_on_line" = "slider" and "rolling" =
+  "contact" select the alternative substitutes (see `setting_notes`).
+- createMultiBody stores links in depth-first order of the tree; the backend maps its
+  creation order to the engine's indices through the joint names ("joint<k+1>").
 - ``CoordinateForce``: joint forces through ``setJointMotorControlArray(TORQUE_CONTROL)``
   every step. ``PointToPoint``: ``applyExternalForce`` (world frame) at both points every
   step, from the engine's own link states. Both are evaluated at the state and time at
@@ -33,12 +47,24 @@ route therefore reads the reaction from the engine's own inverse dynamics
 joints (parent-frame x and y) are inserted in front of each requested joint, at the
 engine's state and its acceleration of the same step (``(v_{k+1} - v_k)/dt``, exact for
 semi-implicit Euler). The sensor stays available (setting ``reaction_method``).
+Closure-constraint forces that reach the child's subtree from outside are taken out
+like the point-to-point forces (checked by Newton's law on the scotch yoke's disc and
+the slotted bar: 3e-14 N).
+
+Constraint forces: ``getConstraintState`` after a step (impulse / dt of that step, so it
+belongs to the state before it, like the reactions). Measured sign conventions:
+POINT2POINT rows hold the force on the CHILD (world x, y, z); PRISMATIC rows (row 1 = the
+in-plane normal of the slot) hold the force on the PARENT; GEAR's one row f gives joint
+forces f (1, ratio). Because the projection is velocity level, a constraint's curvature
+term (centripetal J'v) enters the force one step late, through the position error: a run
+that starts fast on a curved constraint reports at the first sample a force lacking J'v
+(and half of it too much at the second); afterwards the forces are first-order accurate.
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -51,8 +77,12 @@ from ..systems.model import (
     LENGTH_RATE,
     TIME,
     WORLD,
+    Circle,
     CoordinateForce,
+    LinearCoupling,
     Mechanism,
+    PointOnLine,
+    PointOnPoint,
     PointToPoint,
     Prismatic,
     Revolute,
@@ -61,6 +91,10 @@ from ..systems.model import (
 from .base import Backend, Linearization, RunResult, Support
 
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
+_ROLLING = ("coupling", "contact")
+_POINT_ON_LINE = ("prismatic", "slider")
+#: createMultiBody keeps the first 127 links and drops the rest without an error (measured)
+_MAX_LINKS = 127
 
 
 def _num(x) -> float:
@@ -108,14 +142,176 @@ class _CoordForce:
     time_dependent: bool
 
 
-class _Plan:
-    """Numeric translation of a (numeric) mechanism into PyBullet terms."""
+@dataclass
+class _Closure:
+    """A closure constraint and its PyBullet constraint (links are plan link indices,
+    -1 = the fixed base; points in centre-of-mass frames = the description's body frames).
 
-    def __init__(self, mech: Mechanism, massless_mass: float) -> None:
+    kind "p2p" (PointOnPoint): JOINT_POINT2POINT, parent = body_a's link at point_a,
+    child = body_b's link at point_b.
+    kind "prismatic" (PointOnLine, default): a rotor link (revolute, no mass, small
+    inertia) on the pin body at the pin, and a JOINT_PRISMATIC constraint (rotor =
+    parent, axis along the slot in its frame; slot body = child, pivot moved under the
+    pin before each step): one in-plane row normal to the slot plus a row locking the
+    rotor's angle to the slot body's; the rotor's inertia is the only substitute.
+    kind "slider" (PointOnLine, alternative): a slider link (prismatic along the slot,
+    small mass) on the slot body and a JOINT_POINT2POINT pin (parent) - slider (child).
+    kind "gear" (LinearCoupling): JOINT_GEAR jv[a] + ratio jv[b] = target between engine
+    joints a and b; `scale` (w_a) turns its force into the coupling's -multiplier."""
+
+    element: object
+    kind: str
+    parent: int = -1
+    parent_point: tuple[float, float] = (0.0, 0.0)
+    child: int = -1
+    child_point: tuple[float, float] = (0.0, 0.0)
+    # PointOnLine: pin and slot (line) geometry, and the extra link (slider or rotor)
+    pin_link: int = -1
+    pin_point: tuple[float, float] = (0.0, 0.0)
+    line_link: int = -1
+    line_point: tuple[float, float] = (0.0, 0.0)
+    direction: tuple[float, float] = (1.0, 0.0)
+    aux: int = -1
+    #: prismatic: the constraint's in-plane normal row direction in the slot body frame
+    row_normal: tuple[float, float] = (0.0, 1.0)
+    #: (link on which the reported force acts, link of the opposite force): for reactions
+    force_links: tuple[int, int] = (-1, -1)
+    # gear
+    a: int = -1
+    b: int = -1
+    ratio: float = 0.0
+    target: float = 0.0
+    scale: float = 1.0
+    weights: np.ndarray | None = None  # coupling coefficients c (description coordinates)
+    constant: float = 0.0
+
+
+def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
+    """The in-plane linear row of btMultiBodySliderConstraint, in the parent (slot) frame:
+    c0 = (first frame column e_i with |e_i x u| > 1e-6) x u, normalised (here +-z), and
+    row 1 = u x c0 (row 0 = c0 is out of plane, its Jacobian vanishes)."""
+    u3 = np.array([u[0], u[1], 0.0])
+    for e in np.eye(3):
+        c0 = np.cross(e, u3)
+        if np.linalg.norm(c0) > 1e-6:
+            c0 = c0 / np.linalg.norm(c0)
+            c1 = np.cross(u3, c0)
+            c1 = c1 / np.linalg.norm(c1)
+            return float(c1[0]), float(c1[1])
+    raise ValueError("zero slot direction")
+
+
+def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
+                bvec: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, float]:
+    """The coupling sum(c q) = const written on the engine joint values:
+    w . jv = const + c . A^-1 b with w = A^-T c. Returns (c, const, w, rhs)."""
+    cvec = np.zeros(len(coords))
+    for name, coef in c.coefficients:
+        cvec[coords.index(name)] += _num(coef)
+    const = _num(c.constant)
+    w = Ainv.T @ cvec
+    w[np.abs(w) < 1e-14 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
+    return cvec, const, w, const + float(cvec @ Ainv @ bvec)
+
+
+@dataclass
+class _Contact:
+    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
+    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
+
+    coupling: str
+    outer: str
+    inner: str
+    R: float
+    r: float
+    centre: tuple[float, float]       # outer circle centre, outer body frame
+    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
+    hub: int                          # joint index of the inner body (its parent: the arm)
+    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
+
+
+def _rolling_contact(mech: Mechanism) -> _Contact | None:
+    """Find a LinearCoupling that describes rolling of a disc inside a circular track:
+    the disc's joint (the hub) sits on an arm whose own revolute joint is on the track at
+    the centre of the track's circle, the disc's circle is centred on the hub, the hub is
+    R - r from the arm's pivot (they touch), and the coupling involves the hub's
+    coordinate. None if there is no such coupling."""
+    def circles(body):
+        return [s for s in mech.body(body).shapes if isinstance(s, Circle)]
+
+    for c in mech.constraints:
+        if not isinstance(c, LinearCoupling):
+            continue
+        used = {name for name, coef in c.coefficients if _num(coef) != 0}
+        for hub_i, hub in enumerate(mech.joints):
+            if hub.coordinate not in used or not isinstance(hub, Revolute) \
+                    or hub.parent == WORLD:
+                continue
+            arm_joint = mech.joint_of_child(hub.parent)
+            if not isinstance(arm_joint, Revolute) or arm_joint.parent == WORLD:
+                continue
+            pa = np.array([_num(v) for v in arm_joint.parent_anchor])
+            ca = np.array([_num(v) for v in arm_joint.child_anchor])
+            ha = np.array([_num(v) for v in hub.parent_anchor])
+            hc = np.array([_num(v) for v in hub.child_anchor])
+            for outer in circles(arm_joint.parent):
+                oc = np.array([_num(v) for v in outer.center])
+                R = _num(outer.radius)
+                if np.linalg.norm(oc - pa) > 1e-9 * max(R, 1.0):
+                    continue
+                for inner in circles(hub.child):
+                    ic = np.array([_num(v) for v in inner.center])
+                    r = _num(inner.radius)
+                    arm = ha - ca
+                    if (r < R and np.linalg.norm(ic - hc) <= 1e-9 * max(r, 1.0)
+                            and abs(np.linalg.norm(arm) - (R - r)) <= 1e-9 * R):
+                        u = arm / np.linalg.norm(arm)
+                        return _Contact(c.name, arm_joint.parent, hub.child, R, r,
+                                        (float(oc[0]), float(oc[1])),
+                                        (float(ic[0]), float(ic[1])), hub_i,
+                                        (float(u[0]), float(u[1])))
+    return None
+
+
+def _constraint_bodies(mech: Mechanism) -> set[str]:
+    """Bodies a closure constraint acts on (couplings: the children of their joints)."""
+    out: set[str] = set()
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            out |= {c.body_a, c.body_b}
+        elif isinstance(c, PointOnLine):
+            out |= {c.body, c.line_body}
+        elif isinstance(c, LinearCoupling):
+            out |= {mech.joints[mech.coordinates.index(name)].child
+                    for name, _ in c.coefficients}
+    return out - {WORLD}
+
+
+class _Plan:
+    """Numeric translation of a (numeric) mechanism into PyBullet terms.
+
+    `links` lists the engine links: one per description joint (the first `n`), then the
+    extra links (the contact variant's radial slider, one rotor or slider per
+    PointOnLine constraint); `creation_order` puts parents first."""
+
+    def __init__(self, mech: Mechanism, massless_mass: float,
+                 opts: Mapping | None = None, compile_forces: bool = True,
+                 contact: _Contact | None = None) -> None:
+        opts = dict(opts or {})
         self.mech = mech
         self.coords = mech.coordinates
         n = self.n = len(self.coords)
         self.gravity = _num(mech.gravity)
+        masses = [_num(b.mass) for b in mech.bodies]
+        inertias = [_num(b.inertia) for b in mech.bodies]
+        self.m_min = min((m for m in masses if m > 0), default=1.0)
+        self.i_min = min((i for i in inertias if i > 0), default=1.0)
+        parents = {j.parent for j in mech.joints}
+        constrained = _constraint_bodies(mech)
+        leaf_ratio = float(opts.get("massless_leaf_mass_ratio", 1e-6))
+        #: massless bodies that carry nothing but are held by a constraint: singular for
+        #: the articulated-body algorithm, given a small substitute mass (named setting)
+        self.leaf_substitutes: list[str] = []
         link_of: dict[str, int] = {WORLD: -1}
         anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
         # body angle = ang_c . q + ang_d (affine in the coordinates)
@@ -156,6 +352,10 @@ class _Plan:
             mass, inertia = _num(body.mass), _num(body.inertia)
             if body.massless:
                 mass, inertia = massless_mass, 0.0
+                if body.name not in parents and body.name in constrained:
+                    mass = leaf_ratio * self.m_min
+                    inertia = leaf_ratio * self.i_min if isinstance(j, Revolute) else 0.0
+                    self.leaf_substitutes.append(body.name)
             self.links.append(_Link(
                 name=j.name, body=j.child, parent=link_of[j.parent],
                 revolute=isinstance(j, Revolute), mass=mass, inertia=inertia,
@@ -172,8 +372,82 @@ class _Plan:
         self.AinvT = self.Ainv.T
         self.identity_map = bool(np.array_equal(A, np.eye(n)) and not b.any())
 
+        # rolling contact variant: the disc's hub rides on a massless radial slider on the
+        # arm, so that the contact, not the arm, carries the normal force
+        self.contact = contact
+        self.radial_link = -1
+        if contact is not None:
+            hub = self.links[contact.hub]
+            k = len(self.links)
+            u = np.array(contact.radial)
+            self.links.append(_Link(
+                name=f"{contact.coupling}:radial", body=f"{contact.coupling}:radial",
+                parent=hub.parent, revolute=False, mass=0.0, inertia=0.0,
+                position=list(hub.position), orientation=[0.0, 0.0, 0.0, 1.0],
+                inertial_position=[0.0, 0.0, 0.0], axis=[float(u[0]), float(u[1]), 0.0],
+                axis_parent=u))
+            hub.parent, hub.position = k, [0.0, 0.0, 0.0]
+            self.radial_link = k
+
+        # closure constraints (rotors / sliders become extra links after the description's)
+        self.closures: list[_Closure] = []
+        route = str(opts.get("point_on_line", "prismatic"))
+        slider_mass = float(opts.get("slider_mass_ratio", 1e-6)) * self.m_min
+        rotor_inertia = float(opts.get("rotor_inertia_ratio", 1e-6)) * self.i_min
+        for c in mech.constraints:
+            if isinstance(c, PointOnPoint):
+                la, lb = link_of[c.body_a], link_of[c.body_b]
+                self.closures.append(_Closure(
+                    c, "p2p", la, (_num(c.point_a[0]), _num(c.point_a[1])),
+                    lb, (_num(c.point_b[0]), _num(c.point_b[1])), force_links=(la, lb)))
+            elif isinstance(c, PointOnLine):
+                u = np.array([_num(c.direction[0]), _num(c.direction[1])])
+                u = u / float(np.hypot(*u))
+                lp = (_num(c.line_point[0]), _num(c.line_point[1]))
+                pp = (_num(c.point[0]), _num(c.point[1]))
+                lpin, lline = link_of[c.body], link_of[c.line_body]
+                k = len(self.links)
+                geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
+                           direction=(float(u[0]), float(u[1])), aux=k)
+                if route == "slider":
+                    anchor = anchor_of[c.line_body]
+                    self.links.append(_Link(
+                        name=f"{c.name}:slider", body=f"{c.name}:slider", parent=lline,
+                        revolute=False, mass=slider_mass, inertia=0.0,
+                        position=[lp[0] - anchor[0], lp[1] - anchor[1], 0.0],
+                        orientation=[0.0, 0.0, 0.0, 1.0], inertial_position=[0.0, 0.0, 0.0],
+                        axis=[float(u[0]), float(u[1]), 0.0], axis_parent=u))
+                    self.closures.append(_Closure(
+                        c, "slider", lpin, pp, k, (0.0, 0.0), force_links=(lpin, k), **geo))
+                else:
+                    anchor = anchor_of[c.body]
+                    self.links.append(_Link(
+                        name=f"{c.name}:rotor", body=f"{c.name}:rotor", parent=lpin,
+                        revolute=True, mass=0.0, inertia=rotor_inertia,
+                        position=[pp[0] - anchor[0], pp[1] - anchor[1], 0.0],
+                        orientation=[0.0, 0.0, 0.0, 1.0], inertial_position=[0.0, 0.0, 0.0],
+                        axis=[0.0, 0.0, 1.0], axis_parent=np.zeros(2)))
+                    self.closures.append(_Closure(
+                        c, "prismatic", k, (0.0, 0.0), lline, lp,
+                        row_normal=_slider_row_normal(u), force_links=(k, lline), **geo))
+            elif isinstance(c, LinearCoupling):
+                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, b)
+                nz = np.flatnonzero(w)
+                if len(nz) != 2:  # guarded by support()
+                    raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
+                ia, ib = sorted(nz, key=lambda i: -abs(w[i]))
+                self.closures.append(_Closure(
+                    c, "gear", a=int(ia), b=int(ib), ratio=float(w[ib] / w[ia]),
+                    target=float(rhs / w[ia]), scale=float(w[ia]), weights=cvec,
+                    constant=const))
+            else:  # guarded by support()
+                raise TypeError(f"unsupported constraint {c!r}")
+
         self.coord_forces: list[_CoordForce] = []
         self.point_forces: list[_PointForce] = []
+        if not compile_forces:
+            self.point_links = []
+            return
         for f in mech.forces:
             if isinstance(f, CoordinateForce):
                 law = compile_law(f.force, (COORD, COORD_RATE, TIME))
@@ -189,6 +463,18 @@ class _Plan:
                     law, f.body_a, f.body_b, TIME in sp.sympify(f.tension).free_symbols))
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
+
+    def creation_order(self) -> list[int]:
+        """Plan link indices with every parent before its children (the plan order unless
+        a link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
+        done: set[int] = set()
+        order: list[int] = []
+        while len(order) < len(self.links):
+            for i, lk in enumerate(self.links):
+                if i not in done and (lk.parent < 0 or lk.parent in done):
+                    order.append(i)
+                    done.add(i)
+        return order
 
     # --- coordinate maps -------------------------------------------------------------
     def joint_values(self, q: np.ndarray) -> np.ndarray:
@@ -241,6 +527,21 @@ class PyBulletBackend(Backend):
             "massless_link_mass": 0.0,
             "reaction_method": "inverse_dynamics",
             "linearize_step": 1.0e-6,
+            # closure constraints (used only by mechanisms that have them)
+            "constraint_erp": 1.0,
+            "gear_erp": 0.0,
+            "constraint_max_force": 1.0e12,
+            "solver_iterations": 50,
+            "solver_residual_threshold": 0.0,
+            "point_on_line": "prismatic",
+            "rotor_inertia_ratio": 1.0e-6,
+            "slider_mass_ratio": 1.0e-6,
+            "massless_leaf_mass_ratio": 1.0e-6,
+            "rolling": "coupling",
+            "contact_friction": 1.0,
+            "contact_erp": 0.2,
+            "contact_ring_boxes": 720,
+            "contact_breaking_threshold": 0.02,
         }
 
     def setting_notes(self) -> dict[str, str]:
@@ -280,14 +581,81 @@ class PyBulletBackend(Backend):
             "linearize_step": (
                 "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
                 "calculateInverseDynamics and of the applied force elements."),
+            "constraint_erp": (
+                "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
+                "PRISMATIC constraints obey). The constraint solve is velocity-level, "
+                "J(q_k) v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error "
+                "and leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; "
+                "erp 0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
+                "eccentric cam). Set only for constrained mechanisms."),
+            "gear_erp": (
+                "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
+                "coupling solved at velocity level keeps its initial value exactly once the "
+                "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
+                "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
+                "solver's early exit (solver_residual_threshold), not from a missing erp. "
+                "When > 0, relativePositionTarget is set to the coupling's constant."),
+            "constraint_max_force": (
+                "maxForce of every constraint; the engine default 500 N would clip the "
+                "constraint forces (e.g. the start of a fast run)."),
+            "solver_iterations": (
+                "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
+                "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
+            "solver_residual_threshold": (
+                "solverResidualThreshold; the engine default 1e-7 ends the sweeps early "
+                "(that is why the iteration count 'had no effect'): it left a 1e-5 m drift "
+                "of the rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep "
+                "(belt and rolling couplings then hold to 1e-15; same wall time)."),
+            "point_on_line": (
+                "'prismatic' (default): a rotor link (revolute, no mass, inertia "
+                "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
+                "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
+                "under the pin before every step (changeConstraint(jointChildPivot)): the "
+                "engine evaluates the Jacobian at a fixed body point, and with the pivot "
+                "at the slot's line point a slot turning about that point receives no "
+                "torque (measured on the slotted bar). One normal row: well conditioned. "
+                "'slider': a slider link (prismatic along the slot, mass slider_mass_ratio "
+                "x the smallest body mass) and a POINT2POINT pin -> slider; its two world-"
+                "axis rows have effective masses 1/m_slider along the slot and O(1) across "
+                "it, which Gauss-Seidel cannot separate when the slot is oblique (the "
+                "slotted bar diverges); fine for slots along x or y."),
+            "rotor_inertia_ratio": (
+                "Inertia of the rotor links of point_on_line='prismatic', relative to the "
+                "smallest body inertia. The rotor turns with the slot body, so its inertia "
+                "is the substitute's only error; results were identical from 1e-3 to "
+                "1e-12."),
+            "slider_mass_ratio": (
+                "Mass of the slider links of point_on_line='slider', relative to the "
+                "smallest body mass (it moves with the pin: an added point mass)."),
+            "massless_leaf_mass_ratio": (
+                "Mass (and, on a revolute joint, inertia) given to a massless body that "
+                "carries nothing but is held by a closure constraint (e.g. a pin on its "
+                "own guide): zero would make the articulated-body algorithm singular. "
+                "Relative to the smallest body mass/inertia; results are the same from "
+                "1e-3 to 1e-7, 1e-8 diverged (slotted link)."),
+            "rolling": (
+                "'coupling' (default): a LinearCoupling becomes a JOINT_GEAR on the two "
+                "engine joint values it involves (exact at velocity level). 'contact': a "
+                "rolling coupling of a disc on a radius arm inside a circular track is "
+                "replaced by friction contact: the hub rides on a massless radial slider, a "
+                "sphere of the disc's radius touches a ring of contact_ring_boxes boxes "
+                "(polygon with the track circle as incircle) on massless fixed links of the "
+                "track; the coupling's Phi is then the measured slip."),
+            "contact_friction": (
+                "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
+                "Contact variant only."),
+            "contact_erp": "contactERP and frictionERP of the contact variant (engine 0.2).",
+            "contact_ring_boxes": (
+                "Boxes in the ring of the contact variant (16 per fixed link: "
+                "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
+                "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
+            "contact_breaking_threshold": (
+                "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
+                "Smaller values lowered the trajectory error of the contact variant and "
+                "raised its slip (see the report)."),
         }
 
     def support(self, mechanism: Mechanism) -> Support:
-        extra = getattr(mechanism, "constraints", ())
-        if extra:
-            names = ", ".join(f"{c.name} ({type(c).__name__})" for c in extra)
-            return Support(False, "closure constraints are not translated by this backend "
-                                  f"(reduced-coordinate tree only): {names}")
         for j in mechanism.joints:
             if not isinstance(j, (Revolute, Prismatic)):
                 return Support(False, f"joint type {type(j).__name__} not supported")
@@ -301,22 +669,54 @@ class PyBulletBackend(Backend):
             if not isinstance(f, (PointToPoint, CoordinateForce)):
                 return Support(False, f"force element {type(f).__name__} not supported")
         parents = {j.parent for j in mechanism.joints}
+        constrained = _constraint_bodies(mechanism)
         for body in mechanism.bodies:
-            if body.massless and body.name not in parents:
+            if body.massless and body.name not in parents and body.name not in constrained:
                 return Support(False, f"massless body {body.name} carries nothing: singular")
+        if mechanism.constraints:
+            try:
+                plan = _Plan(replace(mechanism, constraints=(), independent=None), 0.0,
+                             compile_forces=False)
+            except TypeError:
+                return Support(False, "mechanism is not numeric (substitute parameters)")
+            except np.linalg.LinAlgError:
+                return Support(False, "singular map between coordinates and joint values")
+            for c in mechanism.constraints:
+                if not isinstance(c, (PointOnPoint, PointOnLine, LinearCoupling)):
+                    return Support(False, f"constraint {c.name}: type {type(c).__name__} "
+                                          "not translated")
+                if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
+                    return Support(False, f"constraint {c.name}: zero slot direction")
+                if isinstance(c, LinearCoupling):
+                    _, _, w, _ = _gear_terms(c, plan.coords, plan.Ainv, plan.b)
+                    k = int(np.count_nonzero(w))
+                    if k != 2:
+                        return Support(False, (
+                            f"coupling {c.name} involves {k} engine joint value(s): "
+                            "PyBullet's JOINT_GEAR constrains exactly two joints "
+                            "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
+                            "joint's current velocity as a target, it is not a three-term "
+                            "constraint, and a one-joint coupling would be a lock"))
         return Support(True)
 
     # --- model building ----------------------------------------------------------------
     def _build(self, p, cid: int, plan: _Plan, settings: dict,
-               split: Sequence[int] = ()) -> tuple[int, list[int], dict[int, tuple[int, int]]]:
+               split: Sequence[int] = (), collision: Mapping[int, int] | None = None,
+               fixed_shapes: tuple[int, Sequence[int]] | None = None
+               ) -> tuple[int, list[int], dict[int, tuple[int, int]]]:
         """Create the multibody; `split` lists joint indices in front of which two massless
-        prismatic joints (parent-frame x, y) are inserted. Returns (body id, engine link
-        index of each description joint, {joint index: (x link, y link)})."""
+        prismatic joints (parent-frame x, y) are inserted; `collision` gives collision
+        shapes of some plan links (default none: no contacts); `fixed_shapes` = (plan
+        link, shapes) adds one massless JOINT_FIXED link per shape on that link (their
+        engine indices go to `plan.fixed_links`). Returns (body id, engine link index of
+        each plan link, {joint index: (x link, y link)})."""
         masses, positions, orientations, inertial, parents, types, axes = [], [], [], [], [], [], []
-        engine_index: list[int] = []
+        shapes: list[int] = []
+        collision = dict(collision or {})
+        engine_index: list[int] = [-1] * len(plan.links)
         virtual: dict[int, tuple[int, int]] = {}
 
-        def add(mass, pos, orn, ipos, parent, jtype, axis) -> int:
+        def add(mass, pos, orn, ipos, parent, jtype, axis, shape=-1) -> int:
             masses.append(mass)
             positions.append(pos)
             orientations.append(orn)
@@ -324,9 +724,11 @@ class PyBulletBackend(Backend):
             parents.append(parent + 1)  # createMultiBody counts links from 1; 0 = base
             types.append(jtype)
             axes.append(axis)
+            shapes.append(shape)
             return len(masses) - 1
 
-        for i, lk in enumerate(plan.links):
+        for i in plan.creation_order():
+            lk = plan.links[i]
             parent = engine_index[lk.parent] if lk.parent >= 0 else -1
             pos = lk.position
             if i in split:
@@ -336,19 +738,38 @@ class PyBulletBackend(Backend):
                 virtual[i] = (vx, vy)
                 parent, pos = vy, [0.0, 0.0, 0.0]
             jtype = p.JOINT_REVOLUTE if lk.revolute else p.JOINT_PRISMATIC
-            engine_index.append(add(lk.mass, pos, lk.orientation, lk.inertial_position,
-                                    parent, jtype, lk.axis))
+            engine_index[i] = add(lk.mass, pos, lk.orientation, lk.inertial_position,
+                                  parent, jtype, lk.axis, collision.get(i, -1))
+        fixed: list[int] = []
+        if fixed_shapes is not None:
+            host, host_shapes = fixed_shapes
+            for shape in host_shapes:
+                fixed.append(add(0.0, [0.0, 0.0, 0.0], [0, 0, 0, 1], [0.0, 0.0, 0.0],
+                                 engine_index[host], p.JOINT_FIXED, [0, 0, 1], shape))
         nl = len(masses)
+        if nl > _MAX_LINKS:
+            raise ValueError(f"pybullet multibodies keep at most {_MAX_LINKS} links "
+                             f"(createMultiBody silently drops the rest); this model "
+                             f"needs {nl}")
+        extra = {"flags": p.URDF_USE_SELF_COLLISION} if collision else {}
         body = p.createMultiBody(
             baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=-1,
             basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1],
-            linkMasses=masses, linkCollisionShapeIndices=[-1] * nl,
+            linkMasses=masses, linkCollisionShapeIndices=shapes,
             linkVisualShapeIndices=[-1] * nl, linkPositions=positions,
             linkOrientations=orientations, linkInertialFramePositions=inertial,
             linkInertialFrameOrientations=[[0, 0, 0, 1]] * nl, linkParentIndices=parents,
-            linkJointTypes=types, linkJointAxis=axes, physicsClientId=cid)
+            linkJointTypes=types, linkJointAxis=axes, physicsClientId=cid, **extra)
         if body < 0:
             raise RuntimeError("pybullet createMultiBody failed")
+        # createMultiBody stores the links in depth-first order of the tree, not in the
+        # order given; its joint names "joint<k+1>" keep the given index k
+        order = {p.getJointInfo(body, e, physicsClientId=cid)[1]: e for e in range(nl)}
+        created = [order[f"joint{k + 1}".encode()] for k in range(nl)]
+        engine_index = [created[k] for k in engine_index]
+        virtual = {i: (created[vx], created[vy]) for i, (vx, vy) in virtual.items()}
+        if fixed_shapes is not None:
+            plan.fixed_links = [created[k] for k in fixed]
         # body-level parameters in their own calls (they reset the link index to -1)
         p.changeDynamics(body, -1, linearDamping=float(settings["linear_damping"]),
                          physicsClientId=cid)
@@ -369,12 +790,15 @@ class PyBulletBackend(Backend):
                     or abs(info[2][2] - lk.inertia) > 1e-12 * max(1.0, lk.inertia)):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
-            p.setJointMotorControlArray(body, list(range(nl)), p.VELOCITY_CONTROL,
-                                        targetVelocities=[0.0] * nl, forces=[0.0] * nl,
-                                        physicsClientId=cid)
+            moving = sorted(set(range(nl)) - set(getattr(plan, "fixed_links", ())
+                                                 if fixed_shapes is not None else ()))
+            p.setJointMotorControlArray(body, moving, p.VELOCITY_CONTROL,
+                                        targetVelocities=[0.0] * len(moving),
+                                        forces=[0.0] * len(moving), physicsClientId=cid)
         return body, engine_index, virtual
 
-    def _connect(self, p, settings: dict, dt: float, gravity: float) -> int:
+    def _connect(self, p, settings: dict, dt: float, gravity: float,
+                 constrained: bool = False) -> int:
         cid = p.connect(p.DIRECT)
         if cid < 0:
             raise RuntimeError("pybullet connect(DIRECT) failed")
@@ -383,7 +807,186 @@ class PyBulletBackend(Backend):
         p.setPhysicsEngineParameter(
             fixedTimeStep=dt, numSubSteps=0,
             jointFeedbackMode=p.JOINT_FEEDBACK_IN_WORLD_SPACE, physicsClientId=cid)
+        if constrained:
+            p.setPhysicsEngineParameter(
+                erp=float(settings["constraint_erp"]),
+                numSolverIterations=int(settings["solver_iterations"]),
+                solverResidualThreshold=float(settings["solver_residual_threshold"]),
+                physicsClientId=cid)
         return cid
+
+    # --- closure constraints -------------------------------------------------------------
+    @staticmethod
+    def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
+        """(x, y, theta, vx, vy, omega) of a link's centre-of-mass frame (-1: the base)."""
+        if link < 0:
+            return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        st = ls[link]
+        com, quat = st[0], st[1]
+        vel, omega = (st[6], st[7][2]) if len(st) > 6 else ((0.0, 0.0, 0.0), 0.0)
+        return com[0], com[1], 2.0 * math.atan2(quat[2], quat[3]), vel[0], vel[1], omega
+
+    @classmethod
+    def _point(cls, ls, link: int, point) -> tuple[float, float, float, float]:
+        """World position and velocity of a body point (centre-of-mass frame)."""
+        x, y, th, vx, vy, om = cls._pose(ls, link)
+        c, s = math.cos(th), math.sin(th)
+        rx, ry = c * point[0] - s * point[1], s * point[0] + c * point[1]
+        return x + rx, y + ry, vx - om * ry, vy + om * rx
+
+    def _place_aux(self, p, cid: int, body: int, eidx: list[int], plan: _Plan) -> None:
+        """Joint values and rates of the extra links from the (consistent) description
+        state. A slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
+        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
+        the rotation of u adds nothing). A rotor is turned to the slot body's angle,
+        th_slot - th_pin, at the relative rate w_slot - w_pin."""
+        n = plan.n
+        ls = p.getLinkStates(body, eidx[:n], computeLinkVelocity=1,
+                             computeForwardKinematics=1, physicsClientId=cid)
+        for c in plan.closures:
+            if c.kind == "slider":
+                px, py, pvx, pvy = self._point(ls, c.pin_link, c.pin_point)
+                lx, ly, lvx, lvy = self._point(ls, c.line_link, c.line_point)
+                th = self._pose(ls, c.line_link)[2]
+                ux = math.cos(th) * c.direction[0] - math.sin(th) * c.direction[1]
+                uy = math.sin(th) * c.direction[0] + math.cos(th) * c.direction[1]
+                s = (px - lx) * ux + (py - ly) * uy
+                sd = (pvx - lvx) * ux + (pvy - lvy) * uy
+                p.resetJointState(body, eidx[c.aux], s, sd, physicsClientId=cid)
+            elif c.kind == "prismatic":
+                _, _, th_l, _, _, w_l = self._pose(ls, c.line_link)
+                _, _, th_p, _, _, w_p = self._pose(ls, c.pin_link)
+                rel = math.remainder(th_l - th_p, 2.0 * math.pi)
+                p.resetJointState(body, eidx[c.aux], rel, w_l - w_p, physicsClientId=cid)
+
+    @staticmethod
+    def _pivot_under_pin(ls, slot_of: Mapping[int, int], c: _Closure) -> list[float]:
+        """The slot body's point under the pin (its projection on the slot line), in the
+        slot body's frame: L + ((P - L) . u) u. PyBullet's JOINT_PRISMATIC evaluates its
+        Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
+        (fixed) the slot body would feel the force at L instead of at the pin (measured: a
+        bar slotted along its own axis through its pivot then swings freely)."""
+        def pose(link):
+            if link < 0:
+                return 0.0, 0.0, 0.0
+            st = ls[slot_of[link]]
+            return st[0][0], st[0][1], 2.0 * math.atan2(st[1][2], st[1][3])
+        x, y, th = pose(c.pin_link)
+        cs, sn = math.cos(th), math.sin(th)
+        px = x + cs * c.pin_point[0] - sn * c.pin_point[1]
+        py = y + sn * c.pin_point[0] + cs * c.pin_point[1]
+        x, y, th = pose(c.line_link)
+        cs, sn = math.cos(th), math.sin(th)
+        lx = x + cs * c.line_point[0] - sn * c.line_point[1]
+        ly = y + sn * c.line_point[0] + cs * c.line_point[1]
+        ux, uy = c.direction
+        s = (px - lx) * (cs * ux - sn * uy) + (py - ly) * (sn * ux + cs * uy)
+        return [c.line_point[0] + s * ux, c.line_point[1] + s * uy, 0.0]
+
+    def _add_constraints(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
+                         cfg: dict) -> list[int]:
+        """One PyBullet constraint per closure (frames relative to the centre-of-mass
+        frames, which are the description's body frames)."""
+        out = []
+        max_force = float(cfg["constraint_max_force"])
+        for c in plan.closures:
+            pa = eidx[c.parent] if c.parent >= 0 else -1
+            ch = eidx[c.child] if c.child >= 0 else -1
+            if c.kind in ("p2p", "slider"):
+                uid = p.createConstraint(
+                    body, pa, body, ch, p.JOINT_POINT2POINT, [0, 0, 0],
+                    [c.parent_point[0], c.parent_point[1], 0.0],
+                    [c.child_point[0], c.child_point[1], 0.0], physicsClientId=cid)
+                p.changeConstraint(uid, maxForce=max_force, physicsClientId=cid)
+            elif c.kind == "prismatic":
+                # parent: the rotor (axis in its frame, aligned with the slot's); child:
+                # the slot body, its pivot moved under the pin before every step
+                uid = p.createConstraint(
+                    body, pa, body, ch, p.JOINT_PRISMATIC,
+                    [c.direction[0], c.direction[1], 0.0], [0.0, 0.0, 0.0],
+                    [c.child_point[0], c.child_point[1], 0.0], physicsClientId=cid)
+                p.changeConstraint(uid, maxForce=max_force, physicsClientId=cid)
+            else:
+                uid = p.createConstraint(body, eidx[c.a], body, eidx[c.b], p.JOINT_GEAR,
+                                         [0, 0, 1], [0, 0, 0], [0, 0, 0], physicsClientId=cid)
+                kw = {"gearRatio": c.ratio, "maxForce": max_force}
+                erp = float(cfg["gear_erp"])
+                if erp:
+                    kw.update(erp=erp, relativePositionTarget=c.target)
+                p.changeConstraint(uid, physicsClientId=cid, **kw)
+            if uid < 0:
+                raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
+            out.append(uid)
+        return out
+
+    @staticmethod
+    def _constraint_forces(plan: _Plan, CF: np.ndarray, JV: np.ndarray
+                           ) -> dict[str, np.ndarray]:
+        """getConstraintState rows -> the contract's physical terms (signs measured).
+        POINT2POINT: rows along world x, y, z holding the force on the CHILD (a bar held
+        at its tip by the base, bar = parent, reads -m g / 2): PointOnPoint reports the
+        force on body_a (the parent), i.e. minus the rows; the slider route, the force on
+        the pin (parent), also minus the rows. PRISMATIC: row 1 is the in-plane normal of
+        the slot (`_slider_row_normal`, turned with the slot body) and holds the force on
+        the PARENT (checked with either body as parent on the scotch yoke); the parent is
+        the rotor, i.e. the pin: + row 1 times that normal. JOINT_GEAR: one row f, the
+        joint forces f (1, ratio) on (a, b) (checked against inverse dynamics), i.e.
+        (f / w_a) w = A^-T c f / w_a: the coupling's generalized force is c f / w_a and
+        -lambda = f / w_a."""
+        out = {}
+        q = plan.coordinates(JV[:, :plan.n]) if plan.closures else None
+        for r, c in enumerate(plan.closures):
+            if c.kind == "gear":
+                out[c.element.name] = CF[:, r, :1] / c.scale
+            elif c.kind == "prismatic":
+                if c.line_link >= 0:
+                    body = plan.links[c.line_link].body
+                    th = q @ plan.ang_c[body] + plan.ang_d[body]
+                else:
+                    th = np.zeros(len(CF))
+                nx, ny = c.row_normal
+                cs, sn = np.cos(th), np.sin(th)
+                f = CF[:, r, 1]
+                out[c.element.name] = np.stack([f * (cs * nx - sn * ny),
+                                                f * (sn * nx + cs * ny)], axis=1)
+            else:
+                out[c.element.name] = -CF[:, r, :2]
+        return out
+
+    def _violations(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
+                    JV: np.ndarray) -> dict[str, np.ndarray]:
+        """Each closure's violation at every sample, from the engine's own forward
+        kinematics: PointOnPoint, distance of the two points (m); PointOnLine, signed
+        distance n . (P - L) of the pin from the slot line (m); LinearCoupling, Phi."""
+        if not plan.closures:
+            return {}
+        N = len(JV)
+        out = {c.element.name: np.empty(N) for c in plan.closures}
+        geo = [c for c in plan.closures if c.kind != "gear"]
+        q = plan.coordinates(JV[:, :plan.n])
+        for c in plan.closures:
+            if c.kind == "gear":
+                out[c.element.name] = q @ c.weights - c.constant
+        if not geo:
+            return out
+        n_all = len(eidx)
+        for k in range(N):
+            p.resetJointStatesMultiDof(body, eidx, [[v] for v in JV[k]], [[0.0]] * n_all,
+                                       physicsClientId=cid)
+            ls = p.getLinkStates(body, eidx, computeForwardKinematics=1, physicsClientId=cid)
+            for c in geo:
+                if c.kind == "p2p":
+                    px, py, _, _ = self._point(ls, c.parent, c.parent_point)
+                    bx, by, _, _ = self._point(ls, c.child, c.child_point)
+                    out[c.element.name][k] = math.hypot(px - bx, py - by)
+                else:
+                    px, py, _, _ = self._point(ls, c.pin_link, c.pin_point)
+                    lx, ly, _, _ = self._point(ls, c.line_link, c.line_point)
+                    th = self._pose(ls, c.line_link)[2]
+                    ux = math.cos(th) * c.direction[0] - math.sin(th) * c.direction[1]
+                    uy = math.sin(th) * c.direction[0] + math.cos(th) * c.direction[1]
+                    out[c.element.name][k] = -uy * (px - lx) + ux * (py - ly)
+        return out
 
     @staticmethod
     def _points(ls, pf: _PointForce) -> tuple[float, float, float, float, float, float,
@@ -425,50 +1028,94 @@ class PyBulletBackend(Backend):
         cfg = self.resolve_settings(settings)
         if cfg["reaction_method"] not in _REACTION_METHODS:
             raise ValueError(f"reaction_method must be one of {_REACTION_METHODS}")
+        if cfg["rolling"] not in _ROLLING:
+            raise ValueError(f"rolling must be one of {_ROLLING}")
+        if cfg["point_on_line"] not in _POINT_ON_LINE:
+            raise ValueError(f"point_on_line must be one of {_POINT_ON_LINE}")
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
-        plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
+        contact = None
+        coupling = None
+        if cfg["rolling"] == "contact" and mechanism.constraints:
+            contact = _rolling_contact(mechanism)
+            if contact is None:
+                raise ValueError(
+                    "rolling='contact' needs a LinearCoupling of a disc (Circle) on a radius "
+                    "arm about the centre of a circular track (Circle) it touches")
+            coupling = next(c for c in mechanism.constraints if c.name == contact.coupling)
+            mechanism = replace(mechanism, constraints=tuple(
+                c for c in mechanism.constraints if c.name != contact.coupling))
+        plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
         n, steps = plan.n, int(round(t_end / dt))
+        n_all = len(plan.links)
+        closures = plan.closures
         joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
-        # one extra step gives the reaction/acceleration of the last sample
-        total = steps + 1 if reaction_joints else steps
+        # one extra step gives the reaction/acceleration (and the constraint forces) of
+        # the last sample
+        total = steps + 1 if (reaction_joints or closures or contact) else steps
 
-        cid = self._connect(p, cfg, dt, plan.gravity)
+        cid = self._connect(p, cfg, dt, plan.gravity,
+                            constrained=bool(closures) or contact is not None)
         try:
-            body, eidx, _ = self._build(p, cid, plan, cfg)
+            shapes, ring = (self._contact_shapes(p, cid, plan, cfg) if contact is not None
+                            else (None, None))
+            body, eidx, _ = self._build(p, cid, plan, cfg, collision=shapes, fixed_shapes=ring)
             jv0 = plan.joint_values(q0)
             jvd0 = plan.A @ np.asarray(qd0, dtype=float)
             for i in range(n):
                 p.resetJointState(body, eidx[i], float(jv0[i]), float(jvd0[i]),
                                   physicsClientId=cid)
+            if n_all > n:
+                self._place_aux(p, cid, body, eidx, plan)
+            cids = self._add_constraints(p, cid, body, eidx, plan, cfg)
+            if contact is not None:
+                self._contact_dynamics(p, cid, body, eidx, plan, cfg)
             if use_sensor:
                 for i in joint_ids:
                     p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
 
-            JV = np.empty((total + 1, n))
-            JVD = np.empty((total + 1, n))
+            JV = np.empty((total + 1, n_all))
+            JVD = np.empty((total + 1, n_all))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
             n_pf = len(plan.point_forces)
             f_point = np.zeros((total + 1, n_pf, 2))  # force on point b (on a: opposite)
             tau_applied = np.zeros((total + 1, n))  # engine joint forces of CoordinateForces
+            CF = np.full((total + 1, len(closures), 6), np.nan)  # getConstraintState rows
+            # contact variant: force of the track on the disc (x, y) and contact count
+            FC = np.zeros((total + 1, 3))
 
             step = p.stepSimulation
             get_states = p.getJointStates
             set_motors = p.setJointMotorControlArray
             get_links = p.getLinkStates
+            get_cstate = p.getConstraintState
+            get_contacts = p.getContactPoints
             apply_force = p.applyExternalForce
             torque_mode, world = p.TORQUE_CONTROL, p.WORLD_FRAME
-            links = eidx
+            links = eidx[:n]
+            all_links = eidx
             has_cf = bool(plan.coord_forces)
             point_links = [eidx[k] for k in plan.point_links]
             pos_of = {k: m for m, k in enumerate(plan.point_links)}
             AinvT, Ainv, bvec = plan.AinvT, plan.Ainv, plan.b
             identity = plan.identity_map
             sensor_slots = [eidx[i] for i in joint_ids]
+            n_cs = len(cids)
+            # PRISMATIC rows are evaluated at the child's pivot, a fixed point of the slot
+            # body: it is moved under the pin before each step (see `_pivot_under_pin`)
+            moving = [(cids[r], c) for r, c in enumerate(closures) if c.kind == "prismatic"]
+            moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
+                                   if lk >= 0})
+            moving_eidx = [eidx[lk] for lk in moving_links]
+            slot_of = {lk: m for m, lk in enumerate(moving_links)}
+            change = p.changeConstraint
+            if contact is not None:
+                ring_links = set(plan.fixed_links)
+                disc_link = eidx[plan.link_of[contact.inner]]
 
-            js = get_states(body, links, physicsClientId=cid)
+            js = get_states(body, all_links, physicsClientId=cid)
             t0 = time.perf_counter()
             for k in range(total):
                 t = k * dt
@@ -478,10 +1125,10 @@ class PyBulletBackend(Backend):
                 JVD[k] = jvd
                 if has_cf:
                     if identity:
-                        tau = plan.coordinate_torques(jv, jvd, t)
+                        tau = plan.coordinate_torques(jv[:n], jvd[:n], t)
                     else:
-                        q = Ainv @ (np.asarray(jv) - bvec)
-                        qd = Ainv @ np.asarray(jvd)
+                        q = Ainv @ (np.asarray(jv[:n]) - bvec)
+                        qd = Ainv @ np.asarray(jvd[:n])
                         tau = plan.coordinate_torques(q, qd, t)
                     tau_applied[k] = tau
                     set_motors(body, links, torque_mode, forces=tau.tolist(),
@@ -500,8 +1147,22 @@ class PyBulletBackend(Backend):
                         if pf.link_a >= 0:
                             apply_force(body, eidx[pf.link_a], [-fx, -fy, 0.0], [ax, ay, 0.0],
                                         world, physicsClientId=cid)
+                if moving:
+                    ls = get_links(body, moving_eidx, physicsClientId=cid)
+                    for uid, c in moving:
+                        change(uid, jointChildPivot=self._pivot_under_pin(ls, slot_of, c),
+                               physicsClientId=cid)
                 step(physicsClientId=cid)
-                js = get_states(body, links, physicsClientId=cid)
+                js = get_states(body, all_links, physicsClientId=cid)
+                # constraint and contact forces read after a step belong to the state
+                # before it
+                for r in range(n_cs):
+                    st = get_cstate(cids[r], physicsClientId=cid)
+                    CF[k, r, : len(st)] = st
+                if contact is not None:
+                    FC[k] = self._contact_force(
+                        get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
+                        ring_links, disc_link)
                 if use_sensor:
                     # the feedback read after a step belongs to the state before it
                     for r, slot in enumerate(sensor_slots):
@@ -511,27 +1172,169 @@ class PyBulletBackend(Backend):
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
 
+            forces = self._constraint_forces(plan, CF[: steps + 1], JV[: steps + 1])
+            f_closure = {c.element.name: forces[c.element.name] for c in closures
+                         if c.kind != "gear"}
+            tau_gear = np.zeros((steps + 1, n))
+            for r, c in enumerate(closures):
+                if c.kind == "gear":
+                    g = CF[: steps + 1, r, 0]
+                    tau_gear[:, c.a] += g
+                    tau_gear[:, c.b] += c.ratio * g
+
             reactions: dict[str, np.ndarray] = {}
             if reaction_joints:
                 if use_sensor:
                     for r, name in enumerate(reaction_joints):
                         reactions[name] = sensor[: steps + 1, r].copy()
                 else:
+                    if contact is not None:
+                        # the contact force acts on the disc (and the track) from outside
+                        # the tree: handled like a closure force on the disc
+                        f_closure = dict(f_closure)
+                        f_closure["__contact__"] = FC[: steps + 1, :2]
                     jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
                     reactions = self._reactions_by_inverse_dynamics(
                         p, cid, plan, cfg, joint_ids, list(reaction_joints),
                         JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1],
-                        f_point[: steps + 1])
+                        f_point[: steps + 1], f_closure)
                 self._remove_coordinate_forces(plan, joint_ids, list(reaction_joints),
-                                               reactions, plan.coordinates(JV[: steps + 1]),
-                                               tau_applied[: steps + 1])
+                                               reactions, plan.coordinates(JV[: steps + 1, :n]),
+                                               tau_applied[: steps + 1] + tau_gear)
+            violation = self._violations(p, cid, body, eidx, plan, JV[: steps + 1])
         finally:
             p.disconnect(physicsClientId=cid)
 
-        q = plan.coordinates(JV[: steps + 1])
-        qd = plan.rates(JVD[: steps + 1])
-        return RunResult(t=np.arange(steps + 1) * dt, q=q, qd=qd, reactions=reactions,
-                         wall_time=wall, integrator_order=1, settings=cfg, steps=steps)
+        q = plan.coordinates(JV[: steps + 1, :n])
+        qd = plan.rates(JVD[: steps + 1, :n])
+        contact_report = None
+        if contact is not None:
+            contact_report = self._contact_report(plan, coupling, q, qd,
+                                                  JV[: steps + 1], FC[: steps + 1])
+            forces[contact.coupling] = contact_report.pop("friction")[:, None]
+            violation[contact.coupling] = contact_report.pop("slip")
+        run = RunResult(t=np.arange(steps + 1) * dt, q=q, qd=qd, reactions=reactions,
+                        wall_time=wall, integrator_order=1, settings=cfg, steps=steps,
+                        constraint_forces=forces)
+        # the substitutes' own error: each closure's violation at every sample (not part
+        # of the contract; read by the reports when present)
+        run.constraint_violation = violation
+        if contact_report is not None:
+            run.contact = contact_report
+        return run
+
+    # --- rolling by friction contact ---------------------------------------------------
+    def _contact_shapes(self, p, cid: int, plan: _Plan, cfg: dict
+                        ) -> tuple[dict[int, int], tuple[int, list[int]]]:
+        """Collision shapes of the contact variant: on the track, a ring of boxes whose
+        inner faces are tangent to the track circle (a regular polygon with the circle as
+        its incircle); on the disc, a sphere of the disc's radius centred on it (sphere-box
+        contacts are analytic in Bullet). Shape frames are relative to the link (joint)
+        frame, not to the centre of mass (measured with getAABB)."""
+        ct = plan.contact
+        n_box = int(cfg["contact_ring_boxes"])
+        if n_box < 8:
+            raise ValueError("contact_ring_boxes must be at least 8")
+        lo, li = plan.link_of[ct.outer], plan.link_of[ct.inner]
+        off = plan.links[lo].inertial_position  # body frame -> link frame: + this
+        cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
+        thick = 0.1 * ct.R
+        half_len = ct.R * math.tan(math.pi / n_box) * 1.001
+        depth = 2.0 * ct.r
+        pos, orn, half = [], [], []
+        for i in range(n_box):
+            a = 2.0 * math.pi * i / n_box
+            rho = ct.R + thick / 2.0
+            pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
+            orn.append(_quat_z(a))
+            half.append([thick / 2.0, half_len, depth])
+        # createCollisionShapeArray keeps only the first 16 children (measured with
+        # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
+        # its own massless fixed link on the track
+        ring = []
+        for k0 in range(0, n_box, 16):
+            sl = slice(k0, min(k0 + 16, n_box))
+            ring.append(p.createCollisionShapeArray(
+                [p.GEOM_BOX] * len(half[sl]), halfExtents=half[sl],
+                collisionFramePositions=pos[sl], collisionFrameOrientations=orn[sl],
+                physicsClientId=cid))
+        off = plan.links[li].inertial_position
+        disc = p.createCollisionShape(
+            p.GEOM_SPHERE, radius=ct.r, collisionFramePosition=[
+                ct.inner_centre[0] + off[0], ct.inner_centre[1] + off[1], 0.0],
+            physicsClientId=cid)
+        if min(ring) < 0 or disc < 0:
+            raise RuntimeError("pybullet could not create the contact shapes")
+        return {li: disc}, (lo, ring)
+
+    def _contact_dynamics(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
+                          cfg: dict) -> None:
+        """Friction and contact solver parameters (Bullet combines the two links'
+        friction coefficients by product: the disc gets 1, the track the setting)."""
+        ct = plan.contact
+        disc = eidx[plan.link_of[ct.inner]]
+        for link, mu in [(e, float(cfg["contact_friction"])) for e in plan.fixed_links] + [
+                (disc, 1.0)]:
+            for key, value in (("lateralFriction", mu), ("spinningFriction", 0.0),
+                               ("rollingFriction", 0.0), ("restitution", 0.0)):
+                p.changeDynamics(body, link, physicsClientId=cid, **{key: value})
+        # only the disc and the ring collide (the ring's compounds overlap each other)
+        for e in plan.fixed_links:
+            p.setCollisionFilterGroupMask(body, e, 1, 2, physicsClientId=cid)
+        p.setCollisionFilterGroupMask(body, disc, 2, 1, physicsClientId=cid)
+        p.setPhysicsEngineParameter(
+            contactERP=float(cfg["contact_erp"]), frictionERP=float(cfg["contact_erp"]),
+            contactSlop=0.0, restitutionVelocityThreshold=0.0,
+            contactBreakingThreshold=float(cfg["contact_breaking_threshold"]),
+            physicsClientId=cid)
+
+    @staticmethod
+    def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, float]:
+        """Force of the track on the disc (world x, y) summed over the contact points of
+        the step, and the number of points. Bullet's normal on B points towards A; the
+        normal and friction impulses push A along +n, +dir and B along -n, -dir."""
+        fx = fy = 0.0
+        count = 0
+        for cp in points:
+            la, lb = cp[3], cp[4]
+            if la in ring and lb == disc:
+                sign = -1.0
+            elif la == disc and lb in ring:
+                sign = 1.0
+            else:
+                continue
+            nrm, fn = cp[7], cp[9]
+            d1, f1, d2, f2 = cp[11], cp[10], cp[13], cp[12]
+            fx += sign * (fn * nrm[0] + f1 * d1[0] + f2 * d2[0])
+            fy += sign * (fn * nrm[1] + f1 * d1[1] + f2 * d2[1])
+            count += 1
+        return fx, fy, float(count)
+
+    @staticmethod
+    def _contact_report(plan: _Plan, coupling: LinearCoupling, q: np.ndarray,
+                        qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
+        """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
+        (m/s), penetration of the disc into the track (radial slider value, m), normal
+        and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
+        component f, track on disc, along t = k x u with u from the track centre to the
+        disc) is what the coupling's -lambda stands for."""
+        ct = plan.contact
+        cvec = np.zeros(plan.n)
+        for name, coef in coupling.coefficients:
+            cvec[plan.coords.index(name)] += _num(coef)
+        const = _num(coupling.constant)
+        arm = plan.mech.joints[ct.hub].parent
+        th = q @ plan.ang_c[arm] + plan.ang_d[arm]
+        ux0, uy0 = ct.radial
+        ux, uy = np.cos(th) * ux0 - np.sin(th) * uy0, np.sin(th) * ux0 + np.cos(th) * uy0
+        normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
+        friction = FC[:, 0] * -uy + FC[:, 1] * ux
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.abs(friction) / normal
+        return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
+                "penetration": JV[:, plan.radial_link], "normal_force": normal,
+                "friction": friction, "friction_ratio": ratio,
+                "contact_points": FC[:, 2]}
 
     @staticmethod
     def _remove_coordinate_forces(plan: _Plan, joint_ids: list[int], names: list[str],
@@ -554,11 +1357,15 @@ class PyBulletBackend(Backend):
     def _reactions_by_inverse_dynamics(self, p, cid: int, plan: _Plan, cfg: dict,
                                        joint_ids: list[int], names: list[str],
                                        JV: np.ndarray, JVD: np.ndarray, JVDD: np.ndarray,
-                                       f_point: np.ndarray) -> dict[str, np.ndarray]:
+                                       f_point: np.ndarray,
+                                       f_closure: Mapping[str, np.ndarray] | None = None
+                                       ) -> dict[str, np.ndarray]:
         """Reaction = inverse-dynamics force on two massless prismatic joints (x, y of the
-        parent frame) inserted in front of the joint, minus the point-to-point forces that
-        reach the child's subtree from outside (they act on the bodies, not through the
-        joint)."""
+        parent frame) inserted in front of the joint, minus the point-to-point forces and
+        the closure-constraint forces that reach the child's subtree from outside (they act
+        on the bodies, not through the joint). Gear (coupling) forces are joint forces: on
+        a revolute joint a couple, on a prismatic joint an axial force that
+        `_remove_coordinate_forces` takes out like the coordinate laws."""
         body, eidx, virtual = self._build(p, cid, plan, cfg, split=set(joint_ids))
         ndof = p.getNumJoints(body, physicsClientId=cid)
         slots = np.array(eidx)
@@ -575,8 +1382,9 @@ class PyBulletBackend(Backend):
                           physicsClientId=cid)
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
-        q = plan.coordinates(JV)
+        q = plan.coordinates(JV[:, :plan.n])
         reactions: dict[str, np.ndarray] = {}
+        f_closure = f_closure or {}
         for r, (i, name) in enumerate(zip(joint_ids, names)):
             joint = plan.mech.joints[i]
             th = q @ plan.ang_c[joint.parent] + plan.ang_d[joint.parent]
@@ -590,6 +1398,23 @@ class PyBulletBackend(Backend):
                     R -= f_point[:, e]
                 elif in_a and not in_b:
                     R += f_point[:, e]
+            # rotor and slider links belong to the subtree of the body that carries them
+            inside = subtree | {lk.body for lk in plan.links[plan.n:]
+                                if lk.parent >= 0 and plan.links[lk.parent].body in subtree}
+            pairs = [(cl.force_links, cl.element.name) for cl in plan.closures
+                     if cl.kind != "gear" and cl.element.name in f_closure]
+            if plan.contact is not None and "__contact__" in f_closure:
+                pairs.append(((plan.link_of[plan.contact.inner],
+                               plan.link_of[plan.contact.outer]), "__contact__"))
+            for (la, lb), key in pairs:
+                # the force f_closure[key] acts on link la, its opposite on link lb
+                in_a = la >= 0 and plan.links[la].body in inside
+                in_b = lb >= 0 and plan.links[lb].body in inside
+                F = np.nan_to_num(f_closure[key])
+                if in_a and not in_b:
+                    R -= F
+                elif in_b and not in_a:
+                    R += F
             reactions[name] = R
         return reactions
 
@@ -600,7 +1425,9 @@ class PyBulletBackend(Backend):
 
         cfg = self.resolve_settings(settings)
         ok = self.support(mechanism)
-        if not ok.ok:
+        if not ok.ok or mechanism.constraints:
+            # calculateMassMatrix / calculateInverseDynamics describe the open tree only;
+            # PyBullet has no constrained linearization (the free-vibration fit remains)
             return None
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
         n = plan.n
@@ -610,6 +1437,13 @@ class PyBulletBackend(Backend):
             body, eidx, _ = self._build(p, cid, plan, cfg)
             jv_eq = plan.joint_values(np.asarray(q_eq, dtype=float))
             zeros = [0.0] * n
+            perm = np.asarray(eidx[:n])  # engine (depth-first) index of each joint
+
+            def engine(x: np.ndarray) -> list[float]:
+                """Joint-ordered values -> the engine's link order."""
+                y = np.empty(n)
+                y[perm] = x
+                return [float(v) for v in y]
 
             def applied(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
                 """Engine joint forces of the autonomous force elements at (jv, jvd)."""
@@ -636,20 +1470,18 @@ class PyBulletBackend(Backend):
                         ip = plan.links[link].inertial_position
                         jac_t, _ = p.calculateJacobian(
                             body, eidx[link], [point[0] + ip[0], point[1] + ip[1], 0.0],
-                            list(map(float, jv)), list(map(float, jvd)), zeros,
-                            physicsClientId=cid)
-                        J = np.asarray(jac_t)[:2]
+                            engine(jv), engine(jvd), zeros, physicsClientId=cid)
+                        J = np.asarray(jac_t)[:2][:, perm]
                         tau = tau + sign * (J.T @ np.array([fx, fy]))
                 return tau
 
             def residual(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
-                tau_id = p.calculateInverseDynamics(body, list(map(float, jv)),
-                                                    list(map(float, jvd)), zeros,
+                tau_id = p.calculateInverseDynamics(body, engine(jv), engine(jvd), zeros,
                                                     physicsClientId=cid)
-                return np.asarray(tau_id) - applied(jv, jvd)
+                return np.asarray(tau_id)[perm] - applied(jv, jvd)
 
             M = np.atleast_2d(np.array(p.calculateMassMatrix(
-                body, list(map(float, jv_eq)), physicsClientId=cid)))
+                body, engine(jv_eq), physicsClientId=cid)))[np.ix_(perm, perm)]
             K = np.zeros((n, n))
             C = np.zeros((n, n))
             v0 = np.zeros(n)
