@@ -46,8 +46,9 @@ def _belongs(metric_name: str, check: str) -> bool:
         CHECKS["frequency"])
 
 
-@pytest.mark.parametrize("system_id,simulator,check", CASES,
-                         ids=[f"{a}-{b}-{c}" for a, b, c in CASES])
+@pytest.mark.parametrize("system_id,simulator,check", [
+    pytest.param(a, b, c, id=f"{a}-{b}-{c}", marks=pytest.mark.xdist_group(a))
+    for a, b, c in CASES])
 def test_conformance(system_id, simulator, check):
     backend = all_backends().get(simulator)
     if backend is None:

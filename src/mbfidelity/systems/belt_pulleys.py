@@ -40,7 +40,8 @@ angle relative to the arm without changing the potential).
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
+from ._reasons import MUJOCO_SOFT_EQUALITY
 from .model import (COORD_RATE, Body, Circle, CoordinateForce, LinearCoupling, Mechanism,
                     Parameter, Revolute, Scenario, Segment)
 
@@ -135,4 +136,7 @@ SYSTEM = System(
     ),
     notes="phi1 is cyclic: every theta = 0 (theta = pi) with any phi1 is an equilibrium; "
           "the linearization has one zero frequency.",
+    expectations=(
+        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+    ),
 )

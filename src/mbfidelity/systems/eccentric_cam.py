@@ -29,7 +29,8 @@ Variant (§4.2): viscous friction c in the block's guide, reduced force -c (e si
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
+from ._reasons import MUJOCO_SOFT_EQUALITY, VELOCITY_LEVEL_STARTUP
 from .model import (COORD_RATE, LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, PointToPoint, Prismatic, Rectangle, Revolute, Scenario)
 
@@ -141,5 +142,12 @@ SYSTEM = System(
                  description="40 rad/s at phi = 0: the disc turns over; the contact force of "
                              "the bilateral model goes negative past phi ~ 2.2 rad (from "
                              "about 34 rad/s at the defaults): a real block would lift off"),
+    ),
+    expectations=(
+        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("pymunk", "rotating.constraint_*", "xfail", VELOCITY_LEVEL_STARTUP),
+        Expectation("pybullet", "rotating.constraint_*", "xfail", VELOCITY_LEVEL_STARTUP),
     ),
 )

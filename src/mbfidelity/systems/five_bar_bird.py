@@ -49,7 +49,8 @@ they are coded as printed in `printed_with_multipliers` below.
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
+from ._reasons import MUJOCO_SOFT_EQUALITY, SEMI_IMPLICIT_DRIFT
 from .model import Body, Circle, Mechanism, Parameter, PointOnPoint, Revolute, Scenario, Segment
 
 PARAMETERS = (
@@ -176,5 +177,12 @@ SYSTEM = System(
                  description="both bars at 0.3 rad from rest: sway and flapping mixed; the "
                              "wings stay clear of alignment (|sin(phi3 + phi4)| > 0.5) and "
                              "the hinges Q, Q' at least 0.08 m apart"),
+    ),
+    expectations=(
+        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("pybullet", "large.trajectory_*", "xfail", SEMI_IMPLICIT_DRIFT),
+        Expectation("pybullet", "large.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),
     ),
 )

@@ -66,7 +66,8 @@ reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
+from ._reasons import MUJOCO_SOFT_EQUALITY
 from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, LinearCoupling,
                     Mechanism, Parameter, Revolute, Scenario, Segment)
 
@@ -187,4 +188,8 @@ SYSTEM = System(
     ),
     notes="The printed E_c takes the disc's spin as phi'; rolling gives "
           "-(R theta' + (R - r) phi')/r (see the module docstring).",
+    expectations=(
+        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+    ),
 )

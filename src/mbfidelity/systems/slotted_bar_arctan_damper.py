@@ -27,7 +27,8 @@ that the motion never reaches from phi = 0 (|phi| = pi/2 would need x infinite).
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
+from ._reasons import MUJOCO_SOFT_EQUALITY
 from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Rectangle, Revolute, Scenario, Segment,
                     coordinate_spring_damper)
@@ -108,5 +109,9 @@ SYSTEM = System(
                  description="0.05 rad from phi = 0: the damper acts in its linear range"),
         Scenario("large", {"phi": 1.0, "x": "h*tan(1.0)"}, checks=("trajectory", "constraint_force"),
                  description="1 rad: x = 1.56 h, the damper saturates near F0"),
+    ),
+    expectations=(
+        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        Expectation("mujoco", "damping.fit_*", "xfail", MUJOCO_SOFT_EQUALITY),
     ),
 )

@@ -1,0 +1,26 @@
+"""Physical reasons for expected failures shared by several mechanisms (each measured;
+the numbers per mechanism are in the results)."""
+
+MUJOCO_SOFT_EQUALITY = (
+    "MuJoCo's equality constraints are soft: the impedance is capped at 0.9999 (solimp) and "
+    "the reference time constant at 2 dt, so each constraint force falls about 1e-4 of "
+    "itself short and a small violation (1e-9 to 1e-7 m) makes up the rest; constraint "
+    "forces are then off by 1e-4 to 2e-3 and trajectories by 1e-6 to 1e-5, against RK4 "
+    "gates near 1e-7. No solref/solimp choice removes the floor (measured).")
+
+MUJOCO_MASSLESS_PIN = (
+    "MuJoCo rejects massless moving bodies, so the massless pin P carries a substitute mass "
+    "(3e-4 of the lightest body) held by soft equalities; the added inertia and the soft "
+    "slot trade against each other and no mass brings the motion or the second mode "
+    "(off by 2e-4, proportional to the substitute mass) within the RK4 gates.")
+
+SEMI_IMPLICIT_DRIFT = (
+    "Semi-implicit Euler on a configuration-dependent mass matrix is not symplectic: the "
+    "phase drifts at first order, (w h) w T, beyond the semi-implicit-Euler gate; the error "
+    "halves with the step (measured convergence at first order).")
+
+VELOCITY_LEVEL_STARTUP = (
+    "The engine's velocity-level constraint solve has no memory of the centripetal load "
+    "at the start of a fast spin (40 rad/s): the contact force misses m_b e w^2 on the "
+    "first step(s) and overshoots on the next, an error that does not shrink with dt; after "
+    "that the force follows the reference within the gate.")
