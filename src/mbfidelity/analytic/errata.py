@@ -126,15 +126,10 @@ def reduced_equations(system: System) -> list[sp.Expr] | None:
     d = derivation_of(system.id)
     if not d.m:
         return list(d.residual)
-    dep = [d.q[i] for i in d.dependent]
     ind = [i for i in d.independent]
-    try:
-        sols = sp.solve(list(d.Phi), dep, dict=True)
-    except NotImplementedError:
+    q_of = d.explicit_dependent  # guarded: sympy's solve does not return on some loops
+    if q_of is None:
         return None
-    if len(sols) != 1:
-        return None
-    q_of = sols[0]
     qi = [d.q[i] for i in ind]
     qdi = [d.qd[i] for i in ind]
     qddi = [d.qdd[i] for i in ind]
