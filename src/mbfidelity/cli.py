@@ -253,8 +253,8 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
     entries = []
     for system in all_systems().values():
         for e in errata(system):
-            if witnesses and e.verdict != "agrees" and e.kind == "eom":
-                e.witnesses = witness(system)
+            if witnesses and e.verdict != "agrees":
+                e.witnesses = witness(system, e)
             entries.append(e.as_dict())
     if as_json:
         _json({"errata": entries})

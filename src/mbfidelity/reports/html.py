@@ -147,10 +147,39 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
     return index
 
 
+def _worst(c, prefixes) -> str:
+    ms = [m for m in c.metrics if any(p in m.name for p in prefixes)]
+    if not ms:
+        return "-"
+    worst = max(ms, key=lambda m: m.value / m.tolerance if m.tolerance else m.value)
+    flag = {"pass": "", "xfail": " (xfail)", "fail": " FAIL", "xpass": " XPASS"}[worst.status]
+    return f"{worst.value:.1e}/{worst.tolerance:.0e}{flag}"
+
+
+def error_table(results) -> list[str]:
+    """System x engine: the worst metric (value/tolerance) of each check."""
+    lines = ["| system | engine | version | trajectory | forces | frequency | wall s |",
+             "|---|---|---|---|---|---|---|"]
+    for c in results:
+        if not c.supported:
+            lines.append(f"| {c.system} | {c.simulator} | {c.engine_version} | unsupported: "
+                         f"{c.reason} | | | |")
+            continue
+        lines.append(
+            f"| {c.system} | {c.simulator} | {c.engine_version} | "
+            f"{_worst(c, ('trajectory_max',))} | {_worst(c, ('.reaction_', '.constraint_'))} | "
+            f"{_worst(c, ('frequency.',))} | {c.wall_time:.2f} |")
+    return lines
+
+
 def _markdown(results, prov: dict) -> str:
     lines = [f"# mbfidelity summary ({prov['git_describe']}, {prov['date']})", "",
-             "| system | simulator | metric | value | tolerance | status |",
-             "|---|---|---|---|---|---|"]
+             "Worst metric of each check, as value/tolerance (relative errors; dt = "
+             f"{results[0].dt if results else ''} s):", ""]
+    lines += error_table(results)
+    lines += ["", "## Every metric", "",
+              "| system | simulator | metric | value | tolerance | status |",
+              "|---|---|---|---|---|---|"]
     for c in results:
         if not c.supported:
             lines.append(f"| {c.system} | {c.simulator} | * | | | unsupported: {c.reason} |")
