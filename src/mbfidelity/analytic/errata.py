@@ -302,9 +302,12 @@ def printed_model_trajectory(system: System, pf: PrintedFormula, values: Mapping
     def rhs(tt, y):
         return np.concatenate([y[k:], acc(*y[:k], *y[k:], tt)])
 
-    res = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0[ind], qd0[ind]]), method="DOP853",
-                    rtol=1e-12, atol=1e-12, t_eval=t)
-    return res.y[:k].T if res.success else None
+    try:
+        res = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0[ind], qd0[ind]]),
+                        method="DOP853", rtol=1e-12, atol=1e-12, t_eval=t)
+    except (ZeroDivisionError, OverflowError, ValueError):
+        return None  # the printed equations are singular on this motion: no witness
+    return res.y[:k].T if res.success and res.y.shape[1] == len(t) else None
 
 
 def printed_model_frequencies(system: System, pf: PrintedFormula,
