@@ -6,7 +6,6 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mbfidelity.analytic.closed_forms import SOLUTIONS
-from mbfidelity.analytic.derivation import derivation_of
 from mbfidelity.analytic.errata import errata
 from mbfidelity.analytic.linear import find_equilibria, operating_equilibrium
 from mbfidelity.analytic.numeric import numeric_model
@@ -17,7 +16,6 @@ from hand import facts
 
 SYSTEMS = list(all_systems())
 HAND = facts()
-G = 9.81
 
 
 def test_every_system_has_hand_facts():

@@ -49,12 +49,16 @@ class Equilibrium:
     modes: list[Mode] = field(default_factory=list)
 
 
-def quadratic_eigenvalues(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """All 2n roots s of det(M s^2 + C s + K) = 0 (first-order companion form)."""
+def companion_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """First-order form A of M q'' + C q' + K q = 0, state (q, q')."""
     n = M.shape[0]
-    A = np.block([[np.zeros((n, n)), np.eye(n)],
-                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    return scipy.linalg.eigvals(A)
+    return np.block([[np.zeros((n, n)), np.eye(n)],
+                     [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+
+
+def quadratic_eigenvalues(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """All 2n roots s of det(M s^2 + C s + K) = 0, as complex numbers."""
+    return scipy.linalg.eigvals(companion_matrix(M, C, K)).astype(complex)
 
 
 def modes_from_eigenvalues(eigenvalues: np.ndarray) -> list[Mode]:

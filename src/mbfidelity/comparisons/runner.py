@@ -10,10 +10,9 @@ from pathlib import Path
 from typing import Iterable, Mapping
 
 import numpy as np
-import scipy.linalg
 
 from .. import __version__
-from ..analytic.linear import operating_equilibrium
+from ..analytic.linear import companion_matrix, operating_equilibrium
 from ..analytic.reference import reference
 from ..simulators import get_backend
 from ..systems import System, get_system
@@ -260,9 +259,7 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     model = numeric_model(system.id, values)
     ind = model.independent
     k_dof = len(ind)
-    Minv = np.linalg.inv(eq.M)
-    A = np.block([[np.zeros((k_dof, k_dof)), np.eye(k_dof)], [-Minv @ eq.K, -Minv @ eq.C]])
-    s_all, vecs = np.linalg.eig(A)
+    s_all, vecs = np.linalg.eig(companion_matrix(eq.M, eq.C, eq.K))
     scales = _coordinate_scales(system, eq.q)[ind]
     oscillatory = [m for m in modes if m.damped_frequency_hz > 0]
     tol = None

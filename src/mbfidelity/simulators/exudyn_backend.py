@@ -84,6 +84,7 @@ from ..systems.model import (
     Revolute,
     compile_law,
 )
+from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Support
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
@@ -817,22 +818,8 @@ class ExudynBackend(Backend):
             mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
         mbs.Assemble()
         eps = float(cfg["linearization_relative_epsilon"])
-
-        def engine_mkd(relative_epsilon: float):
-            sim = self._simulation_settings(exu, cfg, 1.0, 1)
-            sim.staticSolver.newton.numericalDifferentiation.relativeEpsilon = relative_epsilon
-            M, K, D = mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
-            return np.asarray(M), np.asarray(K), np.asarray(D)
-
-        M, K, D = engine_mkd(eps)
-        if cfg["linearization_richardson"]:
-            # Exudyn differentiates forward (error O(eps)); two steps cancel that term
-            _, K2, D2 = engine_mkd(eps / 2)
-            K, D = 2 * K2 - K, 2 * D2 - D
-        n = len(M)
-        A = np.block([[np.zeros((n, n)), np.eye(n)],
-                      [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
-        eig = np.linalg.eigvals(A).astype(complex)
+        M, K, D = self._tree_mkd(exu, mbs, cfg)
+        eig = quadratic_eigenvalues(M, D, K)
         how = ("two forward-difference Jacobians (eps, eps/2) Richardson-extrapolated"
                if cfg["linearization_richardson"] else "one forward-difference Jacobian")
         return Linearization(
@@ -843,6 +830,23 @@ class ExudynBackend(Backend):
                    "relative_epsilon": eps},
         )
 
+
+    def _tree_mkd(self, exu, mbs, cfg: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, K, D of the assembled tree from ``ComputeLinearizedSystem``; Exudyn
+        differentiates forward (error O(eps)), so two steps (eps, eps/2) cancel that term
+        when ``linearization_richardson`` is on."""
+        def engine_mkd(relative_epsilon: float):
+            sim = self._simulation_settings(exu, cfg, 1.0, 1)
+            sim.staticSolver.newton.numericalDifferentiation.relativeEpsilon = relative_epsilon
+            M, K, D = mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
+            return np.asarray(M), np.asarray(K), np.asarray(D)
+
+        eps = float(cfg["linearization_relative_epsilon"])
+        M, K, D = engine_mkd(eps)
+        if cfg["linearization_richardson"]:
+            _, K2, D2 = engine_mkd(eps / 2)
+            K, D = 2 * K2 - K, 2 * D2 - D
+        return M, K, D
 
     def _linearize_constrained(self, mechanism: Mechanism, q_eq: np.ndarray,
                                cfg: dict) -> Linearization:
@@ -860,17 +864,7 @@ class ExudynBackend(Backend):
         n = geo.n
         u_eq = np.linalg.solve(geo.T, q_eq - geo.c)
         eps = float(cfg["linearization_relative_epsilon"])
-
-        def engine_mkd(relative_epsilon: float):
-            sim = self._simulation_settings(exu, cfg, 1.0, 1)
-            sim.staticSolver.newton.numericalDifferentiation.relativeEpsilon = relative_epsilon
-            M, K, D = mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
-            return np.asarray(M), np.asarray(K), np.asarray(D)
-
-        M, K, D = engine_mkd(eps)
-        if cfg["linearization_richardson"]:
-            _, K2, D2 = engine_mkd(eps / 2)
-            K, D = 2 * K2 - K, 2 * D2 - D
+        M, K, D = self._tree_mkd(exu, mbs, cfg)
 
         def forces_and_jacobian(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Exudyn's ODE2 right-hand side f and constraint Jacobian C (n x m) at u."""
@@ -905,10 +899,7 @@ class ExudynBackend(Backend):
         rank = int(np.sum(sv > 1e-12 * max(1.0, float(np.max(sv, initial=0.0)))))
         N = U[:, rank:]
         Mn, Kn, Dn = N.T @ M @ N, N.T @ (K + H) @ N, N.T @ D @ N
-        k = len(Mn)
-        A = np.block([[np.zeros((k, k)), np.eye(k)],
-                      [-np.linalg.solve(Mn, Kn), -np.linalg.solve(Mn, Dn)]])
-        eig = np.linalg.eigvals(A).astype(complex)
+        eig = quadratic_eigenvalues(Mn, Dn, Kn)
         # a rigid mode (belt pulleys) has a structurally zero eigenvalue; the projection
         # leaves ~1e-15 |s| of round-off in it, which would read as a tiny frequency
         tiny = 1e-12 * max(float(np.max(np.abs(eig), initial=0.0)), 1e-300)

@@ -83,6 +83,7 @@ from ..systems.model import (
     Segment,
     compile_law,
 )
+from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Support
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
@@ -197,20 +198,26 @@ class _Plan:
         return self.A @ np.asarray(q, dtype=float) + self.b
 
 
+def _point_loaded_bodies(mech: Mechanism) -> set[str]:
+    """Bodies that a loop or slot constraint or a point-to-point element acts on."""
+    out: set[str] = set()
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            out |= {c.body_a, c.body_b}
+        elif isinstance(c, PointOnLine):
+            out |= {c.body, c.line_body}
+    for f in mech.forces:
+        if isinstance(f, PointToPoint):
+            out |= {f.body_a, f.body_b}
+    return out
+
+
 def _foldable(mech: Mechanism) -> set[str]:
     """Massless bodies whose joints are folded into their single child (exact). A massless
     body with another number of child joints, or that a constraint or a point-to-point
     element refers to, has no such child frame: it becomes a substitute body of small mass
     (setting ``massless_mass_ratio``)."""
-    used = set()
-    for c in mech.constraints:
-        if isinstance(c, PointOnPoint):
-            used |= {c.body_a, c.body_b}
-        elif isinstance(c, PointOnLine):
-            used |= {c.body, c.line_body}
-    for f in mech.forces:
-        if isinstance(f, PointToPoint):
-            used |= {f.body_a, f.body_b}
+    used = _point_loaded_bodies(mech)
     out = set()
     for b in mech.bodies:
         if b.massless and b.name not in used:
@@ -311,7 +318,6 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     substitute_gravcomp, solref, solimp); defaults when None."""
     opts = dict(opts or {})
     n = len(mech.joints)
-    idx = {j.name: i for i, j in enumerate(mech.joints)}
     # body angle = angle_c . q + angle_d (affine in the description coordinates)
     angle_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
     angle_d: dict[str, float] = {WORLD: 0.0}
@@ -360,15 +366,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     # constraint or point force on it) carries no load of its own and can be very light;
     # a massless body that a constraint or a point force loads must be heavier, because
     # MuJoCo's soft constraints scale their stiffness with the mass they move
-    loaded = set()
-    for c in mech.constraints:
-        if isinstance(c, PointOnPoint):
-            loaded |= {c.body_a, c.body_b}
-        elif isinstance(c, PointOnLine):
-            loaded |= {c.body, c.line_body}
-    for f in mech.forces:
-        if isinstance(f, PointToPoint):
-            loaded |= {f.body_a, f.body_b}
+    loaded = _point_loaded_bodies(mech)
     for bd in mech.bodies:
         if bd.massless and bd.name not in foldable:
             key = "massless_mass_ratio" if bd.name in loaded else "link_mass_ratio"
@@ -1322,10 +1320,7 @@ class MujocoBackend(Backend):
         rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
         T = Vt[rank:].T
         Mr, Cr, Kr = (T.T @ X @ T for X in (M, C, K))
-        k = T.shape[1]
-        Minv = np.linalg.inv(Mr)
-        system = np.block([[np.zeros((k, k)), np.eye(k)], [-Minv @ Kr, -Minv @ Cr]])
-        eig = np.linalg.eigvals(system).astype(complex)
+        eig = quadratic_eigenvalues(Mr, Cr, Kr)
         # rigid modes (a free pulley) come out as round-off: make them exact zeros
         eig[np.abs(eig) < 1e-10 * max(np.max(np.abs(eig)), 1e-300)] = 0.0
         residual = float(np.linalg.norm(J.T @ f - rhs) / max(load, 1e-300))
@@ -1372,9 +1367,7 @@ class MujocoBackend(Backend):
             K, C, M = ((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
             perm = comp.vadr
             K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
-            Minv = np.linalg.inv(M)
-            system = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-            eig = np.linalg.eigvals(system).astype(complex)
+            eig = quadratic_eigenvalues(M, C, K)
             A = plan.A  # v = A q + b: matrices in description coordinates are A^T X A
             extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
             method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central differences "

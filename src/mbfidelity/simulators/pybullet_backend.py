@@ -88,6 +88,7 @@ from ..systems.model import (
     Revolute,
     compile_law,
 )
+from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Support
 
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
@@ -1099,7 +1100,7 @@ class PyBulletBackend(Backend):
             has_cf = bool(plan.coord_forces)
             point_links = [eidx[k] for k in plan.point_links]
             pos_of = {k: m for m, k in enumerate(plan.point_links)}
-            AinvT, Ainv, bvec = plan.AinvT, plan.Ainv, plan.b
+            Ainv, bvec = plan.Ainv, plan.b
             identity = plan.identity_map
             sensor_slots = [eidx[i] for i in joint_ids]
             n_cs = len(cids)
@@ -1496,9 +1497,7 @@ class PyBulletBackend(Backend):
                 C[:, i] = (residual(jv_eq, v0 + ev) - residual(jv_eq, v0 - ev)) / (2 * hv)
         finally:
             p.disconnect(physicsClientId=cid)
-        Minv = np.linalg.inv(M)
-        state = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-        eig = np.linalg.eigvals(state).astype(complex)
+        eig = quadratic_eigenvalues(M, C, K)
         return Linearization(
             eigenvalues=eig,
             method=("calculateMassMatrix + central differences of calculateInverseDynamics "
