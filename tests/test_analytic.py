@@ -8,7 +8,7 @@ from scipy.integrate import solve_ivp
 from mbfidelity.analytic.closed_forms import SOLUTIONS
 from mbfidelity.analytic.errata import errata
 from mbfidelity.analytic.linear import find_equilibria, operating_equilibrium
-from mbfidelity.analytic.numeric import numeric_model
+from mbfidelity.analytic.numeric import contact_forces, numeric_model
 from mbfidelity.analytic.reference import reference, sensitivity
 from mbfidelity.systems import all_systems, get_system
 
@@ -180,6 +180,60 @@ def test_double_pendulum_reactions_sum_to_total_momentum_rate():
     np.testing.assert_allclose(model.reaction("elbow", q, qd, qdd, t), m * a2 - m * weight, atol=1e-12)
     np.testing.assert_allclose(model.reaction("pivot", q, qd, qdd, t),
                                m * a1 + m * a2 - 2 * m * weight, atol=1e-12)
+
+
+def _reference_short(system_id, scenario, t_end):
+    s = get_system(system_id)
+    sc = next(x for x in s.scenarios if x.name == scenario)
+    v = s.parameter_values(scenario=sc)
+    return s, v, reference(s, sc, v, 1e-3, t_end)
+
+
+def test_rolling_disc_contact_forces_by_newton_on_the_disc():
+    """Fig. 39 (pinned geometry), Newton-Euler on the disc alone, written out by hand.
+    Centre D = C + (R - r) u with C = R (cos theta, -sin theta), u = (sin phi, -cos phi):
+    the track pushes the disc towards C with N, so N = -u . m_d (a_D - g_vec). About D the
+    friction f t at J = D + r u turns the disc by r f (u x t = 1) and the hub damper by
+    -c_J (r/R)^2 psi', so I_d (phi'' + psi'') = r f - c_J (r/R)^2 psi'."""
+    s, v, ref = _reference_short("rolling_disc_track", "large", 2.0)
+    q, qd, qdd = ref.q, ref.qd, ref.qdd
+    R, r, md, g, Id = v["R"], v["r"], v["m_d"], v["g"], v["I_d"]
+    th, ph = q[:, 0], q[:, 1]
+    w, p, a, b = qd[:, 0], qd[:, 1], qdd[:, 0], qdd[:, 1]
+    ax = R * (-np.cos(th) * w**2 - np.sin(th) * a) + (R - r) * (-np.sin(ph) * p**2 + np.cos(ph) * b)
+    ay = R * (np.sin(th) * w**2 - np.cos(th) * a) + (R - r) * (np.cos(ph) * p**2 + np.sin(ph) * b)
+    F = md * np.c_[ax, ay + g]
+    N_hand = -(np.c_[np.sin(ph), -np.cos(ph)] * F).sum(1)
+    f_hand = (Id * (b + qdd[:, 2]) + v["c_J"] * (r / R) ** 2 * qd[:, 2]) / r
+    model = numeric_model(s.id, v)
+    reactions = {"hub": model.reaction("hub", q, qd, qdd, ref.t, ref.multipliers)}
+    out = contact_forces(s, v, q, reactions, ref.constraint_forces)
+    np.testing.assert_allclose(out["normal"], N_hand, atol=1e-12 * np.abs(N_hand).max())
+    np.testing.assert_allclose(out["friction"], f_hand, atol=1e-10 * np.abs(f_hand).max())
+    assert np.all(N_hand > 0), "the large scenario is chosen with N > 0 throughout"
+
+
+def test_cam_contact_force_by_newton_on_the_block():
+    """Fig. 8: the block rides at y = const - e cos phi, so m_b y'' = N - m_b g - c y'
+    gives N = m_b (e (cos phi phi'^2 + sin phi phi'') + g) + c e sin phi phi'. Spun at
+    40 rad/s the disc throws the block: N turns negative (a real block lifts off)."""
+    s, v, ref = _reference_short("eccentric_cam", "rotating", 0.2)
+    phi, w, a = ref.q[:, 0], ref.qd[:, 0], ref.qdd[:, 0]
+    e, mb, g, c = v["e"], v["m_b"], v["g"], v["c"]
+    N_hand = mb * (e * (np.cos(phi) * w**2 + np.sin(phi) * a) + g) + c * e * np.sin(phi) * w
+    out = contact_forces(s, v, ref.q, {}, ref.constraint_forces)
+    np.testing.assert_allclose(out["block"], N_hand, atol=1e-10 * np.abs(N_hand).max())
+    assert N_hand.min() < 0 < N_hand.max()
+
+
+@pytest.mark.parametrize("system_id", SYSTEMS)
+def test_contact_sources_exist(system_id):
+    s = get_system(system_id)
+    mech = s.mechanism
+    for c in s.contacts(s.symbols):
+        names = ([j.name for j in mech.joints] if c.kind == "reaction"
+                 else [k.name for k in mech.constraints])
+        assert c.target in names, f"{c.name}: {c.source} names nothing in the mechanism"
 
 
 @pytest.mark.parametrize("system_id", SYSTEMS)

@@ -318,7 +318,36 @@ class Derivation:
                 total += b.mass * (self.acceleration(self.poses[name].position) - g_vec)
         for f in mech.forces:
             total -= self._external_force_on(f, subtree, joint)
+        for c in mech.constraints:
+            total -= self._closure_force_on(c, subtree, joint)
         return total
+
+    def _closure_force_on(self, c, subtree: set[str], joint) -> sp.Matrix:
+        """Force of a closure constraint on the subtree (symbols _lambda_k): a loop or slot
+        force where exactly one side is inside; a coupling's generalized force is a couple
+        on revolute coordinates (no net force) and a force along a prismatic axis."""
+        mech = self.mechanism
+        if isinstance(c, (PointOnPoint, PointOnLine)):
+            first, second = (c.body_a, c.body_b) if isinstance(c, PointOnPoint) else (
+                c.body, c.line_body)
+            in_first, in_second = first in subtree, second in subtree
+            if in_first == in_second:
+                return sp.zeros(2, 1)
+            force = self.constraint_force(c)  # on the first body
+            return force if in_first else -force
+        if isinstance(c, LinearCoupling):
+            rows = self.constraint_row_slices()[c.name]
+            lam = sp.Symbol(f"_lambda{rows.start}")
+            total = sp.zeros(2, 1)
+            for name, coef in c.coefficients:
+                owner = mech.joints[mech.coordinates.index(name)]
+                if owner is not joint or isinstance(owner, Revolute):
+                    continue
+                axis = as_column(owner.axis)
+                axis_world = rotation(self.poses[owner.parent].angle) * axis
+                total += -lam * sp.sympify(coef) * axis_world / (axis.T * axis)[0]
+            return total
+        raise TypeError(c)
 
     def _external_force_on(self, f, subtree: set[str], joint) -> sp.Matrix:
         if isinstance(f, PointToPoint):

@@ -290,17 +290,21 @@ class NumericModel:
 
     # --- reactions -----------------------------------------------------------------------
     def reaction(self, joint: str, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-                 t: np.ndarray) -> np.ndarray:
-        """(N, 2) reaction force on the child at `joint`, world axes."""
-        if self.constrained:
-            raise ValueError("tree-joint reactions of a constrained mechanism: use the "
-                             "constraint forces (multipliers)")
+                 t: np.ndarray, lam: np.ndarray | None = None) -> np.ndarray:
+        """(N, 2) reaction force on the child at `joint`, world axes. In a constrained
+        mechanism the closure forces that enter the child's subtree are part of the
+        balance: give the multipliers `lam` (N, m) of the same samples, or they are
+        computed from (q, q', t)."""
         if joint not in self._reactions:
             d = self.derivation
             expr = d.reaction(joint).xreplace(self.subs)
-            self._reactions[joint] = _lambdify(list(d.q) + list(d.qd) + list(d.qdd) + [TIME],
-                                               list(expr))
-        fx, fy = self._reactions[joint](*q.T, *qd.T, *qdd.T, t)
+            lam_syms = [sp.Symbol(f"_lambda{k}") for k in range(self.m)]
+            self._reactions[joint] = _lambdify(
+                list(d.q) + list(d.qd) + list(d.qdd) + [TIME] + lam_syms, list(expr))
+        if self.m and lam is None:
+            lam = self.dynamics_along(q, qd, t)[1]
+        lam_cols = lam.T if self.m else ()
+        fx, fy = self._reactions[joint](*q.T, *qd.T, *qdd.T, t, *lam_cols)
         return np.column_stack([np.broadcast_to(np.asarray(f, dtype=float), (len(t),))
                                 for f in (fx, fy)])
 
@@ -336,3 +340,37 @@ def _numeric_cached(system_id: str, items: tuple) -> NumericModel:
 
 def numeric_model(system_id: str, values: Mapping[str, float]) -> NumericModel:
     return _numeric_cached(system_id, tuple(sorted(values.items())))
+
+
+def contact_forces(system, values: Mapping[str, float], q: np.ndarray,
+                   reactions: Mapping[str, np.ndarray],
+                   constraint_forces: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Each `ContactOutput` of the system along a sampled motion, (N,) per contact: the
+    same projection for the reference and for every engine's own reactions and closure
+    forces. A source missing from the inputs gives NaN (the engine cannot report it)."""
+    from ..systems import coordinate_symbols
+
+    P = system.symbols
+    subs = {getattr(P, k): v for k, v in values.items() if hasattr(P, k)}
+    coords = [coordinate_symbols(c)[0] for c in system.coordinates]
+    out: dict[str, np.ndarray] = {}
+    for c in system.contacts(P):
+        pool = reactions if c.kind == "reaction" else constraint_forces
+        if c.kind not in ("reaction", "constraint"):
+            raise ValueError(f"{system.id}: contact {c.name!r}: source must be "
+                             f"'reaction:<joint>' or 'constraint:<name>', not {c.source!r}")
+        force = pool.get(c.target)
+        if force is None:
+            out[c.name] = np.full(len(q), np.nan)
+            continue
+        force = np.asarray(force, dtype=float)
+        if c.direction is None:
+            if force.shape[1] != 1:
+                raise ValueError(f"{system.id}: contact {c.name!r} needs a direction "
+                                 f"({c.source} is a vector)")
+            out[c.name] = force[:, 0]
+            continue
+        fn = _lambdify(coords, [sp.sympify(x).xreplace(subs) for x in c.direction])
+        ux, uy = (np.broadcast_to(np.asarray(v, dtype=float), (len(q),)) for v in fn(*q.T))
+        out[c.name] = ux * force[:, 0] + uy * force[:, 1]
+    return out

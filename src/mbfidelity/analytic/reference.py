@@ -110,13 +110,12 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
         method = f"DOP853 rtol=atol={TIGHT:g}; error estimated against rtol=atol={LOOSE:g}"
     if model.constrained:
         qdd, lam = model.dynamics_along(q, qd, t)
-        reactions = {}
         constraint_forces = model.constraint_forces(q, lam)
     else:
         qdd = model.accelerations(q, qd, t)
         lam = np.zeros((len(t), 0))
         constraint_forces = {}
-        reactions = {j: model.reaction(j, q, qd, qdd, t) for j in system.reaction_joints}
+    reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in system.reaction_joints}
     energy = model.energy(q, qd) if model.conservative else None
     return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces)
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from .. import __version__
 from ..analytic.linear import companion_matrix, operating_equilibrium
+from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
 from ..systems import System, get_system
@@ -152,7 +153,10 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     ref = reference(system, sc, values, dt, T)
     q0, qd0 = ref.q[0], ref.qd[0]
     joints = system.reaction_joints if "reaction" in sc.checks else ()
-    run = backend.simulate(mech, q0, qd0, T, dt, settings, joints)
+    contacts = system.contacts(system.symbols) if "constraint_force" in sc.checks else ()
+    contact_joints = tuple(c.target for c in contacts
+                           if c.kind == "reaction" and c.target not in joints)
+    run = backend.simulate(mech, q0, qd0, T, dt, settings, joints + contact_joints)
     result.wall_time += run.wall_time
     result.simulated_time += T
     eq = operating_equilibrium(system, values)
@@ -195,6 +199,8 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
                      if f_run is not None else float("inf"))
             result.metrics.append(_judge(system, backend.id, f"{name}.constraint_{cname}",
                                          value, tol))
+    if contacts:
+        _compare_contacts(system, backend, values, ref, run, n, tol, name, result)
     if keep_series:
         result.series[name] = {
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
@@ -202,6 +208,43 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
                           for j in joints if j in run.reactions},
             "tolerance": tol, "scale": scale,
         }
+
+
+def _first_negative(t: np.ndarray, f: np.ndarray) -> float | None:
+    below = np.flatnonzero(f < 0)
+    return float(t[below[0]]) if below.size else None
+
+
+def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -> None:
+    """Contact forces (normal, friction) on the scale of the largest one; for a unilateral
+    contact, where and how far the bilateral model pulls (a real contact would open)."""
+    reactions = {**ref.reactions}
+    missing = [c.target for c in system.contacts(system.symbols)
+               if c.kind == "reaction" and c.target not in reactions]
+    if missing:
+        model = numeric_model(system.id, values)
+        reactions.update({j: model.reaction(j, ref.q, ref.qd, ref.qdd, ref.t, ref.multipliers)
+                          for j in missing})
+    f_ref = contact_forces(system, values, ref.q[:n], {k: v[:n] for k, v in reactions.items()},
+                           {k: v[:n] for k, v in (ref.constraint_forces or {}).items()})
+    f_run = contact_forces(system, values, run.q[:n],
+                           {k: v[:n] for k, v in run.reactions.items()},
+                           {k: v[:n] for k, v in run.constraint_forces.items()})
+    scale = max((float(np.max(np.abs(f))) for f in f_ref.values()), default=1.0)
+    t = ref.t[:n]
+    for c in system.contacts(system.symbols):
+        a, b = f_run[c.name], f_ref[c.name]
+        ok = ~np.isnan(a)
+        value = (float(np.max(np.abs(a[ok] - b[ok])) / max(scale, 1e-300))
+                 if np.any(ok) else float("inf"))
+        metric = _judge(system, backend.id, f"{name}.contact_{c.name}", value, tol)
+        metric.detail = {"reference_min": float(np.min(b)), "reference_max": float(np.max(b)),
+                         "engine_min": float(np.nanmin(a)) if np.any(ok) else None,
+                         "unilateral": c.unilateral}
+        if c.unilateral:
+            metric.detail["reference_first_negative_s"] = _first_negative(t, b)
+            metric.detail["engine_first_negative_s"] = _first_negative(t[ok], a[ok])
+        result.metrics.append(metric)
 
 
 def _energy_of(system, values, q, qd):

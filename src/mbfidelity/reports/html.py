@@ -66,6 +66,10 @@ zeta (w h) w T (see <code>comparisons/tolerances.py</code>).</p>
 <table><tr><th>mode</th><th>reference (linearized M, C, K)</th>{% for sim in sims %}<th>{{ sim }} linearization</th><th>{{ sim }} fit</th>{% endfor %}</tr>
 {% for mode, row in frequencies[sys].items() %}<tr><td>{{ mode }}</td><td>{{ "%.9f"|format(row.reference_hz) }}</td>
 {% for sim in sims %}{% set e = row.engines.get(sim, {}) %}<td>{{ "%.9f"|format(e.get("linearization")) if e.get("linearization") is not none else "-" }}</td><td>{{ "%.9f"|format(e.get("fit")) if e.get("fit") is not none else "-" }}</td>{% endfor %}</tr>{% endfor %}</table>{% endif %}
+{% for w in liftoff[sys] %}<p class="xfail">Contact <b>{{ w.contact }}</b>, scenario {{ w.scenario }}: the
+bilateral model pulls from t = {{ "%.3f"|format(w.t_ref) }} s (reference minimum {{ "%.3g"|format(w.min_ref) }} N);
+a real unilateral contact would open there, so from that instant the comparison is of the
+bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} minimum {{ "%.3g"|format(e.min) }} N{% if e.t is not none %} from t = {{ "%.3f"|format(e.t) }} s{% endif %}{% if not loop.last %}; {% endif %}{% endfor %}.</p>{% endfor %}
 {% if expected[sys] %}<p>Declared expected failures:</p><ul>{% for e in expected[sys] %}<li><b>{{ e.simulator }}</b>, {{ e.metric }}: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
@@ -144,15 +148,36 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
 
         errata = [e.as_dict() for s in systems for e in compute(get_system(s))]
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
+    liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
                            metric_names=metric_names, unsupported=unsupported, figures=figures,
                            titles={s: get_system(s).title for s in systems}, versions=versions,
                            explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
-                           expected={s: get_system(s).expectations for s in systems})
+                           expected={s: get_system(s).expectations for s in systems},
+                           liftoff=liftoff)
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def contact_warnings(comps) -> list[dict]:
+    """Unilateral contacts whose reference force turns negative (the bilateral model pulls
+    where a real contact would open), with each engine's minimum and first negative time."""
+    found: dict[tuple[str, str], dict] = {}
+    for c in comps:
+        for m in c.metrics:
+            d = m.detail or {}
+            if ".contact_" not in m.name or d.get("reference_first_negative_s") is None:
+                continue
+            scenario, contact = m.name.split(".contact_", 1)
+            w = found.setdefault((scenario, contact), {
+                "scenario": scenario, "contact": contact, "engines": {},
+                "t_ref": d["reference_first_negative_s"], "min_ref": d["reference_min"]})
+            if d.get("engine_min") is not None:
+                w["engines"][c.simulator] = {"min": d["engine_min"],
+                                             "t": d.get("engine_first_negative_s")}
+    return list(found.values())
 
 
 def _worst(c, prefixes) -> str:
@@ -175,7 +200,7 @@ def error_table(results) -> list[str]:
             continue
         lines.append(
             f"| {c.system} | {c.simulator} | {c.engine_version} | "
-            f"{_worst(c, ('trajectory_max',))} | {_worst(c, ('.reaction_', '.constraint_'))} | "
+            f"{_worst(c, ('trajectory_max',))} | {_worst(c, ('.reaction_', '.constraint_', '.contact_'))} | "
             f"{_worst(c, ('frequency.',))} | {c.wall_time:.2f} |")
     return lines
 

@@ -50,6 +50,17 @@ class PrintedFormula:
       "damping_ratio"     damping ratio at the operating point
       "constraint_force"  (constraint name, expression or list of expressions in q, q_dot,
                           q_ddot): its physical force (simulators/base.py point 6)
+      "constraint"        list of printed constraint equations Phi(q) = 0 (closure, slot,
+                          rolling), each row an expression in q; its zero set must be the
+                          mechanism's (rows in any order, sign or scale)
+      "constraint_jacobian" matrix (rows x coordinates in system order) of the printed
+                          kinematic constraint equations Phi_q q' = 0 (eq. 110, 114); its
+                          row space must be the derived Phi_q's
+      "dissipation_power" printed P_nc(q, q_dot, t): power of the non-conservative forces
+                          (dampers, friction, motors), compared with Q_nc . q_dot
+    An "eom" may contain printed Lagrange multipliers (eq. 112): list their symbols in
+    `multipliers`; the residuals must be linear in them, and any normalisation or sign of
+    the printed multipliers is accepted (they are fitted, see analytic/errata.py).
     Matrices, frequencies and damping ratios refer to the equilibrium `at` (independent
     coordinate -> value) when given, otherwise to the operating point.
     """
@@ -62,6 +73,35 @@ class PrintedFormula:
     #: parameter relations under which the formula is printed (name -> expression of
     #: other parameters); imposed on every parameter set it is compared at
     relations: Mapping[str, Expr] | None = None
+    #: symbols of the printed Lagrange multipliers in an "eom" (eq. 112), in printed order
+    multipliers: tuple[sp.Symbol, ...] = ()
+
+
+@dataclass(frozen=True)
+class ContactOutput:
+    """A physical contact force, compared and watched.
+
+    Its value is the component along `direction` of a joint reaction (source
+    "reaction:<joint>", the force on the child) or of a closure force (source
+    "constraint:<name>": on the pin of a slot, on body_a of a loop closure; a coupling's
+    scalar force when `direction` is None). `direction` is a unit vector written with the
+    coordinate symbols and the parameters. `unilateral`: the real contact can only push
+    (value >= 0); where the bilateral model pulls, a real mechanism would separate, and
+    the comparison says when."""
+
+    name: str
+    source: str
+    direction: tuple[Expr, Expr] | None = None
+    unilateral: bool = True
+    description: str = ""
+
+    @property
+    def kind(self) -> str:
+        return self.source.split(":", 1)[0]
+
+    @property
+    def target(self) -> str:
+        return self.source.split(":", 1)[1]
 
 
 @dataclass(frozen=True)
@@ -90,6 +130,8 @@ class System:
     #: the monograph's printed formulas, as a function of the parameter symbols
     printed: Callable[[SimpleNamespace], tuple[PrintedFormula, ...]] = lambda P: ()
     reaction_joints: tuple[str, ...] = ()
+    #: physical contact forces (normal, friction) read from reactions or closure forces
+    contacts: Callable[[SimpleNamespace], tuple[ContactOutput, ...]] = lambda P: ()
     expectations: tuple[Expectation, ...] = ()
     #: name of an exact solution in mbfidelity.analytic.closed_forms, if one exists
     exact_solution: str | None = None

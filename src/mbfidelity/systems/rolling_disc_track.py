@@ -66,7 +66,7 @@ reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
+from . import ContactOutput, Expectation, PrintedFormula, System, coordinate_symbols
 from ._reasons import MUJOCO_SOFT_EQUALITY
 from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, LinearCoupling,
                     Mechanism, Parameter, Revolute, Scenario, Segment)
@@ -163,6 +163,18 @@ def printed(P):
     )
 
 
+def contacts(P):
+    ph = coordinate_symbols("phi")[0]
+    return (
+        ContactOutput("normal", "reaction:hub", (-sp.sin(ph), sp.cos(ph)),
+                      description="normal force of the track on the disc at J, towards C "
+                                  "(carried by the massless arm CD)"),
+        ContactOutput("friction", "constraint:rolling", None, unilateral=False,
+                      description="friction force of the track on the disc at J along "
+                                  "t = (cos phi, sin phi): the rolling coupling's -lambda"),
+    )
+
+
 _CHECKS = ("trajectory", "constraint_force")
 
 SYSTEM = System(
@@ -173,6 +185,7 @@ SYSTEM = System(
     build=build,
     operating_point=lambda P: {"theta": 0, "phi": 0, "psi": 0},
     printed=printed,
+    contacts=contacts,
     scenarios=(
         Scenario("small", {"theta": 0.05, "phi": 0.1}, checks=_CHECKS,
                  description="near the equilibrium (0, 0): theta = 0.05, phi = 0.1 rad, from rest"),
@@ -191,5 +204,8 @@ SYSTEM = System(
     expectations=(
         Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
         Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        # from rest at the equilibrium (forced) the soft coupling's lag stays below the gate
+        *(Expectation("mujoco", f"{sc}.contact_*", "xfail", MUJOCO_SOFT_EQUALITY)
+          for sc in ("small", "large", "undamped")),
     ),
 )
