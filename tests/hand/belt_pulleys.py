@@ -16,7 +16,8 @@ so, constant over the configuration space,
     C = diag(c3, c4),      c4 = c1 + c2 rho^2
     K = diag(k, 0),        k = m2 g l cos(theta_eq) = m2 g l at theta_eq = 0.
 
-All of Fig. 38's printed E_c (both forms), E_p, M, K and C agree with this.
+All of Fig. 38's printed E_c (both forms), E_p, M, K and C agree with this, and so does
+its P_nc: the viscous moments' power is -2 D = -c3 theta'^2 - (c1 + c2 rho^2) phi1'^2.
 
 Characteristic equation det(M s^2 + C s + K) = 0:
     (a s^2 + c3 s + k)(d s^2 + c4 s) - b^2 s^4

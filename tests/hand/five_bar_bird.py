@@ -41,17 +41,57 @@ MISPRINTS = {
     # cross terms: the geometry gives +2 l b cos(phi1 + phi3) (wing 1), -2 l b cos(phi2 - phi4)
     # (wing 2) and -2 l a cos(phi1 + phi3) (body); eq. 115 prints -, -cos(phi2 + phi4) and +
     "Fig. 40, eq. 115 (kinetic energy)",
-    # eq. 116 (not yet comparable by the errata layer, see five_bar_bird.printed_with_
-    # multipliers): with the true multipliers every row is off. Row 1: phi1'' has
-    # (m + m_c) l^2 (eq. 115 itself has m_c l^2 w1^2/2), and the phi3 coupling is
-    # (m l b - m_c l a)(cos(phi1+phi3) phi3'' - sin(phi1+phi3) phi3'^2), sign reversed.
-    # Row 2: m l b(-cos(phi2 - phi4) phi4'' - sin(phi2 - phi4) phi4'^2), printed with
+    # eq. 116: Lagrange's equations of T and V above with the multiplier terms of eq. 112
+    # (`eq116_by_hand`); the printed multiplier terms are right, the inertia terms are not.
+    # Row 1: phi1'' has (m + m_c) l^2 (eq. 115 itself has m_c l^2 w1^2/2), and the phi3
+    # coupling is (m l b - m_c l a)(cos(phi1+phi3) phi3'' - sin(phi1+phi3) phi3'^2), sign
+    # reversed. Row 2: m l b(-cos(phi2 - phi4) phi4'' - sin(phi2 - phi4) phi4'^2), printed with
     # phi2 + phi4. Row 3: coupling sign reversed as in row 1. Row 4: as row 2 with
-    # -m l b(cos(phi2 - phi4) phi2'' - sin(phi2 - phi4) phi2'^2); "(I + m b^2 + )" truncated.
+    # -m l b(cos(phi2 - phi4) phi2'' - sin(phi2 - phi4) phi2'^2); its "(I + m b^2 + )" is a
+    # stray plus (I + m b^2 is right). Rows 2-4 are exactly Lagrange's equations of the
+    # printed E_c (inherited errors); row 1's m l^2 is not.
     "Fig. 40, eq. 116, row 1", "Fig. 40, eq. 116, row 2",
     "Fig. 40, eq. 116, row 3", "Fig. 40, eq. 116, row 4",
+    # as a system: with the true accelerations no multipliers satisfy the four printed rows
+    # (four equations, two multipliers, the inertia errors are not constraint forces)
+    "Fig. 40, eq. 116 (as a system, multipliers fitted)",
 }
-# agree: eq. 115 potential energy; eq. 113 and 114 (the loop and its Jacobian)
+# agree: eq. 115 potential energy; eq. 113 (= (-Phi_y, Phi_x) of Phi above: same zero set)
+# and eq. 114 (its Jacobian = [[0, -1], [1, 0]] Phi_q)
+
+
+def eq116_by_hand(p, d, a, lam, v):
+    """Lagrange's equations with multipliers (eq. 112) of T and V above, in the printed
+    multipliers of eq. 114 (force of wing 2 on wing 1 at P = (lam2, -lam1)): four sympy
+    residuals. p, d, a: angles, rates, accelerations (phi1..phi4); v: parameter symbols."""
+    import sympy as sp
+
+    l, A, b, m, I, m_c, g = v.l, v.a, v.b, v.m, v.I, v.m_c, v.g
+    s, c = sp.sin, sp.cos
+    k13 = m * l * b - m_c * l * A  # coefficient of cos(phi1 + phi3) w1 w3 in T
+    s24, c24 = s(p[1] - p[3]), c(p[1] - p[3])
+    L1, L2 = lam
+    return [
+        (m + m_c) * l**2 * a[0] + k13 * (c(p[0] + p[2]) * a[2] - s(p[0] + p[2]) * d[2] ** 2)
+        + (m + m_c) * g * l * s(p[0]) + L1 * l * s(p[0]) + L2 * l * c(p[0]),
+        m * l**2 * a[1] - m * l * b * (c24 * a[3] + s24 * d[3] ** 2)
+        + m * g * l * s(p[1]) - L1 * l * s(p[1]) - L2 * l * c(p[1]),
+        (I + m * b**2 + m_c * A**2) * a[2]
+        + k13 * (c(p[0] + p[2]) * a[0] - s(p[0] + p[2]) * d[0] ** 2)
+        + (m_c * g * A - m * g * b) * s(p[2]) + L1 * A * s(p[2]) - L2 * A * c(p[2]),
+        (I + m * b**2) * a[3] - m * l * b * (c24 * a[1] - s24 * d[1] ** 2)
+        - m * g * b * s(p[3]) - L1 * A * s(p[3]) - L2 * A * c(p[3]),
+    ]
+
+
+def loop_by_hand(p, v):
+    """Phi = P(wing 1) - P(wing 2) (x, y) above, as sympy expressions."""
+    import sympy as sp
+
+    l, A, e = v.l, v.a, v.e
+    s, c = sp.sin, sp.cos
+    return [-l * s(p[0]) + A * s(p[2]) - e + l * s(p[1]) + A * s(p[3]),
+            -l * c(p[0]) - A * c(p[2]) + l * c(p[1]) + A * c(p[3])]
 
 
 def valid(v):

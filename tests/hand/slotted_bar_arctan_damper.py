@@ -1,6 +1,7 @@
 """Fig. 20, §7.1, by hand. x = h tan(phi), x' = h sec^2(phi) phi', so
 T = (I_O + m2 h^2 sec^4 phi) phi'^2 / 2, V = k h^2 tan^2(phi)/2 + m1 g l (1 - cos phi),
-generalized damper force Q = -(2 F0/pi) arctan(x'/v0) h sec^2(phi).
+generalized damper force Q = -(2 F0/pi) arctan(x'/v0) h sec^2(phi); its power Q phi' =
+-(2 F0/pi) arctan(x'/v0) x' is the printed P_nc (the spring has a potential: not in P_nc).
 m'(phi)/2 = 2 m2 h^2 sec^4(phi) tan(phi) (as printed). Linearized at 0:
 M = I_O + m2 h^2, C = (2 F0/pi)(1/v0) h^2, K = k h^2 + m1 g l; a single degree of freedom,
 so |s| = sqrt(K/M) whatever the damping.

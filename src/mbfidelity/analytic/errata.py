@@ -5,6 +5,27 @@ and a random perturbation of them), so that no agreement is a coincidence of the
 values; verdicts are "agrees" or "misprint". The simulators witness a misprint: the
 engines' trajectories are compared with the printed model and with the derived one
 (`printed_model_trajectory`).
+
+Formulas with Lagrange multipliers and constraints (monograph §10, eq. 110-116), judged
+independently of how the monograph normalises, orders or signs them:
+- "constraint": the printed Phi must vanish on our constraint manifold and its Jacobian
+  there must have the rank (row space) of ours: then both zero sets are manifolds of the
+  same dimension, one containing the other, so they coincide locally.
+- "constraint_jacobian": the printed matrix and the derived Phi_q must have the same row
+  space (printed J = T Phi_q with T invertible), measured as the distance between the
+  orthogonal projectors onto the two row spaces (the sine of their largest principal
+  angle: 0 when equal, 1 when the ranks differ).
+- "eom" with `multipliers`: at consistent states with the derived q'', the printed rows
+  are linear in the printed multipliers, r0 + A lam_p = 0. (1) As a system: lam_p fitted by
+  least squares, residual relative to each row's term scale: whether the printed
+  equations admit our motion with some multipliers. (2) Row by row: the derivation's
+  generalized constraint force Phi_q^T lam must equal the printed one, A lam_p (eq. 112:
+  lam_j phi_ij is the generalized force of constraint j), which fixes lam_p from our
+  multipliers by least squares; each row's residual with these lam_p says which rows are
+  wrong (a fit of its own would hide an error of one row in the others).
+- "dissipation_power": the printed P_nc against (Q + dV/dq) . q', the power of every
+  generalized force that has no potential (dampers, friction, motors, time loads); the
+  constraint forces do no work on consistent velocities.
 """
 from __future__ import annotations
 
@@ -36,6 +57,8 @@ class Erratum:
     max_relative_difference: float
     note: str = ""
     witnesses: dict = field(default_factory=dict)
+    #: kind-specific measurements behind the verdict (multiplier fits, row spaces)
+    details: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -148,11 +171,51 @@ def reduced_equations(system: System) -> list[sp.Expr] | None:
     return eqs
 
 
-def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
-    """(max relative difference, derived form as text)."""
+#: rank of a numeric Jacobian: singular values above this fraction of the largest (entries
+#: carry ~1e-16 relative round-off; a rank drop on the manifold would be O(1))
+RANK_TOLERANCE = 1e-10
+
+
+def _row_space(J: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (as rows) of the row space of J."""
+    _, sv, vt = np.linalg.svd(np.atleast_2d(np.asarray(J, dtype=float)))
+    if not sv.size or sv[0] == 0:
+        return np.zeros((0, vt.shape[1]))
+    return vt[: int(np.sum(sv > RANK_TOLERANCE * sv[0]))]
+
+
+def row_space_distance(A: np.ndarray, B: np.ndarray) -> float:
+    """||P_A - P_B||_2 for the orthogonal projectors onto the row spaces of A and B: the
+    sine of the largest principal angle between them, 1 when their ranks differ.
+    Insensitive to the order, sign and scale of the rows (J and T J, T invertible)."""
+    va, vb = _row_space(A), _row_space(B)
+    if va.shape[0] != vb.shape[0]:
+        return 1.0
+    return float(np.linalg.norm(va.T @ va - vb.T @ vb, 2))
+
+
+def _num(expr, env: dict) -> float:
+    return float(sp.sympify(expr).xreplace(env))
+
+
+@lru_cache(maxsize=None)
+def nonconservative_power(system_id: str) -> sp.Expr:
+    """(Q + dV/dq) . q': the power of the generalized forces that have no potential."""
+    d = derivation_of(system_id)
+    if not d.energy_route:
+        # a force element with neither potential nor dissipation declared cannot be sorted
+        # into conservative and non-conservative
+        raise ValueError(f"{system_id}: no potential for every force element; P_nc undefined")
+    grad = sp.Matrix([sp.diff(d.V, x) for x in d.q])
+    return sp.expand(((d.Q + grad).T * d.qd)[0])
+
+
+def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str, dict]:
+    """(max relative difference, derived form as text, details)."""
     d = derivation_of(system.id)
     worst = 0.0
     derived_text = ""
+    details: dict = {}
     for values in _parameter_sets(system, rng):
         values = _with_relations(system, values, pf)
         model = numeric_model(system.id, values)
@@ -217,9 +280,110 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str]:
                 printed = np.array([float(sp.sympify(e).xreplace(env)) for e in exprs])
                 worst = max(worst, float(np.max(np.abs(printed - f[:len(printed)])))
                             / max(float(np.max(np.abs(f))), 1e-12))
+        elif pf.kind == "constraint":
+            derived_text = "; ".join(f"{sp.simplify(r)} = 0" for r in d.Phi)
+            rows = [sp.sympify(r) for r in pf.expr]
+            qs = [coordinate_symbols(n)[0] for n in system.coordinates]
+            jac = sp.Matrix(rows).jacobian(qs)
+            zero = details.get("zero_set_residual", 0.0)
+            dist = details.get("row_space_distance", 0.0)
+            for q, qd, t in _random_states(system, values, rng):
+                env = _env(system, values, q, qd, np.zeros_like(q), t)
+                zero = max([zero] + [abs(_num(r, env)) / _term_scale(r, env) for r in rows])
+                printed_J = np.array(jac.xreplace(env), dtype=float)
+                dist = max(dist, row_space_distance(printed_J, model.constraint_jacobian(q)))
+            details.update(zero_set_residual=zero, row_space_distance=dist)
+            worst = max(zero, dist)
+        elif pf.kind == "constraint_jacobian":
+            derived_text = str(d.Phi_q.applyfunc(sp.simplify))
+            dist = details.get("row_space_distance", 0.0)
+            for q, qd, t in _random_states(system, values, rng):
+                env = _env(system, values, q, qd, np.zeros_like(q), t)
+                printed_J = np.array(sp.Matrix(pf.expr).xreplace(env), dtype=float)
+                dist = max(dist, row_space_distance(printed_J, model.constraint_jacobian(q)))
+            details.update(row_space_distance=dist)
+            worst = dist
+        elif pf.kind == "dissipation_power":
+            P = nonconservative_power(system.id)
+            derived_text = str(P)
+            for q, qd, t in _random_states(system, values, rng):
+                env = _env(system, values, q, qd, np.zeros_like(q), t)
+                # relative to the sum of the terms' magnitudes: P_nc is a sum of squares
+                # that may nearly cancel against a motor's power
+                scale = max(_term_scale(P, env), _term_scale(pf.expr, env))
+                worst = max(worst, abs(_num(pf.expr, env) - _num(P, env)) / scale)
         else:
             raise ValueError(f"unknown printed-formula kind {pf.kind!r}")
-    return worst, derived_text
+    return worst, derived_text, details
+
+
+def _derived_with_multipliers(system_id: str) -> list[str]:
+    """Our Lagrange equations with multipliers (eq. 112 with the derived Phi_q): rows
+    M q'' + h - Q + Phi_q^T lam = 0, as text."""
+    d = derivation_of(system_id)
+    lam = sp.Matrix([sp.Symbol(f"lam{k + 1}") for k in range(d.m)])
+    rows = d.residual + d.Phi_q.T * lam
+    return [str(sp.collect(sp.expand(r), list(lam))) for r in rows]
+
+
+def _compare_multipliers(system: System, pf: PrintedFormula, rng) -> dict:
+    """A printed "eom" with Lagrange multipliers (see the module docstring): worst relative
+    residual per row with the multipliers implied by the derivation (`rows`), of the whole
+    printed system with multipliers fitted by least squares (`system`), and how far the
+    printed constraint-force directions are from spanning ours (`map`)."""
+    lams = list(pf.multipliers)
+    rows = [sp.expand(sp.sympify(r)) for r in pf.expr]
+    A_sym = [[sp.diff(r, L) for L in lams] for r in rows]
+    if any(sp.diff(a, L) != 0 for row in A_sym for a in row for L in lams):
+        raise ValueError(f"{pf.label}: the printed rows are not linear in {lams}")
+    r0_sym = [r.xreplace({L: 0 for L in lams}) for r in rows]
+    # row i is the equation of coordinate i (the printed coordinates are the system's)
+    by_coordinate = len(rows) == len(system.coordinates)
+    out = {"rows": np.zeros(len(rows)), "system": 0.0, "map": 0.0}
+    for values in _parameter_sets(system, rng):
+        values = _with_relations(system, values, pf)
+        model = numeric_model(system.id, values)
+        for q, qd, t in _random_states(system, values, rng):
+            qdd, lam = model.dynamics(q, qd, t)
+            env = _env(system, values, q, qd, qdd, t)
+            A = np.array([[_num(a, env) for a in row] for row in A_sym]).reshape(len(rows), -1)
+            r0 = np.array([_num(r, env) for r in r0_sym])
+
+            def residuals(lam_p):
+                e = {**env, **dict(zip(lams, lam_p))}
+                return np.abs(r0 + A @ lam_p) / np.array([_term_scale(r, e) for r in rows])
+
+            fitted, *_ = np.linalg.lstsq(A, -r0, rcond=None)
+            out["system"] = max(out["system"], float(np.max(residuals(fitted))))
+            if by_coordinate and model.constrained:
+                # M q'' + h - Q = -Phi_q^T lam: the printed A lam_p must be Phi_q^T lam
+                force = model.constraint_jacobian(q).T @ lam
+                mapped, *_ = np.linalg.lstsq(A, force, rcond=None)
+                out["map"] = max(out["map"], float(np.linalg.norm(A @ mapped - force))
+                                 / max(float(np.linalg.norm(force)), 1e-300))
+            else:
+                mapped = fitted
+            out["rows"] = np.maximum(out["rows"], residuals(mapped))
+    return out
+
+
+def _multiplier_errata(system: System, pf: PrintedFormula, rng) -> list[Erratum]:
+    res = _compare_multipliers(system, pf, rng)
+    derived = _derived_with_multipliers(system.id)
+    names = [str(L) for L in pf.multipliers]
+    common = {"multipliers": names, "system_fit_residual": res["system"],
+              "multiplier_map_residual": res["map"]}
+    out = [Erratum(system.id, f"{pf.label} (as a system, multipliers fitted)", "eom",
+                   _printed_text(pf), "; ".join(f"{r} = 0" for r in derived),
+                   "agrees" if res["system"] <= AGREEMENT else "misprint", res["system"],
+                   pf.note, details={**common, "multipliers_from": "least-squares fit"})]
+    for i, (r, w) in enumerate(zip(pf.expr, res["rows"])):
+        out.append(Erratum(
+            system.id, f"{pf.label}, row {i + 1}", "eom", f"{r} = 0",
+            f"{derived[i]} = 0" if i < len(derived) else "",
+            "agrees" if w <= AGREEMENT else "misprint", float(w), pf.note,
+            details={**common, "multipliers_from": "the derivation's constraint forces"}))
+    return out
 
 
 @lru_cache(maxsize=None)
@@ -259,7 +423,7 @@ def _one_equation_each(formulas) -> list[PrintedFormula]:
     """A printed system of equations gets one verdict per equation."""
     out = []
     for pf in formulas:
-        if pf.kind == "eom" and len(pf.expr) > 1:
+        if pf.kind == "eom" and len(pf.expr) > 1 and not pf.multipliers:
             out += [PrintedFormula(f"{pf.label}, row {i + 1}", "eom", [r], pf.note)
                     for i, r in enumerate(pf.expr)]
         else:
@@ -271,10 +435,14 @@ def errata(system: System, seed: int = 20101) -> list[Erratum]:
     rng = np.random.default_rng(seed)
     out = []
     for pf in _one_equation_each(system.printed(system.symbols)):
-        worst, derived = _compare(system, pf, rng)
+        if pf.kind == "eom" and pf.multipliers:
+            # one verdict for the printed system, one per row (module docstring)
+            out += _multiplier_errata(system, pf, rng)
+            continue
+        worst, derived, details = _compare(system, pf, rng)
         verdict = "agrees" if worst <= AGREEMENT else "misprint"
         out.append(Erratum(system.id, pf.label, pf.kind, _printed_text(pf), derived, verdict,
-                           float(worst), pf.note))
+                           float(worst), pf.note, details=details))
     return out
 
 
@@ -282,8 +450,8 @@ def printed_model_trajectory(system: System, pf: PrintedFormula, values: Mapping
                              q0, qd0, t: np.ndarray) -> np.ndarray | None:
     """Integrate the printed equations of motion (kind "eom") when they determine the
     accelerations of the independent coordinates; returns those coordinates (N, k)."""
-    if pf.kind != "eom":
-        return None
+    if pf.kind != "eom" or pf.multipliers:
+        return None  # with multipliers the printed equations need the constraints too
     model = numeric_model(system.id, values)
     syms = [coordinate_symbols(n) for n in system.coordinates]
     ind = model.independent
@@ -353,7 +521,8 @@ def _trajectory_witness(system_id: str) -> dict:
     from .reference import reference
 
     system = get_system(system_id)
-    full = [pf for pf in system.printed(system.symbols) if pf.kind == "eom"]
+    full = [pf for pf in system.printed(system.symbols) if pf.kind == "eom"
+            and not pf.multipliers]
     if not full:
         return {}
     scenario = system.scenarios[-1]

@@ -60,7 +60,8 @@ class PrintedFormula:
                           (dampers, friction, motors), compared with Q_nc . q_dot
     An "eom" may contain printed Lagrange multipliers (eq. 112): list their symbols in
     `multipliers`; the residuals must be linear in them, and any normalisation or sign of
-    the printed multipliers is accepted (they are fitted, see analytic/errata.py).
+    the printed multipliers is accepted (they are fitted, see analytic/errata.py). With one
+    row per coordinate, in system order, each row also gets its own verdict.
     Matrices, frequencies and damping ratios refer to the equilibrium `at` (independent
     coordinate -> value) when given, otherwise to the operating point.
     """

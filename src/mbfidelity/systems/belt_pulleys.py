@@ -32,9 +32,10 @@ clockwise): with the arm hanging down it is the branch on the arm's right (+x) s
 inextensible belt fixes only this difference, not the preload. The analytic layer and the
 engines report the coupling force as -lambda (simulators/base.py point 6).
 
-Printed formulas coded below: E_c in both printed forms, E_p, the equilibrium theta = 0,
-and the matrices M, K, C. P_nc and Q_theta, Q_phi1 are printed too; they enter through
-the C matrix (there is no printed-formula kind for a power or a generalized force).
+Printed formulas coded below: E_c in both printed forms, E_p, P_nc (kind
+"dissipation_power": the viscous moments' power, with c2 (r1/r2)^2 through the belt), the
+equilibrium theta = 0, and the matrices M, K, C. Q_theta, Q_phi1 are printed too (there
+is no printed-formula kind for a generalized force); they enter through P_nc and C.
 The linearization has one zero frequency: phi1 is cyclic (the pulley pair can turn at any
 angle relative to the arm without changing the potential).
 """
@@ -112,6 +113,8 @@ def printed(P):
                        sp.Matrix([[I1 + I2 + m2 * l**2, m12], [m12, I1 + I2 * rho**2]])),
         PrintedFormula("Fig. 38, matrix K", "K", sp.Matrix([[m2 * g * l, 0], [0, 0]])),
         PrintedFormula("Fig. 38, matrix C", "C", sp.Matrix([[c3, 0], [0, c1 + c2 * rho**2]])),
+        PrintedFormula("Fig. 38, P_nc", "dissipation_power",
+                       (-c3 * th_d) * th_d + (-(c1 + c2 * rho**2) * p1_d) * p1_d),
     )
 
 

@@ -42,10 +42,31 @@ the wings aligned (P on the line QQ', where the two assembly branches meet) and 
 (the bars tilted inwards by asin(e/(2l)), where P may turn around the common hinge).
 At the defaults the hanging equilibrium is phi = (-0.0918, 0.0918, 0.5045, 0.5045) rad.
 
-The printed kinetic energy of eq. 115 and the equations of eq. 116 do not follow from this
-geometry (see tests/hand/five_bar_bird.py). Eq. 113, 114 and 116 involve the loop
-equations and their multipliers, which the printed-formula comparison cannot take yet;
-they are coded as printed in `printed_with_multipliers` below.
+Printed formulas (all in `printed`, judged by `mbfidelity errata`):
+- eq. 113 (loop) and eq. 114 (its Jacobian) agree: eq. 113 is -Phi_y, Phi_x of our
+  Phi = P(wing 1) - P(wing 2), i.e. the same zero set, and eq. 114 = T Phi_q with
+  T = [[0, -1], [1, 0]].
+- eq. 115: E_p agrees; E_c is a misprint (cross terms, see tests/hand/five_bar_bird.py).
+- eq. 116 (Lagrange with multipliers, eq. 112): the multiplier terms are right (their
+  coefficients are minus the rows of eq. 114, as eq. 112 says), so the printed multipliers
+  are lambda_p = -T^-T lam of ours and the force of wing 2 on wing 1 at P is
+  (lambda2, -lambda1). The inertia terms are not; the derivation gives, with
+  s13 = sin(phi1 + phi3), c13 = cos(phi1 + phi3), s24 = sin(phi2 - phi4),
+  c24 = cos(phi2 - phi4):
+    row 1  (m + m_c) l^2 phi1'' + (m l b - m_c l a)(c13 phi3'' - s13 phi3'^2) + ...
+    row 2  m l^2 phi2'' - m l b (c24 phi4'' + s24 phi4'^2) + ...
+    row 3  (I + m b^2 + m_c a^2) phi3'' + (m l b - m_c l a)(c13 phi1'' - s13 phi1'^2) + ...
+    row 4  (I + m b^2) phi4'' - m l b (c24 phi2'' - s24 phi2'^2) + ...
+  (gravity and multiplier terms as printed). Inherited from the E_c of eq. 115: the sign
+  of the (m_c l a - m l b) coupling in rows 1 and 3, and phi2 + phi4 for phi2 - phi4 in
+  rows 2 and 4 (rows 2, 3 and 4 are exactly Lagrange's equations of the printed E_c). Not
+  inherited: row 1 prints m l^2 phi1'' where eq. 115 itself gives (m + m_c) l^2. Row 4's
+  "(I + m b^2 + )" is a stray plus sign: both eq. 115 and the geometry give I + m b^2
+  (wing 2 carries no body), nothing is missing. As a system the printed equations admit
+  no multipliers that reproduce the motion (the errata's least-squares fit).
+The monograph prints no formula for the force at P; eq. 112's statement that
+lambda_j phi_ij is the generalized force of constraint j is what the row-by-row check of
+eq. 116 tests.
 """
 import sympy as sp
 
@@ -98,6 +119,12 @@ def _symbols():
 
 
 def printed(P):
+    # the energies first: the errata draw their random states in this order
+    return _printed_energies(P) + _printed_with_multipliers(P)
+
+
+def _printed_energies(P):
+    """Eq. 115 as printed."""
     (p1, d1, _), (p2, d2, _), (p3, d3, _), (p4, d4, _) = _symbols()
     l, a, b, m, I, m_c, g = P.l, P.a, P.b, P.m, P.I, P.m_c, P.g
     half = sp.Rational(1, 2)
@@ -119,11 +146,10 @@ def printed(P):
 LAMBDA = (sp.Symbol("lambda1", real=True), sp.Symbol("lambda2", real=True))
 
 
-def printed_with_multipliers(P):
-    """Eq. 113, 114 and 116 as printed. Not yet comparable by `mbfidelity.analytic.errata`
-    (no kind for constraint equations; an "eom" may not contain multipliers), so they are
-    kept out of `printed`. lambda1, lambda2 (`LAMBDA`) multiply the rows of eq. 114 with
-    the sign of eq. 112: the force of wing 2 on wing 1 at P is (lambda2, -lambda1)."""
+def _printed_with_multipliers(P):
+    """Eq. 113, 114 and 116 as printed. lambda1, lambda2 (`LAMBDA`) multiply the rows of
+    eq. 114 with the sign of eq. 112: the force of wing 2 on wing 1 at P is
+    (lambda2, -lambda1)."""
     (p1, d1, a1), (p2, d2, a2), (p3, d3, a3), (p4, d4, a4) = _symbols()
     l, a, b, e, m, I, m_c, g = P.l, P.a, P.b, P.e, P.m, P.I, P.m_c, P.g
     L1, L2 = LAMBDA
@@ -143,10 +169,12 @@ def printed_with_multipliers(P):
             (I + m * b**2 + m_c * a**2) * a3
             + (m_c * l * a - m * l * b) * (c(p1 + p3) * a1 - s(p1 + p3) * d1**2)
             + (m_c * g * a - m * g * b) * s(p3) + L1 * a * s(p3) - L2 * a * c(p3),
-            # printed "(I + m b^2 + ) phi4''": a term is missing after the plus sign
+            # printed "(I + m b^2 + ) phi4''": a dangling plus; eq. 115 and the geometry
+            # both give I + m b^2 here (module docstring)
             (I + m * b**2) * a4 + m * l * b * (-c(p2 + p4) * a2 + s(p2 + p4) * d2**2)
             - m * g * b * s(p4) - L1 * a * s(p4) - L2 * a * c(p4)],
-            note="lambda1, lambda2: multipliers of eq. 113-114 (sign of eq. 112)"),
+            note="lambda1, lambda2: multipliers of eq. 113-114 (sign of eq. 112)",
+            multipliers=LAMBDA),
     )
 
 

@@ -19,6 +19,8 @@ The damper law of §7.1 opposes the block's velocity v = x':
 F = -(2 F0/pi) arctan(v/v0); its power is the printed P_nc = -(2 F0/pi) arctan(x'/v0) x'.
 (The printed force law carries an extra -sgn(v) factor, which would make the force point
 the same way for both signs of v; the printed P_nc and the rest of §7.1 use the law above.)
+The printed P_nc is compared (kind "dissipation_power") and agrees with the damper's
+power; the spring is conservative (its power is -dE_p/dt, not part of P_nc).
 The bar's central inertia is I_O - m1 l^2.
 
 The slot is a whole line through O, so the model also admits the inverted branch
@@ -93,6 +95,10 @@ def printed(P):
         PrintedFormula("Fig. 20, §7.1 m_red", "M", sp.Matrix([[I_O + m2 * h**2]])),
         PrintedFormula("Fig. 20, §7.1 c_red", "C", sp.Matrix([[2 * F0 * h**2 / (sp.pi * v0)]])),
         PrintedFormula("Fig. 20, §7.1 k_red", "K", sp.Matrix([[k * h**2 + m1 * g * l]])),
+        # printed in the block's velocity x' (x is a coordinate here)
+        PrintedFormula("Fig. 20, §7.1 P_nc", "dissipation_power",
+                       -2 * F0 / sp.pi * sp.atan(coordinate_symbols("x")[1] / v0)
+                       * coordinate_symbols("x")[1]),
     )
 
 

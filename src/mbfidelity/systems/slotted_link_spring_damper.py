@@ -34,6 +34,13 @@ of §9.7)::
   the solid hangs from two massless carriages (coordinates x and y of O) and its
   multiplier is the slot force on O. With the constraint's normal (-1, 0) the pin feels
   (lam, 0): lam is the F_act = F_enllac of §9.7 (positive along +x).
+
+Printed formulas with forces and powers (judged by `mbfidelity errata`): the slot force
+F_enllac = F_act of §9.7 (Fig. 36, the line after the Lagrange equations of the system
+with the actuator), with F_molla = -k (y + l tan(phi) - l0) read off the line before it; it
+agrees with the derived slot force, and with Newton on the solid (tests/hand/
+slotted_link_spring_damper.py). P_nc of eq. 99 and of §9.7 agree with the damper's power
+(§9.7's only on x = x' = 0, the mechanism's motions; its F_act x' term is then zero).
 Coordinates: x, y, phi, s; independent (y, phi) as in eq. 99; x = 0 and
 s = y + l tan(phi) follow from the constraints.
 
@@ -118,6 +125,8 @@ def printed(P):
     stretch = l * sp.tan(phi) + y - l0
     rate = y_d + l * sec**2 * phi_d
     phi_eq = sp.acos((l / b) ** sp.Rational(1, 3))
+    # §9.7: the damper force on P with O released horizontally (x, x')
+    F_c = -c * (y_d + (l - x) * sec**2 * phi_d - sp.tan(phi) * x_d)
     return (
         PrintedFormula("Fig. 34, eq. 99 (E_c)", "kinetic_energy",
                        (I_G + m * b**2) * phi_d**2 / 2 + m * y_d**2 / 2
@@ -139,7 +148,34 @@ def printed(P):
         PrintedFormula("Fig. 36, §9.7 (E_p with x)", "potential_energy",
                        m * g * (y + b * sp.sin(phi))
                        + k * (y + (l - x) * sp.tan(phi) - l0) ** 2 / 2),
+        # the slot force on O: F_act of the actuator that replaces the slot, at x = 0
+        PrintedFormula("Fig. 36, §9.7 (F_enllac = F_act)", "constraint_force",
+                       ("slot_O", slot_force(P)),
+                       note="x-component of the slot's force on the pin O (positive along "
+                            "+x); F_molla = -k (y + l tan(phi) - l0) as in the first line "
+                            "of the same display"),
+        PrintedFormula("Fig. 34, eq. 99 (P_nc)", "dissipation_power",
+                       -c * rate * y_d - c * rate * l * sec**2 * phi_d),
+        PrintedFormula("Fig. 36, §9.7 (P_nc with x)", "dissipation_power",
+                       (slot_force(P) - F_c * sp.tan(phi)) * x_d + F_c * y_d
+                       + F_c * (l - x) * sec**2 * phi_d,
+                       note="F_act taken as the printed F_enllac; x = x' = 0 on the "
+                            "mechanism, so only the restriction to x = 0 is compared"),
     )
+
+
+def slot_force(P):
+    """F_act = F_enllac of §9.7 (Fig. 36) as printed, at x = x' = x'' = 0:
+    m b (-cos(phi) phi'^2 - sin(phi) phi'') + (F_molla + F_c) tan(phi)."""
+    y, y_d, _ = coordinate_symbols("y")
+    phi, phi_d, phi_dd = coordinate_symbols("phi")
+    m, b, k, c, l0, l = P.m, P.b, P.k, P.c, P.l0, P.l
+    # the display's first line has -k (y + l tan(phi) - l0) tan(phi) where its second has
+    # F_molla tan(phi); F_c is the printed damper force at x = x' = 0
+    F_molla = -k * (y + l * sp.tan(phi) - l0)
+    F_c = -c * (y_d + l * sp.sec(phi) ** 2 * phi_d)
+    return (m * b * (-sp.cos(phi) * phi_d**2 - sp.sin(phi) * phi_dd)
+            + (F_molla + F_c) * sp.tan(phi))
 
 
 SYSTEM = System(
