@@ -168,6 +168,8 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                 t_end: Optional[float] = typer.Option(None, "--t-end", help="simulated time, s"),
                 setting: Optional[List[str]] = typer.Option(
                     None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
+                variant: Optional[str] = typer.Option(
+                    None, "--variant", help="build the system's named variant (e.g. contact)"),
                 as_json: bool = typer.Option(False, "--json")) -> None:
     """One comparison: metrics, tolerances, pass/fail."""
     from .comparisons.runner import compare
@@ -183,18 +185,22 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     if not dt > 0 or (t_end is not None and not t_end > 0):
         _fail("--dt and --t-end must be positive")
     try:
-        result = compare(system.id, sim, params, dt=dt, t_end=t_end, settings=_settings(setting))
+        result = compare(system.id, sim, params, dt=dt, t_end=t_end, settings=_settings(setting),
+                         variant=variant)
     except ValueError as exc:
         _fail(str(exc))
     doc = result.as_dict()
     if as_json:
         _json(doc)
     else:
-        typer.echo(f"{result.system} on {result.simulator} {result.engine_version}, dt={dt:g}")
+        shown = f"{result.system}[{result.variant}]" if result.variant else result.system
+        typer.echo(f"{shown} on {result.simulator} {result.engine_version}, dt={dt:g}")
         if not result.supported:
             typer.echo(f"  unsupported: {result.reason}")
+        said = set()
         for m in result.metrics:
-            extra = f"  ({m.reason})" if m.reason else ""
+            extra = f"  ({m.reason})" if m.reason and m.reason not in said else ""
+            said.add(m.reason)
             typer.echo(f"  {m.name:34s} {m.value:10.3e} <= {m.tolerance:9.3e}  {m.status}{extra}")
         typer.echo("PASSED" if result.passed else "FAILED")
     raise typer.Exit(0 if result.passed else 1)
@@ -204,7 +210,11 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
 def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
         sims: Optional[List[str]] = typer.Option(None, "--sims", help="simulator ids"),
         out: Path = typer.Option(Path("results"), "--out", help="output folder"),
-        dt: float = typer.Option(1e-3, "--dt")) -> None:
+        dt: float = typer.Option(1e-3, "--dt"),
+        variants: bool = typer.Option(False, "--variants/--no-variants",
+                                      help="also run each system's variants (e.g. rolling by "
+                                           "friction contact) on the engines that build them")
+        ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
     from rich.progress import Progress
 
@@ -226,7 +236,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
 
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
-        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick)
+        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants)
     doc = write_results(results, out)
     index = write_report(results, doc["provenance"], out)
     elapsed = time.perf_counter() - start

@@ -9,25 +9,34 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Callable, Iterable
 
+from ..systems import get_system
 from .runner import DEFAULT_DT, Comparison, compare, provenance
 
-ROW_FIELDS = ("system", "simulator", "engine_version", "metric", "value", "tolerance", "unit",
+ROW_FIELDS = ("system", "variant", "simulator", "engine_version", "metric", "value", "tolerance", "unit",
               "status", "passed", "reason", "dt", "settings", "git_describe", "date",
               "python", "platform")
 
 
 def _one_system(args) -> list[Comparison]:
     """Every engine on one system, in one process: the references are solved once
-    (cached) and shared by all engines."""
-    system, sims, dt = args
-    return [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
+    (cached) and shared by all engines; with `variants`, also each variant of the system
+    on the engines that build it."""
+    system, sims, dt, variants = args
+    out = [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
+    if variants:
+        for v in get_system(system).variants:
+            # engines that do not build the variant give an "unsupported" row, with why
+            out += [compare(system, sim, dt=dt, keep_series=True, variant=v.name)
+                    for sim in sims]
+    return out
 
 
 def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
                workers: int | None = None,
-               progress: Callable[[Comparison], None] | None = None) -> list[Comparison]:
+               progress: Callable[[Comparison], None] | None = None,
+               variants: bool = False) -> list[Comparison]:
     sims = list(simulators)
-    jobs = [(s, sims, dt) for s in systems]
+    jobs = [(s, sims, dt, variants) for s in systems]
     workers = workers or min(2, os.cpu_count() or 1)
     results: list[Comparison] = []
 
@@ -50,7 +59,7 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
 def tidy_rows(results: list[Comparison], prov: dict) -> list[dict]:
     rows = []
     for c in results:
-        common = {"system": c.system, "simulator": c.simulator,
+        common = {"system": c.system, "variant": c.variant, "simulator": c.simulator,
                   "engine_version": c.engine_version, "dt": c.dt,
                   "settings": json.dumps(c.settings, sort_keys=True),
                   **{k: prov[k] for k in ("git_describe", "date", "python", "platform")}}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 from collections import defaultdict
+from types import SimpleNamespace
 from pathlib import Path
 
 import jinja2
@@ -39,7 +40,7 @@ TEMPLATE = jinja2.Template("""<!doctype html>
 body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}
 table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
 th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.xfail{background:#fbeec8}
-.xpass{background:#f8d0d0}.unsupported{background:#e6e6e6}img{max-width:100%}
+.xpass{background:#f8d0d0}.measured{background:#e3ecf8}.unsupported{background:#e6e6e6}img{max-width:100%}
 code{font-size:12px}
 </style></head><body>
 <h1>mbfidelity: simulators against exact models</h1>
@@ -84,8 +85,9 @@ def _cell(c) -> dict:
     if not c.supported:
         return {"cls": "unsupported", "text": "cannot express: " + html.escape(c.reason)}
     statuses = [m.status for m in c.metrics]
-    worst = next((s for s in ("fail", "xpass", "xfail") if s in statuses), "pass")
-    counts = ", ".join(f"{statuses.count(s)} {s}" for s in ("pass", "fail", "xfail", "xpass")
+    worst = next((s for s in ("fail", "xpass", "xfail", "measured") if s in statuses), "pass")
+    counts = ", ".join(f"{statuses.count(s)} {s}" for s in ("pass", "fail", "xfail", "xpass",
+                                                            "measured")
                        if statuses.count(s))
     return {"cls": worst, "text": counts}
 
@@ -93,7 +95,7 @@ def _cell(c) -> dict:
 def _figures(system_id: str, comps, out: Path) -> list[str]:
     names = []
     scenarios = {name for c in comps for name in c.series}
-    coords = get_system(system_id).coordinates
+    coords = get_system(_base(system_id)).coordinates
     for scenario in sorted(scenarios):
         fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
         drawn_ref = False
@@ -130,7 +132,7 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
     out.mkdir(parents=True, exist_ok=True)
     by_system = defaultdict(list)
     for c in results:
-        by_system[c.system].append(c)
+        by_system[shown_id(c)].append(c)
     sims = list(dict.fromkeys(c.simulator for c in results))
     systems = list(by_system)
     cells = {s: {c.simulator: _cell(c) for c in comps} for s, comps in by_system.items()}
@@ -140,25 +142,52 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
                     for s, comps in by_system.items()}
     unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
                    for s, comps in by_system.items()}
-    figures = {s: [draw_mechanism(s, out)] + _figures(s, comps, out)
+    figures = {s: [draw_mechanism(_base(s), out)] + _figures(s, comps, out)
                for s, comps in by_system.items()}
     frequencies = frequency_table(results)
     if errata is None:
         from ..analytic.errata import errata as compute
 
-        errata = [e.as_dict() for s in systems for e in compute(get_system(s))]
+        errata = [e.as_dict() for s in dict.fromkeys(map(_base, systems))
+                  for e in compute(get_system(s))]
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
     liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
                            metric_names=metric_names, unsupported=unsupported, figures=figures,
-                           titles={s: get_system(s).title for s in systems}, versions=versions,
+                           titles={s: _title(s) for s in systems}, versions=versions,
                            explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
-                           expected={s: get_system(s).expectations for s in systems},
+                           expected={s: _expected(s) for s in systems},
                            liftoff=liftoff)
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def shown_id(c) -> str:
+    """A comparison's row name: the system id, with the variant in brackets."""
+    return f"{c.system}[{c.variant}]" if getattr(c, "variant", "") else c.system
+
+
+def _base(shown: str) -> str:
+    return shown.split("[", 1)[0]
+
+
+def _title(shown: str) -> str:
+    system = get_system(_base(shown))
+    if shown == system.id:
+        return system.title
+    v = system.variant(shown[len(system.id) + 1:-1])
+    return f"{system.title}, variant {v.name}: {v.description}"
+
+
+def _expected(shown: str) -> list:
+    system = get_system(_base(shown))
+    if shown == system.id:
+        return list(system.expectations)
+    v = system.variant(shown[len(system.id) + 1:-1])
+    return [SimpleNamespace(simulator=", ".join(v.settings), metric="(measured, not gated)",
+                            reason=v.reason)]
 
 
 def contact_warnings(comps) -> list[dict]:
@@ -185,7 +214,8 @@ def _worst(c, prefixes) -> str:
     if not ms:
         return "-"
     worst = max(ms, key=lambda m: m.value / m.tolerance if m.tolerance else m.value)
-    flag = {"pass": "", "xfail": " (xfail)", "fail": " FAIL", "xpass": " XPASS"}[worst.status]
+    flag = {"pass": "", "xfail": " (xfail)", "fail": " FAIL", "xpass": " XPASS",
+            "measured": " (measured)"}[worst.status]
     return f"{worst.value:.1e}/{worst.tolerance:.0e}{flag}"
 
 
@@ -195,11 +225,11 @@ def error_table(results) -> list[str]:
              "|---|---|---|---|---|---|---|"]
     for c in results:
         if not c.supported:
-            lines.append(f"| {c.system} | {c.simulator} | {c.engine_version} | unsupported: "
+            lines.append(f"| {shown_id(c)} | {c.simulator} | {c.engine_version} | unsupported: "
                          f"{c.reason} | | | |")
             continue
         lines.append(
-            f"| {c.system} | {c.simulator} | {c.engine_version} | "
+            f"| {shown_id(c)} | {c.simulator} | {c.engine_version} | "
             f"{_worst(c, ('trajectory_max',))} | {_worst(c, ('.reaction_', '.constraint_', '.contact_'))} | "
             f"{_worst(c, ('frequency.',))} | {c.wall_time:.2f} |")
     return lines
@@ -215,9 +245,9 @@ def _markdown(results, prov: dict) -> str:
               "|---|---|---|---|---|---|"]
     for c in results:
         if not c.supported:
-            lines.append(f"| {c.system} | {c.simulator} | * | | | unsupported: {c.reason} |")
+            lines.append(f"| {shown_id(c)} | {c.simulator} | * | | | unsupported: {c.reason} |")
         for m in c.metrics:
-            lines.append(f"| {c.system} | {c.simulator} | {m.name} | {m.value:.3e} | "
+            lines.append(f"| {shown_id(c)} | {c.simulator} | {m.name} | {m.value:.3e} | "
                          f"{m.tolerance:.3e} | {m.status} |")
     return "\n".join(lines) + "\n"
 
@@ -230,7 +260,7 @@ def frequency_table(results) -> dict:
             if not m.name.startswith("frequency.") or not m.detail:
                 continue
             mode = m.name.split("mode")[-1]
-            rows = table.setdefault(c.system, {})
+            rows = table.setdefault(shown_id(c), {})
             row = rows.setdefault(mode, {"reference_hz": m.detail["reference_hz"], "engines": {}})
             kind = "linearization" if "linearization" in m.name else "fit"
             row["engines"].setdefault(c.simulator, {})[kind] = m.detail.get("engine_hz")

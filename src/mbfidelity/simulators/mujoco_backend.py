@@ -1202,8 +1202,13 @@ class MujocoBackend(Backend):
         tids = np.array([m.tendon(e.tendon).id for e in plan.p2p], dtype=int)
         sid = np.array([[m.site(f"{e.element.name}:a").id, m.site(f"{e.element.name}:b").id]
                         for e in plan.p2p], dtype=int).reshape(-1, 2)
+        # rolling by contact: the contact carries what the description's arm and coupling
+        # carried, so it counts as transmitted through the joints (contract point 6)
+        discs = [cl.contact for cl in plan.closures if cl.kind == "contact"]
+        disc_bid = np.array([m.body(plan.carrier[g["disc"]]).id for g in discs], dtype=int)
         N = len(t)
         cf = np.empty((N, len(bodies), 2))
+        ext = np.empty((N, len(discs), 2))
         ten = np.empty((N, len(tids), 2))
         spos = np.empty((N, len(tids), 2, 2))
         for k in range(N):
@@ -1213,6 +1218,8 @@ class MujocoBackend(Backend):
             mujoco.mj_forward(m, d)
             mujoco.mj_rnePostConstraint(m, d)
             cf[k] = d.cfrc_int[bid, 3:5]
+            if len(disc_bid):
+                ext[k] = d.cfrc_ext[disc_bid, 3:5]  # contact force on the disc (world)
             if len(tids):
                 ten[k, :, 0] = d.ten_length[tids]
                 ten[k, :, 1] = d.ten_velocity[tids]
@@ -1224,6 +1231,9 @@ class MujocoBackend(Backend):
             joint = mech.joint(name)
             inside = set(mech.subtree(joint.child))
             r = cf[:, bodies.index(plan.carrier[joint.child])].copy()
+            for i, g in enumerate(discs):
+                if g["disc"] in inside and g["track"] not in inside:
+                    r += ext[:, i]
             # callback forces are joint-space forces, so cfrc_int counts them as
             # transmitted by the joint: take those from outside the subtree out. Native
             # tendon forces are already external (MuJoCo 4.0 puts them in cfrc_ext).

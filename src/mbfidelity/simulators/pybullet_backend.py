@@ -1404,9 +1404,9 @@ class PyBulletBackend(Backend):
                                 if lk.parent >= 0 and plan.links[lk.parent].body in subtree}
             pairs = [(cl.force_links, cl.element.name) for cl in plan.closures
                      if cl.kind != "gear" and cl.element.name in f_closure]
-            if plan.contact is not None and "__contact__" in f_closure:
-                pairs.append(((plan.link_of[plan.contact.inner],
-                               plan.link_of[plan.contact.outer]), "__contact__"))
+            # rolling by contact: the contact carries what the description's arm and
+            # coupling carried, so it counts as transmitted through the joints (contract
+            # point 6) and is not taken out
             for (la, lb), key in pairs:
                 # the force f_closure[key] acts on link la, its opposite on link lb
                 in_a = la >= 0 and plan.links[la].body in inside

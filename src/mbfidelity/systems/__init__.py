@@ -106,6 +106,20 @@ class ContactOutput:
 
 
 @dataclass(frozen=True)
+class Variant:
+    """Another way some engines can build the mechanism (say rolling by friction contact
+    instead of the coupling constraint): the same description, scenarios and references,
+    engine settings per engine. The gates belong to the description; a variant's distance
+    from them is the variant's own error, measured and reported (status "measured"), with
+    `reason` saying why it differs."""
+
+    name: str
+    settings: Mapping[str, Mapping[str, object]]  # engine id -> settings
+    description: str
+    reason: str
+
+
+@dataclass(frozen=True)
 class Expectation:
     """An exception as data (scikit-learn's common-check pattern).
 
@@ -134,10 +148,18 @@ class System:
     #: physical contact forces (normal, friction) read from reactions or closure forces
     contacts: Callable[[SimpleNamespace], tuple[ContactOutput, ...]] = lambda P: ()
     expectations: tuple[Expectation, ...] = ()
+    variants: tuple[Variant, ...] = ()
     #: name of an exact solution in mbfidelity.analytic.closed_forms, if one exists
     exact_solution: str | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
+
+    def variant(self, name: str) -> Variant:
+        for v in self.variants:
+            if v.name == name:
+                return v
+        raise ValueError(f"{self.id} has no variant {name!r}; variants: "
+                         f"{', '.join(v.name for v in self.variants) or 'none'}")
 
     @cached_property
     def all_parameters(self) -> tuple[Parameter, ...]:
