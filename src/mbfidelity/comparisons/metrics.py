@@ -14,6 +14,14 @@ def amplitude(q_ref: np.ndarray, q_eq: np.ndarray) -> np.ndarray:
     return np.maximum(a, 1e-3 * max(float(np.max(a)), 1e-12))
 
 
+def envelope(q_ref: np.ndarray, q_eq: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """Amplitude still to come at each sample: max over later samples and coordinates of
+    |q - q_eq| / scale, normalised to 1 at its start."""
+    dev = np.max(np.abs(q_ref - q_eq) / scale, axis=1)
+    ahead = np.maximum.accumulate(dev[::-1])[::-1]
+    return ahead / max(float(ahead[0]), 1e-300)
+
+
 def trajectory_errors(q: np.ndarray, q_ref: np.ndarray, scale: np.ndarray) -> tuple[float, float]:
     """(max, rms) of |q - q_ref| / scale over time and coordinates."""
     err = np.abs(q - q_ref) / scale

@@ -186,7 +186,8 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     scale = metrics.amplitude(ref.q, eq.q)
     ref_err = float(np.max(ref.error_estimate / scale))
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
-    tol = tolerances.trajectory_tolerance(w, dt, order, T, zeta) + ref_err
+    T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
+    tol = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + ref_err
     n = min(len(run.t), len(ref.t))
     emax, erms = metrics.trajectory_errors(run.q[:n], ref.q[:n], scale)
     name = sc.name

@@ -24,6 +24,11 @@ faster forcing).
   no longer symplectic and drifts at first order, (w h) w T: such cases fail this gate
   and are declared expected failures with that reason, so the gate keeps its teeth (a
   plain explicit Euler, which gains energy, fails it too, as it should).
+  Errors are relative to the initial amplitude, and a drift only grows while there is
+  motion to drift: a phase error rate d gives |q - q_ref| ~ a(t) d t for an amplitude
+  a(t). So T above is the effective duration max_t t a(t)/a(0), taken from the
+  reference's own envelope (`effective_duration`): T itself for a sustained motion,
+  1/(e zeta w) for an exponential decay, in between for a saturating damper.
 * Reactions: a force error follows the acceleration error, w^2 times the position error,
   so relative to the force amplitude it has the same bound.
 * Period: the phase drift per period is (w h)^p times 2 pi at most; for semi-implicit
@@ -66,3 +71,10 @@ def fit_tolerance(w: float, h: float, order: int) -> float:
 
 def discrete_linearization_tolerance(w: float, h: float, order: int) -> float:
     return (w * h) ** order
+
+
+def effective_duration(t, envelope) -> float:
+    """max_t t a(t) / a(0) with a(t) the reference's amplitude still to come (see above)."""
+    import numpy as np
+
+    return float(np.max(np.asarray(t) * np.asarray(envelope)))

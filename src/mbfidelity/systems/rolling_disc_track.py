@@ -59,8 +59,9 @@ input a frequency (H(omega) of the monograph is the linear response to it).
 Printed formulas coded below: E_c and E_p of eq. 110, both equations of motion as
 printed, the equilibrium (theta, phi) = (0, 0) under the printed relation
 M0 = (m_p + m_d) g R, and M, K, C at that equilibrium. P_nc, the generalized forces
-Q_theta, Q_phi and the intermediate derivatives of E_c and E_p are printed too but have no
-printed-formula kind: P_nc is checked through the C matrix and the equations of motion;
+Q_theta, Q_phi and the intermediate derivatives of E_c and E_p are printed too; P_nc is
+compared directly (kind "dissipation_power", motor on), Q_theta and Q_phi through C and the
+equations of motion;
 the intermediate dE_c/dtheta' prints (R + e)^2 where E_c has R^2 + e^2 (the same slip
 reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
@@ -148,6 +149,12 @@ def printed(P):
             - m_d * (R - r) * R * (sp.sin(th + ph) * th_dd + sp.cos(th + ph) * th_d**2)
             + m_d * g * (R - r) * sp.sin(ph) + c_J * (th_d + ph_d),
         ]),
+        # printed with the motor's power T_m(t) theta'; the motor is switched on (T_m =
+        # 1.5 N m) so that its term is tested too
+        PrintedFormula("Fig. 39, eq. 110, P_nc", "dissipation_power",
+                       (-c_O * th_d) * th_d + (-c_J * (th_d + ph_d)) * (th_d + ph_d)
+                       + T_m * th_d, relations={"T_m": 1.5},
+                       note="motor on (T_m = 1.5 N m) so that its power is compared"),
         PrintedFormula("Fig. 39, equilibrium (theta, phi) = (0, 0)", "equilibrium",
                        {"theta": 0, "phi": 0}, relations=balance,
                        note="phi_eq = 0 from dE_p/dphi; theta_eq = 0 with M0 = (m_p + m_d) g R"),

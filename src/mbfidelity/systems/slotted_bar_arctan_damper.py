@@ -30,7 +30,7 @@ that the motion never reaches from phi = 0 (|phi| = pi/2 would need x infinite).
 import sympy as sp
 
 from . import Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from ._reasons import MUJOCO_SOFT_EQUALITY, SEMI_IMPLICIT_DRIFT
 from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Rectangle, Revolute, Scenario, Segment,
                     coordinate_spring_damper)
@@ -118,6 +118,13 @@ SYSTEM = System(
     ),
     expectations=(
         Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        # near rest the soft equality's lag (time constant 2 dt) dominates RK4's error: it
+        # falls 4-8x, not 16x, when dt halves (measured at 1e-3 and 5e-4)
+        Expectation("mujoco", "small.trajectory_max", "xfail", MUJOCO_SOFT_EQUALITY),
         Expectation("mujoco", "damping.fit_*", "xfail", MUJOCO_SOFT_EQUALITY),
+        # reduced coordinates with x = h tan(phi) through the slot: 0.47 rad at h = 1e-3,
+        # 0.23 at h = 5e-4 (Pymunk, maximal coordinates: 1.1e-2)
+        Expectation("pybullet", "large.trajectory_max", "xfail", SEMI_IMPLICIT_DRIFT),
+        Expectation("pybullet", "large.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),
     ),
 )
