@@ -191,3 +191,65 @@ def test_new_rows_serialise_and_render():
     for label in ("Fig. 40, eq. 113", "Fig. 40, eq. 116 (as a system, multipliers fitted)",
                   "Fig. 36, §9.7 (F_enllac = F_act)", "Fig. 34, eq. 99 (P_nc)"):
         assert label in page
+
+
+def _hand_eq116_formula():
+    """Eq. 116 as Lagrange on the hand T, V gives it, with printed-style multipliers of
+    another normalisation (lam = T mu, T invertible): the control of the witnesses."""
+    mu = sp.symbols("mu1 mu2", real=True)
+    T = sp.Matrix([[0, sp.Rational(5, 2)], [-sp.Rational(2, 5), sp.Rational(3, 10)]])
+    lam = T * sp.Matrix(mu)
+    return PrintedFormula("hand eq. 116", "eom", _five_bar_hand_eq116(list(lam)),
+                          multipliers=mu)
+
+
+def test_printed_multiplier_model_of_correct_equations_is_the_derived_one():
+    """Control of the witness machinery of eq. 116: correct equations with multipliers
+    (hand file), integrated on the derived manifold by printed_multiplier_trajectory,
+    follow the reference, and their linearization has the derived modes; the printed
+    eq. 116 does neither."""
+    from mbfidelity.analytic.errata import printed_model_frequencies, printed_multiplier_trajectory
+    from mbfidelity.analytic.linear import operating_equilibrium
+    from mbfidelity.analytic.reference import reference
+
+    s = get_system("five_bar_bird")
+    scenario = s.scenarios[-1]
+    values = s.parameter_values(scenario=scenario)
+    ref = reference(s, scenario, values, 1e-2, t_end=1.0)
+    (printed,) = [pf for pf in s.printed(s.symbols) if pf.multipliers]
+    hand = _hand_eq116_formula()
+    q, drift = printed_multiplier_trajectory(s, hand, values, ref.q[0], ref.qd[0], ref.t)
+    # two DOP853 solves at rtol = atol = 1e-12 of a motion of ~0.5 rad over 1 s
+    assert np.max(np.abs(q - ref.q)) < 1e-8 and drift < 1e-10
+    q, _ = printed_multiplier_trajectory(s, printed, values, ref.q[0], ref.qd[0], ref.t)
+    assert np.max(np.abs(q - ref.q)) > 1e-2
+
+    base = s.parameter_values()
+    derived = np.sort([abs(m.eigenvalue) for m in operating_equilibrium(s, base).modes])
+    np.testing.assert_allclose(printed_model_frequencies(s, hand, base), derived, rtol=1e-9)
+    assert np.max(np.abs(printed_model_frequencies(s, printed, base) / derived - 1)) > 1e-2
+
+
+def test_five_bar_eq116_engine_witness_sides_with_the_derivation():
+    """Every misprint is confirmed by an engine: eq. 116 (the system row and each row cite
+    the same witness) has at least one engine whose trajectory, and modes where it
+    linearizes, are closer to the derived model than to the printed one."""
+    import pytest
+
+    from mbfidelity.analytic.errata import witness
+    from mbfidelity.simulators import all_backends
+
+    if not any(b.available()[0] for b in all_backends().values()):
+        pytest.skip("no simulation engine installed: no witness of eq. 116")
+    s = get_system("five_bar_bird")
+    rows = [e for e in _errata(s.id) if e.label.startswith("Fig. 40, eq. 116")]
+    assert len(rows) == 5
+    for e in rows:
+        w = witness(s, e)
+        assert w, e.label
+        siding = [sim for sim, x in w.items() if x["sides_with"] == "derivation"]
+        assert siding, (e.label, w)
+        for sim in siding:
+            x = w[sim]
+            assert x["verdict"].startswith("sides with the derivation")
+            assert x["max_error_to_derived"] < 0.1 * x["max_error_to_printed"], (sim, x)

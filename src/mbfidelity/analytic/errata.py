@@ -26,6 +26,19 @@ independently of how the monograph normalises, orders or signs them:
 - "dissipation_power": the printed P_nc against (Q + dV/dq) . q', the power of every
   generalized force that has no potential (dampers, friction, motors, time loads); the
   constraint forces do no work on consistent velocities.
+
+Witnesses of a misprinted "eom" with multipliers (`_multiplier_witness`; the system row
+and every row of it cite the same one): the printed rows, linear in (q'', lam_p), are
+written A(q, q', t) [q''; lam_p] + b(q, q', t) = 0 and closed with the DERIVED
+acceleration-level constraint Phi_q q'' = gamma, so the printed dynamics evolve on the
+true constraint manifold; integrated in the independent coordinates with the dependent
+ones completed by Newton (as the reference does), `printed_multiplier_trajectory`. Each
+engine's trajectory on the largest scenario (its first `MULTIPLIER_WITNESS_SECONDS`) is
+compared with the derived and with this printed one. Modes too where the engines
+linearize: the printed system at the derived equilibrium (printed static multipliers
+fitted there), its multipliers eliminated with the left null space N of their
+coefficients and the motion restricted to the manifold with the velocity basis S:
+N^T M_p S s^2 + N^T C_p S s + N^T K_p S (`printed_model_frequencies`).
 """
 from __future__ import annotations
 
@@ -41,9 +54,17 @@ from ..systems import PrintedFormula, System, coordinate_symbols
 from ..systems.model import TIME, Prismatic
 from .derivation import derivation_of
 from .linear import linearize, operating_equilibrium
-from .numeric import numeric_model
+from .numeric import _lambdify, numeric_model
 
 AGREEMENT = 1e-9  # relative; round-off of the numeric comparison is ~1e-14
+#: the witness of printed equations with multipliers integrates the printed model on the
+#: true manifold (Newton completion at every step, like the reference): the first seconds
+#: of the scenario keep `mbfidelity errata` quick, and a misprinted inertia separates the
+#: printed motion from the derived one within a fraction of a second
+MULTIPLIER_WITNESS_SECONDS = 3.0
+#: condition number of the printed augmented matrix [A; Phi_q 0] beyond which the printed
+#: model does not determine (q'', lam_p): singular printed model, no trajectory witness
+SINGULAR_CONDITION = 1e10
 
 
 @dataclass
@@ -478,6 +499,102 @@ def printed_model_trajectory(system: System, pf: PrintedFormula, values: Mapping
     return res.y[:k].T if res.success and res.y.shape[1] == len(t) else None
 
 
+class SingularPrintedModel(ValueError):
+    """The printed equations with multipliers do not determine (q'', lam_p) here."""
+
+
+def _printed_linear_in_unknowns(system: System, pf: PrintedFormula,
+                                values: Mapping[str, float]):
+    """The printed rows of an "eom" with multipliers as A(q, q', t) x + b(q, q', t) with
+    x = (q'', lam_p): (A, b) as sympy matrices with the parameter values substituted, and
+    the symbols (q, q', q'', lam_p). Raises ValueError when the rows are not linear in x."""
+    syms = [coordinate_symbols(n) for n in system.coordinates]
+    q, qd, qdd = ([trio[k] for trio in syms] for k in range(3))
+    lams = list(pf.multipliers)
+    unknowns = qdd + lams
+    rows = sp.Matrix([sp.sympify(r).xreplace(system.subs(values)) for r in pf.expr])
+    A = rows.jacobian(unknowns)
+    if any(x in A.free_symbols for x in unknowns):
+        raise ValueError(f"{pf.label}: the printed rows are not linear in q'' and {lams}")
+    b = rows.xreplace({x: 0 for x in unknowns})
+    return A, b, (q, qd, qdd, lams)
+
+
+def printed_multiplier_trajectory(system: System, pf: PrintedFormula,
+                                  values: Mapping[str, float], q0, qd0,
+                                  t: np.ndarray) -> tuple[np.ndarray, float]:
+    """Integrate printed equations of motion with multipliers on the derived constraint
+    manifold: A [q''; lam_p] + b = 0 (printed) closed by Phi_q q'' = gamma (derived), an
+    index-1 system in all n coordinates, from a consistent (q0, qd0). Not in the
+    independent coordinates as the reference: the printed motion need not stay clear of
+    the singular poses of that chart (the five-bar's printed motion swings the bars inwards
+    to Q = Q', where phi1, phi2 fix no wing angle). Returns (q (N, n) at t, the largest
+    |Phi| along it: the drift, without Baumgarte or projection, is round-off of the
+    integration, ~1e-13 over seconds). Raises `SingularPrintedModel` where the printed
+    augmented matrix is singular (condition > `SINGULAR_CONDITION`), ValueError when the
+    printed rows do not fit this form."""
+    model = numeric_model(system.id, values)
+    if not model.constrained:
+        raise ValueError(f"{system.id}: printed multipliers on an unconstrained system")
+    A_sym, b_sym, (q, qd, _, lams) = _printed_linear_in_unknowns(system, pf, values)
+    n, m = model.n, model.m
+    if A_sym.shape != (n, n + len(lams)) or len(lams) != m:
+        raise ValueError(f"{pf.label}: {A_sym.shape[0]} rows and {len(lams)} multipliers for "
+                         f"{n} coordinates and {m} constraints")
+    args = q + qd + [TIME]
+    A_fn = _lambdify(args, A_sym.tolist(), modules="math")
+    b_fn = _lambdify(args, list(b_sym), modules="math")
+
+    def rhs(tt, y):
+        qq, vv = y[:n], y[n:]
+        aug = np.zeros((n + m, n + m))
+        aug[:n] = np.array(A_fn(*qq, *vv, tt), dtype=float)
+        aug[n:, :n] = model.constraint_jacobian(qq)
+        cond = np.linalg.cond(aug)
+        if not np.isfinite(cond) or cond > SINGULAR_CONDITION:
+            raise SingularPrintedModel(f"the printed model is singular at t = {tt:.4g} s "
+                                       f"(condition {cond:.1e} of [A; Phi_q 0])")
+        b = np.concatenate([-np.array(b_fn(*qq, *vv, tt), dtype=float).reshape(-1),
+                            np.array(model._gamma(*qq, *vv), dtype=float).reshape(-1)])
+        return np.concatenate([vv, np.linalg.solve(aug, b)[:n]])
+
+    res = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([q0, qd0]), method="DOP853",
+                    rtol=1e-12, atol=1e-12, t_eval=t)
+    if not res.success or res.y.shape[1] != len(t):
+        raise SingularPrintedModel(f"the printed model is not integrable: {res.message}")
+    q_t = res.y[:n].T
+    drift = max(float(np.max(np.abs(model.constraint_values(x)))) for x in q_t)
+    return q_t, drift
+
+
+def _printed_multiplier_linearization(system: System, pf: PrintedFormula,
+                                      values: Mapping[str, float], q_eq: np.ndarray):
+    """(M, C, K) of the printed equations with multipliers at q_eq, on the derived
+    manifold (module docstring), or None when q_eq is no equilibrium of the printed
+    model or the printed rows carry time loads."""
+    from scipy.linalg import null_space
+
+    model = numeric_model(system.id, values)
+    rows = sp.Matrix([sp.sympify(r).xreplace(system.subs(values)) for r in pf.expr])
+    if TIME in rows.free_symbols:
+        return None
+    _, _, (q, qd, qdd, lams) = _printed_linear_in_unknowns(system, pf, values)
+    at_rest = {**dict(zip(q, q_eq)), **{x: 0 for x in qd + qdd}}
+    A_lam = np.array(rows.jacobian(lams).xreplace(at_rest), dtype=float)
+    g = np.array(rows.xreplace({**at_rest, **{L: 0 for L in lams}}), dtype=float).reshape(-1)
+    lam_p, *_ = np.linalg.lstsq(A_lam, -g, rcond=None)
+    scale = max(float(np.max(np.abs(g))), float(np.max(np.abs(A_lam * lam_p))), 1e-300)
+    if np.max(np.abs(g + A_lam @ lam_p)) > 1e-8 * scale:
+        return None  # the printed statics do not balance here
+    point = {**at_rest, **dict(zip(lams, lam_p))}
+    M, C, K = (np.array(rows.jacobian(x).xreplace(point), dtype=float) for x in (qdd, qd, q))
+    N = null_space(A_lam.T)  # N^T A_lam = 0: the printed multipliers eliminated
+    S = model.tangent_basis(q_eq)
+    if N.shape[1] != S.shape[1]:
+        return None
+    return N.T @ M @ S, N.T @ C @ S, N.T @ K @ S
+
+
 def printed_model_frequencies(system: System, pf: PrintedFormula,
                               values: Mapping[str, float]) -> np.ndarray | None:
     """|s| of the modes (rad/s) when the printed M, K, C, kinetic or potential energy or
@@ -507,6 +624,14 @@ def printed_model_frequencies(system: System, pf: PrintedFormula,
             K = np.array(sp.hessian(pf.expr, pos).xreplace(env), dtype=float)
     elif pf.kind == "frequency":
         return np.array([float(pf.expr.xreplace(subs))])
+    elif pf.kind == "eom" and pf.multipliers and model.constrained:
+        try:
+            printed = _printed_multiplier_linearization(system, pf, values, eq.q)
+        except (ValueError, TypeError, np.linalg.LinAlgError):
+            return None
+        if printed is None:
+            return None
+        M, C, K = printed
     else:
         return None
     return np.sort(np.abs([s for s in quadratic_eigenvalues(M, C, K) if s.imag >= 0]))
@@ -585,10 +710,106 @@ def _modal_witness(system: System, pf: PrintedFormula) -> dict:
     return out
 
 
+def _constrained_trajectory_witness(system: System, pf: PrintedFormula) -> tuple[dict, str]:
+    """({engine: distances}, note): engines on the first `MULTIPLIER_WITNESS_SECONDS` of
+    the largest-amplitude scenario against the derived model and against the printed
+    equations with multipliers integrated on the derived manifold. The note says why
+    there is no trajectory witness (singular printed model), else it is empty."""
+    from ..simulators import all_backends
+    from .reference import reference
+
+    scenario = system.scenarios[-1]
+    values = system.parameter_values(scenario=scenario)
+    dt = 1e-3
+    t_end = min(scenario.t_end, MULTIPLIER_WITNESS_SECONDS)
+    ref = reference(system, scenario, values, dt, t_end=t_end)
+    try:
+        printed_q, drift = printed_multiplier_trajectory(system, pf, values, ref.q[0],
+                                                         ref.qd[0], ref.t)
+    except SingularPrintedModel as err:
+        return {}, f"no trajectory witness: {err}"
+    ind = numeric_model(system.id, values).independent
+    mech = system.numeric_mechanism(values)
+    out = {}
+    for sim, backend in all_backends().items():
+        ok, _ = backend.available()
+        if not ok or not backend.support(mech).ok:
+            continue
+        run = backend.simulate(mech, ref.q[0], ref.qd[0], t_end, dt)
+        n = min(len(run.t), len(ref.t))
+        to_derived = float(np.max(np.abs(run.q[:n, ind] - ref.q[:n, ind])))
+        to_printed = float(np.max(np.abs(run.q[:n, ind] - printed_q[:n, ind])))
+        out[sim] = {"scenario": scenario.name, "t_end": t_end,
+                    "max_error_to_derived": to_derived, "max_error_to_printed": to_printed,
+                    "derived_to_printed": float(np.max(np.abs(ref.q[:n, ind]
+                                                              - printed_q[:n, ind]))),
+                    "printed_constraint_drift": drift}
+    return out, ""
+
+
+@lru_cache(maxsize=None)
+def _multiplier_witness(system_id: str, label: str) -> dict:
+    """The engines on printed equations with multipliers (module docstring): trajectories
+    and, where the engine linearizes, modes; one entry per engine, its verdict saying which
+    model it sides with (both measures when they agree, "split" when they do not)."""
+    from ..systems import get_system
+
+    system = get_system(system_id)
+    (pf,) = [pf for pf in system.printed(system.symbols) if pf.label == label]
+    trajectories, note = _constrained_trajectory_witness(system, pf)
+    modes = _modal_witness(system, pf)
+    out = {}
+    for sim in list(trajectories) + [s for s in modes if s not in trajectories]:
+        entry, sides, said = {}, [], []
+        if sim in trajectories:
+            w = trajectories[sim]
+            entry.update(w)
+            sides.append("derivation" if w["max_error_to_derived"] < w["max_error_to_printed"]
+                         else "printed")
+            said.append(f"trajectory: max |dq| {w['max_error_to_derived']:.2e} to the derived "
+                        f"model, {w['max_error_to_printed']:.2e} to the printed one "
+                        f"({w['scenario']} scenario, {w['t_end']:g} s)")
+        elif note:
+            said.append(note)
+        if sim in modes:
+            w = modes[sim]
+            entry.update(modes_error_to_derived=w["max_error_to_derived"],
+                         modes_error_to_printed=w["max_error_to_printed"])
+            sides.append("derivation" if w["max_error_to_derived"] < w["max_error_to_printed"]
+                         else "printed")
+            said.append(f"modes: {w['max_error_to_derived']:.1e} from the derived model, "
+                        f"{w['max_error_to_printed']:.1e} from the printed one")
+        if len(set(sides)) == 1:
+            entry["sides_with"] = sides[0]
+            entry["verdict"] = f"sides with the {sides[0]} ({'; '.join(said)})"
+        else:
+            entry["sides_with"] = "split"
+            entry["verdict"] = "split: " + "; ".join(
+                f"{x} sides with the {y}" for x, y in zip(said, sides))
+        out[sim] = entry
+    return out
+
+
+def _multiplier_formula(system: System, label: str | None) -> PrintedFormula | None:
+    """The printed "eom" with multipliers an erratum label refers to (its system row or
+    one of its rows); the first one when label is None."""
+    for pf in system.printed(system.symbols):
+        if pf.kind != "eom" or not pf.multipliers:
+            continue
+        if label is None or label == pf.label or label.startswith(
+                (f"{pf.label} (", f"{pf.label}, row ")):
+            return pf
+    return None
+
+
 def witness(system: System, erratum: Erratum | None = None) -> dict:
-    """The engines' verdict on a misprint: trajectories for equations of motion, their own
-    linearizations for matrices, energies and frequencies."""
+    """The engines' verdict on a misprint: trajectories for equations of motion (with
+    multipliers: on the derived manifold, and modes), their own linearizations for
+    matrices, energies and frequencies."""
     if erratum is None or erratum.kind == "eom":
+        pf = _multiplier_formula(system, None if erratum is None else erratum.label)
+        if pf is not None and (erratum is not None or not _trajectory_witness(system.id)):
+            return _multiplier_witness(system.id, pf.label)
         return _trajectory_witness(system.id)
     for pf in _one_equation_each(system.printed(system.symbols)):
         if pf.label == erratum.label:

@@ -64,6 +64,11 @@ Printed formulas (all in `printed`, judged by `mbfidelity errata`):
   "(I + m b^2 + )" is a stray plus sign: both eq. 115 and the geometry give I + m b^2
   (wing 2 carries no body), nothing is missing. As a system the printed equations admit
   no multipliers that reproduce the motion (the errata's least-squares fit).
+  Engine witness (analytic/errata.py, `_multiplier_witness`): eq. 116 closed with the
+  derived Phi_q q'' = gamma and integrated on the true manifold (all four angles: the
+  printed motion swings the bars inwards to Q = Q', where the phi1, phi2 chart fails)
+  leaves the derived motion by ~0.5 rad within 3 s of the "large" scenario, and its
+  modes at the hanging equilibrium are off by ~24 %; every engine follows the derivation.
 The monograph prints no formula for the force at P; eq. 112's statement that
 lambda_j phi_ij is the generalized force of constraint j is what the row-by-row check of
 eq. 116 tests.
