@@ -16,6 +16,8 @@ install: $(BIN)/.installed
 
 report: install
 	$(BIN)/mbfidelity run --out $(OUT)
+	$(BIN)/mbfidelity errata --out $(OUT) > /dev/null
+	@echo "errata:  $(OUT)/errata.html"
 
 test: install
 	$(BIN)/python -m pytest -q

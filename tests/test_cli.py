@@ -68,3 +68,22 @@ def test_compare_json_contract():
     assert doc["engine_version"]
     for m in doc["metrics"]:
         assert {"name", "value", "tolerance", "passed"} <= set(m)
+
+
+def test_errata_page_and_json(tmp_path):
+    """`errata --out` writes the report page and JSON: every coded printed formula, with
+    the known misprint of Fig. 14, eq. 51 (the spurious 1/2) among them."""
+    res = runner.invoke(app, ["errata", "--no-witnesses", "--json", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    labels = {(e["system"], e["label"]): e["verdict"] for e in doc["errata"]}
+    assert any("eq. 51" in label and verdict == "misprint" for (_, label), verdict in labels.items())
+    page = (tmp_path / "errata.html").read_text()
+    assert "eq. 116" in page and "misprint" in page
+    assert json.loads((tmp_path / "errata.json").read_text())["errata"] == doc["errata"]
+
+
+def test_unknown_variant_is_a_clear_error():
+    res = runner.invoke(app, ["compare", "rolling_disc_track", "--sim", "pymunk",
+                              "--variant", "levitating"])
+    assert res.exit_code == 2 and "no variant 'levitating'" in res.output

@@ -254,7 +254,9 @@ def _split(items):
 @app.command("errata")
 def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                witnesses: bool = typer.Option(True, "--witnesses/--no-witnesses",
-                                              help="run the engines on misprinted equations")
+                                              help="run the engines on misprinted equations"),
+               out: Optional[Path] = typer.Option(
+                   None, "--out", help="also write errata.html and errata.json there")
                ) -> None:
     """Every printed formula coded, compared with the derivation; engines as witnesses."""
     from .analytic.errata import errata, witness
@@ -266,6 +268,13 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
             if witnesses and e.verdict != "agrees":
                 e.witnesses = witness(system, e)
             entries.append(e.as_dict())
+    if out is not None:
+        from .comparisons.runner import provenance
+        from .reports.html import write_errata_page
+
+        page = write_errata_page(entries, provenance(), out)
+        if not as_json:
+            typer.echo(f"errata page: {page.resolve()}")
     if as_json:
         _json({"errata": entries})
         return

@@ -42,6 +42,8 @@ N^T M_p S s^2 + N^T C_p S s + N^T K_p S (`printed_model_frequencies`).
 """
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Mapping
@@ -806,6 +808,14 @@ def witness(system: System, erratum: Erratum | None = None) -> dict:
     """The engines' verdict on a misprint: trajectories for equations of motion (with
     multipliers: on the derived manifold, and modes), their own linearizations for
     matrices, energies and frequencies."""
+    # a printed model may divide by zero on the motion (then it has no trajectory
+    # witness, said in the result): numpy's warnings would only repeat that on stderr
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _witness(system, erratum)
+
+
+def _witness(system: System, erratum: Erratum | None) -> dict:
     if erratum is None or erratum.kind == "eom":
         pf = _multiplier_formula(system, None if erratum is None else erratum.label)
         if pf is not None and (erratum is not None or not _trajectory_witness(system.id)):

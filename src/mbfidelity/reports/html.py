@@ -75,6 +75,8 @@ bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} mi
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
+<p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
+(written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
 <table><tr><th>system</th><th>formula</th><th>verdict</th><th>printed</th><th>derived</th></tr>
 {% for e in errata %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{{ e.system }}</td><td>{{ e.label }}</td><td>{{ e.verdict }}</td>
 <td><code>{{ e.printed }}</code></td><td><code>{{ e.derived }}</code></td></tr>{% endfor %}</table>{% endif %}
@@ -162,6 +164,44 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+ERRATA_TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">
+<title>mbfidelity errata</title><style>
+body{font-family:sans-serif;margin:2em;max-width:1400px}
+table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px;vertical-align:top}
+th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}code{font-size:12px}
+</style></head><body>
+<h1>Errata: the monograph's printed formulas against the derivation</h1>
+<p>git {{ prov.git_describe }} · {{ prov.date }} · engines: {% for sim, v in versions.items() %}{{ sim }} {{ v }}{% if not loop.last %}, {% endif %}{% endfor %}.
+A formula agrees when it matches the derivation to 1e-9 relative at two parameter sets.
+For each misprint the engines are witnesses: they run the mechanism, and their motion (or
+their own linearization) is compared with the printed and with the derived model.</p>
+<table><tr><th>system</th><th>formula</th><th>verdict</th><th>difference</th><th>printed</th><th>derived</th><th>engines (witnesses)</th></tr>
+{% for e in entries %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{{ e.system }}</td><td>{{ e.label }}{% if e.note %}<br><small>{{ e.note }}</small>{% endif %}</td>
+<td>{{ e.verdict }}</td><td>{{ "%.2g"|format(e.max_relative_difference) if e.max_relative_difference is not none else "" }}</td>
+<td><code>{{ e.printed }}</code></td><td><code>{{ e.derived }}</code></td>
+<td>{% for sim, w in (e.witnesses or {}).items() %}<b>{{ sim }}</b>: {{ w.verdict }}<br>{% endfor %}</td></tr>{% endfor %}
+</table></body></html>""")
+
+
+def write_errata_page(entries: list[dict], prov: dict, out: Path) -> Path:
+    """errata.html and errata.json: every printed formula, its verdict and witnesses."""
+    import json
+
+    from ..simulators import all_backends
+
+    out.mkdir(parents=True, exist_ok=True)
+    versions = {}
+    for sim, backend in all_backends().items():
+        ok, _ = backend.available()
+        if ok:
+            versions[sim] = backend.version()
+    (out / "errata.json").write_text(json.dumps({"provenance": prov, "engines": versions,
+                                                 "errata": entries}, indent=1, default=float))
+    page = out / "errata.html"
+    page.write_text(ERRATA_TEMPLATE.render(entries=entries, prov=prov, versions=versions))
+    return page
 
 
 def shown_id(c) -> str:
