@@ -64,6 +64,22 @@ def test_equilibria_counted_by_hand(system_id):
     assert sum(e.stable for e in eqs) == stable
 
 
+@pytest.mark.parametrize("system_id", SYSTEMS)
+def test_a_trajectory_check_starts_near_every_other_stable_equilibrium(system_id):
+    """Issue 3, item 4: besides the monograph's operating point, every stable equilibrium
+    (hand count) gets a generated scenario starting 0.05 away from it."""
+    from mbfidelity.comparisons.runner import near_equilibrium_scenarios
+
+    s = get_system(system_id)
+    v = s.parameter_values()
+    _, stable = HAND[system_id].EQUILIBRIA
+    generated = near_equilibrium_scenarios(s, v)
+    assert len(generated) == stable - 1
+    for sc, eq in generated:
+        q0, _ = s.initial_state(sc, v)
+        assert 0 < np.max(np.abs(q0 - eq.q)) <= 0.05 * max(1.0, np.max(np.abs(eq.q)))
+
+
 def test_sliding_block_inverted_equilibrium_position():
     # rho-equation at phi = pi: k (rho - rho0) + m g (1 - cos pi) = 0
     s = get_system("pendulum_sliding_block")

@@ -154,9 +154,17 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
         result.supported = False
         result.reason = support.reason if not support.ok else unsupported.reason
         return result
-    chosen = [system.scenario(s) for s in scenarios] if scenarios else list(system.scenarios)
-    for sc in chosen:
-        _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series)
+    every = [(sc, None) for sc in system.scenarios] + near_equilibrium_scenarios(system,
+                                                                                base_values)
+    by_name = {sc.name: (sc, eq) for sc, eq in every}
+    for name in scenarios or ():
+        if name not in by_name:
+            raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
+                             f"{', '.join(by_name)}")
+    for name in scenarios or by_name:
+        sc, eq = by_name[name]
+        _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
+                          eq)
     _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series)
     if chosen_variant is None:
         _strict_expectations(system, result)
@@ -167,7 +175,52 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     return result
 
 
-def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series):
+#: start of the generated checks near the other stable equilibria: this far from the
+#: equilibrium on each independent coordinate (rad, or relative to the coordinate scale)
+NEAR_EQUILIBRIUM_OFFSET = 0.05
+NEAR_EQUILIBRIUM_T_END = 5.0
+
+
+def _wrapped_distance(system: System, a: np.ndarray, b: np.ndarray) -> float:
+    d = np.asarray(a, float) - np.asarray(b, float)
+    for i, c in enumerate(system.coordinates):
+        if system.mechanism.angular(c):
+            d[i] = (d[i] + np.pi) % (2 * np.pi) - np.pi
+    return float(np.max(np.abs(d)))
+
+
+def near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> list:
+    """A trajectory check started near every stable equilibrium other than the operating
+    point (the monograph studies one; the others are where a user's mechanism may rest):
+    the independent coordinates NEAR_EQUILIBRIUM_OFFSET away from it, from rest, for
+    NEAR_EQUILIBRIUM_T_END s. Named eq<k>_small after the equilibrium's index in
+    `analyze`. Returns (scenario, equilibrium) pairs."""
+    from ..analytic.linear import find_equilibria
+    from ..analytic.numeric import numeric_model
+    from ..systems.model import Scenario
+
+    op = operating_equilibrium(system, values)
+    model = numeric_model(system.id, values)
+    checks = ("trajectory", "constraint_force") if system.mechanism.constraints else (
+        "trajectory",)
+    out = []
+    for k, eq in enumerate(find_equilibria(system, values)):
+        if not eq.stable or _wrapped_distance(system, eq.q, op.q) < 1e-6:
+            continue
+        q0 = {}
+        for i, c in enumerate(system.coordinates):
+            step = NEAR_EQUILIBRIUM_OFFSET * (
+                1.0 if system.mechanism.angular(c) else max(abs(eq.q[i]), 0.1))
+            q0[c] = float(eq.q[i] + (step if i in model.independent else 0.0))
+        pretty = ", ".join(f"{c} = {x:.4g}" for c, x in zip(system.coordinates, eq.q))
+        out.append((Scenario(f"eq{k}_small", q0, t_end=NEAR_EQUILIBRIUM_T_END, checks=checks,
+                             description=f"near the stable equilibrium ({pretty}), "
+                                         f"{NEAR_EQUILIBRIUM_OFFSET} off, from rest"), eq))
+    return out
+
+
+def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series,
+                      eq=None):
     values = system.parameter_values(params, scenario=sc)
     mech = system.numeric_mechanism(values)
     T = sc.t_end if t_end is None else t_end
@@ -180,7 +233,8 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     run = backend.simulate(mech, q0, qd0, T, dt, settings, joints + contact_joints)
     result.wall_time += run.wall_time
     result.simulated_time += T
-    eq = operating_equilibrium(system, values)
+    if eq is None:
+        eq = operating_equilibrium(system, values)
     w = characteristic_frequency(eq.modes, ref.q, ref.qd, eq.q)
     order = run.integrator_order
     scale = metrics.amplitude(ref.q, eq.q)
