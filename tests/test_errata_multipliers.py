@@ -253,3 +253,26 @@ def test_five_bar_eq116_engine_witness_sides_with_the_derivation():
             x = w[sim]
             assert x["verdict"].startswith("sides with the derivation")
             assert x["max_error_to_derived"] < 0.1 * x["max_error_to_printed"], (sim, x)
+
+
+def test_scotch_yoke_potential_derivatives_by_hand():
+    """Fig. 14, eq. 50 and 52, worked out here from V(phi) = -m g r sin(phi) + V_cot(l),
+    l = h - b - r sin(phi), dV_cot/dl = -F0 cot(pi l / (2 l0)): the hand forms must agree;
+    the same forms with the curvature term's sign flipped, or without the chain rule's
+    cos(phi), must not."""
+    s = get_system("scotch_yoke")
+    P = s.symbols
+    phi = coordinate_symbols("phi")[0]
+    l = P.h - P.b - P.r * sp.sin(phi)
+    u = sp.pi * l / (2 * P.l0)
+    dV = -P.m * P.g * P.r * sp.cos(phi) + P.F0 * sp.cot(u) * P.r * sp.cos(phi)
+    curvature = P.F0 * P.r**2 * sp.cos(phi) ** 2 * sp.pi / (2 * P.l0) / sp.sin(u) ** 2
+    d2V = (P.m * P.g - P.F0 * sp.cot(u)) * P.r * sp.sin(phi) + curvature
+    rng = np.random.default_rng(4)
+    cases = [("potential_gradient", [dV], True),
+             ("potential_gradient", [dV / sp.cos(phi)], False),
+             ("potential_hessian", sp.Matrix([[d2V]]), True),
+             ("potential_hessian", sp.Matrix([[d2V - 2 * curvature]]), False)]
+    for kind, expr, ok in cases:
+        worst, _, _ = _compare(s, PrintedFormula("hand", kind, expr), rng)
+        assert (worst <= AGREEMENT) is ok, (kind, worst)

@@ -233,6 +233,30 @@ def nonconservative_power(system_id: str) -> sp.Expr:
     return sp.expand(((d.Q + grad).T * d.qd)[0])
 
 
+def reduced_gradient(model, q: np.ndarray) -> np.ndarray:
+    """dV/dq_i along the constraint manifold (independent coordinates): S^T grad V."""
+    return model.velocity_basis(q).T @ model.potential_gradient(q)
+
+
+def reduced_hessian(model, q: np.ndarray, step: float = 1e-3) -> np.ndarray:
+    """d2V/dq_i dq_j along the manifold: central differences of `reduced_gradient`,
+    Richardson-extrapolated (truncation ~ step^4: 1e-12 relative, far below the 1e-9
+    agreement threshold; round-off 1e-16/step^2... kept small by the step 1e-3)."""
+    ind = model.independent
+
+    def grad_at(i: int, delta: float) -> np.ndarray:
+        p = np.array(q, dtype=float)
+        p[ind[i]] += delta
+        return reduced_gradient(model, model.complete(p))
+
+    H = np.empty((len(ind), len(ind)))
+    for i in range(len(ind)):
+        d1 = (grad_at(i, step) - grad_at(i, -step)) / (2 * step)
+        d2 = (grad_at(i, step / 2) - grad_at(i, -step / 2)) / step
+        H[:, i] = (4 * d2 - d1) / 3
+    return H
+
+
 def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str, dict]:
     """(max relative difference, derived form as text, details)."""
     d = derivation_of(system.id)
@@ -326,6 +350,21 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str, dict]
                 dist = max(dist, row_space_distance(printed_J, model.constraint_jacobian(q)))
             details.update(row_space_distance=dist)
             worst = dist
+        elif pf.kind in ("potential_gradient", "potential_hessian"):
+            derived_text = ("S^T grad V (the derived potential's gradient along the constraint "
+                            "manifold, in the independent coordinates)" if pf.kind ==
+                            "potential_gradient" else "d/dq_i of S^T grad V (central "
+                            "differences on the manifold, Richardson-extrapolated)")
+            for q, qd, t in _random_states(system, values, rng, count=10):
+                env = _env(system, values, q, qd, np.zeros_like(q), t)
+                if pf.kind == "potential_gradient":
+                    derived = reduced_gradient(model, q)
+                    printed = np.array([_num(e, env) for e in pf.expr])
+                else:
+                    derived = reduced_hessian(model, q)
+                    printed = np.array(sp.Matrix(pf.expr).xreplace(env), dtype=float)
+                worst = max(worst, float(np.max(np.abs(printed - derived)))
+                            / max(float(np.max(np.abs(derived))), 1e-12))
         elif pf.kind == "dissipation_power":
             P = nonconservative_power(system.id)
             derived_text = str(P)

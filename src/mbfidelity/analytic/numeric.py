@@ -209,6 +209,16 @@ class NumericModel:
         Q = np.array(self._Q_static(*q), dtype=float).reshape(-1)
         return self.velocity_basis(q).T @ Q
 
+    def potential_gradient(self, q) -> np.ndarray:
+        """dV/dq in all coordinates (needs every force element's potential)."""
+        if self._V is None:
+            raise ValueError("a force element has no potential: V is undefined")
+        if getattr(self, "_grad_V", None) is None:
+            d = self.derivation
+            grad = [sp.diff(d.V, x).xreplace(self.subs) for x in d.q]
+            self._grad_V = _lambdify(list(d.q), grad)
+        return np.array([float(v) for v in self._grad_V(*q)])
+
     def static_residual(self, q) -> np.ndarray:
         """Residual at rest without the time-dependent loads, in the independent
         coordinates: zero at an equilibrium."""

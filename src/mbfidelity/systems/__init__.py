@@ -56,6 +56,9 @@ class PrintedFormula:
       "constraint_jacobian" matrix (rows x coordinates in system order) of the printed
                           kinematic constraint equations Phi_q q' = 0 (eq. 110, 114); its
                           row space must be the derived Phi_q's
+      "potential_gradient" list, per independent coordinate, of dE_p/dq_i written in the
+                          independent coordinates (compared along the constraint manifold)
+      "potential_hessian" matrix d2E_p/dq_i dq_j in the independent coordinates
       "dissipation_power" printed P_nc(q, q_dot, t): power of the non-conservative forces
                           (dampers, friction, motors), compared with Q_nc . q_dot
     An "eom" may contain printed Lagrange multipliers (eq. 112): list their symbols in

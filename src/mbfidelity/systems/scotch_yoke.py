@@ -13,6 +13,11 @@ Geometry, reconstructed from the printed energies (eq. 45, 47) and spring length
 
 The printed weight potential is -m g r sin(phi) (eq. 47), which fixes the sense of phi.
 The pin-slot contact is a point-on-line constraint whose multiplier is the slot force.
+
+Printed formulas: eq. 43 (the cot law) and eq. 44 (the spring length) are the
+description's inputs; every later formula is written with them, so eq. 46 and 49-55,
+compared below, test them too. Eq. 47 and 48 (weight and spring potentials) are compared
+through their sum, eq. 49 (the reference configurations differ, as the text says).
 """
 import sympy as sp
 
@@ -66,6 +71,14 @@ def printed(P):
     return (
         PrintedFormula("Fig. 14, eq. 45", "kinetic_energy",
                        (I_O + m * (r * sp.cos(phi)) ** 2) * phi_d**2 / 2),
+        PrintedFormula("Fig. 14, eq. 46 (reduced inertia m(phi))", "kinetic_energy",
+                       (I_O + m * (r * sp.cos(phi)) ** 2) * phi_d**2 / 2),
+        PrintedFormula("Fig. 14, eq. 50 (dE_p/dphi)", "potential_gradient",
+                       [(-m * g + F0 * cot) * r * sp.cos(phi)]),
+        PrintedFormula("Fig. 14, eq. 52 (d2E_p/dphi2)", "potential_hessian", sp.Matrix([[
+            m * g * r * sp.sin(phi) - F0 * cot * r * sp.sin(phi)
+            + F0 * r**2 * sp.cos(phi) ** 2 * sp.pi / (2 * l0)
+            * sp.csc(sp.pi * l / (2 * l0)) ** 2]])),
         PrintedFormula("Fig. 14, eq. 49 (with eq. 47-48)", "potential_energy",
                        -m * g * r * sp.sin(phi)
                        - 2 * F0 * l0 / sp.pi * sp.log(sp.sin(sp.pi * l / (2 * l0)))),
