@@ -276,3 +276,19 @@ def test_scotch_yoke_potential_derivatives_by_hand():
     for kind, expr, ok in cases:
         worst, _, _ = _compare(s, PrintedFormula("hand", kind, expr), rng)
         assert (worst <= AGREEMENT) is ok, (kind, worst)
+
+
+def test_slot_actuator_equations_rows_cannot_absorb_the_actuator_force():
+    """§9.7 (Fig. 36): F_act takes the derived slot force on O (it is not fitted), so row 1
+    is a real test: with F_act's sign flipped, row 1 is a misprint and rows 2-3 (without
+    F_act) still agree."""
+    s = get_system("slotted_link_spring_damper")
+    (pf,) = [p for p in s.printed(s.symbols) if p.multipliers]
+    F = pf.multipliers[0]
+    wrong = PrintedFormula(pf.label, "eom", [pf.expr[0] + 2 * F] + list(pf.expr[1:]),
+                           multipliers=pf.multipliers, multiplier_forces=pf.multiplier_forces)
+    rows = {e.label: e.verdict for e in _multiplier_errata(s, wrong, np.random.default_rng(2))}
+    assert rows[f"{pf.label}, row 1"] == "misprint"
+    assert rows[f"{pf.label}, row 2"] == rows[f"{pf.label}, row 3"] == "agrees"
+    right = {e.label: e.verdict for e in _multiplier_errata(s, pf, np.random.default_rng(2))}
+    assert set(right.values()) == {"agrees"}

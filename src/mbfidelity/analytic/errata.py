@@ -417,7 +417,11 @@ def _compare_multipliers(system: System, pf: PrintedFormula, rng) -> dict:
 
             fitted, *_ = np.linalg.lstsq(A, -r0, rcond=None)
             out["system"] = max(out["system"], float(np.max(residuals(fitted))))
-            if by_coordinate and model.constrained:
+            if pf.multiplier_forces:
+                forces = model.constraint_forces(q[None, :], lam[None, :])
+                mapped = np.array([forces[name][0, comp]
+                                   for name, comp in (pf.multiplier_forces[L] for L in lams)])
+            elif by_coordinate and model.constrained:
                 # M q'' + h - Q = -Phi_q^T lam: the printed A lam_p must be Phi_q^T lam
                 force = model.constraint_jacobian(q).T @ lam
                 mapped, *_ = np.linalg.lstsq(A, force, rcond=None)
@@ -439,10 +443,13 @@ def _multiplier_errata(system: System, pf: PrintedFormula, rng) -> list[Erratum]
                    _printed_text(pf), "; ".join(f"{r} = 0" for r in derived),
                    "agrees" if res["system"] <= AGREEMENT else "misprint", res["system"],
                    pf.note, details={**common, "multipliers_from": "least-squares fit"})]
+    by_coordinate = len(pf.expr) == len(system.coordinates)
+    if not (pf.multiplier_forces or by_coordinate):
+        return out  # per-row multipliers would be fitted too: rows could not fail
     for i, (r, w) in enumerate(zip(pf.expr, res["rows"])):
         out.append(Erratum(
             system.id, f"{pf.label}, row {i + 1}", "eom", f"{r} = 0",
-            f"{derived[i]} = 0" if i < len(derived) else "",
+            f"{derived[i]} = 0" if by_coordinate and i < len(derived) else "",
             "agrees" if w <= AGREEMENT else "misprint", float(w), pf.note,
             details={**common, "multipliers_from": "the derivation's constraint forces"}))
     return out

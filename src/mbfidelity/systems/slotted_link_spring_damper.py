@@ -116,9 +116,12 @@ def build(P) -> Mechanism:
     )
 
 
+F_ACT = sp.Symbol("F_act", real=True)
+
+
 def printed(P):
     y, y_d, y_dd = coordinate_symbols("y")
-    x, x_d, _ = coordinate_symbols("x")
+    x, x_d, x_dd = coordinate_symbols("x")
     phi, phi_d, phi_dd = coordinate_symbols("phi")
     m, I_G, b, k, c, l0, l, g = P.m, P.I_G, P.b, P.k, P.c, P.l0, P.l, P.g
     sec = sp.sec(phi)
@@ -154,6 +157,18 @@ def printed(P):
                        note="x-component of the slot's force on the pin O (positive along "
                             "+x); F_molla = -k (y + l tan(phi) - l0) as in the first line "
                             "of the same display"),
+        # §9.7: Lagrange's equations of the system with the actuator (x, y, phi), F_act
+        # its unknown force; on the mechanism x = x' = x'' = 0
+        PrintedFormula("Fig. 36, §9.7 (Lagrange equations with F_act)", "eom", [
+            m * x_dd + m * b * (-sp.cos(phi) * phi_d**2 - sp.sin(phi) * phi_dd)
+            - k * (y + (l - x) * sp.tan(phi) - l0) * sp.tan(phi) - F_ACT + F_c * sp.tan(phi),
+            m * y_dd + m * b * (-sp.sin(phi) * phi_d**2 + sp.cos(phi) * phi_dd) + m * g
+            + k * (y + (l - x) * sp.tan(phi) - l0) - F_c,
+            (I_G + m * b**2) * phi_dd - m * b * sp.sin(phi) * x_dd + m * b * sp.cos(phi) * y_dd
+            + m * g * b * sp.cos(phi) + k * (y + (l - x) * sp.tan(phi) - l0) * (l - x) * sec**2
+            - F_c * (l - x) * sec**2],
+            multipliers=(F_ACT,), multiplier_forces={F_ACT: ("slot_O", 0)},
+            note="F_act: the actuator that replaces the slot of O (a multiplier)"),
         PrintedFormula("Fig. 34, eq. 99 (P_nc)", "dissipation_power",
                        -c * rate * y_d - c * rate * l * sec**2 * phi_d),
         PrintedFormula("Fig. 36, §9.7 (P_nc with x)", "dissipation_power",
