@@ -94,6 +94,28 @@ def _cell(c) -> dict:
     return {"cls": worst, "text": counts}
 
 
+#: points per line in the figures: a 10 in, 80 dpi axis is 800 pixels wide, so a line of
+#: 10^4 samples is drawn as its envelope over 2 x ENVELOPE_BINS points (see `_envelope`)
+ENVELOPE_BINS = 1000
+
+
+def _envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS):
+    """The samples of y that draw the same line at the figure's resolution: the first and
+    last, and in each of `bins` equal runs of samples its minimum and maximum, in time
+    order. Lines with NaN, and short ones, are drawn whole. Drawing (and placing the
+    legend "best", which tests every vertex) is then ~5x cheaper."""
+    n = len(y)
+    if n <= 4 * bins or not np.all(np.isfinite(y)):
+        return t, y
+    size = -(-n // bins)  # samples per run; the last run is padded with its last value
+    padded = np.concatenate([y, np.full(size * bins - n, y[-1])]).reshape(bins, size)
+    base = np.arange(bins) * size
+    idx = np.concatenate([[0, n - 1], base + np.argmin(padded, axis=1),
+                          base + np.argmax(padded, axis=1)])
+    idx = np.unique(np.minimum(idx, n - 1))
+    return t[idx], y[idx]
+
+
 def _figures(system_id: str, comps, out: Path) -> list[str]:
     names = []
     scenarios = {name for c in comps for name in c.series}
@@ -108,13 +130,14 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
             t = s["t"]
             if not drawn_ref:
                 for i, name in enumerate(coords):
-                    axes[0].plot(t, s["q_ref"][:, i], "k-", lw=2.5, alpha=0.35,
+                    axes[0].plot(*_envelope(t, s["q_ref"][:, i]), "k-", lw=2.5, alpha=0.35,
                                  label=f"reference {name}")
                 drawn_ref = True
             for i, name in enumerate(coords):
-                axes[0].plot(t, s["q"][:, i], lw=0.8, label=f"{c.simulator} {name}")
+                axes[0].plot(*_envelope(t, s["q"][:, i]), lw=0.8,
+                             label=f"{c.simulator} {name}")
             err = np.max(np.abs(s["q"] - s["q_ref"]) / s["scale"], axis=1)
-            axes[1].semilogy(t, np.maximum(err, 1e-16), lw=0.8, label=c.simulator)
+            axes[1].semilogy(*_envelope(t, np.maximum(err, 1e-16)), lw=0.8, label=c.simulator)
             axes[1].axhline(s["tolerance"], ls="--", lw=0.6, color=axes[1].lines[-1].get_color())
         axes[0].set_ylabel("coordinates")
         axes[0].legend(fontsize=7, ncol=4)
@@ -144,14 +167,13 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
                     for s, comps in by_system.items()}
     unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
                    for s, comps in by_system.items()}
-    figures = {s: [draw_mechanism(_base(s), out)] + _figures(s, comps, out)
+    figures = {s: _prerendered_figures(comps, out)
+               or [draw_mechanism(_base(s), out)] + _figures(s, comps, out)
                for s, comps in by_system.items()}
     frequencies = frequency_table(results)
     if errata is None:
-        from ..analytic.errata import errata as compute
-
-        errata = [e.as_dict() for s in dict.fromkeys(map(_base, systems))
-                  for e in compute(get_system(s))]
+        errata = [e for s in dict.fromkeys(map(_base, systems))
+                  for e in _errata_of(s, results)]
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
     liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
@@ -357,3 +379,58 @@ def draw_mechanism(system_id: str, out: Path) -> str:
     fig.savefig(out / name, dpi=80)
     plt.close(fig)
     return name
+
+
+# --- the report's expensive parts made ahead, in the matrix runner's worker processes ---
+
+
+def prerender(comps) -> None:
+    """The figures (PNG bytes) and the errata of one system's comparisons (its engines and
+    variants), attached to the comparisons: `write_report` then writes them instead of
+    making them, so these run in parallel, in the worker that already holds the system's
+    derivation and models. Same content as `write_report` makes itself."""
+    import tempfile
+
+    from ..analytic.errata import errata as compute
+
+    groups = defaultdict(list)
+    for c in comps:
+        groups[shown_id(c)].append(c)
+    with tempfile.TemporaryDirectory() as tmp:
+        where = Path(tmp)
+        for s, group in groups.items():
+            names = [draw_mechanism(_base(s), where)] + _figures(s, group, where)
+            group[0].prerendered_figures = (_group_key(group),
+                                            [(n, (where / n).read_bytes()) for n in names])
+    for base in dict.fromkeys(c.system for c in comps):
+        first = next(c for c in comps if c.system == base)
+        first.prerendered_errata = [e.as_dict() for e in compute(get_system(base))]
+
+
+def _prerendered_figures(comps, out: Path) -> list[str] | None:
+    """The figure files of a report row made by `prerender` for exactly these
+    comparisons, written to `out` (None: not prerendered)."""
+    pre = getattr(comps[0], "prerendered_figures", None)
+    if pre is None:
+        return None
+    key, files = pre
+    if key != _group_key(comps):
+        return None  # made for another selection of these comparisons
+    for name, data in files:
+        (out / name).write_bytes(data)
+    return [name for name, _ in files]
+
+
+def _group_key(comps) -> tuple:
+    return tuple((c.system, getattr(c, "variant", ""), c.simulator) for c in comps)
+
+
+def _errata_of(system_id: str, results) -> list[dict]:
+    """The system's errata entries: made by `prerender` if it ran, else here."""
+    pre = next((c.prerendered_errata for c in results if c.system == system_id
+                and getattr(c, "prerendered_errata", None) is not None), None)
+    if pre is not None:
+        return pre
+    from ..analytic.errata import errata as compute
+
+    return [e.as_dict() for e in compute(get_system(system_id))]

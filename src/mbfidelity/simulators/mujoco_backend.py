@@ -772,11 +772,13 @@ class _Compiled:
         its violation (PointOnPoint: distance of the two points, m; PointOnLine: signed
         distance of the pin from the slot line, m; LinearCoupling: Phi)."""
         m, d = self.model, self.data
-        rows: dict[int, list[int]] = {}
         eq_type = int(self.mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-        for r in range(d.nefc):
-            if d.efc_type[r] == eq_type:
-                rows.setdefault(int(d.efc_id[r]), []).append(r)
+        # the equality rows of each closure, in row order (one vectorized pass: this runs
+        # at every sample)
+        nefc = d.nefc
+        eq_rows = np.flatnonzero(d.efc_type[:nefc] == eq_type)
+        eq_ids = d.efc_id[:nefc][eq_rows]
+        efc_force, efc_pos = d.efc_force, d.efc_pos
         forces, viol = [], np.empty(len(self.plan.closures))
         k_slider = k_contact = 0
         mujoco = self.mujoco
@@ -784,8 +786,8 @@ class _Compiled:
             mujoco.mj_rnePostConstraint(m, d)
         obj_body, acc = int(mujoco.mjtObj.mjOBJ_BODY), np.zeros(6)
         for i, (cl, eid) in enumerate(zip(self.plan.closures, self.eq_id)):
-            rr = rows.get(eid, [])
-            f, pos = d.efc_force[rr], d.efc_pos[rr]
+            rr = eq_rows[eq_ids == eid]
+            f, pos = efc_force[rr], efc_pos[rr]
             if cl.kind == "contact":
                 # generalized force of the disc's contacts on the description coordinates
                 # (A^T qfrc); the coupling's value -lam is that on the disc's coordinate
