@@ -476,7 +476,7 @@ def _reduced_cached(system_id: str):
         e = unsign(e)
         # simplify only what is small: on the larger reductions it runs for minutes, and
         # the text is for reading (the comparison is numeric)
-        return sp.simplify(e) if sp.count_ops(e) < 150 else e
+        return sp.simplify(e) if sp.count_ops(e) < 60 else e
     return [tidy(e) for e in eqs]
 
 

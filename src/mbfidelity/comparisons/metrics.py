@@ -60,19 +60,35 @@ def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess
     def model(tt, a, sigma, wd, ph, off):
         return a * np.exp(-sigma * tt) * np.cos(wd * tt + ph) + off
 
+    def jacobian(tt, a, sigma, wd, ph, off):
+        e = np.exp(-sigma * tt)
+        c, s = e * np.cos(wd * tt + ph), e * np.sin(wd * tt + ph)
+        return np.column_stack([c, -a * tt * c, -a * tt * s, -a * s, np.ones_like(tt)])
+
+    def fit(p0):
+        with warnings.catch_warnings():
+            # the covariance is not used; an exact fit makes it inestimable
+            warnings.simplefilter("ignore", scipy.optimize.OptimizeWarning)
+            p, _ = scipy.optimize.curve_fit(model, t, x, p0=p0, jac=jacobian,
+                                            maxfev=20000, xtol=1e-14, ftol=1e-14)
+        return float(np.sum((model(t, *p) - x) ** 2)), p
+
+    # amplitude, phase and offset for the seeded (wd, sigma) by linear least squares, and
+    # four phases: the best of the five fits (a record holding two modes has several
+    # local minima)
+    e = np.exp(-sigma0 * t)
+    basis = np.column_stack([e * np.cos(wd0 * t), e * np.sin(wd0 * t), np.ones_like(t)])
+    (c1, c2, off0), *_ = np.linalg.lstsq(basis, x, rcond=None)
+    seeds = [[float(np.hypot(c1, c2)), sigma0, wd0, float(np.arctan2(-c2, c1)), float(off0)]]
+    seeds += [[a0, sigma0, wd0, ph0, 0.0] for ph0 in (0.0, np.pi / 2, np.pi, -np.pi / 2)]
     best = None
-    for ph0 in (0.0, np.pi / 2, np.pi, -np.pi / 2):
+    for p0 in seeds:
         try:
-            with warnings.catch_warnings():
-                # the covariance is not used; an exact fit makes it inestimable
-                warnings.simplefilter("ignore", scipy.optimize.OptimizeWarning)
-                p, _ = scipy.optimize.curve_fit(model, t, x, p0=[a0, sigma0, wd0, ph0, 0.0],
-                                                maxfev=20000, xtol=1e-14, ftol=1e-14)
+            res = fit(p0)
         except RuntimeError:
             continue
-        res = float(np.sum((model(t, *p) - x) ** 2))
-        if best is None or res < best[0]:
-            best = (res, p)
+        if best is None or res[0] < best[0]:
+            best = res
     if best is None:
         raise RuntimeError("free-vibration fit did not converge")
     _, (a, sigma, wd, ph, off) = best
