@@ -292,3 +292,23 @@ def test_slot_actuator_equations_rows_cannot_absorb_the_actuator_force():
     assert rows[f"{pf.label}, row 2"] == rows[f"{pf.label}, row 3"] == "agrees"
     right = {e.label: e.verdict for e in _multiplier_errata(s, pf, np.random.default_rng(2))}
     assert set(right.values()) == {"agrees"}
+
+
+def test_singular_printed_equations_get_a_residual_witness():
+    """Fig. 39: the printed equations of motion have no phi'' in row 2 (singular: they
+    cannot be integrated), so the witness puts each engine's motion into both sets of
+    equations: an engine's motion must satisfy the derived ones far better."""
+    import pytest
+
+    from mbfidelity.analytic.errata import witness
+    from mbfidelity.simulators import all_backends
+
+    if not any(b.available()[0] for b in all_backends().values()):
+        pytest.skip("no simulation engine installed")
+    s = get_system("rolling_disc_track")
+    e = next(e for e in _errata(s.id) if e.kind == "eom" and e.verdict == "misprint")
+    w = witness(s, e)
+    siding = [x for x in w.values() if x["sides_with"] == "derivation"]
+    assert siding, w
+    for x in siding:
+        assert x["derived_relative_residual"] < 0.1 * min(x["printed_relative_residuals"])
