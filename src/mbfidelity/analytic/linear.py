@@ -7,6 +7,7 @@ One mode per complex-conjugate pair (the member with Im s > 0), one per real eig
 from __future__ import annotations
 
 import itertools
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -232,10 +233,15 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     found: list[np.ndarray] = []
-    candidates = [_solve_static(model, s) for s in [op] + _search_grid(system, values, op)]
-    if model.constrained and any(
-            isinstance(c, (PointOnPoint, PointOnLine)) for c in system.mechanism.constraints):
-        candidates += [_solve_full(model, s) for s in _full_search_starts(system, values, op)]
+    # grid starts may sit on singular poses of the chart (Newton then fails there and
+    # the start is dropped): numpy's warnings would only say so on stderr
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        candidates = [_solve_static(model, s) for s in [op] + _search_grid(system, values, op)]
+        if model.constrained and any(isinstance(c, (PointOnPoint, PointOnLine))
+                                     for c in system.mechanism.constraints):
+            candidates += [_solve_full(model, s)
+                           for s in _full_search_starts(system, values, op)]
     for q in candidates:
         if q is None or not _regular(model, q, op, chart=False):
             continue
