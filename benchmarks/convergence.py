@@ -2,7 +2,7 @@
 compound pendulum (large swing) and the double pendulum; observed order and wall time.
 
 Usage: .venv/bin/python benchmarks/convergence.py
-Writes benchmarks/results/convergence.json and convergence.png.
+Writes benchmarks/records/convergence.json and convergence.png.
 """
 import json
 from pathlib import Path
@@ -20,7 +20,7 @@ DTS = [4e-3, 2e-3, 1e-3, 5e-4]
 
 
 def main() -> None:
-    out = Path(__file__).parent / "results"
+    out = Path(__file__).parent / "records"
     out.mkdir(parents=True, exist_ok=True)
     studies = []
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))

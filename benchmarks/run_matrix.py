@@ -1,8 +1,8 @@
 """Benchmark: wall time of `mbfidelity run` on the default matrix (target: < 2 minutes on the
 project's 2-core machine) and the engines' cost per simulated second, from the same run.
 
-Usage: .venv/bin/python benchmarks/run_matrix.py [--out benchmarks/results]
-Writes benchmarks/results/run_matrix.json (appends a record per invocation).
+Usage: .venv/bin/python benchmarks/run_matrix.py [--out benchmarks/records]
+Writes benchmarks/records/run_matrix.json (appends a record per invocation).
 """
 import argparse
 import json
@@ -16,7 +16,7 @@ from pathlib import Path
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    ap.add_argument("--out", default=str(Path(__file__).parent / "records"))
     args = ap.parse_args()
     exe = Path(sys.executable).parent / "mbfidelity"
     with tempfile.TemporaryDirectory() as tmp:
