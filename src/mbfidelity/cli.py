@@ -80,7 +80,10 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
                             "reason": why if not ok else (sup.reason if not sup.ok else "")}
         rows.append({"system": s.id, "title": s.title, "source": s.source,
                      "coordinates": list(s.coordinates),
-                     "scenarios": [sc.name for sc in s.scenarios], "simulators": support})
+                     "scenarios": [sc.name for sc in s.scenarios], "simulators": support,
+                     "variants": {v.name: {"simulators": list(v.settings),
+                                           "description": v.description}
+                                  for v in s.variants}})
     if as_json:
         _json({"systems": rows, "simulators": list(backends)})
         return
@@ -89,6 +92,8 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
         marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
                          for b in backends)
         typer.echo(f"{r['system']:26s} {marks} {r['source']}")
+        for name, v in r["variants"].items():
+            typer.echo(f"  variant {name}: {', '.join(v['simulators'])}")
 
 
 def _modes(eq):
