@@ -275,14 +275,14 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
                      if f_run is not None else float("inf"))
             result.metrics.append(_judge(system, backend.id, f"{name}.constraint_{cname}",
                                          value, tol))
-    if contacts:
-        _compare_contacts(system, backend, values, ref, run, n, tol, name, result)
+    contact_series = (_compare_contacts(system, backend, values, ref, run, n, tol, name, result)
+                      if contacts else {})
     if keep_series:
         result.series[name] = {
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
             "reactions": {j: (ref.reactions[j][:n], run.reactions[j][:n])
                           for j in joints if j in run.reactions},
-            "tolerance": tol, "scale": scale,
+            "tolerance": tol, "scale": scale, "contacts": contact_series,
         }
 
 
@@ -291,9 +291,10 @@ def _first_negative(t: np.ndarray, f: np.ndarray) -> float | None:
     return float(t[below[0]]) if below.size else None
 
 
-def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -> None:
+def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -> dict:
     """Contact forces (normal, friction) on the scale of the largest one; for a unilateral
-    contact, where and how far the bilateral model pulls (a real contact would open)."""
+    contact, where and how far the bilateral model pulls (a real contact would open).
+    Returns the series, name -> (reference, engine), for the report."""
     reactions = {**ref.reactions}
     missing = [c.target for c in system.contacts(system.symbols)
                if c.kind == "reaction" and c.target not in reactions]
@@ -324,6 +325,7 @@ def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -
             metric.detail["reference_first_negative_s"] = _first_negative(t, b)
             metric.detail["engine_first_negative_s"] = _first_negative(t[ok], a[ok])
         result.metrics.append(metric)
+    return {c.name: (f_ref[c.name], f_run[c.name]) for c in system.contacts(system.symbols)}
 
 
 def _energy_of(system, values, q, qd):

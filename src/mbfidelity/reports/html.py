@@ -121,7 +121,9 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
     scenarios = {name for c in comps for name in c.series}
     coords = get_system(_base(system_id)).coordinates
     for scenario in sorted(scenarios):
-        fig, axes = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+        with_contacts = any(c.series.get(scenario, {}).get("contacts") for c in comps)
+        fig, axes = plt.subplots(3 if with_contacts else 2, 1,
+                                 figsize=(10, 8.5 if with_contacts else 6), sharex=True)
         drawn_ref = False
         for c in comps:
             s = c.series.get(scenario)
@@ -136,14 +138,25 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
             for i, name in enumerate(coords):
                 axes[0].plot(*_envelope(t, s["q"][:, i]), lw=0.8,
                              label=f"{c.simulator} {name}")
+            if with_contacts:
+                for k, (cname, (f_ref, f_run)) in enumerate(sorted(s["contacts"].items())):
+                    if not any(ln.get_label() == f"reference {cname}" for ln in axes[2].lines):
+                        axes[2].plot(*_envelope(t, f_ref), "k-", lw=2.5, alpha=0.35,
+                                     label=f"reference {cname}")
+                    axes[2].plot(*_envelope(t, np.nan_to_num(f_run)), lw=0.8,
+                                 ls="-" if k == 0 else "--", label=f"{c.simulator} {cname}")
             err = np.max(np.abs(s["q"] - s["q_ref"]) / s["scale"], axis=1)
             axes[1].semilogy(*_envelope(t, np.maximum(err, 1e-16)), lw=0.8, label=c.simulator)
             axes[1].axhline(s["tolerance"], ls="--", lw=0.6, color=axes[1].lines[-1].get_color())
         axes[0].set_ylabel("coordinates")
         axes[0].legend(fontsize=7, ncol=4)
         axes[1].set_ylabel("|q - q_ref| / amplitude")
-        axes[1].set_xlabel("t [s]")
+        axes[-1].set_xlabel("t [s]")
         axes[1].legend(fontsize=7)
+        if with_contacts:
+            axes[2].axhline(0.0, color="k", lw=0.5, ls=":")
+            axes[2].set_ylabel("contact forces [N]")
+            axes[2].legend(fontsize=7, ncol=4)
         fig.suptitle(f"{system_id}, scenario {scenario} (dashed: tolerances)")
         fig.tight_layout()
         name = f"{system_id}-{scenario}.png"
