@@ -328,8 +328,7 @@ class Derivation:
         on revolute coordinates (no net force) and a force along a prismatic axis."""
         mech = self.mechanism
         if isinstance(c, (PointOnPoint, PointOnLine)):
-            first, second = (c.body_a, c.body_b) if isinstance(c, PointOnPoint) else (
-                c.body, c.line_body)
+            first, second = c.bodies
             in_first, in_second = first in subtree, second in subtree
             if in_first == in_second:
                 return sp.zeros(2, 1)

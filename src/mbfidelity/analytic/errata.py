@@ -240,8 +240,8 @@ def reduced_gradient(model, q: np.ndarray) -> np.ndarray:
 
 def reduced_hessian(model, q: np.ndarray, step: float = 1e-3) -> np.ndarray:
     """d2V/dq_i dq_j along the manifold: central differences of `reduced_gradient`,
-    Richardson-extrapolated (truncation ~ step^4: 1e-12 relative, far below the 1e-9
-    agreement threshold; round-off 1e-16/step^2... kept small by the step 1e-3)."""
+    Richardson-extrapolated: truncation ~ step^4 = 1e-12 and round-off of the gradient
+    differences ~ 1e-16/step = 1e-13, both far below the 1e-9 agreement threshold."""
     ind = model.independent
 
     def grad_at(i: int, delta: float) -> np.ndarray:
@@ -685,11 +685,19 @@ def printed_model_frequencies(system: System, pf: PrintedFormula,
     return np.sort(np.abs([s for s in quadratic_eigenvalues(M, C, K) if s.imag >= 0]))
 
 
+def _witness_engines(mech):
+    """(id, backend) of every installed engine that can express the mechanism."""
+    from ..simulators import all_backends
+
+    for sim, backend in all_backends().items():
+        if backend.available()[0] and backend.support(mech).ok:
+            yield sim, backend
+
+
 @lru_cache(maxsize=None)
 def _trajectory_witness(system_id: str) -> dict:
     """Engines on the largest-amplitude scenario, against the derived model and against
     the printed equations of motion integrated as printed (independent coordinates)."""
-    from ..simulators import all_backends
     from ..systems import get_system
     from .reference import reference
 
@@ -708,10 +716,7 @@ def _trajectory_witness(system_id: str) -> dict:
         return _residual_witness(system, full[0], scenario, values, dt)
     mech = system.numeric_mechanism(values)
     out = {}
-    for sim, backend in all_backends().items():
-        ok, _ = backend.available()
-        if not ok or not backend.support(mech).ok:
-            continue
+    for sim, backend in _witness_engines(mech):
         run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt)
         n = min(len(run.t), len(ref.t))
         to_derived = float(np.max(np.abs(run.q[:n, ind] - ref.q[:n, ind])))
@@ -734,7 +739,6 @@ def _residual_witness(system: System, pf: PrintedFormula, scenario, values, dt: 
     (w h)^2, far below the misprints' O(1e-2..1)), put into the derived equations
     (relative acceleration error) and into each printed row (residual over the sum of
     its terms' magnitudes). An engine sides with the equations its motion satisfies."""
-    from ..simulators import all_backends
     from .reference import reference
 
     ref = reference(system, scenario, values, dt)
@@ -744,10 +748,7 @@ def _residual_witness(system: System, pf: PrintedFormula, scenario, values, dt: 
     rows = [sp.sympify(r).xreplace(system.subs(values)) for r in pf.expr]
     mech = system.numeric_mechanism(values)
     out = {}
-    for sim, backend in all_backends().items():
-        ok, _ = backend.available()
-        if not ok or not backend.support(mech).ok:
-            continue
+    for sim, backend in _witness_engines(mech):
         run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt)
         qdd = np.gradient(run.qd, dt, axis=0)
         picks = range(1, len(run.t) - 1, RESIDUAL_STRIDE)
@@ -775,7 +776,6 @@ def _residual_witness(system: System, pf: PrintedFormula, scenario, values, dt: 
 def _modal_witness(system: System, pf: PrintedFormula) -> dict:
     """Each engine's own linearization at the equilibrium, against the modes of the
     derived model and of the model with the printed formula in place."""
-    from ..simulators import all_backends
     from .linear import modes_from_eigenvalues
 
     values = _with_relations(system, system.parameter_values(), pf)
@@ -788,10 +788,7 @@ def _modal_witness(system: System, pf: PrintedFormula) -> dict:
         return {}  # the misprint does not change the modes: no modal witness
     mech = system.numeric_mechanism(values).without_time_loads()
     out = {}
-    for sim, backend in all_backends().items():
-        ok, _ = backend.available()
-        if not ok or not backend.support(mech).ok:
-            continue
+    for sim, backend in _witness_engines(mech):
         lin = backend.linearize(mech, eq.q)
         if lin is None:
             continue
@@ -811,7 +808,6 @@ def _constrained_trajectory_witness(system: System, pf: PrintedFormula) -> tuple
     the largest-amplitude scenario against the derived model and against the printed
     equations with multipliers integrated on the derived manifold. The note says why
     there is no trajectory witness (singular printed model), else it is empty."""
-    from ..simulators import all_backends
     from .reference import reference
 
     scenario = system.scenarios[-1]
@@ -827,10 +823,7 @@ def _constrained_trajectory_witness(system: System, pf: PrintedFormula) -> tuple
     ind = numeric_model(system.id, values).independent
     mech = system.numeric_mechanism(values)
     out = {}
-    for sim, backend in all_backends().items():
-        ok, _ = backend.available()
-        if not ok or not backend.support(mech).ok:
-            continue
+    for sim, backend in _witness_engines(mech):
         run = backend.simulate(mech, ref.q[0], ref.qd[0], t_end, dt)
         n = min(len(run.t), len(ref.t))
         to_derived = float(np.max(np.abs(run.q[:n, ind] - ref.q[:n, ind])))

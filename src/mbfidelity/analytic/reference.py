@@ -135,7 +135,11 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
         qdd = model.accelerations(q, qd, t)
         lam = np.zeros((len(t), 0))
         constraint_forces = {}
-    reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in system.reaction_joints}
+    # the reaction checks' joints and those the contact forces are read from
+    joints = dict.fromkeys(system.reaction_joints)
+    joints.update(dict.fromkeys(c.target for c in system.contacts(system.symbols)
+                                if c.kind == "reaction"))
+    reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in joints}
     energy = model.energy(q, qd) if model.conservative else None
     return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces)
 

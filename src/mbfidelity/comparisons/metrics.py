@@ -56,7 +56,7 @@ def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess
     wd0 = w_guess * np.sqrt(max(1 - zeta_guess**2, 1e-6))
     sigma0 = zeta_guess * w_guess
     a0 = float(np.max(np.abs(xs[: max(len(xs) // 20, 3)])))
-    # linear least squares for amplitude/phase given (wd, sigma) seeds the nonlinear fit
+
     def model(tt, a, sigma, wd, ph, off):
         return a * np.exp(-sigma * tt) * np.cos(wd * tt + ph) + off
 

@@ -6,13 +6,15 @@ import fnmatch
 import platform
 import subprocess
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Iterable, Mapping
 
 import numpy as np
 
 from .. import __version__
-from ..analytic.linear import companion_matrix, operating_equilibrium
+from ..analytic.linear import (companion_matrix, find_equilibria, operating_equilibrium,
+                               wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
@@ -181,22 +183,23 @@ NEAR_EQUILIBRIUM_OFFSET = 0.05
 NEAR_EQUILIBRIUM_T_END = 5.0
 
 
-def _wrapped_distance(system: System, a: np.ndarray, b: np.ndarray) -> float:
-    d = np.asarray(a, float) - np.asarray(b, float)
-    for i, c in enumerate(system.coordinates):
-        if system.mechanism.angular(c):
-            d[i] = (d[i] + np.pi) % (2 * np.pi) - np.pi
-    return float(np.max(np.abs(d)))
-
-
 def near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> list:
+    """See `_near_equilibrium_scenarios`; computed once per system and parameter set (every
+    engine of a system is compared on the same ones)."""
+    return list(_near_equilibrium_cached(system.id, tuple(sorted(values.items()))))
+
+
+@lru_cache(maxsize=64)
+def _near_equilibrium_cached(system_id: str, items: tuple) -> tuple:
+    return tuple(_near_equilibrium_scenarios(get_system(system_id), dict(items)))
+
+
+def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> list:
     """A trajectory check started near every stable equilibrium other than the operating
     point (the monograph studies one; the others are where a user's mechanism may rest):
     the independent coordinates NEAR_EQUILIBRIUM_OFFSET away from it, from rest, for
     NEAR_EQUILIBRIUM_T_END s. Named eq<k>_small after the equilibrium's index in
     `analyze`. Returns (scenario, equilibrium) pairs."""
-    from ..analytic.linear import find_equilibria
-    from ..analytic.numeric import numeric_model
     from ..systems.model import Scenario
 
     op = operating_equilibrium(system, values)
@@ -205,7 +208,7 @@ def near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> l
         "trajectory",)
     out = []
     for k, eq in enumerate(find_equilibria(system, values)):
-        if not eq.stable or _wrapped_distance(system, eq.q, op.q) < 1e-6:
+        if not eq.stable or np.allclose(wrap_angles(system, eq.q, op.q), op.q, atol=1e-6):
             continue
         q0 = {}
         for i, c in enumerate(system.coordinates):
@@ -295,14 +298,8 @@ def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -
     """Contact forces (normal, friction) on the scale of the largest one; for a unilateral
     contact, where and how far the bilateral model pulls (a real contact would open).
     Returns the series, name -> (reference, engine), for the report."""
-    reactions = {**ref.reactions}
-    missing = [c.target for c in system.contacts(system.symbols)
-               if c.kind == "reaction" and c.target not in reactions]
-    if missing:
-        model = numeric_model(system.id, values)
-        reactions.update({j: model.reaction(j, ref.q, ref.qd, ref.qdd, ref.t, ref.multipliers)
-                          for j in missing})
-    f_ref = contact_forces(system, values, ref.q[:n], {k: v[:n] for k, v in reactions.items()},
+    f_ref = contact_forces(system, values, ref.q[:n],
+                           {k: v[:n] for k, v in ref.reactions.items()},
                            {k: v[:n] for k, v in (ref.constraint_forces or {}).items()})
     f_run = contact_forces(system, values, run.q[:n],
                            {k: v[:n] for k, v in run.reactions.items()},
@@ -329,13 +326,11 @@ def _compare_contacts(system, backend, values, ref, run, n, tol, name, result) -
 
 
 def _energy_of(system, values, q, qd):
-    from ..analytic.numeric import numeric_model
 
     return numeric_model(system.id, values).energy(q, qd)
 
 
 def _kinetic_amplitude(system, values, q, qd) -> float:
-    from ..analytic.numeric import numeric_model
 
     model = numeric_model(system.id, values)
     T = np.array([0.5 * v @ model.mass_matrix(x) @ v for x, v in zip(q[::10], qd[::10])])
@@ -378,7 +373,6 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     # free-vibration fit (every engine): each oscillatory mode released alone from its
     # state-space eigenvector (exact for non-proportional damping too), fitted on the
     # coordinate where it is largest
-    from ..analytic.numeric import numeric_model
 
     model = numeric_model(system.id, values)
     ind = model.independent

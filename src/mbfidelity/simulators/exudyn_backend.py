@@ -356,12 +356,12 @@ class ExudynBackend(Backend):
             for c in mechanism.constraints:
                 if isinstance(c, PointOnPoint):
                     [_num(v) for v in (*c.point_a, *c.point_b)]
-                    constrained_bodies |= {c.body_a, c.body_b}
+                    constrained_bodies |= set(c.bodies)
                 elif isinstance(c, PointOnLine):
                     [_num(v) for v in (*c.point, *c.line_point)]
                     if np.hypot(*[_num(v) for v in c.direction]) == 0:
                         return Support(False, f"constraint {c.name}: zero slot direction")
-                    constrained_bodies |= {c.body, c.line_body}
+                    constrained_bodies |= set(c.bodies)
                 elif isinstance(c, LinearCoupling):
                     coefs = [_num(v) for _, v in c.coefficients]
                     _num(c.constant)
@@ -777,8 +777,7 @@ class ExudynBackend(Backend):
             f_c = constraint_forces[c.name]
             if isinstance(c, (PointOnPoint, PointOnLine)):
                 # the first body feels f_c, the second -f_c
-                first, second = ((c.body_a, c.body_b) if isinstance(c, PointOnPoint)
-                                 else (c.body, c.line_body))
+                first, second = c.bodies
                 in_1, in_2 = first in subtree, second in subtree
                 if in_1 != in_2:
                     total -= f_c if in_1 else -f_c

@@ -202,10 +202,8 @@ def _point_loaded_bodies(mech: Mechanism) -> set[str]:
     """Bodies that a loop or slot constraint or a point-to-point element acts on."""
     out: set[str] = set()
     for c in mech.constraints:
-        if isinstance(c, PointOnPoint):
-            out |= {c.body_a, c.body_b}
-        elif isinstance(c, PointOnLine):
-            out |= {c.body, c.line_body}
+        if isinstance(c, (PointOnPoint, PointOnLine)):
+            out |= set(c.bodies)
     for f in mech.forces:
         if isinstance(f, PointToPoint):
             out |= {f.body_a, f.body_b}

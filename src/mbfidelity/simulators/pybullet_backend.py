@@ -278,10 +278,8 @@ def _constraint_bodies(mech: Mechanism) -> set[str]:
     """Bodies a closure constraint acts on (couplings: the children of their joints)."""
     out: set[str] = set()
     for c in mech.constraints:
-        if isinstance(c, PointOnPoint):
-            out |= {c.body_a, c.body_b}
-        elif isinstance(c, PointOnLine):
-            out |= {c.body, c.line_body}
+        if isinstance(c, (PointOnPoint, PointOnLine)):
+            out |= set(c.bodies)
         elif isinstance(c, LinearCoupling):
             out |= {mech.joints[mech.coordinates.index(name)].child
                     for name, _ in c.coefficients}

@@ -335,11 +335,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
 
 
 def _closure_bodies(c) -> tuple[str, ...]:
-    if isinstance(c, PointOnPoint):
-        return (c.body_a, c.body_b)
-    if isinstance(c, PointOnLine):
-        return (c.body, c.line_body)
-    return ()
+    return c.bodies if isinstance(c, (PointOnPoint, PointOnLine)) else ()
 
 
 def _rotation_fixed(mech: Mechanism, body: str) -> bool:

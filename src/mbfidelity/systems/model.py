@@ -205,6 +205,11 @@ class PointOnPoint:
     body_b: str
     point_b: Vec
 
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """(the body its force is reported on, the other one)."""
+        return self.body_a, self.body_b
+
 
 @dataclass(frozen=True)
 class PointOnLine:
@@ -219,6 +224,11 @@ class PointOnLine:
     line_body: str
     line_point: Vec
     direction: Vec
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """(the pin's body, on which its force is reported; the slot's body)."""
+        return self.body, self.line_body
 
 
 @dataclass(frozen=True)
@@ -288,10 +298,7 @@ class Mechanism:
         for c in self.constraints:
             used = ([name for name, _ in c.coefficients] if isinstance(c, LinearCoupling)
                     else [])
-            bodies = {PointOnPoint: lambda c: (c.body_a, c.body_b),
-                      PointOnLine: lambda c: (c.body, c.line_body),
-                      LinearCoupling: lambda c: ()}[type(c)](c)
-            for b in bodies:
+            for b in (() if isinstance(c, LinearCoupling) else c.bodies):
                 if b != WORLD and b not in names:
                     raise ValueError(f"constraint {c.name}: unknown body {b!r}")
             for name in used:
