@@ -13,12 +13,15 @@ are M, K and C.
 """
 from __future__ import annotations
 
+import inspect
+import pickle
 from dataclasses import dataclass
 from functools import lru_cache
 
 import sympy as sp
 
 from ..systems import System, coordinate_symbols, get_system
+from . import cache
 from ..systems.model import (
     COORD,
     COORD_RATE,
@@ -373,10 +376,29 @@ class Derivation:
         raise TypeError(f)
 
 
+def cache_key(system: System) -> str:
+    """Content key of the system's persistent cache entries (`analytic.cache`)."""
+    return cache.system_key(inspect.getsourcefile(system.build))
+
+
 @lru_cache(maxsize=None)
 def derivation_of(system_id: str) -> Derivation:
-    """The (cached) symbolic derivation of a catalog system."""
-    return Derivation(get_system(system_id).mechanism)
+    """The symbolic derivation of a catalog system: derived once per process, and kept in
+    the persistent cache (with its closed-form reduction, also expensive) across
+    processes."""
+    system = get_system(system_id)
+    key = cache_key(system)
+    blob = cache.load(key, "derivation.pickle")
+    if blob is not None:
+        try:
+            return pickle.loads(blob)
+        except Exception:  # an unreadable entry is rebuilt, never trusted
+            pass
+    derivation = Derivation(system.mechanism)
+    if derivation.m:
+        derivation.reduced_dynamics()
+    cache.store(key, "derivation.pickle", pickle.dumps(derivation, protocol=pickle.HIGHEST_PROTOCOL))
+    return derivation
 
 
 def derive(system: System) -> Derivation:

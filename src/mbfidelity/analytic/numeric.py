@@ -14,7 +14,10 @@ static multipliers. Without constraints S = I and these reduce to eq. 104-109.
 """
 from __future__ import annotations
 
-from functools import lru_cache
+import builtins
+import dis
+import inspect
+from functools import cached_property, lru_cache, partial
 from typing import Callable, Mapping
 
 import numpy as np
@@ -22,7 +25,8 @@ import sympy as sp
 
 from ..systems import get_system
 from ..systems.model import TIME
-from .derivation import Derivation, derivation_of
+from . import cache
+from .derivation import Derivation, cache_key, derivation_of
 
 NEWTON_TOL = 1e-14
 NEWTON_MAX = 50
@@ -41,69 +45,164 @@ def _matrix(fn, *args) -> np.ndarray:
     return np.atleast_2d(np.array(fn(*args), dtype=float))
 
 
-class NumericModel:
-    """A derivation with parameter values substituted and compiled."""
+@lru_cache(maxsize=None)
+def _namespace(modules: str) -> dict:
+    """The globals lambdify gives its generated code for `modules`."""
+    return _lambdify([], 0, modules).__globals__
 
-    def __init__(self, derivation: Derivation, subs: Mapping[sp.Symbol, float]):
-        d = self.derivation = derivation
+
+def _global_names(code) -> set[str]:
+    names = {ins.argval for ins in dis.get_instructions(code) if ins.opname == "LOAD_GLOBAL"}
+    for const in code.co_consts:
+        if hasattr(const, "co_code"):
+            names |= _global_names(const)
+    return names
+
+
+def _from_source(source: str, modules: str, label: str) -> Callable:
+    namespace = dict(_namespace(modules))
+    exec(compile(source, f"<mbfidelity {label}>", "exec"), namespace)
+    return namespace["_lambdifygenerated"]
+
+
+class CompiledSystem:
+    """Every numeric function of one system's derivation, compiled once, with the
+    parameter values as leading arguments (`NumericModel` binds them): a new parameter
+    set costs no compilation. The generated source of each function is kept in the
+    persistent cache (`analytic.cache`); a cached function and a freshly compiled one
+    are the same source executed the same way."""
+
+    def __init__(self, system_id: str):
+        system = get_system(system_id)
+        self.system_id = system_id
+        self.key = cache_key(system)
+        self.parameters = [p.symbol for p in system.all_parameters]
+        self.parameter_names = [p.name for p in system.all_parameters]
+        self._functions: dict[str, Callable | None] = {}
+
+    @cached_property
+    def derivation(self) -> Derivation:
+        return derivation_of(self.system_id)
+
+    def function(self, name: str, build: Callable[[], tuple | None]) -> Callable | None:
+        """The compiled function `name`; `build()` gives (args, expression, modules), or
+        None where the function does not exist for this system."""
+        if name in self._functions:
+            return self._functions[name]
+        payload = cache.load(self.key, f"{name}.py")
+        if payload is not None:
+            modules, _, source = payload.decode().partition("\n")
+            fn = None if modules == "none" else _from_source(source, modules, name)
+        else:
+            spec = build()
+            if spec is None:
+                fn, modules, source = None, "none", ""
+            else:
+                args, expr, modules = spec
+                source = inspect.getsource(_lambdify(self.parameters + list(args), expr, modules))
+                fn = _from_source(source, modules, name)
+            # the source runs in lambdify's fixed namespace for its modules: cache it only
+            # when every global it reads is there
+            if fn is None or _global_names(fn.__code__) <= set(_namespace(modules)) | set(
+                    dir(builtins)):
+                cache.store(self.key, f"{name}.py", f"{modules}\n{source}".encode())
+        self._functions[name] = fn
+        return fn
+
+
+@lru_cache(maxsize=None)
+def compiled_system(system_id: str) -> CompiledSystem:
+    return CompiledSystem(system_id)
+
+
+class NumericModel:
+    """A derivation's compiled functions bound to parameter values."""
+
+    def __init__(self, compiled: CompiledSystem, values: Mapping[str, float]):
+        self.compiled = compiled
+        d = self.derivation = compiled.derivation
+        self.values = {k: float(values[k]) for k in compiled.parameter_names}
+        self.parameter_values = tuple(self.values[k] for k in compiled.parameter_names)
+        self.subs = dict(zip(compiled.parameters, self.parameter_values))
         self.n, self.m = d.n, d.m
         self.independent, self.dependent = list(d.independent), list(d.dependent)
         self.constrained = self.m > 0
-        self.subs = dict(subs)
         q, qd, qdd = list(d.q), list(d.qd), list(d.qdd)
-        self._args = q + qd + [TIME]
-        M = d.M.xreplace(self.subs)
-        rhs = (d.Q - d.h).xreplace(self.subs)
-        self._M = _lambdify(q, M)
-        self._rhs = _lambdify(self._args, list(rhs))
-        self._acc_explicit = None
-        if self.n <= 3 and not self.constrained:
-            # explicit q'' keeps the reference solver's right-hand side cheap
-            self._acc_explicit = _lambdify(self._args, list(M.LUsolve(rhs)), modules="math")
-        self._residual = _lambdify(q + qd + qdd + [TIME], list(d.residual.xreplace(self.subs)))
+        args = q + qd + [TIME]
         zero_vel = {v: 0 for v in qd + qdd}
-        self._Q_static = _lambdify(q, list(d.Q_autonomous.xreplace({**self.subs, **zero_vel})))
-        self._energy = _lambdify(q + qd, (d.T + d.V).xreplace(self.subs)) if d.energy_route else None
-        self._V = _lambdify(q, d.V.xreplace(self.subs)) if d.energy_route else None
+        fn = self._bound
+        self._M = fn("M", lambda: (q, d.M, "numpy"))
+        self._rhs = fn("rhs", lambda: (args, list(d.Q - d.h), "numpy"))
+        # explicit q'' keeps the reference solver's right-hand side cheap
+        self._acc_explicit = fn("acc_explicit", lambda: (
+            args, list(d.M.LUsolve(d.Q - d.h)), "math") if self.n <= 3 and not self.constrained
+            else None)
+        self._residual = fn("residual", lambda: (q + qd + qdd + [TIME], list(d.residual), "numpy"))
+        self._Q_static = fn("Q_static", lambda: (
+            q, list(d.Q_autonomous.xreplace(zero_vel)), "numpy"))
+        energy_route = d.energy_route
+        self._energy = fn("energy", lambda: (q + qd, d.T + d.V, "numpy") if energy_route
+                          else None)
+        self._V = fn("V", lambda: (q, d.V, "numpy") if energy_route else None)
         # route 1 linearization: Jacobians of the autonomous residual (eq. 104-109)
-        r_aut = (d.M * d.qdd + d.h - d.Q_autonomous).xreplace(self.subs)
-        self._lin_C = _lambdify(q, r_aut.jacobian(d.qd).xreplace(zero_vel))
-        self._lin_K = _lambdify(q, r_aut.jacobian(d.q).xreplace(zero_vel))
-        if d.energy_route:
-            self._hess_T = _lambdify(q, sp.hessian(d.T, qd).xreplace(self.subs))
-            self._hess_V = _lambdify(q, sp.hessian(d.V, q).xreplace(self.subs))
-            self._hess_D = _lambdify(q, sp.hessian(d.D, qd).xreplace(
-                {**self.subs, **{v: 0 for v in qd}}))
+        r_aut = d.M * d.qdd + d.h - d.Q_autonomous
+        self._lin_C = fn("lin_C", lambda: (q, r_aut.jacobian(d.qd).xreplace(zero_vel), "numpy"))
+        self._lin_K = fn("lin_K", lambda: (q, r_aut.jacobian(d.q).xreplace(zero_vel), "numpy"))
+        if energy_route:
+            self._hess_T = fn("hess_T", lambda: (q, sp.hessian(d.T, qd), "numpy"))
+            self._hess_V = fn("hess_V", lambda: (q, sp.hessian(d.V, q), "numpy"))
+            self._hess_D = fn("hess_D", lambda: (
+                q, sp.hessian(d.D, qd).xreplace({v: 0 for v in qd}), "numpy"))
         if self.constrained:
-            self._Phi = _lambdify(q, list(d.Phi.xreplace(self.subs)))
-            self._Phi_q = _lambdify(q, d.Phi_q.xreplace(self.subs))
-            self._gamma = _lambdify(q + qd, list(d.gamma.xreplace(self.subs)))
-            self._Phi_hess = [_lambdify(q, H.xreplace(self.subs)) for H in d.Phi_hessians]
+            self._Phi = fn("Phi", lambda: (q, list(d.Phi), "numpy"))
+            self._Phi_q = fn("Phi_q", lambda: (q, d.Phi_q, "numpy"))
+            self._gamma = fn("gamma", lambda: (q + qd, list(d.gamma), "numpy"))
+            self._Phi_hess = [fn(f"Phi_hess{k}", lambda H=H: (q, H, "numpy"))
+                              for k, H in enumerate(d.Phi_hessians)]
         self._reactions: dict[str, Callable] = {}
         self._warm: np.ndarray | None = None
         # closed-form reduction (constraints solved symbolically): a cheap explicit ODE
         self._explicit = None
-        reduced = d.reduced_dynamics() if self.constrained else None
-        if reduced is not None and len(self.independent) <= 3:
-            q_full, S, M_r, rhs_r = (x.xreplace(self.subs) for x in reduced)
-            qi = [d.q[i] for i in self.independent]
-            qdi = [d.qd[i] for i in self.independent]
-            self._explicit = (
-                _lambdify(qi, list(q_full), modules="math"),
-                _lambdify(qi + qdi, list(S * sp.Matrix(qdi)), modules="math"),
-                _lambdify(qi + qdi + [TIME], list(M_r.LUsolve(rhs_r)), modules="math"),
-            )
+        small_reduced = self.constrained and len(self.independent) <= 3
+        qi = [d.q[i] for i in self.independent]
+        qdi = [d.qd[i] for i in self.independent]
+
+        def reduced(part):
+            r = d.reduced_dynamics() if small_reduced else None
+            return None if r is None else part(*r)
+
+        explicit = (
+            fn("explicit_q", lambda: reduced(lambda q_full, S, M_r, rhs_r: (
+                qi, list(q_full), "math"))),
+            fn("explicit_qd", lambda: reduced(lambda q_full, S, M_r, rhs_r: (
+                qi + qdi, list(S * sp.Matrix(qdi)), "math"))),
+            fn("explicit_acc", lambda: reduced(lambda q_full, S, M_r, rhs_r: (
+                qi + qdi + [TIME], list(M_r.LUsolve(rhs_r)), "math"))),
+        )
+        if explicit[0] is not None:
+            self._explicit = explicit
         # route 2 with closed-form constraints: exact Hessian of V(q(q_i))
-        self._hess_V_reduced = None
-        if reduced is not None and d.energy_route:
-            qi = [d.q[i] for i in self.independent]
-            V_r = d.V.xreplace(dict(zip(d.q, reduced[0]))).xreplace(self.subs)
-            self._hess_V_reduced = _lambdify(qi, sp.hessian(V_r, qi))
+
+        def hess_V_reduced():
+            r = d.reduced_dynamics() if self.constrained and energy_route else None
+            if r is None:
+                return None
+            V_r = d.V.xreplace(dict(zip(d.q, r[0])))
+            return qi, sp.hessian(V_r, qi), "numpy"
+
+        self._hess_V_reduced = fn("hess_V_reduced", hess_V_reduced)
+
+    def _bound(self, name: str, build) -> Callable | None:
+        f = self.compiled.function(name, build)
+        return None if f is None else partial(f, *self.parameter_values)
+
+    @cached_property
+    def conservative(self) -> bool:
+        """No dissipation and no time-dependent load at these parameter values."""
+        d = self.derivation
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
-        #: no dissipation and no time-dependent load at these parameter values
-        self.conservative = bool(d.energy_route and sp.simplify(dissipation) == 0
-                                 and not q_aut_t)
+        return bool(d.energy_route and sp.simplify(dissipation) == 0 and not q_aut_t)
 
     # --- constraint manifold -------------------------------------------------------------
     def constraint_values(self, q) -> np.ndarray:
@@ -215,8 +314,8 @@ class NumericModel:
             raise ValueError("a force element has no potential: V is undefined")
         if getattr(self, "_grad_V", None) is None:
             d = self.derivation
-            grad = [sp.diff(d.V, x).xreplace(self.subs) for x in d.q]
-            self._grad_V = _lambdify(list(d.q), grad)
+            self._grad_V = self._bound("grad_V", lambda: (
+                list(d.q), [sp.diff(d.V, x) for x in d.q], "numpy"))
         return np.array([float(v) for v in self._grad_V(*q)])
 
     def static_residual(self, q) -> np.ndarray:
@@ -307,10 +406,10 @@ class NumericModel:
         computed from (q, q', t)."""
         if joint not in self._reactions:
             d = self.derivation
-            expr = d.reaction(joint).xreplace(self.subs)
             lam_syms = [sp.Symbol(f"_lambda{k}") for k in range(self.m)]
-            self._reactions[joint] = _lambdify(
-                list(d.q) + list(d.qd) + list(d.qdd) + [TIME] + lam_syms, list(expr))
+            self._reactions[joint] = self._bound(f"reaction-{joint}", lambda: (
+                list(d.q) + list(d.qd) + list(d.qdd) + [TIME] + lam_syms,
+                list(d.reaction(joint)), "numpy"))
         if self.m and lam is None:
             lam = self.dynamics_along(q, qd, t)[1]
         lam_cols = lam.T if self.m else ()
@@ -319,33 +418,54 @@ class NumericModel:
                                 for f in (fx, fy)])
 
     def accelerations(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray) -> np.ndarray:
-        return np.array([self.acceleration(a, b, c) for a, b, c in zip(q, qd, t)])
+        return self.dynamics_along(q, qd, t)[0]
 
     def constraint_forces(self, q: np.ndarray, lam: np.ndarray) -> dict[str, np.ndarray]:
         """Physical constraint forces along a sampled motion (see base.py point 6)."""
         d = self.derivation
         out = {}
+        rows = d.constraint_row_slices()
         for c in d.mechanism.constraints:
-            expr = d.constraint_force(c).xreplace(self.subs)
-            lam_syms = sorted((s for s in expr.free_symbols if s.name.startswith("_lambda")),
-                              key=lambda s: int(s.name[7:]))
-            fn = _lambdify(list(d.q) + lam_syms, list(expr))
-            cols = [int(s.name[7:]) for s in lam_syms]
+            cols = list(range(rows[c.name].start, rows[c.name].stop))
+            lam_syms = [sp.Symbol(f"_lambda{k}") for k in cols]
+            fn = self._bound(f"constraint_force-{c.name}", lambda c=c, lam_syms=lam_syms: (
+                list(d.q) + lam_syms, list(d.constraint_force(c)), "numpy"))
             vals = fn(*q.T, *lam[:, cols].T)
             out[c.name] = np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), (len(q),))
                                            for v in vals])
         return out
 
     def dynamics_along(self, q: np.ndarray, qd: np.ndarray, t: np.ndarray):
-        """(q'' (N, n), multipliers (N, m)) along a sampled motion."""
-        out = [self.dynamics(a, b, c) for a, b, c in zip(q, qd, t)]
-        return np.array([o[0] for o in out]), np.array([o[1] for o in out]).reshape(len(t), self.m)
+        """(q'' (N, n), multipliers (N, m)) along a sampled motion: the augmented system
+        of every sample assembled from array-valued functions and solved as one batch."""
+        d, n, m, N = self.derivation, self.n, self.m, len(t)
+        q, qd, t = np.asarray(q, float), np.asarray(qd, float), np.asarray(t, float)
+        args = (*q.T, *qd.T, t)
+        A = np.zeros((N, n + m, n + m))
+        A[:, :n, :n] = self._along("M_flat", lambda: (list(d.q), list(d.M), "numpy"),
+                                   q.T, N).reshape(N, n, n)
+        b = np.zeros((N, n + m))
+        b[:, :n] = self._along("rhs", None, args, N)
+        if m:
+            J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
+                            q.T, N).reshape(N, m, n)
+            A[:, :n, n:] = np.transpose(J, (0, 2, 1))
+            A[:, n:, :n] = J
+            b[:, n:] = self._along("gamma", None, (*q.T, *qd.T), N)
+        sol = np.linalg.solve(A, b[..., None])[..., 0]
+        return sol[:, :n], sol[:, n:]
+
+    def _along(self, name: str, build, args, N: int) -> np.ndarray:
+        """(N, k) values of the list-valued compiled function `name` at N samples."""
+        fn = self.compiled.function(name, build)
+        values = fn(*self.parameter_values, *args)
+        return np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in values],
+                        axis=1)
 
 
 @lru_cache(maxsize=64)
 def _numeric_cached(system_id: str, items: tuple) -> NumericModel:
-    system = get_system(system_id)
-    return NumericModel(derivation_of(system_id), system.subs(dict(items)))
+    return NumericModel(compiled_system(system_id), dict(items))
 
 
 def numeric_model(system_id: str, values: Mapping[str, float]) -> NumericModel:
@@ -361,7 +481,8 @@ def contact_forces(system, values: Mapping[str, float], q: np.ndarray,
     from ..systems import coordinate_symbols
 
     P = system.symbols
-    subs = {getattr(P, k): v for k, v in values.items() if hasattr(P, k)}
+    compiled = compiled_system(system.id)
+    bound = tuple(float(values[k]) for k in compiled.parameter_names)
     coords = [coordinate_symbols(c)[0] for c in system.coordinates]
     out: dict[str, np.ndarray] = {}
     for c in system.contacts(P):
@@ -380,7 +501,8 @@ def contact_forces(system, values: Mapping[str, float], q: np.ndarray,
                                  f"({c.source} is a vector)")
             out[c.name] = force[:, 0]
             continue
-        fn = _lambdify(coords, [sp.sympify(x).xreplace(subs) for x in c.direction])
-        ux, uy = (np.broadcast_to(np.asarray(v, dtype=float), (len(q),)) for v in fn(*q.T))
+        fn = compiled.function(f"contact_direction-{c.name}", lambda c=c: (
+            coords, [sp.sympify(x) for x in c.direction], "numpy"))
+        ux, uy = (np.broadcast_to(np.asarray(v, dtype=float), (len(q),)) for v in fn(*bound, *q.T))
         out[c.name] = ux * force[:, 0] + uy * force[:, 1]
     return out
