@@ -43,13 +43,78 @@ faster forcing).
   FIT_RESOLUTION, the precision of a least-squares sinusoid fit over tens of periods of a
   sampled record, and the amplitude dependence of the frequency at the test amplitude
   (a pendulum's frequency shifts by amplitude^2/16: 6e-8 at 1e-3 rad).
+* Where the bounds hold. Each bound above is the leading term of the error's expansion
+  in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
+  schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
+  about (w h)^2 and the leading coefficient is at most 1/12, so the bound holds up to
+  w h = ASYMPTOTIC_LIMIT[p] = 0.5; semi-implicit Euler's offset (w h)/2 and its modified
+  frequency 2 arcsin(w h/2)/h agree with their leading terms to (w h)^2/24 up to
+  w h = 0.2. Beyond that range a gate says nothing and the metric is `unresolved`, with
+  the reason. A bound that exceeds what the metric can still tell apart (a trajectory
+  error of MAX_TRAJECTORY_TOLERANCE = 0.1 of the amplitude: the motion is then no longer
+  the reference's; a frequency error of MAX_FREQUENCY_TOLERANCE = 0.05) is unresolved too:
+  a pass would mean nothing.
+* Stability. An explicit scheme diverges on a mode with w h above its stability limit on
+  the imaginary axis (RK4: 2 sqrt 2; semi-implicit Euler: 2); a comparison refuses such a
+  step before stepping (`stability_refusal`).
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
+import math
 
 FD_FREQUENCY = 1e-6
 FIT_RESOLUTION = 1e-5
 #: amplitude of the free-vibration test, relative to the coordinate scale
 FIT_AMPLITUDE = 1e-3
+
+
+#: largest w h where the order-p bound holds (see the module docstring)
+ASYMPTOTIC_LIMIT = {1: 0.2}
+ASYMPTOTIC_LIMIT_HIGHER_ORDER = 0.5
+MAX_TRAJECTORY_TOLERANCE = 0.1
+MAX_FREQUENCY_TOLERANCE = 0.05
+
+
+@dataclass(frozen=True)
+class Gate:
+    """A tolerance and, when its bound says nothing there, why (`unresolved`)."""
+
+    tolerance: float
+    unresolved: str = ""
+
+
+def asymptotic_limit(order: int) -> float:
+    return ASYMPTOTIC_LIMIT.get(order, ASYMPTOTIC_LIMIT_HIGHER_ORDER)
+
+
+def gate(tolerance: float, w: float, h: float, order: int, ceiling: float,
+         what: str = "of the amplitude") -> Gate:
+    """`tolerance` as a Gate: unresolved outside the bound's range of w h, or above the
+    ceiling the metric can still discriminate."""
+    limit = asymptotic_limit(order)
+    if w * h > limit:
+        return Gate(tolerance, f"step too coarse for an order-{order} scheme at w = {w:.4g} "
+                               f"rad/s: w h = {w * h:.3g} > {limit:g}, where the error bound "
+                               f"no longer holds")
+    if not tolerance <= ceiling:
+        return Gate(tolerance, f"the error bound {tolerance:.3g} exceeds {ceiling:g} {what}: "
+                               f"at this step and duration a pass would mean nothing")
+    return Gate(tolerance)
+
+
+def stability_refusal(w: float, h: float, scheme: str, limit: float | None) -> str:
+    """'' when the step is stable on the fastest mode w; otherwise one line naming w h and
+    the scheme's limit (an implicit scheme has none: `limit` None)."""
+    if limit is None or not w * h > limit:
+        return ""
+    return (f"dt = {h:g} s cannot be stable with {scheme}: w h = {w * h:.3g} at the fastest "
+            f"mode (w = {w:.4g} rad/s) exceeds the scheme's stability limit {limit:.3g}")
+
+
+#: stability limits on the imaginary axis of the explicit schemes the engines use
+RK4_STABILITY = 2 * math.sqrt(2)
+SEMI_IMPLICIT_EULER_STABILITY = 2.0
 
 
 def trajectory_tolerance(w: float, h: float, order: int, t_end: float, zeta: float = 0.0) -> float:
