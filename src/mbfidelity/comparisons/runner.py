@@ -30,11 +30,14 @@ class Metric:
     value: float
     tolerance: float
     passed: bool
-    status: str  # pass | fail | xfail | xpass | unsupported | measured (variants)
+    #: pass | fail | xfail | xpass | unresolved | unsupported | measured (variants)
+    status: str
     reason: str = ""
     unit: str = "relative"
     #: the compared quantities themselves (e.g. reference and engine frequency in Hz)
     detail: dict = field(default_factory=dict)
+    #: an unresolved metric the system declares (it does not fail the comparison)
+    expected: bool = False
 
     def as_dict(self) -> dict:
         d = {"name": self.name, "value": self.value, "tolerance": self.tolerance,
@@ -43,6 +46,8 @@ class Metric:
             d["reason"] = self.reason
         if self.detail:
             d["detail"] = self.detail
+        if self.status == "unresolved":
+            d["expected"] = self.expected
         return d
 
 
@@ -63,11 +68,20 @@ class Comparison:
     series: dict = field(default_factory=dict)
     #: name of the system's variant the engine built ("" for the description itself)
     variant: str = ""
+    #: runs that did not complete: {"scenario", "outcome" (diverged | crashed |
+    #: timed_out), "t_reached", "message"}; each also fails a `<scenario>.completed` metric
+    incidents: list = field(default_factory=list)
+
+    @property
+    def outcome(self) -> str:
+        """completed, or the first incident's outcome."""
+        return self.incidents[0]["outcome"] if self.incidents else "completed"
 
     @property
     def passed(self) -> bool:
-        return self.supported and all(m.status in ("pass", "xfail", "measured")
-                                      for m in self.metrics)
+        return self.supported and all(
+            m.status in ("pass", "xfail", "measured") or (m.status == "unresolved" and m.expected)
+            for m in self.metrics)
 
     def as_dict(self) -> dict:
         return {
@@ -77,6 +91,7 @@ class Comparison:
             "reason": self.reason, "metrics": [m.as_dict() for m in self.metrics],
             "passed": self.passed, "wall_time_s": self.wall_time,
             "simulated_time_s": self.simulated_time, "variant": self.variant,
+            "outcome": self.outcome, "incidents": self.incidents,
         }
 
 
@@ -87,13 +102,23 @@ def expectation_for(system: System, simulator: str, metric: str):
     return None
 
 
-def _judge(system: System, simulator: str, name: str, value: float, tol: float,
-           unit: str = "relative") -> Metric:
-    ok = bool(np.isfinite(value) and value <= tol)
+def _judge(system: System, simulator: str, name: str, value: float,
+           tol: "float | tolerances.Gate", unit: str = "relative") -> Metric:
+    """Pass or fail against the gate; `unresolved` where the gate's bound says nothing
+    (tolerances: range of w h, ceilings), which fails the comparison unless the system
+    declares the metric (an "unresolved" or "xfail" expectation)."""
+    gate = tol if isinstance(tol, tolerances.Gate) else tolerances.Gate(tol)
     exp = expectation_for(system, simulator, name)
+    declared = exp is not None and exp.kind in ("xfail", "unresolved")
+    if gate.unresolved:
+        reason = gate.unresolved + (f"; declared: {exp.reason}" if declared else "")
+        return Metric(name, value, gate.tolerance, False, "unresolved", reason, unit,
+                      expected=declared)
+    ok = bool(np.isfinite(value) and value <= gate.tolerance)
     if exp is not None and exp.kind == "xfail":
-        return Metric(name, value, tol, ok, "pass" if ok else "xfail", exp.reason, unit)
-    return Metric(name, value, tol, ok, "pass" if ok else "fail", "", unit)
+        return Metric(name, value, gate.tolerance, ok, "pass" if ok else "xfail", exp.reason,
+                      unit)
+    return Metric(name, value, gate.tolerance, ok, "pass" if ok else "fail", "", unit)
 
 
 def _strict_expectations(system: System, result: "Comparison") -> None:
@@ -101,13 +126,17 @@ def _strict_expectations(system: System, result: "Comparison") -> None:
     least one of them fails; when every one passes it is an unexpected pass (strict):
     the problem was fixed and the declaration must go."""
     for exp in system.expectations:
-        if exp.kind != "xfail" or not fnmatch.fnmatch(result.simulator, exp.simulator):
+        if exp.kind not in ("xfail", "unresolved") or not fnmatch.fnmatch(result.simulator,
+                                                                          exp.simulator):
             continue
         covered = [m for m in result.metrics if fnmatch.fnmatch(m.name, exp.metric)
                    and expectation_for(system, result.simulator, m.name) is exp]
-        if covered and all(m.passed for m in covered):
+        met = any(m.status == "unresolved" for m in covered) if exp.kind == "unresolved" \
+            else not all(m.passed for m in covered)
+        if covered and not met:
             for m in covered:
-                m.status = "xpass"
+                if m.passed:
+                    m.status = "xpass"
 
 
 def characteristic_frequency(eq_modes, ref_q, ref_qd, q_eq) -> float:
@@ -233,7 +262,11 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     contacts = system.contacts(system.symbols) if "constraint_force" in sc.checks else ()
     contact_joints = tuple(c.target for c in contacts
                            if c.kind == "reaction" and c.target not in joints)
-    run = backend.simulate(mech, q0, qd0, T, dt, settings, joints + contact_joints)
+    name = sc.name
+    run = _guarded_run(backend, result, name, T, mech, q0, qd0, T, dt, settings,
+                       joints + contact_joints)
+    if run is None:
+        return
     result.wall_time += run.wall_time
     result.simulated_time += T
     if eq is None:
@@ -244,10 +277,10 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     ref_err = float(np.max(ref.error_estimate / scale))
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
     T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
-    tol = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + ref_err
+    tol = tolerances.gate(tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + ref_err,
+                          w, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
     n = min(len(run.t), len(ref.t))
     emax, erms = metrics.trajectory_errors(run.q[:n], ref.q[:n], scale)
-    name = sc.name
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_max", emax, tol))
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
     if len(system.coordinates) == 1:
@@ -255,8 +288,9 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
         p_run = metrics.mean_period(run.t[:n], run.q[:n, 0] - eq.q[0])
         if p_ref is not None:
             value = abs(p_run - p_ref) / p_ref if p_run is not None else float("inf")
-            result.metrics.append(_judge(system, backend.id, f"{name}.period", value,
-                                         tolerances.period_tolerance(w, dt, order, p_ref, zeta)))
+            result.metrics.append(_judge(system, backend.id, f"{name}.period", value, tolerances.gate(
+                tolerances.period_tolerance(w, dt, order, p_ref, zeta), w, dt, order,
+                tolerances.MAX_FREQUENCY_TOLERANCE, "relative")))
     if ref.energy is not None:
         model_energy = _energy_of(system, values, run.q[:n], run.qd[:n])
         e_scale = max(_kinetic_amplitude(system, values, ref.q, ref.qd), 1e-300)
@@ -285,8 +319,34 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
             "reactions": {j: (ref.reactions[j][:n], run.reactions[j][:n])
                           for j in joints if j in run.reactions},
-            "tolerance": tol, "scale": scale, "contacts": contact_series,
+            "tolerance": tol.tolerance, "scale": scale, "contacts": contact_series,
         }
+
+
+def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
+    """`backend.simulate(*args)`, or None when the engine raised: the run is recorded as
+    an incident (crashed, with the engine's message) and `<label>.completed` fails. A run
+    that returns non-finite states is recorded as diverged at the first such sample (its
+    metrics, computed on NaN, fail too)."""
+    try:
+        run = backend.simulate(*args)
+    except Exception as exc:  # an engine's own failure is data, not a traceback
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        result.incidents.append({"scenario": label, "outcome": "crashed", "t_reached": None,
+                                 "message": f"{type(exc).__name__}: {message}"[:500]})
+        result.metrics.append(Metric(f"{label}.completed", 0.0, 1.0, False, "fail", message,
+                                     unit="fraction of the run"))
+        return None
+    finite = np.all(np.isfinite(run.q), axis=1) & np.all(np.isfinite(run.qd), axis=1)
+    if not np.all(finite):
+        k = int(np.argmin(finite))
+        reached = float(run.t[k - 1]) if k > 0 else 0.0
+        result.incidents.append({"scenario": label, "outcome": "diverged",
+                                 "t_reached": reached,
+                                 "message": f"non-finite state at t = {run.t[k]:.6g} s"})
+        result.metrics.append(Metric(f"{label}.completed", reached / t_end, 1.0, False, "fail",
+                                     "the engine's state diverged", unit="fraction of the run"))
+    return run
 
 
 def _first_negative(t: np.ndarray, f: np.ndarray) -> float | None:
@@ -354,7 +414,9 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
 
         got = [m for m in modes_from_eigenvalues(lin.eigenvalues) if m.frequency_hz > 0]
         discrete_order = lin.extra.get("discrete_order")
-        tol = (tolerances.discrete_linearization_tolerance(w_max, dt, discrete_order)
+        tol = (tolerances.gate(tolerances.discrete_linearization_tolerance(
+                   w_max, dt, discrete_order), w_max, dt, discrete_order,
+                   tolerances.MAX_FREQUENCY_TOLERANCE, "relative")
                if discrete_order else tolerances.FD_FREQUENCY)
         for i, m in enumerate(modes):
             if i < len(got):
@@ -391,10 +453,15 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
         q0 = model.complete(guess)
         qd0 = model.velocity_basis(q0) @ (tolerances.FIT_AMPLITUDE * np.real(v[k_dof:]))
         T = max(min(t_end or 10.0, 40 / m.frequency_hz), 10 / m.frequency_hz)
-        run = backend.simulate(mech, q0, qd0, T, dt, settings, ())
+        run = _guarded_run(backend, result, f"fit_mode{i + 1}", T,
+                           mech, q0, qd0, T, dt, settings, ())
+        if run is None:
+            continue
         result.wall_time += run.wall_time
         result.simulated_time += T
-        tol = tolerances.fit_tolerance(w_max, dt, run.integrator_order)
+        tol = tolerances.gate(tolerances.fit_tolerance(w_max, dt, run.integrator_order),
+                              w_max, dt, run.integrator_order,
+                              tolerances.MAX_FREQUENCY_TOLERANCE, "relative")
         j = int(np.argmax(np.abs(v[:k_dof]) / scales))
         try:
             w_fit, z_fit = metrics.fit_damped_sinusoid(run.t, run.q[:, ind[j]] - eq.q[ind[j]],

@@ -131,7 +131,11 @@ class Expectation:
     """An exception as data (scikit-learn's common-check pattern).
 
     kind "xfail": the metric is expected to fail its gate (strict: a pass is reported);
-    kind "unsupported": the engine cannot express the mechanism (or scenario) at all.
+    kind "unsupported": the engine cannot express the mechanism (or scenario) at all;
+    kind "unresolved": at the default step the metric's error bound says nothing (outside
+    its range of w h, or above the ceiling a gate can discriminate: comparisons/
+    tolerances.py), so it is measured and shown, not judged (strict too: a declaration
+    whose metrics all resolve is reported, and their passes become unexpected).
     `simulator` and `metric` are fnmatch patterns ("*" matches all)."""
 
     simulator: str
