@@ -10,10 +10,13 @@ conventions 1-8) into one engine and runs it. The contract:
 2. `available()` returns ``(True, "")`` or ``(False, reason)``; a missing engine is a
    visible skip, never an error.
 3. `version()` is the engine's version string; it is recorded in every result.
-4. `default_settings()` returns every setting the backend uses, as JSON values, with the
-   engine's distorting defaults neutralised (SIMULATORS.md); `setting_notes()` says, per
-   key, which engine default it replaces and why. Users may override any key; unknown
-   keys raise `ValueError` naming the valid ones.
+4. Settings are declared once, in the backend's `SETTINGS` table: per key a `Setting`
+   with its default (a JSON value, the engine's distorting defaults neutralised,
+   SIMULATORS.md), the values or the type it admits, and a note saying which engine
+   default it replaces and why. `default_settings()` and `setting_notes()` derive from
+   the table. Users may override any key; `resolve_settings` checks every override
+   centrally: an unknown key, a value of the wrong type or outside the admitted values
+   raises `ValueError` naming the valid ones.
 5. `support(mechanism)` returns `Support(ok, reason)`: whether this backend can express
    the mechanism; when it cannot, the reason is reported as data, not raised.
 6. `simulate(mechanism, q0, qd0, t_end, dt, settings, reaction_joints)` builds a fresh
@@ -42,13 +45,54 @@ conventions 1-8) into one engine and runs it. The contract:
 """
 from __future__ import annotations
 
+import copy
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
+from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
 
 from ..systems.model import Mechanism
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One engine setting (contract point 4). `allowed` is either the tuple of admitted
+    values or the type of the value (a type or a tuple of types): ``float`` admits ints
+    too, ``list`` a list of numbers, ``type(None)`` null; booleans are never numbers."""
+
+    default: object
+    allowed: object
+    note: str
+
+    def check(self, engine: str, key: str, value: object) -> None:
+        """Raise `ValueError` when `value` is not admitted."""
+        if not _is_types(self.allowed):
+            if value not in self.allowed:
+                raise ValueError(f"{engine} setting {key} must be one of "
+                                 f"{', '.join(map(repr, self.allowed))}; got {value!r}")
+            return
+        types = self.allowed if isinstance(self.allowed, tuple) else (self.allowed,)
+        if not any(_has_type(value, t) for t in types):
+            names = " or ".join("null" if t is type(None) else t.__name__ for t in types)
+            raise ValueError(f"{engine} setting {key} must be {names}; got {value!r}")
+
+
+def _is_types(allowed: object) -> bool:
+    return isinstance(allowed, type) or (
+        isinstance(allowed, tuple) and all(isinstance(a, type) for a in allowed))
+
+
+def _has_type(value: object, kind: type) -> bool:
+    if kind is bool:
+        return isinstance(value, bool)
+    if isinstance(value, bool):
+        return False
+    if kind is float:
+        return isinstance(value, (int, float))
+    if kind is list:
+        return isinstance(value, (list, tuple)) and all(_has_type(v, float) for v in value)
+    return isinstance(value, kind)
 
 
 @dataclass(frozen=True)
@@ -83,6 +127,8 @@ class Linearization:
 
 class Backend(ABC):
     id: str = ""
+    #: every setting the backend uses (contract point 4), in the order they are reported
+    SETTINGS: ClassVar[Mapping[str, Setting]] = {}
 
     @abstractmethod
     def available(self) -> tuple[bool, str]:
@@ -92,12 +138,13 @@ class Backend(ABC):
     def version(self) -> str:
         """See the contract in the module docstring."""
 
-    @abstractmethod
     def default_settings(self) -> dict:
-        """See the contract in the module docstring."""
+        """Every setting's default, from `SETTINGS` (fresh copies: callers may mutate)."""
+        return {key: copy.deepcopy(s.default) for key, s in self.SETTINGS.items()}
 
     def setting_notes(self) -> dict[str, str]:
-        return {}
+        """Per setting, which engine default it replaces and why, from `SETTINGS`."""
+        return {key: s.note for key, s in self.SETTINGS.items()}
 
     def support(self, mechanism: Mechanism) -> Support:
         return Support(True)
@@ -114,10 +161,12 @@ class Backend(ABC):
 
     # helpers shared by backends
     def resolve_settings(self, settings: Mapping | None) -> dict:
-        merged = dict(self.default_settings())
+        """The defaults with the user's overrides, each checked against `SETTINGS`."""
+        merged = self.default_settings()
         for key, value in (settings or {}).items():
-            if key not in merged:
+            if key not in self.SETTINGS:
                 raise ValueError(
                     f"unknown {self.id} setting {key!r}; valid: {', '.join(sorted(merged))}")
+            self.SETTINGS[key].check(self.id, key, value)
             merged[key] = value
         return merged

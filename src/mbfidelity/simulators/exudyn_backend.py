@@ -85,7 +85,7 @@ from ..systems.model import (
     compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import Backend, Linearization, RunResult, Setting, Support
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -233,6 +233,85 @@ def _geometry(mech: Mechanism) -> _Geometry:
 
 class ExudynBackend(Backend):
     id = "exudyn"
+    SETTINGS = {
+        "solver": Setting(
+            "RK44", tuple(_SOLVER_ORDER),
+            "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 (classical "
+            "Runge-Kutta, order 4) works on the kinematic tree without Newton iterations; "
+            "also offered: RK44, RK67, RK33, ExplicitMidpoint, ExplicitEuler, "
+            "GeneralizedAlpha, TrapezoidalIndex2 (integrator_order reports the order of "
+            "the one used)."),
+        "constrained_solver": Setting(
+            "GeneralizedAlpha", _CONSTRAINT_SOLVERS,
+            "Mechanisms with closure constraints (exact index-3 constraints: Exudyn's "
+            "explicit solvers stop with 'contains constraints that cannot be solved'): "
+            "GeneralizedAlpha (Exudyn's default, order 2) or TrapezoidalIndex2 (order 2, "
+            "index-2 velocity constraints; positions drift slowly); 'solver' applies to "
+            "unconstrained mechanisms only."),
+        "constrained_spectral_radius": Setting(
+            0.9, float,
+            "GeneralizedAlpha on constrained mechanisms: Exudyn's default 0.9 kept; rho = "
+            "1 (no numerical damping) lets the index-3 multipliers oscillate (measured: "
+            "scotch yoke slot force error 1e4, slotted bar arctan damper failed Newton); "
+            "0.8-0.99 changed trajectory errors by < 10 %."),
+        "automatic_step_size": Setting(
+            False, bool,
+            "Exudyn default True lets error-controlled explicit solvers change the step; "
+            "False keeps the fixed step dt the contract asks for."),
+        "ga_spectral_radius": Setting(
+            1.0, float,
+            "GeneralizedAlpha as 'solver' (unconstrained mechanisms). Exudyn default 0.9 "
+            "adds numerical damping (energy decays); 1.0 removes it (no constraints, so "
+            "rho = 1 is stable). Constrained: constrained_spectral_radius."),
+        "ga_adaptive_step": Setting(
+            False, bool,
+            "Implicit solvers only. Exudyn default True silently reduces the step after a "
+            "failed Newton solve; False keeps dt fixed (a failure is raised instead)."),
+        "newton_relative_tolerance": Setting(
+            1e-13, float,
+            "Implicit solvers only. Exudyn default 1e-8 limits the accuracy of small "
+            "motions; tightened."),
+        "newton_absolute_tolerance": Setting(
+            1e-14, float,
+            "Implicit solvers only. Exudyn default 1e-10; tightened for small amplitudes."),
+        "modified_newton": Setting(
+            False, bool,
+            "Implicit solvers only. Exudyn default True reuses an old Jacobian; full "
+            "Newton converges to the tight tolerances."),
+        "end_of_step_accelerations": Setting(
+            True, bool,
+            "Exudyn default True (kept): explicit solvers recompute the accelerations at "
+            "the end of each step, so the sampled centre-of-mass accelerations (used for "
+            "reactions) belong to the sampled state; False leaves last-stage "
+            "accelerations."),
+        "native_linear_laws": Setting(
+            True, bool,
+            "Backend choice: laws affine in the length/coordinate and its rate (no TIME) "
+            "use Exudyn's built-in spring-damper and the tree's PD terms (C++); False "
+            "sends every law through Python user functions (same model, slower)."),
+        "write_solution_file": Setting(
+            False, bool,
+            "Exudyn default True writes coordinatesSolution.txt every 0.01 s (disk I/O "
+            "inside the timed loop); the backend samples with in-memory sensors at every "
+            "step instead (sensor write period dt replaces the 0.01 s default)."),
+        "linearization_relative_epsilon": Setting(
+            1e-4, float,
+            "linearize(): relative step of Exudyn's numerical Jacobian (K, D), a forward "
+            "difference. Exudyn default 1e-7 balances truncation and round-off at "
+            "~1e-7..1e-6 absolute error in K and D; with linearization_richardson, 1e-4 "
+            "gives ~1e-10 relative."),
+        "linearization_richardson": Setting(
+            True, bool,
+            "linearize(): True evaluates Exudyn's Jacobian at eps and eps/2 and "
+            "extrapolates (2 J(eps/2) - J(eps), error O(eps^2)); False is Exudyn's single "
+            "forward difference (what ComputeODE2Eigenvalues uses)."),
+        "linearization_constraint_step": Setting(
+            1e-5, float,
+            "linearize() with closure constraints: step (engine coordinate units) of the "
+            "central differences of Exudyn's constraint Jacobian that give the constraint "
+            "stiffness d(C lam)/du at a loaded equilibrium; Exudyn's "
+            "ComputeODE2Eigenvalues leaves this term out."),
+    }
 
     # --- identity --------------------------------------------------------------------------
     def available(self) -> tuple[bool, str]:
@@ -247,94 +326,6 @@ class ExudynBackend(Backend):
         import exudyn
 
         return str(exudyn.__version__)
-
-    def default_settings(self) -> dict:
-        return {
-            "solver": "RK44",
-            "constrained_solver": "GeneralizedAlpha",
-            "constrained_spectral_radius": 0.9,
-            "automatic_step_size": False,
-            "ga_spectral_radius": 1.0,
-            "ga_adaptive_step": False,
-            "newton_relative_tolerance": 1e-13,
-            "newton_absolute_tolerance": 1e-14,
-            "modified_newton": False,
-            "end_of_step_accelerations": True,
-            "native_linear_laws": True,
-            "write_solution_file": False,
-            "linearization_relative_epsilon": 1e-4,
-            "linearization_richardson": True,
-            "linearization_constraint_step": 1e-5,
-        }
-
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "solver": "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 "
-                      "(classical Runge-Kutta, order 4) works on the kinematic tree without "
-                      "Newton iterations; also offered: " + ", ".join(_SOLVER_ORDER)
-                      + " (integrator_order reports the order of the one used).",
-            "constrained_solver": "Mechanisms with closure constraints (exact index-3 "
-                                  "constraints: Exudyn's explicit solvers stop with "
-                                  "'contains constraints that cannot be solved'): "
-                                  "GeneralizedAlpha (Exudyn's default, order 2) or "
-                                  "TrapezoidalIndex2 (order 2, index-2 velocity "
-                                  "constraints; positions drift slowly); 'solver' applies "
-                                  "to unconstrained mechanisms only.",
-            "constrained_spectral_radius": "GeneralizedAlpha on constrained mechanisms: "
-                                           "Exudyn's default 0.9 kept; rho = 1 (no "
-                                           "numerical damping) lets the index-3 multipliers "
-                                           "oscillate (measured: scotch yoke slot force "
-                                           "error 1e4, slotted bar arctan damper failed "
-                                           "Newton); 0.8-0.99 changed trajectory errors by "
-                                           "< 10 %.",
-            "automatic_step_size": "Exudyn default True lets error-controlled explicit "
-                                   "solvers change the step; False keeps the fixed step dt "
-                                   "the contract asks for.",
-            "ga_spectral_radius": "GeneralizedAlpha as 'solver' (unconstrained mechanisms). "
-                                  "Exudyn default 0.9 adds numerical damping (energy "
-                                  "decays); 1.0 removes it (no constraints, so rho = 1 is "
-                                  "stable). Constrained: constrained_spectral_radius.",
-            "ga_adaptive_step": "Implicit solvers only. Exudyn default True silently reduces "
-                                "the step after a failed Newton solve; False keeps dt fixed "
-                                "(a failure is raised instead).",
-            "newton_relative_tolerance": "Implicit solvers only. Exudyn default 1e-8 limits "
-                                         "the accuracy of small motions; tightened.",
-            "newton_absolute_tolerance": "Implicit solvers only. Exudyn default 1e-10; "
-                                         "tightened for small amplitudes.",
-            "modified_newton": "Implicit solvers only. Exudyn default True reuses an old "
-                               "Jacobian; full Newton converges to the tight tolerances.",
-            "end_of_step_accelerations": "Exudyn default True (kept): explicit solvers "
-                                         "recompute the accelerations at the end of each "
-                                         "step, so the sampled centre-of-mass accelerations "
-                                         "(used for reactions) belong to the sampled state; "
-                                         "False leaves last-stage accelerations.",
-            "native_linear_laws": "Backend choice: laws affine in the length/coordinate and "
-                                  "its rate (no TIME) use Exudyn's built-in spring-damper and "
-                                  "the tree's PD terms (C++); False sends every law through "
-                                  "Python user functions (same model, slower).",
-            "write_solution_file": "Exudyn default True writes coordinatesSolution.txt every "
-                                   "0.01 s (disk I/O inside the timed loop); the backend "
-                                   "samples with in-memory sensors at every step instead "
-                                   "(sensor write period dt replaces the 0.01 s default).",
-            "linearization_relative_epsilon": "linearize(): relative step of Exudyn's "
-                                              "numerical Jacobian (K, D), a forward "
-                                              "difference. Exudyn default 1e-7 balances "
-                                              "truncation and round-off at ~1e-7..1e-6 "
-                                              "absolute error in K and D; with "
-                                              "linearization_richardson, 1e-4 gives ~1e-10 "
-                                              "relative.",
-            "linearization_richardson": "linearize(): True evaluates Exudyn's Jacobian at "
-                                        "eps and eps/2 and extrapolates (2 J(eps/2) - "
-                                        "J(eps), error O(eps^2)); False is Exudyn's single "
-                                        "forward difference (what ComputeODE2Eigenvalues "
-                                        "uses).",
-            "linearization_constraint_step": "linearize() with closure constraints: step "
-                                             "(engine coordinate units) of the central "
-                                             "differences of Exudyn's constraint Jacobian "
-                                             "that give the constraint stiffness "
-                                             "d(C lam)/du at a loaded equilibrium; Exudyn's "
-                                             "ComputeODE2Eigenvalues leaves this term out.",
-        }
 
     # --- support ---------------------------------------------------------------------------
     def support(self, mechanism: Mechanism) -> Support:
@@ -700,12 +691,7 @@ class ExudynBackend(Backend):
     @staticmethod
     def _solver_for(mechanism: Mechanism, cfg: dict) -> str:
         """The solver this mechanism runs: 'solver' without closure constraints,
-        'constrained_solver' with them (both settings are validated either way)."""
-        for key, valid in (("solver", tuple(_SOLVER_ORDER)),
-                           ("constrained_solver", _CONSTRAINT_SOLVERS)):
-            if str(cfg[key]) not in valid:
-                raise ValueError(f"unknown exudyn {key} {cfg[key]!r}; valid: "
-                                 f"{', '.join(valid)}")
+        'constrained_solver' with them."""
         return str(cfg["constrained_solver" if mechanism.constraints else "solver"])
 
     @staticmethod

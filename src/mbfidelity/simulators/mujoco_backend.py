@@ -84,7 +84,7 @@ from ..systems.model import (
     compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import Backend, Linearization, RunResult, Setting, Support
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -915,6 +915,127 @@ class _PassiveInstalled:
 
 class MujocoBackend(Backend):
     id = "mujoco"
+    SETTINGS = {
+        "integrator": Setting(
+            "RK4", tuple(_INTEGRATORS),
+            "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) phase "
+            "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
+            "every custom and time-dependent force, is evaluated at each stage at the "
+            "stage time). Also accepted: Euler, implicit, implicitfast (order 1). With "
+            "Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
+        "native_springs": Setting(
+            True, bool,
+            "true: force laws linear in length/coordinate and rate (no time) use MuJoCo's "
+            "own tendon stiffness/springlength/damping and joint "
+            "stiffness/springref/damping (exact for the description, free length 0 "
+            "included); false: every law goes through the passive callback. Only the "
+            "implicit integrators see the difference (they differentiate native damping "
+            "but not callback forces, mujoco #2433)."),
+        "linearization": Setting(
+            "inverseFD", _LINEARIZATIONS,
+            "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD (finite "
+            "differences of mj_inverse), central differences by combining +eps and -eps; "
+            "eigenvalues of the first-order system. 'transitionFD': mjd_transitionFD "
+            "discrete A on a copy of the model with the Euler integrator when the run "
+            "uses RK4 (RK4 is not supported there), mapped with ln(lambda)/dt; carries "
+            "the step's own O(h) error."),
+        "fd_eps": Setting(
+            1e-6, float,
+            "Finite-difference step of mjd_inverseFD / mjd_transitionFD."),
+        "autoreset": Setting(
+            False, bool,
+            "false replaces MuJoCo's default (autoreset on), which silently resets the "
+            "state to qpos0 when an acceleration is NaN or huge and would show a "
+            "divergence as a jump back to the start; off, it shows as NaN/inf."),
+        "constraint_timeconst_steps": Setting(
+            2.0, float,
+            "Closure equalities: solref time constant in time steps (solref[0] = steps * "
+            "dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. MuJoCo clamps "
+            "it to 2 dt unless refsafe is off; measured on the scotch yoke with RK4: 2 is "
+            "best (1: same trajectory, 20x the force error; 0.5: 15x worse; 0.3: "
+            "unstable)."),
+        "constraint_dampratio": Setting(
+            1.0, float,
+            "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
+            "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
+        "constraint_solimp": Setting(
+            [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
+            "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
+            "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
+            "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
+            "trajectory error 10x larger."),
+        "refsafe": Setting(
+            True, bool,
+            "MuJoCo's default (on): solref time constants below 2 dt are raised to 2 dt. "
+            "Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
+        "diagexact": Setting(
+            True, bool,
+            "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint regularisation "
+            "uses the exact diagonal of J M^-1 J^T instead of the body_invweight0 "
+            "estimate; with the estimate the scotch yoke's slot force was 6 % low at t = "
+            "0 and its violation 3e-6 m (5e-9 m exact)."),
+        "slider_mass_ratio": Setting(
+            0.3, float,
+            "Mass of each point-on-line slider as a fraction of the largest point mass "
+            "its pin body can give up (the rest keeps a positive inertia); it is taken "
+            "out of the pin body (exact while the constraint holds). Lighter sliders pass "
+            "less inertial force through the soft connect but condition it worse across "
+            "rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
+        "massless_mass_ratio": Setting(
+            3e-4, float,
+            "Substitute mass of a massless body that a constraint or point force loads "
+            "(e.g. a massless pin in a slot), times the lightest body's mass; weight "
+            "cancelled. Not compensated: it adds inertia, while a lighter one softens the "
+            "constraints through it (their stiffness scales with the mass they move). "
+            "Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give similar "
+            "trajectories (~5e-3), 1e-3 three times the frequency error (6e-4), 1e-2 and "
+            "1e-4 2x-8x worse trajectories."),
+        "link_mass_ratio": Setting(
+            1e-9, float,
+            "Substitute mass of a massless kinematic link that cannot be folded (several "
+            "child joints, no constraint on it), times the lightest body's mass; its tree "
+            "children carry the inertia, so it can be tiny (belt arm: 1e-3 gave 3e-6 "
+            "trajectory error, 1e-9 gives 8e-10)."),
+        "substitute_gravcomp": Setting(
+            True, bool,
+            "Cancel the weight of substitute bodies whose mass is not taken from a body "
+            "of the description (MuJoCo body gravcomp=1)."),
+        "rolling": Setting(
+            "coupling", ("coupling", "contact"),
+            "'coupling' (default): a rolling LinearCoupling is a tendon equality (an "
+            "exact linear relation, soft like every equality). 'contact': a disc inside a "
+            "ring is built as friction contact (sphere disc, ring of ring_segments boxes, "
+            "the arm's length freed by a radial slide so that the contact's normal force "
+            "holds the disc); the coupling's force is the contacts' generalized force on "
+            "the disc's coordinate over its coefficient, its violation the accumulated "
+            "slip c.q - const. linearize always uses the coupling."),
+        "contact_timeconst_steps": Setting(
+            2.0, float,
+            "rolling='contact': solref[0] of the contacts in steps."),
+        "contact_dampratio": Setting(
+            1.0, float,
+            "rolling='contact': solref[1] of the contacts."),
+        "contact_solimp": Setting(
+            [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
+            "rolling='contact': solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
+            "energy: 0.215 rad error in SIMULATORS.md)."),
+        "contact_friction": Setting(
+            1.0, float,
+            "rolling='contact': sliding friction coefficient of the disc."),
+        "contact_cone": Setting(
+            "pyramidal", ("pyramidal", "elliptic"),
+            "rolling='contact': MuJoCo friction cone, pyramidal or elliptic."),
+        "impratio": Setting(
+            1.0, float,
+            "rolling='contact': MuJoCo impratio (friction-to-normal impedance)."),
+        "noslip_iterations": Setting(
+            0, int,
+            "rolling='contact': MuJoCo's noslip post-processing iterations (0 = off, "
+            "MuJoCo's default); they remove the regularised friction's creep."),
+        "ring_segments": Setting(
+            720, int,
+            "rolling='contact': number of boxes forming the ring."),
+    }
 
     def available(self) -> tuple[bool, str]:
         try:
@@ -928,148 +1049,11 @@ class MujocoBackend(Backend):
 
         return mujoco.__version__
 
-    def default_settings(self) -> dict:
-        return {
-            "integrator": "RK4",
-            "native_springs": True,
-            "linearization": "inverseFD",
-            "fd_eps": 1e-6,
-            "autoreset": False,
-            "constraint_timeconst_steps": 2.0,
-            "constraint_dampratio": 1.0,
-            "constraint_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
-            "refsafe": True,
-            "diagexact": True,
-            "slider_mass_ratio": 0.3,
-            "massless_mass_ratio": 3e-4,
-            "link_mass_ratio": 1e-9,
-            "substitute_gravcomp": True,
-            "rolling": "coupling",
-            "contact_timeconst_steps": 2.0,
-            "contact_dampratio": 1.0,
-            "contact_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
-            "contact_friction": 1.0,
-            "contact_cone": "pyramidal",
-            "impratio": 1.0,
-            "noslip_iterations": 0,
-            "ring_segments": 720,
-        }
-
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "integrator": (
-                "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) "
-                "phase error on a pendulum) by 'RK4' (fourth order; the passive callback, "
-                "hence every custom and time-dependent force, is evaluated at each stage at "
-                "the stage time). Also accepted: Euler, implicit, implicitfast (order 1). "
-                "With Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
-            "native_springs": (
-                "true: force laws linear in length/coordinate and rate (no time) use "
-                "MuJoCo's own tendon stiffness/springlength/damping and joint "
-                "stiffness/springref/damping (exact for the description, free length 0 "
-                "included); false: every law goes through the passive callback. Only the "
-                "implicit integrators see the difference (they differentiate native "
-                "damping but not callback forces, mujoco #2433)."),
-            "linearization": (
-                "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD "
-                "(finite differences of mj_inverse), central differences by combining "
-                "+eps and -eps; eigenvalues of the first-order system. 'transitionFD': "
-                "mjd_transitionFD discrete A on a copy of the model with the Euler "
-                "integrator when the run uses RK4 (RK4 is not supported there), mapped "
-                "with ln(lambda)/dt; carries the step's own O(h) error."),
-            "fd_eps": "Finite-difference step of mjd_inverseFD / mjd_transitionFD.",
-            "autoreset": (
-                "false replaces MuJoCo's default (autoreset on), which silently resets the "
-                "state to qpos0 when an acceleration is NaN or huge and would show a "
-                "divergence as a jump back to the start; off, it shows as NaN/inf."),
-            "constraint_timeconst_steps": (
-                "Closure equalities: solref time constant in time steps (solref[0] = "
-                "steps * dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. "
-                "MuJoCo clamps it to 2 dt unless refsafe is off; measured on the scotch "
-                "yoke with RK4: 2 is best (1: same trajectory, 20x the force error; 0.5: "
-                "15x worse; 0.3: unstable)."),
-            "constraint_dampratio": (
-                "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
-                "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
-            "constraint_solimp": (
-                "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
-                "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
-                "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
-                "trajectory error 10x larger."),
-            "refsafe": (
-                "MuJoCo's default (on): solref time constants below 2 dt are raised to "
-                "2 dt. Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
-            "diagexact": (
-                "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint "
-                "regularisation uses the exact diagonal of J M^-1 J^T instead of the "
-                "body_invweight0 estimate; with the estimate the scotch yoke's slot force "
-                "was 6 % low at t = 0 and its violation 3e-6 m (5e-9 m exact)."),
-            "slider_mass_ratio": (
-                "Mass of each point-on-line slider as a fraction of the largest point mass "
-                "its pin body can give up (the rest keeps a positive inertia); it is taken "
-                "out of the pin body (exact while the constraint holds). Lighter sliders "
-                "pass less inertial force through the soft connect but condition it worse "
-                "across rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
-            "massless_mass_ratio": (
-                "Substitute mass of a massless body that a constraint or point force "
-                "loads (e.g. a massless pin in a slot), times the lightest body's mass; "
-                "weight cancelled. Not compensated: it adds inertia, while a lighter one "
-                "softens the constraints through it (their stiffness scales with the mass "
-                "they move). Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give "
-                "similar trajectories (~5e-3), 1e-3 three times the frequency error "
-                "(6e-4), 1e-2 and 1e-4 2x-8x worse trajectories."),
-            "link_mass_ratio": (
-                "Substitute mass of a massless kinematic link that cannot be folded "
-                "(several child joints, no constraint on it), times the lightest body's "
-                "mass; its tree children carry the inertia, so it can be tiny (belt arm: "
-                "1e-3 gave 3e-6 trajectory error, 1e-9 gives 8e-10)."),
-            "substitute_gravcomp": (
-                "Cancel the weight of substitute bodies whose mass is not taken from a "
-                "body of the description (MuJoCo body gravcomp=1)."),
-            "rolling": (
-                "'coupling' (default): a rolling LinearCoupling is a tendon equality (an "
-                "exact linear relation, soft like every equality). 'contact': a disc "
-                "inside a ring is built as friction contact (sphere disc, ring of "
-                "ring_segments boxes, the arm's length freed by a radial slide so that "
-                "the contact's normal force holds the disc); the coupling's force is the "
-                "contacts' generalized force on the disc's coordinate over its "
-                "coefficient, its violation the accumulated slip c.q - const. "
-                "linearize always uses the coupling."),
-            "contact_timeconst_steps": "rolling='contact': solref[0] of the contacts in steps.",
-            "contact_dampratio": "rolling='contact': solref[1] of the contacts.",
-            "contact_solimp": (
-                "rolling='contact': solimp of the contacts (MuJoCo's default 0.9 0.95 "
-                "lost energy: 0.215 rad error in SIMULATORS.md)."),
-            "contact_friction": "rolling='contact': sliding friction coefficient of the disc.",
-            "contact_cone": "rolling='contact': MuJoCo friction cone, pyramidal or elliptic.",
-            "impratio": "rolling='contact': MuJoCo impratio (friction-to-normal impedance).",
-            "noslip_iterations": (
-                "rolling='contact': MuJoCo's noslip post-processing iterations (0 = off, "
-                "MuJoCo's default); they remove the regularised friction's creep."),
-            "ring_segments": "rolling='contact': number of boxes forming the ring.",
-        }
-
     def support(self, mechanism: Mechanism) -> Support:
         reason = _check(mechanism)
         return Support(not reason, reason)
 
     # --- translation ---------------------------------------------------------------------
-    def _resolve(self, settings: Mapping | None) -> dict:
-        s = self.resolve_settings(settings)
-        if s["integrator"] not in _INTEGRATORS:
-            raise ValueError(f"mujoco setting integrator must be one of {list(_INTEGRATORS)}, "
-                             f"got {s['integrator']!r}")
-        if s["linearization"] not in _LINEARIZATIONS:
-            raise ValueError(f"mujoco setting linearization must be one of {_LINEARIZATIONS}, "
-                             f"got {s['linearization']!r}")
-        if s["rolling"] not in ("coupling", "contact"):
-            raise ValueError(f"mujoco setting rolling must be 'coupling' or 'contact', "
-                             f"got {s['rolling']!r}")
-        if s["contact_cone"] not in ("pyramidal", "elliptic"):
-            raise ValueError(f"mujoco setting contact_cone must be 'pyramidal' or 'elliptic', "
-                             f"got {s['contact_cone']!r}")
-        return s
-
     def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
               dt: float | None = None) -> _Plan:
         reason = _check(mechanism)
@@ -1107,7 +1091,7 @@ class MujocoBackend(Backend):
         """The MJCF text of the translated mechanism (with the integrator setting and,
         when given, the time step), to save and load with ``MjModel.from_xml_path``.
         Laws that need the passive callback are not in the file."""
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         xml = self._plan(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
@@ -1130,7 +1114,7 @@ class MujocoBackend(Backend):
                  reaction_joints: Sequence[str] = ()) -> RunResult:
         import mujoco
 
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         plan = self._plan(mechanism, s, dt=dt)
         for name in reaction_joints:
             mechanism.joint(name)  # KeyError for an unknown joint
@@ -1341,7 +1325,7 @@ class MujocoBackend(Backend):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         import mujoco
 
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         s["rolling"] = "coupling"  # a contact has no linearization: the exact coupling
         plan = self._plan(mechanism, s, autonomous=True, dt=dt)
         n, eps = plan.n, float(s["fd_eps"])

@@ -89,7 +89,7 @@ from ..systems.model import (
     compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import Backend, Linearization, RunResult, Setting, Support
 
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
 _ROLLING = ("coupling", "contact")
@@ -498,6 +498,140 @@ class _Plan:
 
 class PyBulletBackend(Backend):
     id = "pybullet"
+    SETTINGS = {
+        "joint_velocity_motors": Setting(
+            False, bool,
+            "False: every joint's default velocity motor (target 0) is switched off with "
+            "VELOCITY_CONTROL force=0. PyBullet's default (True here) locks the joints "
+            "(bullet3 #2463)."),
+        "linear_damping": Setting(
+            0.0, float,
+            "Replaces the engine default 0.04 (a velocity-proportional plus quadratic "
+            "drag on every link: -15 % period on a 2 rad swing). Set with its own "
+            "changeDynamics call: PyBullet's body-level setters (linearDamping, "
+            "angularDamping, maxJointVelocity) reset the link index to -1, so "
+            "mass/inertia passed in the same call land on the base (it becomes a floating "
+            "base)."),
+        "angular_damping": Setting(
+            0.0, float,
+            "Replaces the engine default 0.04 (see linear_damping)."),
+        "max_joint_velocity": Setting(
+            1.0e6, float,
+            "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate."),
+        "explicit_inertia": Setting(
+            True, bool,
+            "True: the description's mass and central inertia are set on every link with "
+            "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
+            "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
+            "No collision shapes are created, so there are no contacts between links."),
+        "sleeping": Setting(
+            False, bool,
+            "False: deactivation disabled. PyBullet multibodies created without "
+            "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared joint "
+            "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
+        "massless_link_mass": Setting(
+            0.0, float,
+            "Mass given to the description's massless link bodies; 0 (default) is exact: "
+            "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
+            "child. A positive value is a substitute whose effect shows in the error."),
+        "reaction_method": Setting(
+            "inverse_dynamics", _REACTION_METHODS,
+            "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
+            "massless prismatic joints in front of each reaction joint, at the engine's "
+            "state and acceleration of the same step. 'joint_sensor': "
+            "enableJointForceTorqueSensor (world-space feedback); exact on a single link, "
+            "wrong on chains in motion (its constraint pass re-adds Coriolis terms)."),
+        "linearize_step": Setting(
+            1e-6, float,
+            "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
+            "calculateInverseDynamics and of the applied force elements."),
+        "constraint_erp": Setting(
+            1.0, float,
+            "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
+            "PRISMATIC constraints obey). The constraint solve is velocity-level, J(q_k) "
+            "v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error and "
+            "leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; erp "
+            "0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
+            "eccentric cam). Set only for constrained mechanisms."),
+        "gear_erp": Setting(
+            0.0, float,
+            "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
+            "coupling solved at velocity level keeps its initial value exactly once the "
+            "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
+            "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
+            "solver's early exit (solver_residual_threshold), not from a missing erp. "
+            "When > 0, relativePositionTarget is set to the coupling's constant."),
+        "constraint_max_force": Setting(
+            1.0e12, float,
+            "maxForce of every constraint; the engine default 500 N would clip the "
+            "constraint forces (e.g. the start of a fast run)."),
+        "solver_iterations": Setting(
+            50, int,
+            "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
+            "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
+        "solver_residual_threshold": Setting(
+            0.0, float,
+            "solverResidualThreshold; the engine default 1e-7 ends the sweeps early (that "
+            "is why the iteration count 'had no effect'): it left a 1e-5 m drift of the "
+            "rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep (belt "
+            "and rolling couplings then hold to 1e-15; same wall time)."),
+        "point_on_line": Setting(
+            "prismatic", _POINT_ON_LINE,
+            "'prismatic' (default): a rotor link (revolute, no mass, inertia "
+            "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
+            "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
+            "under the pin before every step (changeConstraint(jointChildPivot)): the "
+            "engine evaluates the Jacobian at a fixed body point, and with the pivot at "
+            "the slot's line point a slot turning about that point receives no torque "
+            "(measured on the slotted bar). One normal row: well conditioned. 'slider': a "
+            "slider link (prismatic along the slot, mass slider_mass_ratio x the smallest "
+            "body mass) and a POINT2POINT pin -> slider; its two world-axis rows have "
+            "effective masses 1/m_slider along the slot and O(1) across it, which "
+            "Gauss-Seidel cannot separate when the slot is oblique (the slotted bar "
+            "diverges); fine for slots along x or y."),
+        "rotor_inertia_ratio": Setting(
+            1e-6, float,
+            "Inertia of the rotor links of point_on_line='prismatic', relative to the "
+            "smallest body inertia. The rotor turns with the slot body, so its inertia is "
+            "the substitute's only error; results were identical from 1e-3 to 1e-12."),
+        "slider_mass_ratio": Setting(
+            1e-6, float,
+            "Mass of the slider links of point_on_line='slider', relative to the smallest "
+            "body mass (it moves with the pin: an added point mass)."),
+        "massless_leaf_mass_ratio": Setting(
+            1e-6, float,
+            "Mass (and, on a revolute joint, inertia) given to a massless body that "
+            "carries nothing but is held by a closure constraint (e.g. a pin on its own "
+            "guide): zero would make the articulated-body algorithm singular. Relative to "
+            "the smallest body mass/inertia; results are the same from 1e-3 to 1e-7, 1e-8 "
+            "diverged (slotted link)."),
+        "rolling": Setting(
+            "coupling", _ROLLING,
+            "'coupling' (default): a LinearCoupling becomes a JOINT_GEAR on the two "
+            "engine joint values it involves (exact at velocity level). 'contact': a "
+            "rolling coupling of a disc on a radius arm inside a circular track is "
+            "replaced by friction contact: the hub rides on a massless radial slider, a "
+            "sphere of the disc's radius touches a ring of contact_ring_boxes boxes "
+            "(polygon with the track circle as incircle) on massless fixed links of the "
+            "track; the coupling's Phi is then the measured slip."),
+        "contact_friction": Setting(
+            1.0, float,
+            "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
+            "Contact variant only."),
+        "contact_erp": Setting(
+            0.2, float,
+            "contactERP and frictionERP of the contact variant (engine 0.2)."),
+        "contact_ring_boxes": Setting(
+            720, int,
+            "Boxes in the ring of the contact variant (16 per fixed link: "
+            "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
+            "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
+        "contact_breaking_threshold": Setting(
+            0.02, float,
+            "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
+            "Smaller values lowered the trajectory error of the contact variant and "
+            "raised its slip (see the report)."),
+    }
 
     # --- contract points 1-5 ---------------------------------------------------------
     def available(self) -> tuple[bool, str]:
@@ -514,145 +648,6 @@ class PyBulletBackend(Backend):
         except Exception:  # pragma: no cover
             import pybullet
             return f"api {pybullet.getAPIVersion()}"
-
-    def default_settings(self) -> dict:
-        return {
-            "joint_velocity_motors": False,
-            "linear_damping": 0.0,
-            "angular_damping": 0.0,
-            "max_joint_velocity": 1.0e6,
-            "explicit_inertia": True,
-            "sleeping": False,
-            "massless_link_mass": 0.0,
-            "reaction_method": "inverse_dynamics",
-            "linearize_step": 1.0e-6,
-            # closure constraints (used only by mechanisms that have them)
-            "constraint_erp": 1.0,
-            "gear_erp": 0.0,
-            "constraint_max_force": 1.0e12,
-            "solver_iterations": 50,
-            "solver_residual_threshold": 0.0,
-            "point_on_line": "prismatic",
-            "rotor_inertia_ratio": 1.0e-6,
-            "slider_mass_ratio": 1.0e-6,
-            "massless_leaf_mass_ratio": 1.0e-6,
-            "rolling": "coupling",
-            "contact_friction": 1.0,
-            "contact_erp": 0.2,
-            "contact_ring_boxes": 720,
-            "contact_breaking_threshold": 0.02,
-        }
-
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "joint_velocity_motors": (
-                "False: every joint's default velocity motor (target 0) is switched off with "
-                "VELOCITY_CONTROL force=0. PyBullet's default (True here) locks the joints "
-                "(bullet3 #2463)."),
-            "linear_damping": (
-                "Replaces the engine default 0.04 (a velocity-proportional plus quadratic drag "
-                "on every link: -15 % period on a 2 rad swing). Set with its own changeDynamics "
-                "call: PyBullet's body-level setters (linearDamping, angularDamping, "
-                "maxJointVelocity) reset the link index to -1, so mass/inertia passed in the "
-                "same call land on the base (it becomes a floating base)."),
-            "angular_damping": "Replaces the engine default 0.04 (see linear_damping).",
-            "max_joint_velocity": (
-                "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate."),
-            "explicit_inertia": (
-                "True: the description's mass and central inertia are set on every link with "
-                "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
-                "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
-                "No collision shapes are created, so there are no contacts between links."),
-            "sleeping": (
-                "False: deactivation disabled. PyBullet multibodies created without "
-                "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared joint "
-                "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
-            "massless_link_mass": (
-                "Mass given to the description's massless link bodies; 0 (default) is exact: "
-                "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
-                "child. A positive value is a substitute whose effect shows in the error."),
-            "reaction_method": (
-                "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
-                "massless prismatic joints in front of each reaction joint, at the engine's "
-                "state and acceleration of the same step. 'joint_sensor': "
-                "enableJointForceTorqueSensor (world-space feedback); exact on a single link, "
-                "wrong on chains in motion (its constraint pass re-adds Coriolis terms)."),
-            "linearize_step": (
-                "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
-                "calculateInverseDynamics and of the applied force elements."),
-            "constraint_erp": (
-                "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
-                "PRISMATIC constraints obey). The constraint solve is velocity-level, "
-                "J(q_k) v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error "
-                "and leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; "
-                "erp 0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
-                "eccentric cam). Set only for constrained mechanisms."),
-            "gear_erp": (
-                "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
-                "coupling solved at velocity level keeps its initial value exactly once the "
-                "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
-                "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
-                "solver's early exit (solver_residual_threshold), not from a missing erp. "
-                "When > 0, relativePositionTarget is set to the coupling's constant."),
-            "constraint_max_force": (
-                "maxForce of every constraint; the engine default 500 N would clip the "
-                "constraint forces (e.g. the start of a fast run)."),
-            "solver_iterations": (
-                "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
-                "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
-            "solver_residual_threshold": (
-                "solverResidualThreshold; the engine default 1e-7 ends the sweeps early "
-                "(that is why the iteration count 'had no effect'): it left a 1e-5 m drift "
-                "of the rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep "
-                "(belt and rolling couplings then hold to 1e-15; same wall time)."),
-            "point_on_line": (
-                "'prismatic' (default): a rotor link (revolute, no mass, inertia "
-                "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
-                "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
-                "under the pin before every step (changeConstraint(jointChildPivot)): the "
-                "engine evaluates the Jacobian at a fixed body point, and with the pivot "
-                "at the slot's line point a slot turning about that point receives no "
-                "torque (measured on the slotted bar). One normal row: well conditioned. "
-                "'slider': a slider link (prismatic along the slot, mass slider_mass_ratio "
-                "x the smallest body mass) and a POINT2POINT pin -> slider; its two world-"
-                "axis rows have effective masses 1/m_slider along the slot and O(1) across "
-                "it, which Gauss-Seidel cannot separate when the slot is oblique (the "
-                "slotted bar diverges); fine for slots along x or y."),
-            "rotor_inertia_ratio": (
-                "Inertia of the rotor links of point_on_line='prismatic', relative to the "
-                "smallest body inertia. The rotor turns with the slot body, so its inertia "
-                "is the substitute's only error; results were identical from 1e-3 to "
-                "1e-12."),
-            "slider_mass_ratio": (
-                "Mass of the slider links of point_on_line='slider', relative to the "
-                "smallest body mass (it moves with the pin: an added point mass)."),
-            "massless_leaf_mass_ratio": (
-                "Mass (and, on a revolute joint, inertia) given to a massless body that "
-                "carries nothing but is held by a closure constraint (e.g. a pin on its "
-                "own guide): zero would make the articulated-body algorithm singular. "
-                "Relative to the smallest body mass/inertia; results are the same from "
-                "1e-3 to 1e-7, 1e-8 diverged (slotted link)."),
-            "rolling": (
-                "'coupling' (default): a LinearCoupling becomes a JOINT_GEAR on the two "
-                "engine joint values it involves (exact at velocity level). 'contact': a "
-                "rolling coupling of a disc on a radius arm inside a circular track is "
-                "replaced by friction contact: the hub rides on a massless radial slider, a "
-                "sphere of the disc's radius touches a ring of contact_ring_boxes boxes "
-                "(polygon with the track circle as incircle) on massless fixed links of the "
-                "track; the coupling's Phi is then the measured slip."),
-            "contact_friction": (
-                "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
-                "Contact variant only."),
-            "contact_erp": "contactERP and frictionERP of the contact variant (engine 0.2).",
-            "contact_ring_boxes": (
-                "Boxes in the ring of the contact variant (16 per fixed link: "
-                "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
-                "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
-            "contact_breaking_threshold": (
-                "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
-                "Smaller values lowered the trajectory error of the contact variant and "
-                "raised its slip (see the report)."),
-        }
 
     def support(self, mechanism: Mechanism) -> Support:
         for j in mechanism.joints:
@@ -1025,12 +1020,6 @@ class PyBulletBackend(Backend):
         import pybullet as p
 
         cfg = self.resolve_settings(settings)
-        if cfg["reaction_method"] not in _REACTION_METHODS:
-            raise ValueError(f"reaction_method must be one of {_REACTION_METHODS}")
-        if cfg["rolling"] not in _ROLLING:
-            raise ValueError(f"rolling must be one of {_ROLLING}")
-        if cfg["point_on_line"] not in _POINT_ON_LINE:
-            raise ValueError(f"point_on_line must be one of {_POINT_ON_LINE}")
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")

@@ -107,7 +107,7 @@ from ..systems.model import (
     as_column,
     rotation,
 )
-from .base import Backend, Linearization, RunResult, Support
+from .base import Backend, Linearization, RunResult, Setting, Support
 
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
@@ -1131,6 +1131,109 @@ def _point_state(st: tuple[float, ...], local) -> tuple[float, float, float, flo
 
 class PymunkBackend(Backend):
     id = "pymunk"
+    SETTINGS = {
+        "error_bias": Setting(
+            0.0, float,
+            "Fraction of a joint's position error left after 1 s, on every constraint. "
+            "Pymunk's default (1-0.1)^60 = 1.8e-3 removes only part of the error per step "
+            "and its correction velocity enters the real velocity: measured on the 2 rad "
+            "compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory error and "
+            "5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error in the next "
+            "step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad."),
+        "iterations": Setting(
+            50, int,
+            "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk default "
+            "10). A single joint is solved in one iteration; a chain is not: on the small "
+            "double-pendulum swing the reaction error was 1.8e-3 (relative) with 10 and "
+            "1.4e-4 with 20 or more (20, 30, 50, 100 identical; trajectories identical "
+            "from 10 on, reactions 65 % off with 1). 50 keeps a margin at negligible "
+            "cost. Closed loops with slider substitutes need it: the scotch yoke diverged "
+            "with 10 at slider_mass_fraction 0.1."),
+        "start_iterations": Setting(
+            1000, int,
+            "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
+            "step from the previous step's impulses; the first step has none, and a "
+            "closed loop or a slider substitute then leaves it unconverged: with 50 "
+            "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
+            "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
+            "unchanged (they converge from the warm start). Tree mechanisms were already "
+            "converged (bit-identical results)."),
+        "damping": Setting(
+            1.0, float,
+            "space.damping, the fraction of velocity kept after 1 s. Pymunk's default is "
+            "already 1 (no damping); stated explicitly so it is recorded."),
+        "sleep_time_threshold": Setting(
+            None, (float, type(None)),
+            "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
+            "Sleeping froze a small oscillation when enabled (SIMULATORS.md)."),
+        "element_forces": Setting(
+            "position_updated", _FORCE_MODES,
+            "When force elements are evaluated in a step. Chipmunk moves positions (x += "
+            "h v) before it applies body.force, so a force computed from the sampled "
+            "state before space.step() ('step_start', what user code usually does) makes "
+            "the step explicit Euler for that force: energy grew by 114 % (elastic "
+            "pendulum) and 90 % (sliding block) in 10 s at h = 1e-3. 'position_updated' "
+            "(default) evaluates the laws at x + h v and t + h, the configuration at "
+            "which Chipmunk pre-steps its constraints and its own DampedSpring: a "
+            "consistent semi-implicit Euler step (energy drift 0.4-0.5 %). No engine "
+            "default is replaced: Pymunk has no hook for laws of length rate or time, so "
+            "the backend applies body forces and torques."),
+        "groove_half_length": Setting(
+            1000.0, float,
+            "Chipmunk grooves are finite segments: a prismatic side without a limit (and "
+            "every point-on-line slot) is given this extent in m (the groove ends act as "
+            "stops). Finite limits of the description are used as the groove ends."),
+        "slider_mass_fraction": Setting(
+            0.5, float,
+            "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
+            "exact (pin off the pin body's centre of mass, or slot line off the slot "
+            "body's): a 'pin slider' (point mass pinned to the pin point) and/or a 'slot "
+            "carrier' (glued to the slot body, centre on the slot line) runs in an exact "
+            "groove. Its mass is this fraction of the host body's effective mass at that "
+            "point, m I / (I + m d^2). Chipmunk has no such substitute and no massless "
+            "bodies. With compensation (below) the fraction does not enter the dynamics "
+            "(scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and 0.5), only the "
+            "convergence of the Gauss-Seidel solve, since a light body between heavy ones "
+            "converges slowly: from the cold start (no cached impulses) the slot force at "
+            "samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at 0.5 with 50 iterations; the "
+            "rhombus loop diverged at 0.05 with 50 iterations (exact with 500). Must stay "
+            "below 1 (the host keeps a positive moment)."),
+        "slider_compensation": Setting(
+            True, bool,
+            "true: the substitute's mass (and a slot carrier's moment) is taken out of "
+            "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
+            "host + substitute have exactly the described inertia; false: the substitute "
+            "adds its mass to the mechanism (teaching mode: shows the dynamic effect of a "
+            "slider mass; measured with fraction 0.05, 10 s: trajectory error 0.33-1.9 of "
+            "the amplitude on the scotch yoke, 0.37-140 on the slotted link, against "
+            "3-10e-3 compensated)."),
+        "rolling": Setting(
+            "coupling", _ROLLING,
+            "'coupling' (default): a LinearCoupling of two bodies hinged on a carrier "
+            "(gear pair, belt, disc rolling in a moving track) is a PivotJoint between "
+            "them at the pitch point, re-anchored before every solve (exact rows, the "
+            "coupling's position error corrected by Chipmunk's own error correction). "
+            "'contact': where the description draws the pitch circles (Circle shapes), "
+            "they collide instead (a Circle inside a ring of Segments, or two Circles) "
+            "with Coulomb friction and the carrier arm removed (the contact holds the "
+            "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
+            "its friction, at zero): what a game-physics user would build. Measured on "
+            "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
+            "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
+            "the disc passes from one chord to the next (normal impulse 0, then twice), "
+            "3-6 s per 10 s run (coupling 0.4 s)."),
+        "contact_friction": Setting(
+            10.0, float,
+            "Friction coefficient of the rolling contact (rolling = 'contact'); Chipmunk "
+            "multiplies the two shapes' coefficients, this one goes on the inner shape "
+            "and 1 on the ring. Must exceed |friction| / normal force at all times or the "
+            "disc slides."),
+        "contact_segments": Setting(
+            720, int,
+            "Number of Segment shapes of a ring (rolling = 'contact'), inscribed in the "
+            "pitch circle; space.collision_slop is set to the chord's sagitta so that the "
+            "polygon's penetration is not 'corrected' against the carrier joint."),
+    }
     #: of the last constrained run: relative residual of the momentum balance behind the
     #: constraint forces (0 when the engine's constraints are exactly the description's),
     #: and notes on substitutes that could not be compensated
@@ -1147,117 +1250,6 @@ class PymunkBackend(Backend):
         import pymunk
 
         return f"{pymunk.version} (Chipmunk {pymunk.chipmunk_version.split('-')[0]})"
-
-    def default_settings(self) -> dict:
-        return {
-            "error_bias": 0.0,
-            "iterations": 50,
-            "start_iterations": 1000,
-            "damping": 1.0,
-            "sleep_time_threshold": None,
-            "element_forces": "position_updated",
-            "groove_half_length": 1000.0,
-            "slider_mass_fraction": 0.5,
-            "slider_compensation": True,
-            "rolling": "coupling",
-            "contact_friction": 10.0,
-            "contact_segments": 720,
-        }
-
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "error_bias": (
-                "Fraction of a joint's position error left after 1 s, on every constraint. "
-                "Pymunk's default (1-0.1)^60 = 1.8e-3 removes only part of the error per "
-                "step and its correction velocity enters the real velocity: measured on the "
-                "2 rad compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory "
-                "error and 5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error "
-                "in the next step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad."),
-            "iterations": (
-                "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk "
-                "default 10). A single joint is solved in one iteration; a chain is not: "
-                "on the small double-pendulum swing the reaction error was 1.8e-3 "
-                "(relative) with 10 and 1.4e-4 with 20 or more (20, 30, 50, 100 identical; "
-                "trajectories identical from 10 on, reactions 65 % off with 1). 50 keeps a "
-                "margin at negligible cost. Closed loops with slider substitutes need it: "
-                "the scotch yoke diverged with 10 at slider_mass_fraction 0.1."),
-            "start_iterations": (
-                "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
-                "step from the previous step's impulses; the first step has none, and a "
-                "closed loop or a slider substitute then leaves it unconverged: with 50 "
-                "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
-                "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
-                "unchanged (they converge from the warm start). Tree mechanisms were already "
-                "converged (bit-identical results)."),
-            "damping": (
-                "space.damping, the fraction of velocity kept after 1 s. Pymunk's default "
-                "is already 1 (no damping); stated explicitly so it is recorded."),
-            "sleep_time_threshold": (
-                "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
-                "Sleeping froze a small oscillation when enabled (SIMULATORS.md)."),
-            "element_forces": (
-                "When force elements are evaluated in a step. Chipmunk moves positions "
-                "(x += h v) before it applies body.force, so a force computed from the "
-                "sampled state before space.step() ('step_start', what user code usually "
-                "does) makes the step explicit Euler for that force: energy grew by 114 % "
-                "(elastic pendulum) and 90 % (sliding block) in 10 s at h = 1e-3. "
-                "'position_updated' (default) evaluates the laws at x + h v and t + h, the "
-                "configuration at which Chipmunk pre-steps its constraints and its own "
-                "DampedSpring: a consistent semi-implicit Euler step (energy drift 0.4-0.5 %). "
-                "No engine default is replaced: Pymunk has no hook for laws of length "
-                "rate or time, so the backend applies body forces and torques."),
-            "groove_half_length": (
-                "Chipmunk grooves are finite segments: a prismatic side without a limit "
-                "(and every point-on-line slot) is given this extent in m (the groove ends "
-                "act as stops). Finite limits of the description are used as the groove "
-                "ends."),
-            "slider_mass_fraction": (
-                "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
-                "exact (pin off the pin body's centre of mass, or slot line off the slot "
-                "body's): a 'pin slider' (point mass pinned to the pin point) and/or a "
-                "'slot carrier' (glued to the slot body, centre on the slot line) runs in "
-                "an exact groove. Its mass is this fraction of the host body's effective "
-                "mass at that point, m I / (I + m d^2). Chipmunk has no such substitute and "
-                "no massless bodies. With compensation (below) the fraction does not enter "
-                "the dynamics (scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and "
-                "0.5), only the convergence of the Gauss-Seidel solve, since a light body "
-                "between heavy ones converges slowly: from the cold start (no cached "
-                "impulses) the slot force at samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at "
-                "0.5 with 50 iterations; the rhombus loop diverged at 0.05 with 50 "
-                "iterations (exact with 500). Must stay below 1 (the host keeps a positive "
-                "moment)."),
-            "slider_compensation": (
-                "true: the substitute's mass (and a slot carrier's moment) is taken out of "
-                "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
-                "host + substitute have exactly the described inertia; false: the "
-                "substitute adds its mass to the mechanism (teaching mode: shows the "
-                "dynamic effect of a slider mass; measured with fraction 0.05, 10 s: "
-                "trajectory error 0.33-1.9 of the amplitude on the scotch yoke, 0.37-140 on "
-                "the slotted link, against 3-10e-3 compensated)."),
-            "rolling": (
-                "'coupling' (default): a LinearCoupling of two bodies hinged on a carrier "
-                "(gear pair, belt, disc rolling in a moving track) is a PivotJoint between "
-                "them at the pitch point, re-anchored before every solve (exact rows, the "
-                "coupling's position error corrected by Chipmunk's own error correction). "
-                "'contact': where the description draws the pitch circles (Circle shapes), "
-                "they collide instead (a Circle inside a ring of Segments, or two Circles) "
-                "with Coulomb friction and the carrier arm removed (the contact holds the "
-                "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
-                "its friction, at zero): what a game-physics user would build. Measured on "
-                "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
-                "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
-                "the disc passes from one chord to the next (normal impulse 0, then twice), "
-                "3-6 s per 10 s run (coupling 0.4 s)."),
-            "contact_friction": (
-                "Friction coefficient of the rolling contact (rolling = 'contact'); "
-                "Chipmunk multiplies the two shapes' coefficients, this one goes on the "
-                "inner shape and 1 on the ring. Must exceed |friction| / normal force at all "
-                "times or the disc slides."),
-            "contact_segments": (
-                "Number of Segment shapes of a ring (rolling = 'contact'), inscribed in the "
-                "pitch circle; space.collision_slop is set to the chord's sagitta so that "
-                "the polygon's penetration is not 'corrected' against the carrier joint."),
-        }
 
     def support(self, mechanism: Mechanism) -> Support:
         plan = _plan(mechanism, self.default_settings())
@@ -1424,10 +1416,6 @@ class PymunkBackend(Backend):
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
         cfg = self.resolve_settings(settings)
-        if cfg["element_forces"] not in _FORCE_MODES:
-            raise ValueError(f"element_forces must be one of {_FORCE_MODES}")
-        if cfg["rolling"] not in _ROLLING:
-            raise ValueError(f"rolling must be one of {_ROLLING}")
         layout = _plan(mechanism, cfg)
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
