@@ -65,14 +65,8 @@ from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
     CoordinateForce,
     LinearCoupling,
@@ -82,10 +76,10 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
-    compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Setting, Support
+from .plan import ForceLaw, constrained_bodies, coordinate_map, description_reason, num, rot
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -104,36 +98,10 @@ _SOLVER_ORDER = {
 _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
-def _num(x) -> float:
-    value = sp.sympify(x)
-    if value.free_symbols:
-        raise ValueError(f"expression {value} still has free symbols")
-    return float(value)
-
-
-def _rot2(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s], [s, c]])
-
-
 def _rot3(angle: float) -> np.ndarray:
     out = np.eye(3)
-    out[:2, :2] = _rot2(angle)
+    out[:2, :2] = rot(angle)
     return out
-
-
-def _affine(expr, x: sp.Symbol, v: sp.Symbol) -> tuple[float, float, float] | None:
-    """(a0, ax, av) when expr == a0 + ax x + av v with numbers only (no TIME), else None."""
-    expr = sp.sympify(expr)
-    if TIME in expr.free_symbols:
-        return None
-    ax, av = sp.diff(expr, x), sp.diff(expr, v)
-    if ax.free_symbols or av.free_symbols:
-        return None
-    a0 = expr.xreplace({x: 0, v: 0})
-    if a0.free_symbols:
-        return None
-    return float(a0), float(ax), float(av)
 
 
 @dataclass
@@ -170,7 +138,7 @@ class _Geometry:
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
-        return self.com[body] + _rot2(-self.beta[body]) @ np.asarray(point, dtype=float)
+        return self.com[body] + rot(-self.beta[body]) @ np.asarray(point, dtype=float)
 
     def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
@@ -187,48 +155,32 @@ def _geometry(mech: Mechanism) -> _Geometry:
     rotations: list[float] = []
     beta: dict[str, float] = {WORLD: 0.0}
     com: dict[str, np.ndarray] = {WORLD: np.zeros(2)}
-    angle_rows: dict[str, tuple[np.ndarray, float]] = {WORLD: (np.zeros(n), 0.0)}
-    T = np.zeros((n, n))
-    c = np.zeros(n)
+    cmap = coordinate_map(mech)
     for i, j in enumerate(mech.joints):
         p = j.parent
         parents.append(link_of[p] if p != WORLD else -1)
         link_of[j.child] = i
-        parent_anchor = np.array([_num(v) for v in j.parent_anchor])
-        child_anchor = np.array([_num(v) for v in j.child_anchor])
-        offset = _num(j.angle_offset)
-        row_p, const_p = angle_rows[p]
+        parent_anchor = np.array([num(v) for v in j.parent_anchor])
+        child_anchor = np.array([num(v) for v in j.child_anchor])
+        offset = num(j.angle_offset)
         # the joint point in the parent's link frame
-        offsets.append(com[p] + _rot2(-beta[p]) @ parent_anchor)
-        e_i = np.zeros(n)
-        e_i[i] = 1.0
+        offsets.append(com[p] + rot(-beta[p]) @ parent_anchor)
         if isinstance(j, Revolute):
             types.append("R")
             rotations.append(offset - beta[p])
             beta[j.child] = 0.0
-            angle_rows[j.child] = (row_p + e_i, const_p + offset)
-            sign = -1.0 if j.clockwise else 1.0  # clockwise: the coordinate is -angle
-            if j.absolute:  # sign q = theta_child - offset = theta_parent + u
-                T[i] = sign * (row_p + e_i)
-                c[i] = sign * const_p
-            else:
-                T[i] = sign * e_i
-        elif isinstance(j, Prismatic):
+        else:
             types.append("P")
-            axis = np.array([_num(v) for v in j.axis])
-            length = float(np.hypot(*axis))
+            axis = np.array([num(v) for v in j.axis])
             alpha = math.atan2(axis[1], axis[0])
             rotations.append(alpha - beta[p])
             beta[j.child] = alpha - offset
-            angle_rows[j.child] = (row_p.copy(), const_p + offset)
-            T[i] = e_i / length  # the engine slides by u = |axis| q
-        else:  # pragma: no cover - the Joint union is closed
-            raise TypeError(j)
-        com[j.child] = -_rot2(-beta[j.child]) @ child_anchor
-    mass = {b.name: _num(b.mass) for b in mech.bodies}
-    inertia = {b.name: _num(b.inertia) for b in mech.bodies}
+        com[j.child] = -rot(-beta[j.child]) @ child_anchor
+    mass = {b.name: num(b.mass) for b in mech.bodies}
+    inertia = {b.name: num(b.inertia) for b in mech.bodies}
+    angle_rows = {body: (cmap.angle_v[body], cmap.angle_v0[body]) for body in cmap.angle_v}
     return _Geometry(n, link_of, parents, types, offsets, rotations, beta, com, mass, inertia,
-                     T, c, angle_rows, _num(mech.gravity))
+                     cmap.T, cmap.c, angle_rows, num(mech.gravity))
 
 
 class ExudynBackend(Backend):
@@ -329,53 +281,17 @@ class ExudynBackend(Backend):
 
     # --- support ---------------------------------------------------------------------------
     def support(self, mechanism: Mechanism) -> Support:
-        try:
-            _num(mechanism.gravity)
-            for b in mechanism.bodies:
-                _num(b.mass), _num(b.inertia)
-            for j in mechanism.joints:
-                if not isinstance(j, (Revolute, Prismatic)):
-                    return Support(False, f"joint {j.name}: type {type(j).__name__} not mapped")
-                for v in (*j.parent_anchor, *j.child_anchor, j.angle_offset):
-                    _num(v)
-                if isinstance(j, Prismatic) and np.hypot(*[_num(v) for v in j.axis]) == 0:
-                    return Support(False, f"joint {j.name}: zero prismatic axis")
-        except ValueError as exc:
-            return Support(False, f"mechanism is not numeric: {exc}")
-        constrained_bodies: set[str] = set()
-        try:
-            for c in mechanism.constraints:
-                if isinstance(c, PointOnPoint):
-                    [_num(v) for v in (*c.point_a, *c.point_b)]
-                    constrained_bodies |= set(c.bodies)
-                elif isinstance(c, PointOnLine):
-                    [_num(v) for v in (*c.point, *c.line_point)]
-                    if np.hypot(*[_num(v) for v in c.direction]) == 0:
-                        return Support(False, f"constraint {c.name}: zero slot direction")
-                    constrained_bodies |= set(c.bodies)
-                elif isinstance(c, LinearCoupling):
-                    coefs = [_num(v) for _, v in c.coefficients]
-                    _num(c.constant)
-                    if not any(coefs):
-                        return Support(False, f"constraint {c.name}: all coefficients are 0")
-                    constrained_bodies |= {mechanism.joints[mechanism.coordinates.index(n)].child
-                                           for n, v in zip((n for n, _ in c.coefficients), coefs)
-                                           if v}
-                else:
-                    return Support(False, f"constraint {c.name}: type {type(c).__name__} "
-                                          "not mapped")
-        except ValueError as exc:
-            return Support(False, f"constraint is not numeric: {exc}")
-        for f in mechanism.forces:
-            if not isinstance(f, (PointToPoint, CoordinateForce)):
-                return Support(False, f"force {f.name}: type {type(f).__name__} not mapped")
+        reason = description_reason(mechanism)
+        if reason:
+            return Support(False, reason)
+        held = constrained_bodies(mechanism)
         # a massless body with nothing massive below it makes the tree's mass matrix
         # singular; with closure constraints the implicit solver's augmented matrix
         # [M C_q^T; C_q 0] can still be regular when a constraint fixes that subtree
         for b in mechanism.bodies:
             sub = mechanism.subtree(b.name)
             if b.massless and all(mechanism.body(x).massless for x in sub):
-                if constrained_bodies & set(sub):
+                if held & set(sub):
                     continue
                 return Support(False, f"massless body {b.name} carries no mass: the kinematic "
                                       "tree's mass matrix would be singular")
@@ -418,7 +334,8 @@ class ExudynBackend(Backend):
             i = mech.coordinates.index(f.coordinate)
             row = geo.T[i]
             single = np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0
-            aff = _affine(f.force, COORD, COORD_RATE) if settings["native_linear_laws"] else None
+            law = ForceLaw.of(f)
+            aff = law.linear if settings["native_linear_laws"] else None
             if aff is not None and single:
                 s = row[i]  # q_i = s u_i, so Q_u = s F(s u, s u_t)
                 a0, ax, av = aff
@@ -426,7 +343,7 @@ class ExudynBackend(Backend):
                 P[i] += -s * s * ax
                 D[i] += -s * s * av
             else:
-                python_laws.append((i, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+                python_laws.append((i, law.law))
 
         tree_args = dict(
             nodeNumber=node, gravity=[0.0, -geo.gravity, 0.0], baseOffset=[0.0, 0.0, 0.0],
@@ -456,7 +373,7 @@ class ExudynBackend(Backend):
                 continue  # acts on nothing
             markers = []
             for body, point in ((f.body_a, f.point_a), (f.body_b, f.point_b)):
-                pt = [_num(v) for v in point]
+                pt = [num(v) for v in point]
                 if body == WORLD:
                     if ground is None:
                         ground = mbs.AddObject(ObjectGround())
@@ -466,18 +383,17 @@ class ExudynBackend(Backend):
                     markers.append(mbs.AddMarker(MarkerKinematicTreeRigid(
                         objectNumber=tree, linkNumber=geo.link_of[body],
                         localPosition=[*geo.local_point(body, pt), 0.0])))
-            aff = (_affine(f.tension, LENGTH, LENGTH_RATE)
-                   if settings["native_linear_laws"] else None)
+            law = ForceLaw.of(f)
+            aff = law.linear if settings["native_linear_laws"] else None
             if aff is not None:
                 b0, bl, bv = aff  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
                 conn = ObjectConnectorSpringDamper(markerNumbers=markers, referenceLength=0.0,
                                                    stiffness=bl, damping=bv, force=b0)
             else:
-                law = compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))
                 # referenceLength 0, so deltaL is the length itself
                 conn = ObjectConnectorSpringDamper(
                     markerNumbers=markers, referenceLength=0.0,
-                    springForceUserFunction=self._tension_user_function(law))
+                    springForceUserFunction=self._tension_user_function(law.law))
             connectors[f.name] = mbs.AddObject(conn)
         return exu, mbs, SC, node, tree, geo, connectors
 
@@ -499,7 +415,7 @@ class ExudynBackend(Backend):
         ground: list[int] = []
 
         def rigid_marker(body: str, point) -> int:
-            pt = [_num(v) for v in point]
+            pt = [num(v) for v in point]
             if body == WORLD:
                 if not ground:
                     ground.append(mbs.AddObject(ObjectGround()))
@@ -517,10 +433,10 @@ class ExudynBackend(Backend):
                     rigid_marker(c.body_a, c.point_a), rigid_marker(c.body_b, c.point_b)]))
                 items.append(_ClosureItem(c.name, "point", obj))
             elif isinstance(c, PointOnLine):
-                d = np.array([_num(v) for v in c.direction])
+                d = np.array([num(v) for v in c.direction])
                 d = d / float(np.hypot(*d))
                 normal = np.array([-d[1], d[0]])  # the slot normal of the description
-                normal_local = _rot2(-geo.beta[c.line_body]) @ normal
+                normal_local = rot(-geo.beta[c.line_body]) @ normal
                 # Exudyn: (p1 - p0) . A1 n1 = 0, p0 the pin, p1 the slot point
                 obj = mbs.AddObject(ObjectJointPrismatic2D(
                     markerNumbers=[rigid_marker(c.body, c.point),
@@ -531,9 +447,9 @@ class ExudynBackend(Backend):
             elif isinstance(c, LinearCoupling):
                 a = np.zeros(geo.n)
                 for name, coef in c.coefficients:
-                    a[mech.coordinates.index(name)] += _num(coef)
+                    a[mech.coordinates.index(name)] += num(coef)
                 row = a @ geo.T                      # Phi = row . u + offset
-                offset = float(a @ geo.c) - _num(c.constant)
+                offset = float(a @ geo.c) - num(c.constant)
                 if node_marker is None:
                     node_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
                     ground_node = mbs.AddNode(NodePointGround())
@@ -754,7 +670,7 @@ class ExudynBackend(Backend):
                 i = mech.coordinates.index(f.coordinate)
                 if mech.joints[i] is not joint or isinstance(joint, Revolute):
                     continue
-                law = compile_law(f.force, (COORD, COORD_RATE, TIME))
+                law = ForceLaw.of(f).law
                 force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])
                 total -= ExudynBackend._slide_force(geo, joint, u, force)
         for c in mech.constraints:
@@ -769,7 +685,7 @@ class ExudynBackend(Backend):
                     total -= f_c if in_1 else -f_c
             elif isinstance(c, LinearCoupling) and isinstance(joint, Prismatic):
                 # a generalized force on the joint's own slide acts between parent and child
-                coef = sum(_num(v) for name, v in c.coefficients if name == joint.coordinate)
+                coef = sum(num(v) for name, v in c.coefficients if name == joint.coordinate)
                 if coef:
                     total -= ExudynBackend._slide_force(geo, joint, u, coef * f_c[:, 0])
         return total
@@ -781,7 +697,7 @@ class ExudynBackend(Backend):
         coordinate (virtual power: F axis / |axis|^2, axis turned with the parent)."""
         row, const = geo.angle_rows[joint.parent]
         th_parent = u @ row + const
-        axis = np.array([_num(v) for v in joint.axis])
+        axis = np.array([num(v) for v in joint.axis])
         axis = axis / float(axis @ axis)
         ax_world = np.stack([np.cos(th_parent) * axis[0] - np.sin(th_parent) * axis[1],
                              np.sin(th_parent) * axis[0] + np.cos(th_parent) * axis[1]],

@@ -61,14 +61,8 @@ from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
     Circle,
     CoordinateForce,
@@ -81,48 +75,17 @@ from ..systems.model import (
     Rectangle,
     Revolute,
     Segment,
-    compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Setting, Support
+from .plan import ForceLaw, coordinate_map, description_reason, num, rot
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
-def _num(x) -> float:
-    return float(sp.sympify(x))
-
-
 def _fmt(*xs: float) -> str:
     return " ".join(format(float(x), ".17g") for x in xs)
-
-
-def _rot(th: float) -> np.ndarray:
-    c, s = math.cos(th), math.sin(th)
-    return np.array([[c, -s], [s, c]])
-
-
-def _linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
-    """(a, b, c) with law = a + b x + c xd, or None when the law is not of that form."""
-    expr = sp.sympify(expr)
-    if not expr.free_symbols <= {x, xd} or not expr.is_polynomial(x, xd):
-        return None
-    if expr.free_symbols and sp.Poly(expr, x, xd).total_degree() > 1:
-        return None
-    a = float(expr.xreplace({x: 0, xd: 0}))
-    return a, float(sp.diff(expr, x)), float(sp.diff(expr, xd))
-
-
-def _vector_law(expr, args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
-    """A law evaluated on arrays (post-processing of reactions)."""
-    fn = sp.lambdify(args, sp.sympify(expr), modules="numpy")
-
-    def call(*arrays: np.ndarray) -> np.ndarray:
-        out = np.asarray(fn(*arrays), dtype=float)
-        return np.broadcast_to(out, np.shape(arrays[0])).astype(float)
-
-    return call
 
 
 @dataclass
@@ -236,25 +199,25 @@ def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCo
         if jd.coordinate not in names or not isinstance(jd, Revolute):
             continue
         disc = mech.body(jd.child)
-        ca = [_num(v) for v in jd.child_anchor]
+        ca = [num(v) for v in jd.child_anchor]
         circles = [sh for sh in disc.shapes if isinstance(sh, Circle)
-                   and [_num(v) for v in sh.center] == ca]
+                   and [num(v) for v in sh.center] == ca]
         if not circles or jd.parent == WORLD:
             continue
-        r = _num(circles[0].radius)
+        r = num(circles[0].radius)
         arm = jd.parent
         ja = mech.joint_of_child(arm)
         if not isinstance(ja, Revolute) or arm not in foldable or ja.parent == WORLD:
             return (f"the disc {disc.name}'s arm {arm} must be a massless body hinged on "
                     "the track")
         track = mech.body(ja.parent)
-        centre = [_num(v) for v in ja.parent_anchor]
+        centre = [num(v) for v in ja.parent_anchor]
         rings = [sh for sh in track.shapes if isinstance(sh, Circle)
-                 and [_num(v) for v in sh.center] == centre]
+                 and [num(v) for v in sh.center] == centre]
         if not rings:
             return f"no Circle on {track.name} centred at the arm's hinge"
-        R = _num(rings[0].radius)
-        arm_len = math.dist([_num(v) for v in ja.child_anchor], [_num(v) for v in jd.parent_anchor])
+        R = num(rings[0].radius)
+        arm_len = math.dist([num(v) for v in ja.child_anchor], [num(v) for v in jd.parent_anchor])
         if not (R > r and abs(arm_len - (R - r)) <= 1e-9 * R):
             return f"the arm length {arm_len} is not R - r = {R - r} (rolling inside the ring)"
         g = (R - r) * angle_c[arm] + r * angle_c[disc.name] - R * angle_c[track.name]
@@ -269,44 +232,16 @@ def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCo
 
 def _check(mech: Mechanism) -> str:
     """Empty string when the mechanism can be translated, else the reason."""
+    reason = description_reason(mech)
+    if reason:
+        return reason
     for b in mech.bodies:
-        for x in (b.mass, b.inertia):
-            if sp.sympify(x).free_symbols:
-                return f"body {b.name}: parameters are not numeric (use numeric_mechanism)"
-        m, inertia = _num(b.mass), _num(b.inertia)
+        m, inertia = num(b.mass), num(b.inertia)
         if not b.massless and (m <= 0 or inertia <= 0):
             return (f"body {b.name}: mass {m} and inertia {inertia} must both be > 0 "
                     "(MuJoCo rejects moving bodies with zero mass or inertia)")
     if all(b.massless for b in mech.bodies):
         return "every body is massless (no mass scale for the substitute bodies)"
-    if sp.sympify(mech.gravity).free_symbols:
-        return "gravity is not numeric"
-    placeholders = {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}
-    for f in mech.forces:
-        if not isinstance(f, (PointToPoint, CoordinateForce)):
-            return f"force element {f!r} is not supported"
-        law = f.tension if isinstance(f, PointToPoint) else f.force
-        if sp.sympify(law).free_symbols - placeholders:
-            return f"force element {f.name}: law has non-numeric parameters"
-    for j in mech.joints:
-        if isinstance(j, Prismatic) and math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0:
-            return f"joint {j.name}: zero axis"
-    for c in mech.constraints:
-        if isinstance(c, LinearCoupling):
-            nums = [v for _, v in c.coefficients] + [c.constant]
-        elif isinstance(c, PointOnPoint):
-            nums = [*c.point_a, *c.point_b]
-        elif isinstance(c, PointOnLine):
-            nums = [*c.point, *c.line_point, *c.direction]
-        else:
-            return (f"constraint {c!r}: unknown constraint type (MuJoCo translates "
-                    "PointOnPoint, PointOnLine and LinearCoupling)")
-        if any(sp.sympify(x).free_symbols for x in nums):
-            return f"constraint {c.name}: parameters are not numeric (use numeric_mechanism)"
-        if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
-            return f"constraint {c.name}: zero slot direction"
-        if isinstance(c, LinearCoupling) and not any(_num(v) for _, v in c.coefficients):
-            return f"constraint {c.name}: every coefficient is zero"
     return ""
 
 
@@ -316,30 +251,9 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     substitute_gravcomp, solref, solimp); defaults when None."""
     opts = dict(opts or {})
     n = len(mech.joints)
-    # body angle = angle_c . q + angle_d (affine in the description coordinates)
-    angle_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
-    angle_d: dict[str, float] = {WORLD: 0.0}
-    A = np.zeros((n, n))
-    b = np.zeros(n)
-    for i, j in enumerate(mech.joints):
-        cp, dp = angle_c[j.parent], angle_d[j.parent]
-        off = _num(j.angle_offset)
-        if isinstance(j, Revolute):
-            sign = -1.0 if getattr(j, "clockwise", False) else 1.0
-            if j.absolute:
-                angle_c[j.child] = sign * np.eye(n)[i]
-                angle_d[j.child] = off
-                A[i] = sign * np.eye(n)[i] - cp  # v = theta_child - theta_parent - offset
-                b[i] = -dp
-            else:
-                angle_c[j.child] = cp + sign * np.eye(n)[i]
-                angle_d[j.child] = dp + off
-                A[i, i] = sign
-        else:
-            angle_c[j.child] = cp.copy()
-            angle_d[j.child] = dp + off
-            A[i, i] = math.hypot(_num(j.axis[0]), _num(j.axis[1]))  # MuJoCo normalizes axes
-    Ainv = np.linalg.inv(A)
+    cmap = coordinate_map(mech)
+    A, b, Ainv = cmap.A, cmap.b, cmap.T
+    angle_c, angle_d = cmap.angle_c, cmap.angle_d
 
     foldable = _foldable(mech)
     carrier: dict[str, str] = {}
@@ -359,7 +273,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
 
     plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
     plan.opts = opts
-    m_min = min(_num(bd.mass) for bd in mech.bodies if not bd.massless)
+    m_min = min(num(bd.mass) for bd in mech.bodies if not bd.massless)
     # massless bodies that cannot be folded: a pure kinematic link (several children, no
     # constraint or point force on it) carries no load of its own and can be very light;
     # a massless body that a constraint or a point force loads must be heavier, because
@@ -385,11 +299,11 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             pins.setdefault(c.body, []).append(c)
     slider_mass: dict[str, float] = {}
     for body, cons in pins.items():
-        pts = [np.array([_num(c.point[0]), _num(c.point[1])]) for c in cons]
+        pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
         if body == WORLD:
             for c in cons:
                 lb = c.line_body
-                ml = m_min if lb == WORLD or mech.body(lb).massless else _num(mech.body(lb).mass)
+                ml = m_min if lb == WORLD or mech.body(lb).massless else num(mech.body(lb).mass)
                 slider_mass[c.name] = ratio * ml
             continue
         bd = mech.body(body)
@@ -398,7 +312,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             for c in cons:
                 slider_mass[c.name] = ratio * ms
             continue
-        mp, ip = _num(bd.mass), _num(bd.inertia)
+        mp, ip = num(bd.mass), num(bd.inertia)
         # the largest point masses at the pins that leave a positive inertia
         bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
         masses = [ratio * bound for _ in cons]
@@ -422,10 +336,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
         else:
             coef = np.zeros(n)
             for name, value in c.coefficients:
-                coef[mech.coordinates.index(name)] += _num(value)
+                coef[mech.coordinates.index(name)] += num(value)
             w = Ainv.T @ coef  # c . q = c . A^-1 (v - b)
             weights = {mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
-            offset = _num(c.constant) + float(coef @ Ainv @ b)
+            offset = num(c.constant) + float(coef @ Ainv @ b)
             if opts.get("rolling", "coupling") == "contact":
                 geo = _rolling_geometry(mech, angle_c, foldable, c, coef)
                 if isinstance(geo, str):
@@ -439,9 +353,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     joint_native: dict[int, list[float]] = {}
     for f in mech.forces:
         if isinstance(f, PointToPoint):
-            if autonomous and TIME in sp.sympify(f.tension).free_symbols:
+            law = ForceLaw.of(f)
+            if autonomous and law.time_dependent:
                 continue
-            lin = _linear_law(f.tension, LENGTH, LENGTH_RATE) if native else None
+            lin = law.linear if native else None
             spec = None
             if lin is not None:
                 a, k, c = lin
@@ -449,13 +364,13 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
                     spec = (k, -a / k + 0.0, c)
                 elif k == 0 and a == 0 and c >= 0:
                     spec = (0.0, 0.0, c)
-            plan.p2p.append(_P2P(f, f.name, spec,
-                                 compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))))
+            plan.p2p.append(_P2P(f, f.name, spec, law.law))
         else:
-            if autonomous and f.time_dependent:
+            law = ForceLaw.of(f)
+            if autonomous and law.time_dependent:
                 continue
             i = mech.coordinates.index(f.coordinate)
-            lin = _linear_law(f.force, COORD, COORD_RATE) if native else None
+            lin = law.linear if native else None
             spec = None
             single = np.count_nonzero(A[i]) == 1 and b[i] == 0
             if lin is not None and single:
@@ -464,7 +379,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
                 spec = (a / s, kq / s**2, cq / s**2)
                 acc = joint_native.setdefault(i, [0.0, 0.0, 0.0])
                 acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-            plan.coord.append(_Coord(f, i, spec, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+            plan.coord.append(_Coord(f, i, spec, law.law))
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
     # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
     for i, (a, k, c) in joint_native.items():
@@ -484,35 +399,35 @@ def _poses(plan: _Plan, q: np.ndarray) -> tuple[dict, dict]:
     joints = {}
     for i, j in enumerate(mech.joints):
         pp, thp = poses[j.parent]
-        Rp = _rot(thp)
+        Rp = rot(thp)
         th = float(plan.angle_c[j.child] @ q + plan.angle_d[j.child])
-        pa = np.array([_num(j.parent_anchor[0]), _num(j.parent_anchor[1])])
-        ca = np.array([_num(j.child_anchor[0]), _num(j.child_anchor[1])])
+        pa = np.array([num(j.parent_anchor[0]), num(j.parent_anchor[1])])
+        ca = np.array([num(j.child_anchor[0]), num(j.child_anchor[1])])
         if isinstance(j, Revolute):
             anchor = pp + Rp @ pa
             joints[j.name] = (anchor, None)
         else:
-            axis = np.array([_num(j.axis[0]), _num(j.axis[1])])
+            axis = np.array([num(j.axis[0]), num(j.axis[1])])
             anchor = pp + Rp @ (pa + q[i] * axis)
             joints[j.name] = (anchor, Rp @ axis)
-        poses[j.child] = (anchor - _rot(th) @ ca, th)
+        poses[j.child] = (anchor - rot(th) @ ca, th)
     return poses, joints
 
 
 def _shape_geoms(shape) -> str:
     if isinstance(shape, Segment):
-        a = [_num(v) for v in shape.a]
-        b = [_num(v) for v in shape.b]
-        r = _num(shape.width) / 2
+        a = [num(v) for v in shape.a]
+        b = [num(v) for v in shape.b]
+        r = num(shape.width) / 2
         if a == b:
             return f'<geom type="sphere" size="{_fmt(r)}" pos="{_fmt(a[0], a[1], 0)}"/>'
         return f'<geom type="capsule" size="{_fmt(r)}" fromto="{_fmt(a[0], a[1], 0, b[0], b[1], 0)}"/>'
     if isinstance(shape, Circle):
-        c = [_num(v) for v in shape.center]
-        return f'<geom type="sphere" size="{_fmt(_num(shape.radius))}" pos="{_fmt(c[0], c[1], 0)}"/>'
+        c = [num(v) for v in shape.center]
+        return f'<geom type="sphere" size="{_fmt(num(shape.radius))}" pos="{_fmt(c[0], c[1], 0)}"/>'
     if isinstance(shape, Rectangle):
-        c = [_num(v) for v in shape.center]
-        w, h = _num(shape.width), _num(shape.height)
+        c = [num(v) for v in shape.center]
+        w, h = num(shape.width), num(shape.height)
         return (f'<geom type="box" size="{_fmt(w / 2, h / 2, min(w, h) / 4)}" '
                 f'pos="{_fmt(c[0], c[1], 0)}"/>')
     return ""
@@ -528,7 +443,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         f = e.element
         for tag, body, pt in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
             sites.setdefault(body, []).append(
-                f'<site name="{f.name}:{tag}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+                f'<site name="{f.name}:{tag}" pos="{_fmt(num(pt[0]), num(pt[1]), 0)}"/>')
     gravcomp = ' gravcomp="1"' if plan.opts.get("substitute_gravcomp", True) else ""
     sliders: dict[str, list[str]] = {}
     for cl in plan.closures:
@@ -537,11 +452,11 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
             for site, body, pt in ((cl.site1, c.body_a, c.point_a),
                                    (cl.site2, c.body_b, c.point_b)):
                 sites.setdefault(body, []).append(
-                    f'<site name="{site}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+                    f'<site name="{site}" pos="{_fmt(num(pt[0]), num(pt[1]), 0)}"/>')
         elif cl.kind == "slider":
             sites.setdefault(c.body, []).append(
-                f'<site name="{cl.site1}" pos="{_fmt(_num(c.point[0]), _num(c.point[1]), 0)}"/>')
-            lp, dr = [_num(v) for v in c.line_point], [_num(v) for v in c.direction]
+                f'<site name="{cl.site1}" pos="{_fmt(num(c.point[0]), num(c.point[1]), 0)}"/>')
+            lp, dr = [num(v) for v in c.line_point], [num(v) for v in c.direction]
             # the slot body's MJCF frame is its description frame (slot bodies are never
             # folded): the slider starts at line_point, its joint value is the distance
             # along the unit slot direction
@@ -565,7 +480,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         if cl.kind != "contact":
             continue
         geo = cl.contact
-        disc_c = [_num(v) for v in mech.joint(geo["disc_joint"]).child_anchor]
+        disc_c = [num(v) for v in mech.joint(geo["disc_joint"]).child_anchor]
         contact_geoms.setdefault(plan.carrier[geo["disc"]], []).append(
             f'<geom name="{cl.element.name}:disc" type="sphere" size="{_fmt(geo["r"])}" '
             f'pos="{_fmt(disc_c[0], disc_c[1], 0)}" contype="2" conaffinity="0"{cparams}/>')
@@ -585,12 +500,12 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         ind = "  " * depth
         p, th = poses[name]
         pp, thp = poses[plan.mj_parent[name]]
-        rel = _rot(thp).T @ (p - pp)
+        rel = rot(thp).T @ (p - pp)
         ang = th - thp
         body = mech.body(name)
         lines = [f'{ind}<body name="{name}" pos="{_fmt(rel[0], rel[1], 0)}" '
                  f'quat="{_fmt(math.cos(ang / 2), 0, 0, math.sin(ang / 2))}">']
-        RbT = _rot(th).T
+        RbT = rot(th).T
         for i in plan.chains[name]:
             j = mech.joints[i]
             anchor, axis = janchor[j.name]
@@ -614,7 +529,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
                     u = RbT @ ((hub - anchor) / np.linalg.norm(hub - anchor))
                     lines.append(f'{ind}  <joint name="{cl.slider}" type="slide" '
                                  f'axis="{_fmt(u[0], u[1], 0)}"/>')
-        m, inertia = _num(body.mass), _num(body.inertia)
+        m, inertia = num(body.mass), num(body.inertia)
         com = (0.0, 0.0)
         if name in plan.substitutes:
             m, inertia = plan.substitutes[name]
@@ -634,7 +549,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         lines.append(f"{ind}</body>")
         return lines
 
-    g = _num(mech.gravity)
+    g = num(mech.gravity)
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
@@ -795,7 +710,7 @@ class _Compiled:
                 j = cl.contact["j"]
                 forces.append(np.array([Q[j] / cl.coef[j]]))
                 q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
-                viol[i] = cl.coef @ q - _num(cl.element.constant)
+                viol[i] = cl.coef @ q - num(cl.element.constant)
                 k_contact += 1
             elif cl.kind == "tendon":
                 # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
@@ -1226,23 +1141,21 @@ class MujocoBackend(Backend):
                 in_a, in_b = f.body_a in inside, f.body_b in inside
                 if in_a == in_b or e.native is not None:
                     continue
-                tension = _vector_law(f.tension, (LENGTH, LENGTH_RATE, TIME))(
-                    ten[:, i, 0], ten[:, i, 1], t)
+                tension = ForceLaw.of(f).vector_law(ten[:, i, 0], ten[:, i, 1], t)
                 ab = spos[:, i, 1] - spos[:, i, 0]
                 unit = ab / np.linalg.norm(ab, axis=1)[:, None]
                 on_inside = tension[:, None] * unit * (1.0 if in_a else -1.0)
                 r -= on_inside
             if isinstance(joint, Prismatic):
                 ji = mech.joints.index(joint)
-                axis = np.array([_num(joint.axis[0]), _num(joint.axis[1])])
+                axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
                 th = q @ plan.angle_c[joint.parent] + plan.angle_d[joint.parent]
                 c, s_ = np.cos(th), np.sin(th)
                 axis_w = np.stack([c * axis[0] - s_ * axis[1], s_ * axis[0] + c * axis[1]], 1)
                 axis_w /= float(axis @ axis)  # force F on q is F axis/|axis|^2 in space
                 for e in plan.coord:
                     if e.j == ji:
-                        F = _vector_law(e.element.force, (COORD, COORD_RATE, TIME))(
-                            q[:, ji], qd[:, ji], t)
+                        F = ForceLaw.of(e.element).vector_law(q[:, ji], qd[:, ji], t)
                         r -= F[:, None] * axis_w
             out[name] = r
         return out

@@ -68,14 +68,8 @@ from dataclasses import dataclass, replace
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
     Circle,
     CoordinateForce,
@@ -83,24 +77,17 @@ from ..systems.model import (
     Mechanism,
     PointOnLine,
     PointOnPoint,
-    PointToPoint,
-    Prismatic,
     Revolute,
-    compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import Backend, Linearization, RunResult, Setting, Support
+from .plan import ForceLaw, constrained_bodies, coordinate_map, description_reason, num
 
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
 _ROLLING = ("coupling", "contact")
 _POINT_ON_LINE = ("prismatic", "slider")
 #: createMultiBody keeps the first 127 links and drops the rest without an error (measured)
 _MAX_LINKS = 127
-
-
-def _num(x) -> float:
-    """A number from a numeric description entry (sympy or float)."""
-    return float(sp.sympify(x))
 
 
 def _quat_z(angle: float) -> list[float]:
@@ -208,8 +195,8 @@ def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
     w . jv = const + c . A^-1 b with w = A^-T c. Returns (c, const, w, rhs)."""
     cvec = np.zeros(len(coords))
     for name, coef in c.coefficients:
-        cvec[coords.index(name)] += _num(coef)
-    const = _num(c.constant)
+        cvec[coords.index(name)] += num(coef)
+    const = num(c.constant)
     w = Ainv.T @ cvec
     w[np.abs(w) < 1e-14 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
     return cvec, const, w, const + float(cvec @ Ainv @ bvec)
@@ -243,7 +230,7 @@ def _rolling_contact(mech: Mechanism) -> _Contact | None:
     for c in mech.constraints:
         if not isinstance(c, LinearCoupling):
             continue
-        used = {name for name, coef in c.coefficients if _num(coef) != 0}
+        used = {name for name, coef in c.coefficients if num(coef) != 0}
         for hub_i, hub in enumerate(mech.joints):
             if hub.coordinate not in used or not isinstance(hub, Revolute) \
                     or hub.parent == WORLD:
@@ -251,18 +238,18 @@ def _rolling_contact(mech: Mechanism) -> _Contact | None:
             arm_joint = mech.joint_of_child(hub.parent)
             if not isinstance(arm_joint, Revolute) or arm_joint.parent == WORLD:
                 continue
-            pa = np.array([_num(v) for v in arm_joint.parent_anchor])
-            ca = np.array([_num(v) for v in arm_joint.child_anchor])
-            ha = np.array([_num(v) for v in hub.parent_anchor])
-            hc = np.array([_num(v) for v in hub.child_anchor])
+            pa = np.array([num(v) for v in arm_joint.parent_anchor])
+            ca = np.array([num(v) for v in arm_joint.child_anchor])
+            ha = np.array([num(v) for v in hub.parent_anchor])
+            hc = np.array([num(v) for v in hub.child_anchor])
             for outer in circles(arm_joint.parent):
-                oc = np.array([_num(v) for v in outer.center])
-                R = _num(outer.radius)
+                oc = np.array([num(v) for v in outer.center])
+                R = num(outer.radius)
                 if np.linalg.norm(oc - pa) > 1e-9 * max(R, 1.0):
                     continue
                 for inner in circles(hub.child):
-                    ic = np.array([_num(v) for v in inner.center])
-                    r = _num(inner.radius)
+                    ic = np.array([num(v) for v in inner.center])
+                    r = num(inner.radius)
                     arm = ha - ca
                     if (r < R and np.linalg.norm(ic - hc) <= 1e-9 * max(r, 1.0)
                             and abs(np.linalg.norm(arm) - (R - r)) <= 1e-9 * R):
@@ -274,18 +261,6 @@ def _rolling_contact(mech: Mechanism) -> _Contact | None:
     return None
 
 
-def _constraint_bodies(mech: Mechanism) -> set[str]:
-    """Bodies a closure constraint acts on (couplings: the children of their joints)."""
-    out: set[str] = set()
-    for c in mech.constraints:
-        if isinstance(c, (PointOnPoint, PointOnLine)):
-            out |= set(c.bodies)
-        elif isinstance(c, LinearCoupling):
-            out |= {mech.joints[mech.coordinates.index(name)].child
-                    for name, _ in c.coefficients}
-    return out - {WORLD}
-
-
 class _Plan:
     """Numeric translation of a (numeric) mechanism into PyBullet terms.
 
@@ -294,61 +269,43 @@ class _Plan:
     PointOnLine constraint); `creation_order` puts parents first."""
 
     def __init__(self, mech: Mechanism, massless_mass: float,
-                 opts: Mapping | None = None, compile_forces: bool = True,
+                 opts: Mapping | None = None,
                  contact: _Contact | None = None) -> None:
         opts = dict(opts or {})
         self.mech = mech
         self.coords = mech.coordinates
-        n = self.n = len(self.coords)
-        self.gravity = _num(mech.gravity)
-        masses = [_num(b.mass) for b in mech.bodies]
-        inertias = [_num(b.inertia) for b in mech.bodies]
+        self.n = len(self.coords)
+        self.gravity = num(mech.gravity)
+        masses = [num(b.mass) for b in mech.bodies]
+        inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
         self.i_min = min((i for i in inertias if i > 0), default=1.0)
         parents = {j.parent for j in mech.joints}
-        constrained = _constraint_bodies(mech)
+        constrained = constrained_bodies(mech)
         leaf_ratio = float(opts.get("massless_leaf_mass_ratio", 1e-6))
         #: massless bodies that carry nothing but are held by a constraint: singular for
         #: the articulated-body algorithm, given a small substitute mass (named setting)
         self.leaf_substitutes: list[str] = []
         link_of: dict[str, int] = {WORLD: -1}
         anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
-        # body angle = ang_c . q + ang_d (affine in the coordinates)
-        ang_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
-        ang_d: dict[str, float] = {WORLD: 0.0}
-        A = np.zeros((n, n))
-        b = np.zeros(n)
+        cmap = self.map = coordinate_map(mech)
         self.links: list[_Link] = []
         for i, j in enumerate(mech.joints):
             body = mech.body(j.child)
-            pa = (_num(j.parent_anchor[0]), _num(j.parent_anchor[1]))
-            ca = (_num(j.child_anchor[0]), _num(j.child_anchor[1]))
-            off = _num(j.angle_offset)
+            pa = (num(j.parent_anchor[0]), num(j.parent_anchor[1]))
+            ca = (num(j.child_anchor[0]), num(j.child_anchor[1]))
+            off = num(j.angle_offset)
             panchor = anchor_of[j.parent]
-            e_i = np.eye(n)[i]
             axis_parent = np.zeros(2)
             if isinstance(j, Revolute):
                 axis = [0.0, 0.0, 1.0]
-                turn = -e_i if getattr(j, "clockwise", False) else e_i
-                if j.absolute:
-                    ang_c[j.child], ang_d[j.child] = turn.copy(), off
-                    A[i] = turn - ang_c[j.parent]
-                    b[i] = -ang_d[j.parent]
-                else:
-                    ang_c[j.child], ang_d[j.child] = ang_c[j.parent] + turn, ang_d[j.parent] + off
-                    A[i] = turn
-            elif isinstance(j, Prismatic):
-                ax = np.array([_num(j.axis[0]), _num(j.axis[1])])
-                length = float(np.hypot(*ax))
-                axis_parent = ax / length
+            else:
+                ax = np.array([num(j.axis[0]), num(j.axis[1])])
+                axis_parent = ax / cmap.A[i, i]
                 c, s = math.cos(-off), math.sin(-off)
                 axis = [c * axis_parent[0] - s * axis_parent[1],
                         s * axis_parent[0] + c * axis_parent[1], 0.0]
-                ang_c[j.child], ang_d[j.child] = ang_c[j.parent].copy(), ang_d[j.parent] + off
-                A[i] = length * e_i
-            else:  # guarded by support()
-                raise TypeError(f"unsupported joint {j!r}")
-            mass, inertia = _num(body.mass), _num(body.inertia)
+            mass, inertia = num(body.mass), num(body.inertia)
             if body.massless:
                 mass, inertia = massless_mass, 0.0
                 if body.name not in parents and body.name in constrained:
@@ -365,11 +322,11 @@ class _Plan:
             link_of[j.child] = i
             anchor_of[j.child] = ca
         self.link_of = link_of
-        self.ang_c, self.ang_d = ang_c, ang_d
-        self.A, self.b = A, b
-        self.Ainv = np.linalg.inv(A)
+        self.ang_c, self.ang_d = cmap.angle_c, cmap.angle_d
+        self.A, self.b = cmap.A, cmap.b
+        self.Ainv = cmap.T
         self.AinvT = self.Ainv.T
-        self.identity_map = bool(np.array_equal(A, np.eye(n)) and not b.any())
+        self.identity_map = cmap.identity
 
         # rolling contact variant: the disc's hub rides on a massless radial slider on the
         # arm, so that the contact, not the arm, carries the normal force
@@ -397,13 +354,13 @@ class _Plan:
             if isinstance(c, PointOnPoint):
                 la, lb = link_of[c.body_a], link_of[c.body_b]
                 self.closures.append(_Closure(
-                    c, "p2p", la, (_num(c.point_a[0]), _num(c.point_a[1])),
-                    lb, (_num(c.point_b[0]), _num(c.point_b[1])), force_links=(la, lb)))
+                    c, "p2p", la, (num(c.point_a[0]), num(c.point_a[1])),
+                    lb, (num(c.point_b[0]), num(c.point_b[1])), force_links=(la, lb)))
             elif isinstance(c, PointOnLine):
-                u = np.array([_num(c.direction[0]), _num(c.direction[1])])
+                u = np.array([num(c.direction[0]), num(c.direction[1])])
                 u = u / float(np.hypot(*u))
-                lp = (_num(c.line_point[0]), _num(c.line_point[1]))
-                pp = (_num(c.point[0]), _num(c.point[1]))
+                lp = (num(c.line_point[0]), num(c.line_point[1]))
+                pp = (num(c.point[0]), num(c.point[1]))
                 lpin, lline = link_of[c.body], link_of[c.line_body]
                 k = len(self.links)
                 geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
@@ -430,7 +387,7 @@ class _Plan:
                         c, "prismatic", k, (0.0, 0.0), lline, lp,
                         row_normal=_slider_row_normal(u), force_links=(k, lline), **geo))
             elif isinstance(c, LinearCoupling):
-                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, b)
+                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, self.b)
                 nz = np.flatnonzero(w)
                 if len(nz) != 2:  # guarded by support()
                     raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
@@ -444,22 +401,17 @@ class _Plan:
 
         self.coord_forces: list[_CoordForce] = []
         self.point_forces: list[_PointForce] = []
-        if not compile_forces:
-            self.point_links = []
-            return
         for f in mech.forces:
+            law = ForceLaw.of(f)
             if isinstance(f, CoordinateForce):
-                law = compile_law(f.force, (COORD, COORD_RATE, TIME))
                 self.coord_forces.append(_CoordForce(
-                    self.coords.index(f.coordinate), law,
-                    TIME in sp.sympify(f.force).free_symbols))
-            elif isinstance(f, PointToPoint):
-                law = compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))
+                    self.coords.index(f.coordinate), law.law, law.time_dependent))
+            else:
                 self.point_forces.append(_PointForce(
                     f.name, link_of[f.body_a],
-                    (_num(f.point_a[0]), _num(f.point_a[1])),
-                    link_of[f.body_b], (_num(f.point_b[0]), _num(f.point_b[1])),
-                    law, f.body_a, f.body_b, TIME in sp.sympify(f.tension).free_symbols))
+                    (num(f.point_a[0]), num(f.point_a[1])),
+                    link_of[f.body_b], (num(f.point_b[0]), num(f.point_b[1])),
+                    law.law, f.body_a, f.body_b, law.time_dependent))
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
@@ -477,14 +429,14 @@ class _Plan:
 
     # --- coordinate maps -------------------------------------------------------------
     def joint_values(self, q: np.ndarray) -> np.ndarray:
-        return self.A @ np.asarray(q, dtype=float) + self.b
+        return self.map.engine_values(q)
 
     def coordinates(self, jv: np.ndarray) -> np.ndarray:
         """Rows of engine joint values -> description coordinates."""
-        return (np.asarray(jv) - self.b) @ self.AinvT
+        return self.map.coordinates(jv)
 
     def rates(self, jvd: np.ndarray) -> np.ndarray:
-        return np.asarray(jvd) @ self.AinvT
+        return self.map.rates(jvd)
 
     def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
         """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
@@ -650,47 +602,26 @@ class PyBulletBackend(Backend):
             return f"api {pybullet.getAPIVersion()}"
 
     def support(self, mechanism: Mechanism) -> Support:
-        for j in mechanism.joints:
-            if not isinstance(j, (Revolute, Prismatic)):
-                return Support(False, f"joint type {type(j).__name__} not supported")
-            if isinstance(j, Prismatic):
-                try:
-                    if math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0.0:
-                        return Support(False, f"prismatic joint {j.name} has a zero axis")
-                except TypeError:
-                    return Support(False, "mechanism is not numeric (substitute parameters)")
-        for f in mechanism.forces:
-            if not isinstance(f, (PointToPoint, CoordinateForce)):
-                return Support(False, f"force element {type(f).__name__} not supported")
+        reason = description_reason(mechanism)
+        if reason:
+            return Support(False, reason)
         parents = {j.parent for j in mechanism.joints}
-        constrained = _constraint_bodies(mechanism)
+        constrained = constrained_bodies(mechanism)
         for body in mechanism.bodies:
             if body.massless and body.name not in parents and body.name not in constrained:
                 return Support(False, f"massless body {body.name} carries nothing: singular")
-        if mechanism.constraints:
-            try:
-                plan = _Plan(replace(mechanism, constraints=(), independent=None), 0.0,
-                             compile_forces=False)
-            except TypeError:
-                return Support(False, "mechanism is not numeric (substitute parameters)")
-            except np.linalg.LinAlgError:
-                return Support(False, "singular map between coordinates and joint values")
-            for c in mechanism.constraints:
-                if not isinstance(c, (PointOnPoint, PointOnLine, LinearCoupling)):
-                    return Support(False, f"constraint {c.name}: type {type(c).__name__} "
-                                          "not translated")
-                if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
-                    return Support(False, f"constraint {c.name}: zero slot direction")
-                if isinstance(c, LinearCoupling):
-                    _, _, w, _ = _gear_terms(c, plan.coords, plan.Ainv, plan.b)
-                    k = int(np.count_nonzero(w))
-                    if k != 2:
-                        return Support(False, (
-                            f"coupling {c.name} involves {k} engine joint value(s): "
-                            "PyBullet's JOINT_GEAR constrains exactly two joints "
-                            "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
-                            "joint's current velocity as a target, it is not a three-term "
-                            "constraint, and a one-joint coupling would be a lock"))
+        cmap = coordinate_map(mechanism)
+        for c in mechanism.constraints:
+            if isinstance(c, LinearCoupling):
+                _, _, w, _ = _gear_terms(c, mechanism.coordinates, cmap.T, cmap.b)
+                k = int(np.count_nonzero(w))
+                if k != 2:
+                    return Support(False, (
+                        f"coupling {c.name} involves {k} engine joint value(s): "
+                        "PyBullet's JOINT_GEAR constrains exactly two joints "
+                        "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
+                        "joint's current velocity as a target, it is not a three-term "
+                        "constraint, and a one-joint coupling would be a lock"))
         return Support(True)
 
     # --- model building ----------------------------------------------------------------
@@ -1309,8 +1240,8 @@ class PyBulletBackend(Backend):
         ct = plan.contact
         cvec = np.zeros(plan.n)
         for name, coef in coupling.coefficients:
-            cvec[plan.coords.index(name)] += _num(coef)
-        const = _num(coupling.constant)
+            cvec[plan.coords.index(name)] += num(coef)
+        const = num(coupling.constant)
         arm = plan.mech.joints[ct.hub].parent
         th = q @ plan.ang_c[arm] + plan.ang_d[arm]
         ux0, uy0 = ct.radial
@@ -1398,7 +1329,7 @@ class PyBulletBackend(Backend):
                 # the force f_closure[key] acts on link la, its opposite on link lb
                 in_a = la >= 0 and plan.links[la].body in inside
                 in_b = lb >= 0 and plan.links[lb].body in inside
-                F = np.nan_to_num(f_closure[key])
+                F = np.nan_tonum(f_closure[key])
                 if in_a and not in_b:
                     R -= F
                 elif in_b and not in_a:

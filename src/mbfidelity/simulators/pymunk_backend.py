@@ -96,7 +96,6 @@ from ..systems.model import (
     TIME,
     WORLD,
     Circle,
-    CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -108,6 +107,7 @@ from ..systems.model import (
     rotation,
 )
 from .base import Backend, Linearization, RunResult, Setting, Support
+from .plan import body_states, description_reason, num, point_state, rot
 
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
@@ -243,10 +243,6 @@ class _Compiled:
     balance: object = None  # lazily built momentum-balance solver
 
 
-def _num(x) -> float:
-    return float(sp.sympify(x))
-
-
 def _is_number(x) -> bool:
     return not sp.sympify(x).free_symbols
 
@@ -256,11 +252,7 @@ def _cross(r: sp.Matrix, f: sp.Matrix) -> sp.Expr:
 
 
 def _vec(v) -> np.ndarray:
-    return np.array([_num(v[0]), _num(v[1])])
-
-
-def _rot(th: float) -> np.ndarray:
-    return np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+    return np.array([num(v[0]), num(v[1])])
 
 
 def _through_origin(base: np.ndarray, direction: np.ndarray) -> bool:
@@ -288,7 +280,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
     out: list[_Groove] = []
 
     def ends(j: Prismatic) -> tuple[float | None, float | None]:
-        return tuple(None if v is None else _num(v) for v in j.limits)  # type: ignore[return-value]
+        return tuple(None if v is None else num(v) for v in j.limits)  # type: ignore[return-value]
 
     folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
     for j in mech.joints:
@@ -296,19 +288,19 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
             continue
         # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
         # with the rotation locked the pin can be the child's centre of mass
-        base = _vec(j.parent_anchor) - _rot(_num(j.angle_offset)) @ _vec(j.child_anchor)
+        base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
         axis = _vec(j.axis)
         if j.parent != WORLD and not _through_origin(base, axis):
             return (f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                     f"parent's centre of mass. {_GROOVE_LIMIT}")
         out.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *ends(j), (0.0, 0.0),
-                           _num(j.angle_offset)))
+                           num(j.angle_offset)))
     for fold in folds.values():
         if isinstance(fold.inner, Revolute):
             # the link turns with its child: the pivot (a point of the parent) slides on a
             # line of the child, base + q direction in the child's frame
             rev, pri = fold.inner, fold.outer
-            back = _rot(-_num(pri.angle_offset))
+            back = rot(-num(pri.angle_offset))
             base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
             direction = -back @ _vec(pri.axis)
             anchor = _vec(rev.parent_anchor)
@@ -318,7 +310,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
             # the link turns with its parent: the pin (a point of the child) slides on a
             # line of the parent
             pri, rev = fold.inner, fold.outer
-            base = _vec(pri.parent_anchor) + _rot(_num(pri.angle_offset)) @ (
+            base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
                 _vec(rev.parent_anchor) - _vec(pri.child_anchor))
             direction = _vec(pri.axis)
             anchor = _vec(rev.child_anchor)
@@ -400,7 +392,7 @@ def _component(mech: Mechanism, group: set[str], real: set[str],
         for j in joints:
             if not isinstance(j, Prismatic):
                 continue
-            off = _num(j.angle_offset)
+            off = num(j.angle_offset)
             if j.parent in known and j.child not in known:
                 angles.append((j.child, j.parent, off))
                 known.add(j.child)
@@ -429,18 +421,18 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch), or why the coupling cannot
     be expressed."""
     k: dict[str, float] = {}
-    k0 = _num(c.constant)
+    k0 = num(c.constant)
     for name, coef in c.coefficients:
         j = mech.joints[mech.coordinates.index(name)]
         if isinstance(j, Prismatic):
             return (f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
                     "only angles (GearJoint)")
         s = -1.0 if j.clockwise else 1.0
-        coef = _num(coef)
+        coef = num(coef)
         k[j.child] = k.get(j.child, 0.0) + coef * s
         if not j.absolute:
             k[j.parent] = k.get(j.parent, 0.0) - coef * s
-        k0 += coef * s * _num(j.angle_offset)
+        k0 += coef * s * num(j.angle_offset)
     scale = max((abs(v) for v in k.values()), default=0.0)
     bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
     if not bodies:
@@ -503,7 +495,7 @@ def _pitch_circles(mech: Mechanism, a: str, hub_a, rho_a: float, b: str, hub_b, 
             if isinstance(s, Circle) and _is_number(s.radius):
                 centre = _vec(s.center)
                 if (np.allclose(centre, hub, rtol=0, atol=1e-9 * max(rho, 1.0))
-                        and abs(_num(s.radius) - rho) <= 1e-9 * max(rho, 1.0)):
+                        and abs(num(s.radius) - rho) <= 1e-9 * max(rho, 1.0)):
                     return True
         return None
 
@@ -516,14 +508,13 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
     """The engine layout (bodies, folded links, pivots, grooves, substitutes), or the
     reason the mechanism cannot be expressed."""
     cfg = cfg or {}
-    if not _is_number(mech.gravity):
-        return "gravity is not numeric (pass a numeric mechanism)"
+    reason = description_reason(mech)
+    if reason:
+        return reason
     dynamic: list[str] = []
     massless: list[str] = []
     for b in mech.bodies:
-        if not (_is_number(b.mass) and _is_number(b.inertia)):
-            return f"body {b.name}: mass/inertia not numeric (pass a numeric mechanism)"
-        m, i = _num(b.mass), _num(b.inertia)
+        m, i = num(b.mass), num(b.inertia)
         if m == 0 and i == 0:
             massless.append(b.name)
         elif m > 0 and i > 0:
@@ -531,39 +522,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
         else:
             return (f"body {b.name}: mass {m} and inertia {i}; Chipmunk needs both > 0 "
                     "(or both 0 for a massless link that can be eliminated)")
-    for j in mech.joints:
-        if not isinstance(j, (Revolute, Prismatic)):
-            return f"joint {j.name}: type {type(j).__name__} not supported"
-        values = [*j.parent_anchor, *j.child_anchor, j.angle_offset]
-        if isinstance(j, Prismatic):
-            values += [*j.axis, *(v for v in j.limits if v is not None)]
-        if not all(_is_number(v) for v in values):
-            return f"joint {j.name}: geometry not numeric (pass a numeric mechanism)"
-        if isinstance(j, Prismatic) and _num(j.axis[0]) ** 2 + _num(j.axis[1]) ** 2 == 0:
-            return f"joint {j.name}: zero prismatic axis"
-    constraints = tuple(getattr(mech, "constraints", ()))
-    for c in constraints:
-        if isinstance(c, LinearCoupling):
-            values = [v for _, v in c.coefficients] + [c.constant]
-        elif isinstance(c, PointOnPoint):
-            values = [*c.point_a, *c.point_b]
-        elif isinstance(c, PointOnLine):
-            values = [*c.point, *c.line_point, *c.direction]
-        else:
-            return f"constraint {getattr(c, 'name', c)}: type {type(c).__name__} not supported"
-        if not all(_is_number(v) for v in values):
-            return f"constraint {c.name}: geometry not numeric (pass a numeric mechanism)"
-        if isinstance(c, PointOnLine) and not _vec(c.direction).any():
-            return f"constraint {c.name}: zero slot direction"
-    for f in mech.forces:
-        if not isinstance(f, (PointToPoint, CoordinateForce)):
-            return f"force element {f.name}: type {type(f).__name__} not supported"
-        law = f.tension if isinstance(f, PointToPoint) else f.force
-        if sp.sympify(law).free_symbols - {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}:
-            return f"force element {f.name}: law has free parameters (pass a numeric mechanism)"
-        if isinstance(f, PointToPoint) and not all(
-                _is_number(v) for v in (*f.point_a, *f.point_b)):
-            return f"force element {f.name}: points not numeric"
+    constraints = mech.constraints
 
     # --- massless bodies: fold (revolute + prismatic), arm (revolutes), free group ------
     geometric = [c for c in constraints if isinstance(c, (PointOnPoint, PointOnLine))]
@@ -659,7 +618,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 else:  # slot carrier glued to the slot body, its centre on the line
                     foot = base - float(base @ direction) * direction
                     host = mech.body(slot)
-                    m, inertia = _num(host.mass), _num(host.inertia)
+                    m, inertia = num(host.mass), num(host.inertia)
                     mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(foot)))
                     name = f"_slot_carrier_{c.name}"
                     layout.carriers.append(_Carrier(name, slot, "slot", tuple(foot), mass,
@@ -672,7 +631,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                     layout.infinite.add(pin)
                 else:  # pin slider: a point mass pinned to the pin point
                     host = mech.body(pin)
-                    m, inertia = _num(host.mass), _num(host.inertia)
+                    m, inertia = num(host.mass), num(host.inertia)
                     mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(point)))
                     name = f"_pin_slider_{c.name}"
                     layout.carriers.append(_Carrier(name, pin, "pin", tuple(point), mass,
@@ -699,14 +658,14 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
     # --- engine masses; compensation of the slider substitutes -------------------------
     for name in dynamic:
         b = mech.body(name)
-        layout.engine_mass[name] = (_num(b.mass),
-                                    math.inf if name in layout.infinite else _num(b.inertia))
+        layout.engine_mass[name] = (num(b.mass),
+                                    math.inf if name in layout.infinite else num(b.inertia))
     for car in layout.carriers:
         layout.engine_mass[car.name] = (car.mass, car.moment)
     if layout.carriers and cfg.get("slider_compensation", True):
         for host in dict.fromkeys(car.host for car in layout.carriers):
             cars = [car for car in layout.carriers if car.host == host]
-            m, inertia = _num(mech.body(host).mass), _num(mech.body(host).inertia)
+            m, inertia = num(mech.body(host).mass), num(mech.body(host).inertia)
             m1 = m - sum(car.mass for car in cars)
             first = sum(car.mass * np.array(car.point) for car in cars)
             c1 = -first / m1 if m1 > 0 else np.zeros(2)
@@ -726,7 +685,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 if not ok and body in layout.cog:
                     del layout.cog[body]
                     b = mech.body(body)
-                    layout.engine_mass[body] = (_num(b.mass), _num(b.inertia))
+                    layout.engine_mass[body] = (num(b.mass), num(b.inertia))
                     layout.notes.append(f"slider substitutes on {body} not compensated (its "
                                         "centre of gravity must stay on a groove)")
     for g in layout.grooves:
@@ -994,12 +953,12 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
     coords = [kin.coordinate(j) for j in mech.joints]
     coords_np = sp.lambdify(state, coords + [kin.rate(c) for c in coords],
                             modules="numpy", cse=True)
-    masses = {b.name: _num(b.mass) for b in mech.bodies}
+    masses = {b.name: num(b.mass) for b in mech.bodies}
     pitch_phi = []
     for pitch in layout.pitches:
         c = next(c for c in mech.constraints if c.name == pitch.name)
-        phi = sum((_num(coef) * coords[mech.coordinates.index(name)]
-                   for name, coef in c.coefficients), sp.Integer(0)) - _num(c.constant)
+        phi = sum((num(coef) * coords[mech.coordinates.index(name)]
+                   for name, coef in c.coefficients), sp.Integer(0)) - num(c.constant)
         pitch_phi.append(sp.lambdify(kin.P, phi, modules="math", cse=True))
     compiled = _Compiled(layout, kin, loads, loaded, loads_math, external_np, coords_np, masses,
                          pitch_phi)
@@ -1086,47 +1045,6 @@ class _Balance:
         state = [s for k in range(len(kin.index))
                  for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
         self.external = sp.lambdify([*state, H, TIME], flat, modules="numpy", cse=True)
-
-
-def _initial_states(mech: Mechanism, q0, qd0) -> dict[str, tuple[float, ...]]:
-    """(x, y, theta, vx, vy, omega) of every description body's frame at (q0, qd0), by
-    planar forward kinematics in joint order (conventions 3-5)."""
-    st: dict[str, tuple[float, ...]] = {WORLD: (0.0,) * 6}
-
-    def rot(th: float, v) -> tuple[float, float]:
-        c, s = math.cos(th), math.sin(th)
-        return c * v[0] - s * v[1], s * v[0] + c * v[1]
-
-    for j, q, qd in zip(mech.joints, q0, qd0):
-        x, y, th_p, vx, vy, w_p = st[j.parent]
-        pa = (_num(j.parent_anchor[0]), _num(j.parent_anchor[1]))
-        ca = (_num(j.child_anchor[0]), _num(j.child_anchor[1]))
-        off = _num(j.angle_offset)
-        if isinstance(j, Revolute):
-            if j.clockwise:
-                q, qd = -q, -qd
-            th = (0.0 if j.absolute else th_p) + q + off
-            w = (0.0 if j.absolute else w_p) + qd
-            r = rot(th_p, pa)
-            va = (vx - w_p * r[1], vy + w_p * r[0])
-        else:
-            th, w = th_p + off, w_p
-            axis = (_num(j.axis[0]), _num(j.axis[1]))
-            r = rot(th_p, (pa[0] + q * axis[0], pa[1] + q * axis[1]))
-            slide = rot(th_p, axis)
-            va = (vx - w_p * r[1] + qd * slide[0], vy + w_p * r[0] + qd * slide[1])
-        a = (x + r[0], y + r[1])
-        rc = rot(th, ca)
-        st[j.child] = (a[0] - rc[0], a[1] - rc[1], th, va[0] + w * rc[1], va[1] - w * rc[0], w)
-    return st
-
-
-def _point_state(st: tuple[float, ...], local) -> tuple[float, float, float, float]:
-    """World position and velocity of a body point, from the body frame's state."""
-    x, y, th, vx, vy, w = st
-    c, s = math.cos(th), math.sin(th)
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return x + rx, y + ry, vx - w * ry, vy + w * rx
 
 
 class PymunkBackend(Backend):
@@ -1264,12 +1182,12 @@ class PymunkBackend(Backend):
 
         layout = comp.layout
         space = pymunk.Space()
-        space.gravity = (0.0, -_num(mech.gravity))
+        space.gravity = (0.0, -num(mech.gravity))
         space.damping = float(cfg["damping"])
         space.iterations = int(cfg["iterations"])
         sleep = cfg["sleep_time_threshold"]
         space.sleep_time_threshold = math.inf if sleep is None else float(sleep)
-        state = _initial_states(mech, q0, qd0)
+        state = body_states(mech, q0, qd0)
         bodies: dict[str, pymunk.Body] = {WORLD: space.static_body}
         for name in layout.engine:
             m, inertia = layout.engine_mass[name]
@@ -1279,13 +1197,13 @@ class PymunkBackend(Backend):
                 cog = layout.cog.get(name)
             else:
                 car = next(c for c in layout.carriers if c.name == name)
-                x, y, vx, vy = _point_state(state[car.host], car.point)
+                x, y, vx, vy = point_state(state[car.host], car.point)
                 th, w = (state[car.host][2], state[car.host][5]) if car.kind == "slot" else (0.0, 0.0)
                 cog = None
             body.angle = th  # before the position: pymunk places the frame with the angle
             if cog:
                 body.center_of_gravity = cog
-                _, _, vx, vy = _point_state((x, y, th, vx, vy, w), cog)
+                _, _, vx, vy = point_state((x, y, th, vx, vy, w), cog)
             body.position = (x, y)
             body.velocity = (vx, vy)  # of the centre of gravity
             body.angular_velocity = w
@@ -1495,7 +1413,7 @@ class PymunkBackend(Backend):
         transient at sample 1: the first step also builds the steady O(h^2) joint gap of
         the position update, and its impulse contains that correction."""
         j = mech.joint(joint)
-        g = _num(mech.gravity)
+        g = num(mech.gravity)
         dynamic = comp.layout.dynamic
         total = np.zeros((len(t) - 1, 2))
         for name in mech.subtree(j.child):
@@ -1540,7 +1458,7 @@ class PymunkBackend(Backend):
         A = np.stack(arrays(bal.A(*pos)), axis=-1).reshape(m_steps, nrow, ncol)
         centres = arrays(bal.centres(*pos))
         rhs = np.zeros((m_steps, nrow))
-        g = _num(mech.gravity)
+        g = num(mech.gravity)
         carriers = {c.name: c for c in layout.carriers}
         for k, name in enumerate(layout.engine):
             host = name if name in layout.dynamic else carriers[name].host
@@ -1550,7 +1468,7 @@ class PymunkBackend(Backend):
             fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
-                inertia = _num(mech.body(name).inertia) if name in layout.dynamic else 0.0
+                inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
             rx, ry = S[1:, 6 * k] - centres[2 * i], S[1:, 6 * k + 1] - centres[2 * i + 1]
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
