@@ -55,3 +55,66 @@ def test_setting_types():
     assert Setting(None, (float, type(None)), "n").check("e", "k", None) is None
     with pytest.raises(ValueError, match="must be float or null"):
         Setting(None, (float, type(None)), "n").check("e", "k", "x")
+
+
+# --- exactness declared per element kind --------------------------------------------
+
+from dataclasses import replace  # noqa: E402
+
+from mbfidelity.comparisons.runner import expectation_for, expectations  # noqa: E402
+from mbfidelity.simulators.base import LEVELS, expected_failures  # noqa: E402
+from mbfidelity.simulators.plan import ELEMENT_KINDS, elements  # noqa: E402
+from mbfidelity.systems import get_system  # noqa: E402
+from mbfidelity.systems.model import LinearCoupling  # noqa: E402
+
+
+def _numeric(system_id):
+    system = get_system(system_id)
+    return system.numeric_mechanism(system.parameter_values())
+
+
+@pytest.mark.parametrize("backend", BACKENDS, ids=lambda b: b.id)
+def test_every_element_kind_is_declared(backend):
+    assert set(backend.EXPRESSIONS) == set(ELEMENT_KINDS)
+    for kind, cases in backend.EXPRESSIONS.items():
+        assert cases and all(e.level in LEVELS and e.how for e in cases), kind
+        if len(cases) > 1:
+            assert all(e.when for e in cases), f"{kind}: several cases need their conditions"
+
+
+@pytest.mark.parametrize("backend", BACKENDS, ids=lambda b: b.id)
+def test_catalog_elements_take_declared_cases(backend):
+    for system_id in ("rhombus_linkage", "slotted_link_spring_damper", "belt_pulleys",
+                      "rolling_disc_track", "mass_spring_damper"):
+        mech = _numeric(system_id)
+        assert backend.support(mech).ok
+        for kind, element in elements(mech):
+            assert backend.expression(mech, element) in backend.EXPRESSIONS[kind]
+
+
+def test_support_follows_the_declarations():
+    point_mass = _numeric("compound_pendulum")
+    point_mass = replace(point_mass, bodies=tuple(replace(b, inertia=0)
+                                                  for b in point_mass.bodies))
+    support = all_backends()["mujoco"].support(point_mass)
+    assert not support.ok and "zero mass or inertia" in support.reason
+    assert all_backends()["pybullet"].support(point_mass).ok
+    disc = _numeric("rolling_disc_track")
+    three = LinearCoupling("three", tuple((c, k + 1.0) for k, c in enumerate(disc.coordinates)))
+    support = all_backends()["pybullet"].support(replace(disc, constraints=(three,)))
+    assert not support.ok and "JOINT_GEAR constrains exactly two joints" in support.reason
+
+
+def test_expected_failures_derive_from_soft_expressions():
+    mujoco, exudyn = all_backends()["mujoco"], all_backends()["exudyn"]
+    (group,) = expected_failures(mujoco, _numeric("rhombus_linkage"))  # loop and slot: one
+    assert {e.metric for e in group} >= {"*.trajectory_*", "*.constraint_*"}
+    assert all(e.simulator == "mujoco" and e.kind == "xfail" and "soft" in e.reason
+               for e in group)
+    assert expected_failures(exudyn, _numeric("rhombus_linkage")) == ()
+    assert expected_failures(mujoco, _numeric("double_pendulum")) == ()
+    # the comparisons merge them after the system's own declarations
+    system = get_system("scotch_yoke")
+    assert expectations(system, "mujoco")[-1] == group
+    assert expectation_for(system, "mujoco", "large.constraint_slot") in group
+    assert expectation_for(system, "exudyn", "large.constraint_slot") is None

@@ -18,7 +18,8 @@ from ..analytic.linear import (companion_matrix, find_equilibria, operating_equi
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
-from ..systems import System, get_system
+from ..simulators.base import expected_failures
+from ..systems import Expectation, System, get_system
 from . import metrics, tolerances
 
 DEFAULT_DT = 1e-3
@@ -80,10 +81,27 @@ class Comparison:
         }
 
 
+def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
+    """The declarations that judge `simulator` on `system`, in matching order: the system's
+    own (mechanism-specific), each one declaration, then those the backend's declared
+    soft or substitute expressions of the system's elements imply
+    (`simulators.base.expected_failures`), each a group of patterns declared together."""
+    return tuple((e,) for e in system.expectations) + _declared(system.id, simulator)
+
+
+@lru_cache(maxsize=None)
+def _declared(system_id: str, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
+    system = get_system(system_id)
+    backend = get_backend(simulator)
+    mech = system.numeric_mechanism(system.parameter_values())
+    return expected_failures(backend, mech) if backend.support(mech).ok else ()
+
+
 def expectation_for(system: System, simulator: str, metric: str):
-    for e in system.expectations:
-        if fnmatch.fnmatch(simulator, e.simulator) and fnmatch.fnmatch(metric, e.metric):
-            return e
+    for group in expectations(system, simulator):
+        for e in group:
+            if fnmatch.fnmatch(simulator, e.simulator) and fnmatch.fnmatch(metric, e.metric):
+                return e
     return None
 
 
@@ -97,14 +115,14 @@ def _judge(system: System, simulator: str, name: str, value: float, tol: float,
 
 
 def _strict_expectations(system: System, result: "Comparison") -> None:
-    """An expected failure covers the metrics its pattern matches and is met when at
-    least one of them fails; when every one passes it is an unexpected pass (strict):
-    the problem was fixed and the declaration must go."""
-    for exp in system.expectations:
-        if exp.kind != "xfail" or not fnmatch.fnmatch(result.simulator, exp.simulator):
-            continue
-        covered = [m for m in result.metrics if fnmatch.fnmatch(m.name, exp.metric)
-                   and expectation_for(system, result.simulator, m.name) is exp]
+    """An expected failure covers the metrics its patterns match (those it is the first
+    match for) and is met when at least one of them fails; when every one passes it is an
+    unexpected pass (strict): the problem was fixed and the declaration must go."""
+    for group in expectations(system, result.simulator):
+        mine = [e for e in group
+                if e.kind == "xfail" and fnmatch.fnmatch(result.simulator, e.simulator)]
+        covered = [m for m in result.metrics
+                   if any(expectation_for(system, result.simulator, m.name) is e for e in mine)]
         if covered and all(m.passed for m in covered):
             for m in covered:
                 m.status = "xpass"

@@ -78,8 +78,26 @@ from ..systems.model import (
     Revolute,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Setting, Support
-from .plan import ForceLaw, constrained_bodies, coordinate_map, description_reason, num, rot
+from .base import EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    TIME_LOAD,
+    ForceLaw,
+    constrained_bodies,
+    coordinate_map,
+    num,
+    rot,
+)
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -280,22 +298,51 @@ class ExudynBackend(Backend):
         return str(exudyn.__version__)
 
     # --- support ---------------------------------------------------------------------------
-    def support(self, mechanism: Mechanism) -> Support:
-        reason = description_reason(mechanism)
-        if reason:
-            return Support(False, reason)
-        held = constrained_bodies(mechanism)
+    EXPRESSIONS = {
+        BODY: (Expression(EXACT, "a link of the ObjectKinematicTree with its mass, centre of "
+                                 "mass and inertia"),),
+        MASSLESS_BODY: (
+            Expression(EXACT, "a zero-mass link: the mass matrix stays regular while a "
+                              "massive descendant carries its coordinates, or a closure "
+                              "constraint holds it (augmented matrix [M C^T; C 0])",
+                       when="a massive body below it, or a constraint on its subtree"),
+            Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
+                                    "kinematic tree's mass matrix would be singular",
+                       when="only massless bodies below it, none constrained"),
+        ),
+        REVOLUTE: (Expression(EXACT, "RevoluteZ link of the kinematic tree"),),
+        PRISMATIC: (Expression(EXACT, "PrismaticX link, the joint frame turned to the axis"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, "ObjectConnectorSpringDamper with its own "
+                                                  "stiffness, damping and force (C++)"),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "ObjectConnectorSpringDamper with a "
+                                                  "springForceUserFunction, called at every "
+                                                  "integrator stage"),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "the tree's PD terms and joint force "
+                                                    "vector (C++) where the coordinate is one "
+                                                    "engine coordinate, otherwise the tree's "
+                                                    "forceUserFunction"),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "the tree's forceUserFunction, called at "
+                                                    "every integrator stage"),),
+        TIME_LOAD: (Expression(EXACT, "a user function, called at every integrator stage "
+                                      "with the stage time"),),
+        POINT_ON_POINT: (Expression(EXACT, "ObjectJointRevolute2D: index-3 algebraic "
+                                           "equations, met to round-off"),),
+        POINT_ON_LINE: (Expression(EXACT, "ObjectJointPrismatic2D with the rotation free: an "
+                                          "exact pin in slot"),),
+        LINEAR_COUPLING: (Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
+                                            "coordinates (affine in the description's, so "
+                                            "the coupling stays linear)"),),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
         # a massless body with nothing massive below it makes the tree's mass matrix
         # singular; with closure constraints the implicit solver's augmented matrix
         # [M C_q^T; C_q 0] can still be regular when a constraint fixes that subtree
-        for b in mechanism.bodies:
-            sub = mechanism.subtree(b.name)
-            if b.massless and all(mechanism.body(x).massless for x in sub):
-                if held & set(sub):
-                    continue
-                return Support(False, f"massless body {b.name} carries no mass: the kinematic "
-                                      "tree's mass matrix would be singular")
-        return Support(True)
+        sub = mechanism.subtree(element.name)
+        if not all(mechanism.body(x).massless for x in sub):
+            return cases[0]
+        return cases[0] if constrained_bodies(mechanism) & set(sub) else cases[1]
 
     # --- model building --------------------------------------------------------------------
     def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict):

@@ -77,8 +77,47 @@ from ..systems.model import (
     Segment,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Setting, Support
-from .plan import ForceLaw, coordinate_map, description_reason, num, rot
+from .base import (
+    EXACT,
+    SOFT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    TIME_LOAD,
+    ForceLaw,
+    coordinate_map,
+    num,
+    rot,
+)
+
+#: what MuJoCo's soft equalities cost (SIMULATORS.md; each measured, the numbers per
+#: mechanism are in the results)
+SOFT_EQUALITY = (
+    "MuJoCo's equality constraints are soft: the impedance is capped at 0.9999 (solimp) and "
+    "the reference time constant at 2 dt, so each constraint force falls about 1e-4 of "
+    "itself short and a small violation (1e-9 to 1e-7 m) makes up the rest; constraint "
+    "forces are then off by 1e-4 to 2e-3 and trajectories by 1e-6 to 1e-5, against RK4 "
+    "gates near 1e-7. No solref/solimp choice removes the floor (measured).")
+#: the metrics a soft closure is expected to push beyond the RK4 gates: its own force and
+#: the contact forces read from it, the motion and the energy the motion carries
+SOFT_EQUALITY_METRICS = ("*.trajectory_*", "*.energy_drift", "*.constraint_*", "*.contact_*")
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -228,21 +267,6 @@ def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCo
                 "track": track.name, "centre": centre, "R": R, "r": r,
                 "j": mech.joints.index(jd)}
     return "no disc (a body with a Circle centred on its hinge) among the coupled coordinates"
-
-
-def _check(mech: Mechanism) -> str:
-    """Empty string when the mechanism can be translated, else the reason."""
-    reason = description_reason(mech)
-    if reason:
-        return reason
-    for b in mech.bodies:
-        m, inertia = num(b.mass), num(b.inertia)
-        if not b.massless and (m <= 0 or inertia <= 0):
-            return (f"body {b.name}: mass {m} and inertia {inertia} must both be > 0 "
-                    "(MuJoCo rejects moving bodies with zero mass or inertia)")
-    if all(b.massless for b in mech.bodies):
-        return "every body is massless (no mass scale for the substitute bodies)"
-    return ""
 
 
 def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
@@ -964,16 +988,75 @@ class MujocoBackend(Backend):
 
         return mujoco.__version__
 
-    def support(self, mechanism: Mechanism) -> Support:
-        reason = _check(mechanism)
-        return Support(not reason, reason)
+    EXPRESSIONS = {
+        BODY: (
+            Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
+                              "explicit <inertial> (planar inertia on z, the same on x and y)",
+                       when="mass and inertia > 0"),
+            Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass or inertia",
+                       when="mass or inertia 0, not both"),
+        ),
+        MASSLESS_BODY: (
+            Expression(EXACT, "folded: its joints become a chain of joints of its single "
+                              "child's MJCF body, anchors and axes at the reference "
+                              "configuration",
+                       when="one child joint, and no constraint or point force on it"),
+            Expression(SUBSTITUTE, "a body of small mass (link_mass_ratio of the lightest "
+                                   "body for a kinematic link, massless_mass_ratio where a "
+                                   "constraint or a point force loads it), weight cancelled: "
+                                   "MuJoCo rejects massless moving bodies",
+                       when="several child joints, or loaded by a constraint or point force"),
+        ),
+        REVOLUTE: (Expression(EXACT, "hinge about z on the relative angle (absolute and "
+                                     "clockwise coordinates through v = A q + b)"),),
+        PRISMATIC: (Expression(EXACT, "slide joint in the x-y plane (limits are admissible "
+                                      "intervals, not stops)"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, "spatial tendon with its own stiffness, "
+                                                  "springlength and damping (native_springs; "
+                                                  "otherwise the passive callback)"),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "spatial tendon, -T dL/dq from the passive "
+                                                  "callback at every integrator stage"),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "joint stiffness, springref and damping "
+                                                    "where the coordinate is one engine joint, "
+                                                    "otherwise the passive callback"),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "passive callback (set_mjcb_passive) at "
+                                                    "every integrator stage"),),
+        TIME_LOAD: (Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
+                                      "stage time"),),
+        POINT_ON_POINT: (Expression(SOFT, "connect equality between two sites",
+                                    expected_failures=SOFT_EQUALITY_METRICS,
+                                    reason=SOFT_EQUALITY),),
+        POINT_ON_LINE: (Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
+                                               "the slot body (slide joint along the slot) "
+                                               "connected to the pin, its mass taken out of "
+                                               "the pin body (exact while the constraint "
+                                               "holds); the connect is soft",
+                                   expected_failures=SOFT_EQUALITY_METRICS,
+                                   reason=SOFT_EQUALITY),),
+        LINEAR_COUPLING: (Expression(SOFT, "fixed tendon sum(w_j v_j) over the engine joint "
+                                           "values held by a tendon equality (an exact linear "
+                                           "relation; soft like every equality)",
+                                     expected_failures=SOFT_EQUALITY_METRICS,
+                                     reason=SOFT_EQUALITY),),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == BODY:
+            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+        return cases[0] if element.name in _foldable(mechanism) else cases[1]
+
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        if all(b.massless for b in mechanism.bodies):
+            return "every body is massless (no mass scale for the substitute bodies)"
+        return ""
 
     # --- translation ---------------------------------------------------------------------
     def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
               dt: float | None = None) -> _Plan:
-        reason = _check(mechanism)
-        if reason:
-            raise ValueError(f"mujoco cannot express this mechanism: {reason}")
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
         steps = float(settings["constraint_timeconst_steps"])
         opts = {
             "slider_mass_ratio": float(settings["slider_mass_ratio"]),

@@ -80,9 +80,40 @@ from ..systems.model import (
     Revolute,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Setting, Support
-from .plan import ForceLaw, constrained_bodies, coordinate_map, description_reason, num
+from .base import (
+    EXACT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    TIME_LOAD,
+    ForceLaw,
+    constrained_bodies,
+    coordinate_map,
+    num,
+)
 
+_POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
+                "states at the start of the step (the single stage of its semi-implicit "
+                "Euler)")
+_JOINT_FORCE = ("joint force through setJointMotorControlArray(TORQUE_CONTROL) every step, "
+                "tau = A^-T Q")
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
 _ROLLING = ("coupling", "contact")
 _POINT_ON_LINE = ("prismatic", "slider")
@@ -601,28 +632,64 @@ class PyBulletBackend(Backend):
             import pybullet
             return f"api {pybullet.getAPIVersion()}"
 
-    def support(self, mechanism: Mechanism) -> Support:
-        reason = description_reason(mechanism)
-        if reason:
-            return Support(False, reason)
-        parents = {j.parent for j in mechanism.joints}
-        constrained = constrained_bodies(mechanism)
-        for body in mechanism.bodies:
-            if body.massless and body.name not in parents and body.name not in constrained:
-                return Support(False, f"massless body {body.name} carries nothing: singular")
+    EXPRESSIONS = {
+        BODY: (Expression(EXACT, "a link of the reduced-coordinate multibody with the "
+                                 "explicit mass and central inertia (changeDynamics), "
+                                 "no collision shape"),),
+        MASSLESS_BODY: (
+            Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body "
+                              "algorithm inverts only each joint's articulated inertia, "
+                              "which its child carries", when="it carries a child"),
+            Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of "
+                                   "the smallest body's), since zero would make the "
+                                   "articulated-body algorithm singular",
+                       when="it carries nothing but a closure constraint holds it"),
+            Expression(UNSUPPORTED, "a massless link that carries nothing is singular for "
+                                    "the articulated-body algorithm",
+                       when="it carries nothing and no constraint holds it"),
+        ),
+        REVOLUTE: (Expression(EXACT, "revolute link about z, the joint frame turned by "
+                                     "angle_offset"),),
+        PRISMATIC: (Expression(EXACT, "prismatic link along the unit axis (its length in "
+                                      "v = A q + b)"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, _POINT_FORCE),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _POINT_FORCE),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _JOINT_FORCE),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _JOINT_FORCE),),
+        TIME_LOAD: (Expression(EXACT, "evaluated at the time of the start of each step, the "
+                                      "single stage of the semi-implicit Euler step"),),
+        POINT_ON_POINT: (Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
+                                           "erp 1 (no regularisation; the position error of "
+                                           "a step is removed in the next)"),),
+        POINT_ON_LINE: (Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
+                                               "inertia rotor_inertia_ratio of the smallest) "
+                                               "and a JOINT_PRISMATIC rotor -> slot body whose "
+                                               "pivot follows the pin: the rotor's inertia is "
+                                               "the only substitute (point_on_line='slider': "
+                                               "a slider link of small mass)"),),
+        LINEAR_COUPLING: (
+            Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, "
+                              "solved at velocity level (exact for a linear constraint)",
+                       when="two engine joint values"),
+            Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
+                                    "(jv_a + ratio jv_b = target); its gearAuxLink only adds "
+                                    "that joint's current velocity as a target, it is not a "
+                                    "three-term constraint, and a one-joint coupling would be "
+                                    "a lock", when="one, or three or more, engine joint values"),
+        ),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == MASSLESS_BODY:
+            if any(j.parent == element.name for j in mechanism.joints):
+                return cases[0]
+            return cases[1] if element.name in constrained_bodies(mechanism) else cases[2]
         cmap = coordinate_map(mechanism)
-        for c in mechanism.constraints:
-            if isinstance(c, LinearCoupling):
-                _, _, w, _ = _gear_terms(c, mechanism.coordinates, cmap.T, cmap.b)
-                k = int(np.count_nonzero(w))
-                if k != 2:
-                    return Support(False, (
-                        f"coupling {c.name} involves {k} engine joint value(s): "
-                        "PyBullet's JOINT_GEAR constrains exactly two joints "
-                        "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
-                        "joint's current velocity as a target, it is not a three-term "
-                        "constraint, and a one-joint coupling would be a lock"))
-        return Support(True)
+        _, _, w, _ = _gear_terms(element, mechanism.coordinates, cmap.T, cmap.b)
+        k = int(np.count_nonzero(w))
+        return cases[0] if k == 2 else replace(
+            cases[1], how=f"it involves {k} engine joint value(s): {cases[1].how}")
 
     # --- model building ----------------------------------------------------------------
     def _build(self, p, cid: int, plan: _Plan, settings: dict,

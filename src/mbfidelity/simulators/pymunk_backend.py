@@ -106,9 +106,39 @@ from ..systems.model import (
     as_column,
     rotation,
 )
-from .base import Backend, Linearization, RunResult, Setting, Support
-from .plan import body_states, description_reason, num, point_state, rot
+from .base import (
+    EXACT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    TIME_LOAD,
+    body_states,
+    description_reason,
+    num,
+    point_state,
+    rot,
+)
 
+_ELEMENT_FORCE = ("body forces and torques from one compiled function of the body states, "
+                  "evaluated at the position-updated state x + h v (element_forces): a "
+                  "consistent semi-implicit Euler step")
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
 #: how a rolling coupling with drawn pitch circles is built
@@ -1169,11 +1199,69 @@ class PymunkBackend(Backend):
 
         return f"{pymunk.version} (Chipmunk {pymunk.chipmunk_version.split('-')[0]})"
 
-    def support(self, mechanism: Mechanism) -> Support:
-        plan = _plan(mechanism, self.default_settings())
-        if isinstance(plan, str):
-            return Support(False, plan)
-        return Support(True)
+    EXPRESSIONS = {
+        BODY: (
+            Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
+                              "(centre of gravity at its origin), no shapes",
+                       when="mass and inertia > 0"),
+            Expression(UNSUPPORTED, "Chipmunk needs mass and moment > 0 (or both 0 for a "
+                                    "massless link that can be eliminated)",
+                       when="mass or inertia 0, not both"),
+        ),
+        MASSLESS_BODY: (Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
+                                          "folded into one GrooveJoint (a revolute and a "
+                                          "prismatic joint), an arm PinJoint (revolute joints "
+                                          "at two points), or a free group whose positions "
+                                          "solve its joint equations; other shapes are "
+                                          "refused (support)"),),
+        REVOLUTE: (Expression(EXACT, "PivotJoint at the two anchors"),),
+        PRISMATIC: (Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and a "
+                                      "GearJoint locking the rotation; refused (support) "
+                                      "unless the path passes through the parent's centre "
+                                      "of mass or the parent is the world. " + _GROOVE_LIMIT),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
+        TIME_LOAD: (Expression(EXACT, _ELEMENT_FORCE + ", at t + h"),),
+        POINT_ON_POINT: (Expression(EXACT, "PivotJoint"),),
+        POINT_ON_LINE: (
+            Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot "
+                                                  "body's centre of mass (or the slot is on "
+                                                  "the world or a body whose rotation is "
+                                                  "fixed) and the pin is the pin body's"),
+            Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
+                                   "carrier (glued to the slot body, centred on the line) in "
+                                   "an exact GrooveJoint, their mass taken out of the host "
+                                   "(slider_compensation). " + _GROOVE_LIMIT,
+                       when="otherwise"),
+        ),
+        LINEAR_COUPLING: (
+            Expression(EXACT, "GearJoint on the absolute angles of two bodies",
+                       when="two body angles"),
+            Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
+                              "moved to the pitch point before every solve: its tangential "
+                              "row is the coupling (gear pair, belt, rolling); other "
+                              "couplings are refused (support)",
+                       when="three body angles, two hinged on a carrier"),
+        ),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == BODY:
+            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+        layout = _plan(mechanism, self.default_settings())
+        if isinstance(layout, str):  # refused as a whole: see translation_reason
+            return cases[0]
+        if kind == POINT_ON_LINE:
+            substituted = any(car.constraint == element.name for car in layout.carriers)
+            return cases[1] if substituted else cases[0]
+        return cases[1] if any(p.name == element.name for p in layout.pitches) else cases[0]
+
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        layout = _plan(mechanism, self.default_settings())
+        return layout if isinstance(layout, str) else ""
 
     # --- building ------------------------------------------------------------------------
     @staticmethod

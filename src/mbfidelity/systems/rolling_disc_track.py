@@ -67,8 +67,7 @@ reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
 import sympy as sp
 
-from . import ContactOutput, Expectation, PrintedFormula, System, Variant, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from . import ContactOutput, PrintedFormula, System, Variant, coordinate_symbols
 from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, LinearCoupling,
                     Mechanism, Parameter, Revolute, Scenario, Segment)
 
@@ -219,12 +218,5 @@ SYSTEM = System(
                        "the normal force chatters from facet to facet, the disc creeps "
                        "(micro-slip) and the contact dissipates; the description's gates are "
                        "those of an ideal rolling constraint"),
-    ),
-    expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        # from rest at the equilibrium (forced) the soft coupling's lag stays below the gate
-        *(Expectation("mujoco", f"{sc}.contact_*", "xfail", MUJOCO_SOFT_EQUALITY)
-          for sc in ("small", "large", "undamped")),
     ),
 )
