@@ -118,3 +118,18 @@ def test_expected_failures_derive_from_soft_expressions():
     assert expectations(system, "mujoco")[-1] == group
     assert expectation_for(system, "mujoco", "large.constraint_slot") in group
     assert expectation_for(system, "exudyn", "large.constraint_slot") is None
+
+
+def test_variant_is_description_data():
+    """The rolling-by-contact variant is a RollingContact element in place of the rolling
+    coupling, not a shape the backends recognise."""
+    system = get_system("rolling_disc_track")
+    mech = system.numeric_mechanism(system.parameter_values(), "contact")
+    (contact,) = mech.constraints
+    assert contact.coupling == _numeric("rolling_disc_track").constraints[0]
+    for sid in system.variant("contact").settings:
+        backend = all_backends()[sid]
+        assert backend.support(mech).ok
+        assert backend.expression(mech, contact).level == "substitute"
+    support = all_backends()["exudyn"].support(mech)
+    assert not support.ok and support.reason.startswith("RollingContact rolling:")

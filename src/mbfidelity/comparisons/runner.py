@@ -167,7 +167,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     merged = backend.resolve_settings(wanted)
     result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt,
                         variant=variant or "")
-    mech = system.numeric_mechanism(base_values)
+    mech = system.numeric_mechanism(base_values, variant)
     support = backend.support(mech)
     unsupported = expectation_for(system, simulator, "*")
     if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
@@ -184,8 +184,9 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     for name in scenarios or by_name:
         sc, eq = by_name[name]
         _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
-                          eq)
-    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series)
+                          eq, variant)
+    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
+                         variant)
     if chosen_variant is None:
         _strict_expectations(system, result)
     else:
@@ -241,9 +242,9 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
 
 
 def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series,
-                      eq=None):
+                      eq=None, variant=None):
     values = system.parameter_values(params, scenario=sc)
-    mech = system.numeric_mechanism(values)
+    mech = system.numeric_mechanism(values, variant)
     T = sc.t_end if t_end is None else t_end
     ref = reference(system, sc, values, dt, T)
     q0, qd0 = ref.q[0], ref.qd[0]
@@ -355,14 +356,15 @@ def _kinetic_amplitude(system, values, q, qd) -> float:
     return float(np.max(T))
 
 
-def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series):
+def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series,
+                         variant=None):
     """Modes of the operating equilibrium: the engine's own linearization, and a
     free-vibration fit of each modal coordinate after a small modal release."""
     eq = operating_equilibrium(system, values)
     if not eq.stable:
         return
     # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
-    mech = system.numeric_mechanism(values).without_time_loads()
+    mech = system.numeric_mechanism(values, variant).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
     ref_w = np.array([abs(m.eigenvalue) for m in modes])
     w_max = float(np.max(ref_w)) if len(ref_w) else 0.0

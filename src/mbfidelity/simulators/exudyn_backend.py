@@ -91,6 +91,7 @@ from .plan import (
     POINT_TO_POINT_LINEAR,
     PRISMATIC,
     REVOLUTE,
+    ROLLING_CONTACT,
     TIME_LOAD,
     ForceLaw,
     constrained_bodies,
@@ -332,6 +333,9 @@ class ExudynBackend(Backend):
         LINEAR_COUPLING: (Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
                                             "coordinates (affine in the description's, so "
                                             "the coupling stays linear)"),),
+        ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
+                                                  "Exudyn holds the rolling coupling exactly "
+                                                  "(LinearCoupling)"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,

@@ -36,8 +36,9 @@ Translation (generic over the description, see `to_mjcf`):
   regularisation (relative to each world-axis row's diagonal) soften the row across a
   rotating slot; ``LinearCoupling`` -> a fixed tendon ``sum(w_j v_j)`` over the engine joint
   values (w = A^-T c, any number of coordinates) held by a tendon equality (exact linear
-  relation). With ``rolling="contact"`` a rolling coupling of a disc inside a ring is built
-  as friction contact instead (`_rolling_geometry`). Massless bodies that cannot be folded
+  relation); ``RollingContact`` (a variant's stand-in for a rolling coupling) -> friction
+  contact of a sphere disc on a ring of boxes, the arm's length freed by a radial slide
+  (`_contact_geometry`). Massless bodies that cannot be folded
   (several child joints, or loaded by a constraint or a point force) become substitute
   bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
   Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
@@ -66,7 +67,6 @@ from ..systems.model import (
     WORLD,
     Circle,
     CoordinateForce,
-    LinearCoupling,
     Mechanism,
     PointOnLine,
     PointOnPoint,
@@ -74,6 +74,7 @@ from ..systems.model import (
     Prismatic,
     Rectangle,
     Revolute,
+    RollingContact,
     Segment,
 )
 from ..analytic.linear import quadratic_eigenvalues
@@ -100,9 +101,11 @@ from .plan import (
     POINT_TO_POINT_LINEAR,
     PRISMATIC,
     REVOLUTE,
+    ROLLING_CONTACT,
     TIME_LOAD,
     ForceLaw,
     coordinate_map,
+    coupled,
     num,
     rot,
 )
@@ -163,7 +166,7 @@ class _Closure:
     inertia: float = 0.0
     gravcomp: bool = False
     coef: np.ndarray | None = None  # LinearCoupling: coefficients over the coordinates
-    contact: dict = field(default_factory=dict)  # rolling='contact': see _rolling_geometry
+    contact: dict = field(default_factory=dict)  # RollingContact: see _contact_geometry
 
 
 #: radius of gyration of the substitute bodies (their inertia is mass * GYRATION**2)
@@ -226,47 +229,17 @@ def _foldable(mech: Mechanism) -> set[str]:
     return out
 
 
-def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCoupling,
-                      coef: np.ndarray) -> dict | str:
-    """The friction-contact variant of a rolling coupling: a disc (a body with a Circle
-    centred on its hinge, radius r) carried by a massless arm hinged at the centre of a
-    Circle of radius R on a track body, at distance R - r (rolling inside). The coupling
-    must be the no-slip condition of that geometry, (R - r) a_arm + r a_disc - R a_track
-    (absolute angles). Returns the geometry or the reason it does not apply."""
-    names = [nm for nm, _ in c.coefficients]
-    for jd in mech.joints:
-        if jd.coordinate not in names or not isinstance(jd, Revolute):
-            continue
-        disc = mech.body(jd.child)
-        ca = [num(v) for v in jd.child_anchor]
-        circles = [sh for sh in disc.shapes if isinstance(sh, Circle)
-                   and [num(v) for v in sh.center] == ca]
-        if not circles or jd.parent == WORLD:
-            continue
-        r = num(circles[0].radius)
-        arm = jd.parent
-        ja = mech.joint_of_child(arm)
-        if not isinstance(ja, Revolute) or arm not in foldable or ja.parent == WORLD:
-            return (f"the disc {disc.name}'s arm {arm} must be a massless body hinged on "
-                    "the track")
-        track = mech.body(ja.parent)
-        centre = [num(v) for v in ja.parent_anchor]
-        rings = [sh for sh in track.shapes if isinstance(sh, Circle)
-                 and [num(v) for v in sh.center] == centre]
-        if not rings:
-            return f"no Circle on {track.name} centred at the arm's hinge"
-        R = num(rings[0].radius)
-        arm_len = math.dist([num(v) for v in ja.child_anchor], [num(v) for v in jd.parent_anchor])
-        if not (R > r and abs(arm_len - (R - r)) <= 1e-9 * R):
-            return f"the arm length {arm_len} is not R - r = {R - r} (rolling inside the ring)"
-        g = (R - r) * angle_c[arm] + r * angle_c[disc.name] - R * angle_c[track.name]
-        cn, gn = coef / np.linalg.norm(coef), g / np.linalg.norm(g)
-        if min(np.linalg.norm(cn - gn), np.linalg.norm(cn + gn)) > 1e-9:
-            return "the coupling is not the no-slip condition of the disc in the ring"
-        return {"disc": disc.name, "arm_joint": ja.name, "disc_joint": jd.name,
-                "track": track.name, "centre": centre, "R": R, "r": r,
-                "j": mech.joints.index(jd)}
-    return "no disc (a body with a Circle centred on its hinge) among the coupled coordinates"
+def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict:
+    """Where a RollingContact sits in the MJCF: the disc's hub joint, the arm's hinge on
+    the track (the ring's centre, track frame) and the radii. The arm must fold into the
+    disc's MJCF body, which then also carries the radial slide that frees its length."""
+    if c.arm not in foldable:
+        raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
+                         "link that carries the disc only")
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    return {"disc": c.disc, "arm_joint": hinge.name, "disc_joint": hub.name,
+            "track": c.track, "centre": [num(v) for v in hinge.parent_anchor],
+            "R": num(c.track_radius), "r": num(c.disc_radius), "j": mech.joints.index(hub)}
 
 
 def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
@@ -364,12 +337,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             w = Ainv.T @ coef  # c . q = c . A^-1 (v - b)
             weights = {mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
             offset = num(c.constant) + float(coef @ Ainv @ b)
-            if opts.get("rolling", "coupling") == "contact":
-                geo = _rolling_geometry(mech, angle_c, foldable, c, coef)
-                if isinstance(geo, str):
-                    raise ValueError(f"mujoco rolling='contact' cannot build {c.name}: {geo}")
+            if isinstance(c, RollingContact):
                 plan.closures.append(_Closure(c, "contact", slider=f"{c.name}:radial",
-                                              weights=weights, offset=offset, contact=geo,
+                                              weights=weights, offset=offset,
+                                              contact=_contact_geometry(mech, c, foldable),
                                               coef=coef))
             else:
                 plan.closures.append(_Closure(c, "tendon", weights=weights, offset=offset,
@@ -939,41 +910,32 @@ class MujocoBackend(Backend):
             True, bool,
             "Cancel the weight of substitute bodies whose mass is not taken from a body "
             "of the description (MuJoCo body gravcomp=1)."),
-        "rolling": Setting(
-            "coupling", ("coupling", "contact"),
-            "'coupling' (default): a rolling LinearCoupling is a tendon equality (an "
-            "exact linear relation, soft like every equality). 'contact': a disc inside a "
-            "ring is built as friction contact (sphere disc, ring of ring_segments boxes, "
-            "the arm's length freed by a radial slide so that the contact's normal force "
-            "holds the disc); the coupling's force is the contacts' generalized force on "
-            "the disc's coordinate over its coefficient, its violation the accumulated "
-            "slip c.q - const. linearize always uses the coupling."),
         "contact_timeconst_steps": Setting(
             2.0, float,
-            "rolling='contact': solref[0] of the contacts in steps."),
+            "RollingContact: solref[0] of the contacts in steps."),
         "contact_dampratio": Setting(
             1.0, float,
-            "rolling='contact': solref[1] of the contacts."),
+            "RollingContact: solref[1] of the contacts."),
         "contact_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
-            "rolling='contact': solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
+            "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
             "energy: 0.215 rad error in SIMULATORS.md)."),
         "contact_friction": Setting(
             1.0, float,
-            "rolling='contact': sliding friction coefficient of the disc."),
+            "RollingContact: sliding friction coefficient of the disc."),
         "contact_cone": Setting(
             "pyramidal", ("pyramidal", "elliptic"),
-            "rolling='contact': MuJoCo friction cone, pyramidal or elliptic."),
+            "RollingContact: MuJoCo friction cone, pyramidal or elliptic."),
         "impratio": Setting(
             1.0, float,
-            "rolling='contact': MuJoCo impratio (friction-to-normal impedance)."),
+            "RollingContact: MuJoCo impratio (friction-to-normal impedance)."),
         "noslip_iterations": Setting(
             0, int,
-            "rolling='contact': MuJoCo's noslip post-processing iterations (0 = off, "
+            "RollingContact: MuJoCo's noslip post-processing iterations (0 = off, "
             "MuJoCo's default); they remove the regularised friction's creep."),
         "ring_segments": Setting(
             720, int,
-            "rolling='contact': number of boxes forming the ring."),
+            "RollingContact: number of boxes forming the ring."),
     }
 
     def available(self) -> tuple[bool, str]:
@@ -1038,6 +1000,13 @@ class MujocoBackend(Backend):
                                            "relation; soft like every equality)",
                                      expected_failures=SOFT_EQUALITY_METRICS,
                                      reason=SOFT_EQUALITY),),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
+                                                 "of ring_segments boxes (soft, regularised "
+                                                 "friction; the arm's length freed by a "
+                                                 "radial slide); its force is the contacts' "
+                                                 "generalized force on the disc's coordinate "
+                                                 "over its coefficient, its violation the "
+                                                 "slip; linearize uses the coupling"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,
@@ -1070,7 +1039,6 @@ class MujocoBackend(Backend):
             "solimp": tuple(float(x) for x in settings["constraint_solimp"]),
             "refsafe": bool(settings["refsafe"]),
             "diagexact": bool(settings["diagexact"]),
-            "rolling": settings["rolling"],
             "contact_timeconst_steps": float(settings["contact_timeconst_steps"]),
             "contact_dampratio": float(settings["contact_dampratio"]),
             "contact_solref": (float(settings["contact_timeconst_steps"]) * (dt or 0.002),
@@ -1322,7 +1290,7 @@ class MujocoBackend(Backend):
         import mujoco
 
         s = self.resolve_settings(settings)
-        s["rolling"] = "coupling"  # a contact has no linearization: the exact coupling
+        mechanism = coupled(mechanism)  # a contact has no linearization: the exact coupling
         plan = self._plan(mechanism, s, autonomous=True, dt=dt)
         n, eps = plan.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)

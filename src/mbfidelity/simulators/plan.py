@@ -21,7 +21,7 @@ them and lives here:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property, singledispatch
 from typing import Callable, Iterator
 
@@ -44,6 +44,7 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
+    RollingContact,
     compile_law,
 )
 
@@ -92,11 +93,12 @@ TIME_LOAD = "time load"
 POINT_ON_POINT = "PointOnPoint"
 POINT_ON_LINE = "PointOnLine"
 LINEAR_COUPLING = "LinearCoupling"
+ROLLING_CONTACT = "RollingContact"
 
 #: every kind of element a description holds, in the order backends declare them
 ELEMENT_KINDS = (BODY, MASSLESS_BODY, REVOLUTE, PRISMATIC, POINT_TO_POINT_LINEAR,
                  POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR, COORDINATE_FORCE_CUSTOM,
-                 TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING)
+                 TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING, ROLLING_CONTACT)
 
 
 @singledispatch
@@ -143,6 +145,11 @@ def _(element: PointOnLine) -> str:
 @element_kind.register
 def _(element: LinearCoupling) -> str:
     return LINEAR_COUPLING
+
+
+@element_kind.register
+def _(element: RollingContact) -> str:
+    return ROLLING_CONTACT
 
 
 def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
@@ -226,6 +233,13 @@ def _force_law(element) -> ForceLaw:
     return law
 
 
+def coupled(mech: Mechanism) -> Mechanism:
+    """The mechanism with each RollingContact replaced by the rolling coupling it stands
+    for (what an engine linearizes, or balances forces against)."""
+    return replace(mech, constraints=tuple(
+        c.coupling if isinstance(c, RollingContact) else c for c in mech.constraints))
+
+
 def constrained_bodies(mech: Mechanism) -> set[str]:
     """The bodies a closure constraint acts on: the two bodies of a PointOnPoint or
     PointOnLine, the children of the joints whose coordinates a LinearCoupling involves
@@ -269,10 +283,13 @@ def description_reason(mech: Mechanism) -> str:
                 for v in (*f.point_a, *f.point_b):
                     num(v)
         for c in mech.constraints:
-            if isinstance(c, LinearCoupling):
+            if isinstance(c, (LinearCoupling, RollingContact)):
                 num(c.constant)
                 if not any(num(v) for _, v in c.coefficients):
                     return f"constraint {c.name}: every coefficient is zero"
+                if isinstance(c, RollingContact) and not 0 < num(c.disc_radius) < num(
+                        c.track_radius):
+                    return f"constraint {c.name}: the disc must be smaller than the track"
             elif isinstance(c, PointOnPoint):
                 for v in (*c.point_a, *c.point_b):
                     num(v)

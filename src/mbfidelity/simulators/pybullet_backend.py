@@ -28,8 +28,11 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   values are refused by `support`. Massless bodies that carry nothing but are held by a
   constraint get a small substitute mass. Constraint frames are centre-of-mass frames
   (= body frames). The violation of each closure is measured at every sample
-  (``RunResult.constraint_violation``). Settings "point_on_line" = "slider" and "rolling" =
-  "contact" select the alternative substitutes (see `setting_notes`).
+  (``RunResult.constraint_violation``). The setting "point_on_line" = "slider" selects
+  the alternative substitute (see `setting_notes`). ``RollingContact`` (a variant's
+  stand-in for a rolling coupling): the hub rides on a massless radial slider, a sphere
+  of the disc's radius touches a ring of boxes on massless fixed links of the track
+  (`_contact_shapes`); the coupling's Phi is then the measured slip.
 - createMultiBody stores links in depth-first order of the tree; the backend maps its
   creation order to the engine's indices through the joint names ("joint<k+1>").
 - ``CoordinateForce``: joint forces through ``setJointMotorControlArray(TORQUE_CONTROL)``
@@ -71,13 +74,13 @@ import numpy as np
 
 from ..systems.model import (
     WORLD,
-    Circle,
     CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
     PointOnPoint,
     Revolute,
+    RollingContact,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import (
@@ -102,6 +105,7 @@ from .plan import (
     POINT_TO_POINT_LINEAR,
     PRISMATIC,
     REVOLUTE,
+    ROLLING_CONTACT,
     TIME_LOAD,
     ForceLaw,
     constrained_bodies,
@@ -115,7 +119,6 @@ _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's
 _JOINT_FORCE = ("joint force through setJointMotorControlArray(TORQUE_CONTROL) every step, "
                 "tau = A^-T Q")
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
-_ROLLING = ("coupling", "contact")
 _POINT_ON_LINE = ("prismatic", "slider")
 #: createMultiBody keeps the first 127 links and drops the rest without an error (measured)
 _MAX_LINKS = 127
@@ -249,47 +252,18 @@ class _Contact:
     radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
 
 
-def _rolling_contact(mech: Mechanism) -> _Contact | None:
-    """Find a LinearCoupling that describes rolling of a disc inside a circular track:
-    the disc's joint (the hub) sits on an arm whose own revolute joint is on the track at
-    the centre of the track's circle, the disc's circle is centred on the hub, the hub is
-    R - r from the arm's pivot (they touch), and the coupling involves the hub's
-    coordinate. None if there is no such coupling."""
-    def circles(body):
-        return [s for s in mech.body(body).shapes if isinstance(s, Circle)]
-
-    for c in mech.constraints:
-        if not isinstance(c, LinearCoupling):
-            continue
-        used = {name for name, coef in c.coefficients if num(coef) != 0}
-        for hub_i, hub in enumerate(mech.joints):
-            if hub.coordinate not in used or not isinstance(hub, Revolute) \
-                    or hub.parent == WORLD:
-                continue
-            arm_joint = mech.joint_of_child(hub.parent)
-            if not isinstance(arm_joint, Revolute) or arm_joint.parent == WORLD:
-                continue
-            pa = np.array([num(v) for v in arm_joint.parent_anchor])
-            ca = np.array([num(v) for v in arm_joint.child_anchor])
-            ha = np.array([num(v) for v in hub.parent_anchor])
-            hc = np.array([num(v) for v in hub.child_anchor])
-            for outer in circles(arm_joint.parent):
-                oc = np.array([num(v) for v in outer.center])
-                R = num(outer.radius)
-                if np.linalg.norm(oc - pa) > 1e-9 * max(R, 1.0):
-                    continue
-                for inner in circles(hub.child):
-                    ic = np.array([num(v) for v in inner.center])
-                    r = num(inner.radius)
-                    arm = ha - ca
-                    if (r < R and np.linalg.norm(ic - hc) <= 1e-9 * max(r, 1.0)
-                            and abs(np.linalg.norm(arm) - (R - r)) <= 1e-9 * R):
-                        u = arm / np.linalg.norm(arm)
-                        return _Contact(c.name, arm_joint.parent, hub.child, R, r,
-                                        (float(oc[0]), float(oc[1])),
-                                        (float(ic[0]), float(ic[1])), hub_i,
-                                        (float(u[0]), float(u[1])))
-    return None
+def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
+    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
+    the track, the disc's circle at its hub, and the radial slider runs along the arm
+    from that hinge to the hub."""
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    centre = tuple(num(v) for v in hinge.parent_anchor)
+    arm = (np.array([num(v) for v in hub.parent_anchor])
+           - np.array([num(v) for v in hinge.child_anchor]))
+    u = arm / np.linalg.norm(arm)
+    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
+                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
+                    (float(u[0]), float(u[1])))
 
 
 class _Plan:
@@ -588,15 +562,6 @@ class PyBulletBackend(Backend):
             "guide): zero would make the articulated-body algorithm singular. Relative to "
             "the smallest body mass/inertia; results are the same from 1e-3 to 1e-7, 1e-8 "
             "diverged (slotted link)."),
-        "rolling": Setting(
-            "coupling", _ROLLING,
-            "'coupling' (default): a LinearCoupling becomes a JOINT_GEAR on the two "
-            "engine joint values it involves (exact at velocity level). 'contact': a "
-            "rolling coupling of a disc on a radius arm inside a circular track is "
-            "replaced by friction contact: the hub rides on a massless radial slider, a "
-            "sphere of the disc's radius touches a ring of contact_ring_boxes boxes "
-            "(polygon with the track circle as incircle) on massless fixed links of the "
-            "track; the coupling's Phi is then the measured slip."),
         "contact_friction": Setting(
             1.0, float,
             "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
@@ -667,6 +632,11 @@ class PyBulletBackend(Backend):
                                                "pivot follows the pin: the rotor's inertia is "
                                                "the only substitute (point_on_line='slider': "
                                                "a slider link of small mass)"),),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
+                                                 "of contact_ring_boxes boxes (velocity-level "
+                                                 "contact with erp; the hub on a massless "
+                                                 "radial slider); its force is the tangential "
+                                                 "contact force, its violation the slip"),),
         LINEAR_COUPLING: (
             Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, "
                               "solved at velocity level (exact for a linear constraint)",
@@ -1022,16 +992,12 @@ class PyBulletBackend(Backend):
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
         contact = None
-        coupling = None
-        if cfg["rolling"] == "contact" and mechanism.constraints:
-            contact = _rolling_contact(mechanism)
-            if contact is None:
-                raise ValueError(
-                    "rolling='contact' needs a LinearCoupling of a disc (Circle) on a radius "
-                    "arm about the centre of a circular track (Circle) it touches")
-            coupling = next(c for c in mechanism.constraints if c.name == contact.coupling)
+        rolling = [c for c in mechanism.constraints if isinstance(c, RollingContact)]
+        if rolling:
+            contact = _contact_of(mechanism, rolling[0])
+            coupling = rolling[0].coupling
             mechanism = replace(mechanism, constraints=tuple(
-                c for c in mechanism.constraints if c.name != contact.coupling))
+                c for c in mechanism.constraints if c is not rolling[0]))
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
         n, steps = plan.n, int(round(t_end / dt))
         n_all = len(plan.links)

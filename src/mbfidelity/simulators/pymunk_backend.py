@@ -5,7 +5,7 @@ Translation of the description (conventions of `mbfidelity.systems.model`):
 * every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the
   description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
   substitute is compensated, below); the world is ``space.static_body`` (at the origin,
-  angle 0). No shapes are created (except for the optional contact variant of rolling),
+  angle 0). No shapes are created (except for a RollingContact's circles),
   so nothing can collide.
 * ``Revolute`` -> ``PivotJoint`` at the two local anchors.
 * ``Prismatic`` -> ``GrooveJoint`` whose slot is the path of the child's centre of mass
@@ -52,10 +52,10 @@ Translation of the description (conventions of `mbfidelity.systems.model`):
     solve (pre-solve callback, at the position-updated configuration): its tangential
     row is the coupling, its normal row is implied by the carrier (redundant), and the
     coupling's position error is put into the tangential anchor gap so that Chipmunk's
-    own error correction removes it. With ``rolling = "contact"`` the pitch circles,
-    when the description draws them as circle shapes, become colliding shapes instead (a
-    Circle in a ring of ``contact_segments`` Segments) with friction ``contact_friction``,
-    and the massless carrier arm is removed (the contact holds the disc).
+    own error correction removes it. A ``RollingContact`` (a variant's stand-in for such
+    a coupling) makes the pitch circles colliding shapes instead (a Circle in a ring of
+    ``contact_segments`` Segments) with friction ``contact_friction``, and the massless
+    carrier arm is removed (the contact holds the disc).
     Other couplings (three bodies without a common carrier, prismatic coordinates) are
     refused with the reason.
 * Force elements are applied as body forces and torques, evaluated every step by one
@@ -95,7 +95,6 @@ from ..systems.model import (
     LENGTH_RATE,
     TIME,
     WORLD,
-    Circle,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -103,6 +102,7 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
+    RollingContact,
     as_column,
     rotation,
 )
@@ -128,8 +128,10 @@ from .plan import (
     POINT_TO_POINT_LINEAR,
     PRISMATIC,
     REVOLUTE,
+    ROLLING_CONTACT,
     TIME_LOAD,
     body_states,
+    coupled,
     description_reason,
     num,
     point_state,
@@ -141,8 +143,6 @@ _ELEMENT_FORCE = ("body forces and torques from one compiled function of the bod
                   "consistent semi-implicit Euler step")
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
-#: how a rolling coupling with drawn pitch circles is built
-_ROLLING = ("coupling", "contact")
 
 
 @dataclass(frozen=True)
@@ -271,10 +271,6 @@ class _Compiled:
     masses: dict[str, float]
     pitch_phi: list[Callable]  # per pitch coupling: (*positions) -> Phi
     balance: object = None  # lazily built momentum-balance solver
-
-
-def _is_number(x) -> bool:
-    return not sp.sympify(x).free_symbols
 
 
 def _cross(r: sp.Matrix, f: sp.Matrix) -> sp.Expr:
@@ -447,9 +443,11 @@ def _component(mech: Mechanism, group: set[str], real: set[str],
 
 
 def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
-              massless: set[str]):
+              massless: set[str], contact: bool = False):
     """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch), or why the coupling cannot
-    be expressed."""
+    be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
+    circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
+    contact replaces."""
     k: dict[str, float] = {}
     k0 = num(c.constant)
     for name, coef in c.coefficients:
@@ -502,36 +500,19 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             continue
         lam = ka / (ka + kb)
         wrap = 2 * math.pi * abs(k[K]) if K in massless else 0.0
-        contact = _pitch_circles(mech, A, hubs[A][0], abs(lam) * d, B, hubs[B][0],
-                                 abs(lam - 1) * d, not 0.0 < lam < 1.0)
-        if contact is not None and K not in massless:
-            contact = None  # the carrier's hinges would keep the distance: see _build
+        circles = None
+        if contact:
+            if K not in massless:  # the carrier's hinges would keep the distance: see _build
+                return (f"contact {c.name}: the disc and the track must be hinged on a "
+                        "massless carrier arm, which the contact replaces")
+            circles = (A, hubs[A][0], abs(lam) * d, B, hubs[B][0], abs(lam - 1) * d,
+                       not 0.0 < lam < 1.0)
         return "pitch", _Pitch(c.name, A, B, hubs[A][0], hubs[B][0], d, lam, ka + kb, wrap, K,
-                               contact)
+                               circles)
     return (f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
             "couples the absolute angles of two bodies, and a coupling of three is "
             "expressible here only as two bodies hinged on a common carrier (gear pair, "
             "belt, rolling: a pivot at the pitch point)")
-
-
-def _pitch_circles(mech: Mechanism, a: str, hub_a, rho_a: float, b: str, hub_b, rho_b: float,
-                   internal: bool):
-    """The drawn circles of a and b that are the pitch circles (centred at the hubs, with
-    the pitch radii), or None."""
-    def find(body, hub, rho):
-        if body == WORLD:
-            return None
-        for s in mech.body(body).shapes:
-            if isinstance(s, Circle) and _is_number(s.radius):
-                centre = _vec(s.center)
-                if (np.allclose(centre, hub, rtol=0, atol=1e-9 * max(rho, 1.0))
-                        and abs(num(s.radius) - rho) <= 1e-9 * max(rho, 1.0)):
-                    return True
-        return None
-
-    if find(a, hub_a, rho_a) and find(b, hub_b, rho_b):
-        return (a, hub_a, rho_a, b, hub_b, rho_b, internal)
-    return None
 
 
 def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
@@ -671,19 +652,15 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
             layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -half, half,
                                           tuple(anchor), None))
         else:
-            out = _coupling(mech, c, engine_ok, mset)
+            rolling = isinstance(c, RollingContact)
+            out = _coupling(mech, c.coupling if rolling else c, engine_ok, mset, rolling)
             if isinstance(out, str):
                 return out
             kind, value = out
-            if kind == "gear":
-                layout.gears.append(value)
-            else:
-                if cfg.get("rolling", "coupling") == "contact" and value.contact is None:
-                    return (f"rolling = 'contact': coupling {c.name} has no drawn pitch "
-                            "circles (Circle shapes centred at the hubs with the pitch radii) "
-                            "on a massless carrier (an arm the contact can replace) to "
-                            "collide; use rolling = 'coupling'")
-                layout.pitches.append(value)
+            if kind == "gear" and rolling:
+                return (f"contact {c.name}: the disc and the track must be hinged on a "
+                        "massless carrier arm, which the contact replaces")
+            (layout.gears if kind == "gear" else layout.pitches).append(value)
 
     # --- engine masses; compensation of the slider substitutes -------------------------
     for name in dynamic:
@@ -1155,30 +1132,15 @@ class PymunkBackend(Backend):
             "slider mass; measured with fraction 0.05, 10 s: trajectory error 0.33-1.9 of "
             "the amplitude on the scotch yoke, 0.37-140 on the slotted link, against "
             "3-10e-3 compensated)."),
-        "rolling": Setting(
-            "coupling", _ROLLING,
-            "'coupling' (default): a LinearCoupling of two bodies hinged on a carrier "
-            "(gear pair, belt, disc rolling in a moving track) is a PivotJoint between "
-            "them at the pitch point, re-anchored before every solve (exact rows, the "
-            "coupling's position error corrected by Chipmunk's own error correction). "
-            "'contact': where the description draws the pitch circles (Circle shapes), "
-            "they collide instead (a Circle inside a ring of Segments, or two Circles) "
-            "with Coulomb friction and the carrier arm removed (the contact holds the "
-            "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
-            "its friction, at zero): what a game-physics user would build. Measured on "
-            "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
-            "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
-            "the disc passes from one chord to the next (normal impulse 0, then twice), "
-            "3-6 s per 10 s run (coupling 0.4 s)."),
         "contact_friction": Setting(
             10.0, float,
-            "Friction coefficient of the rolling contact (rolling = 'contact'); Chipmunk "
+            "Friction coefficient of a RollingContact; Chipmunk "
             "multiplies the two shapes' coefficients, this one goes on the inner shape "
             "and 1 on the ring. Must exceed |friction| / normal force at all times or the "
             "disc slides."),
         "contact_segments": Setting(
             720, int,
-            "Number of Segment shapes of a ring (rolling = 'contact'), inscribed in the "
+            "Number of Segment shapes of a RollingContact's ring, inscribed in the "
             "pitch circle; space.collision_slop is set to the chord's sagitta so that the "
             "polygon's penetration is not 'corrected' against the carrier joint."),
     }
@@ -1236,6 +1198,15 @@ class PymunkBackend(Backend):
                                    "(slider_compensation). " + _GROOVE_LIMIT,
                        when="otherwise"),
         ),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "the pitch circles collide (a Circle "
+                                                 "inside a ring of contact_segments Segments) "
+                                                 "with Coulomb friction, the carrier arm "
+                                                 "removed: what a game-physics user would "
+                                                 "build. Measured on rolling_disc_track: "
+                                                 "trajectory error 2-10 % of the amplitude "
+                                                 "(coupling 2-2.6e-3), slip up to 3e-4 m, "
+                                                 "single-step losses of contact from one "
+                                                 "chord to the next"),),
         LINEAR_COUPLING: (
             Expression(EXACT, "GearJoint on the absolute angles of two bodies",
                        when="two body angles"),
@@ -1305,11 +1276,10 @@ class PymunkBackend(Backend):
         constraints: list = []
         for parent, child, pa, ca in layout.pivots:
             constraints.append(pymunk.PivotJoint(bodies[parent], bodies[child], pa, ca))
-        contact = cfg["rolling"] == "contact"
         # a rolling contact holds the disc itself: the arm that stood for it goes (kept, the
         # distance would be enforced twice and Gauss-Seidel may leave the contact's normal
         # impulse, hence its friction, at zero)
-        replaced = {p.carrier for p in layout.pitches if contact and p.contact is not None}
+        replaced = {p.carrier for p in layout.pitches if p.contact is not None}
         for a, b, pa, pb, _, link in layout.pins:
             if link not in replaced:
                 constraints.append(pymunk.PinJoint(bodies[a], bodies[b], pa, pb))
@@ -1325,7 +1295,7 @@ class PymunkBackend(Backend):
         for a, b, phase, ratio in layout.gears:
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
         for i, (pitch, phi) in enumerate(zip(layout.pitches, comp.pitch_phi)):
-            if contact and pitch.contact is not None:
+            if pitch.contact is not None:
                 PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
             else:
                 constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch, phi))
@@ -1376,7 +1346,7 @@ class PymunkBackend(Backend):
 
     @staticmethod
     def _contact_shapes(space, bodies, pitch: _Pitch, index: int, cfg: dict) -> None:
-        """The pitch circles as colliding shapes with friction (rolling = 'contact')."""
+        """The pitch circles as colliding shapes with friction (a RollingContact)."""
         import pymunk
 
         a, hub_a, rho_a, b, hub_b, rho_b, internal = pitch.contact
@@ -1425,6 +1395,9 @@ class PymunkBackend(Backend):
         layout = _plan(mechanism, cfg)
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
+        # a RollingContact's force is balanced as the coupling it stands for (the layout
+        # holds the contact itself)
+        mechanism = coupled(mechanism)
         comp = _compile(mechanism, layout)
         q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
         space, bodies = self._build(mechanism, comp, q0, qd0, cfg)
