@@ -18,7 +18,8 @@ from ..analytic.linear import (companion_matrix, find_equilibria, operating_equi
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
-from ..systems import System, get_system
+from ..simulators.base import expected_failures
+from ..systems import Expectation, System, get_system
 from . import metrics, tolerances
 
 DEFAULT_DT = 1e-3
@@ -95,10 +96,27 @@ class Comparison:
         }
 
 
+def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
+    """The declarations that judge `simulator` on `system`, in matching order: the system's
+    own (mechanism-specific), each one declaration, then those the backend's declared
+    soft or substitute expressions of the system's elements imply
+    (`simulators.base.expected_failures`), each a group of patterns declared together."""
+    return tuple((e,) for e in system.expectations) + _declared(system.id, simulator)
+
+
+@lru_cache(maxsize=None)
+def _declared(system_id: str, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
+    system = get_system(system_id)
+    backend = get_backend(simulator)
+    mech = system.numeric_mechanism(system.parameter_values())
+    return expected_failures(backend, mech) if backend.support(mech).ok else ()
+
+
 def expectation_for(system: System, simulator: str, metric: str):
-    for e in system.expectations:
-        if fnmatch.fnmatch(simulator, e.simulator) and fnmatch.fnmatch(metric, e.metric):
-            return e
+    for group in expectations(system, simulator):
+        for e in group:
+            if fnmatch.fnmatch(simulator, e.simulator) and fnmatch.fnmatch(metric, e.metric):
+                return e
     return None
 
 
@@ -122,17 +140,19 @@ def _judge(system: System, simulator: str, name: str, value: float,
 
 
 def _strict_expectations(system: System, result: "Comparison") -> None:
-    """An expected failure covers the metrics its pattern matches and is met when at
-    least one of them fails; when every one passes it is an unexpected pass (strict):
-    the problem was fixed and the declaration must go."""
-    for exp in system.expectations:
-        if exp.kind not in ("xfail", "unresolved") or not fnmatch.fnmatch(result.simulator,
-                                                                          exp.simulator):
-            continue
-        covered = [m for m in result.metrics if fnmatch.fnmatch(m.name, exp.metric)
-                   and expectation_for(system, result.simulator, m.name) is exp]
-        met = any(m.status == "unresolved" for m in covered) if exp.kind == "unresolved" \
-            else not all(m.passed for m in covered)
+    """An expected failure covers the metrics its patterns match (those it is the first
+    match for) and is met when at least one of them does not pass (an "unresolved"
+    declaration: when one of them is unresolved); otherwise its passes are unexpected
+    (strict): the problem was fixed and the declaration must go."""
+    for group in expectations(system, result.simulator):
+        mine = [e for e in group if e.kind in ("xfail", "unresolved")
+                and fnmatch.fnmatch(result.simulator, e.simulator)]
+        covered = [m for m in result.metrics
+                   if any(expectation_for(system, result.simulator, m.name) is e for e in mine)]
+        if any(e.kind == "unresolved" for e in mine):
+            met = any(m.status == "unresolved" for m in covered)
+        else:
+            met = not all(m.passed for m in covered)
         if covered and not met:
             for m in covered:
                 if m.passed:
@@ -178,7 +198,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     merged = backend.resolve_settings(wanted)
     result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt,
                         variant=variant or "")
-    mech = system.numeric_mechanism(base_values)
+    mech = system.numeric_mechanism(base_values, variant)
     support = backend.support(mech)
     unsupported = expectation_for(system, simulator, "*")
     if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
@@ -195,8 +215,9 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     for name in scenarios or by_name:
         sc, eq = by_name[name]
         _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
-                          eq)
-    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series)
+                          eq, variant)
+    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
+                         variant)
     if chosen_variant is None:
         _strict_expectations(system, result)
     else:
@@ -252,9 +273,9 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
 
 
 def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series,
-                      eq=None):
+                      eq=None, variant=None):
     values = system.parameter_values(params, scenario=sc)
-    mech = system.numeric_mechanism(values)
+    mech = system.numeric_mechanism(values, variant)
     T = sc.t_end if t_end is None else t_end
     ref = reference(system, sc, values, dt, T)
     q0, qd0 = ref.q[0], ref.qd[0]
@@ -397,14 +418,15 @@ def _kinetic_amplitude(system, values, q, qd) -> float:
     return float(np.max(T))
 
 
-def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series):
+def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series,
+                         variant=None):
     """Modes of the operating equilibrium: the engine's own linearization, and a
     free-vibration fit of each modal coordinate after a small modal release."""
     eq = operating_equilibrium(system, values)
     if not eq.stable:
         return
     # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
-    mech = system.numeric_mechanism(values).without_time_loads()
+    mech = system.numeric_mechanism(values, variant).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
     ref_w = np.array([abs(m.eigenvalue) for m in modes])
     w_max = float(np.max(ref_w)) if len(ref_w) else 0.0

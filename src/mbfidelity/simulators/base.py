@@ -10,12 +10,26 @@ conventions 1-8) into one engine and runs it. The contract:
 2. `available()` returns ``(True, "")`` or ``(False, reason)``; a missing engine is a
    visible skip, never an error.
 3. `version()` is the engine's version string; it is recorded in every result.
-4. `default_settings()` returns every setting the backend uses, as JSON values, with the
-   engine's distorting defaults neutralised (SIMULATORS.md); `setting_notes()` says, per
-   key, which engine default it replaces and why. Users may override any key; unknown
-   keys raise `ValueError` naming the valid ones.
-5. `support(mechanism)` returns `Support(ok, reason)`: whether this backend can express
-   the mechanism; when it cannot, the reason is reported as data, not raised.
+4. Settings are declared once, in the backend's `SETTINGS` table: per key a `Setting`
+   with its default (a JSON value, the engine's distorting defaults neutralised,
+   SIMULATORS.md), the values or the type it admits, and a note saying which engine
+   default it replaces and why. `default_settings()` and `setting_notes()` derive from
+   the table. Users may override any key; `resolve_settings` checks every override
+   centrally: an unknown key, a value of the wrong type or outside the admitted values
+   raises `ValueError` naming the valid ones.
+5. Exactness is declared per element kind of the description (`plan.ELEMENT_KINDS`): the
+   backend's `EXPRESSIONS` table gives, per kind, the `Expression`(s) it can build, each
+   exact, soft, substitute or unsupported, with how and why; where the case depends on
+   the element (a massless link that can or cannot be folded, a slot through the centres
+   of mass or not), `choose` picks it. A soft or substitute expression names the metrics
+   it is expected to fail wherever the element occurs (`expected_failures`, with the
+   physical `reason`); the comparisons derive the strict expected failures of a
+   mechanism from them (`expected_failures(backend, mechanism)`), so system modules
+   declare only what is specific to the mechanism. `support(mechanism)` follows from the
+   declarations: `Support(ok, reason)`, false with the reason when the description is not
+   translatable (`plan.description_reason`), when the engine's structure refuses it
+   (`translation_reason`) or when one of its elements is unsupported; reported as data,
+   not raised.
 6. `simulate(mechanism, q0, qd0, t_end, dt, settings, reaction_joints)` builds a fresh
    model, integrates from the state (q0, qd0) (description coordinates) with fixed step
    dt for round(t_end/dt) steps, and returns a `RunResult` sampled at every step,
@@ -39,16 +53,91 @@ conventions 1-8) into one engine and runs it. The contract:
    Discrete-time eigenvalues are mapped with ln(lambda)/dt.
 8. Backends never change the mechanism: a substitute (an intermediate slider body of
    small mass, a penalty spring) is named in the settings and its own error is measured.
+9. Shared steps: what every backend needs before its engine enters is computed once, in
+   `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
+   map between description coordinates and engine joint values, forward kinematics),
+   and settings are validated here; a backend translates the plan into its engine,
+   steps it and reads out.
 """
 from __future__ import annotations
 
+import copy
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
-from typing import Mapping, Sequence
+from typing import ClassVar, Mapping, Sequence
 
 import numpy as np
 
+from ..systems import Expectation
 from ..systems.model import Mechanism
+from .plan import description_reason, element_kind, elements
+
+EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
+LEVELS = (EXACT, SOFT, SUBSTITUTE, UNSUPPORTED)
+
+
+@dataclass(frozen=True)
+class Expression:
+    """How a backend expresses one element kind (contract point 5): `level` (exact, soft,
+    substitute, unsupported), `how` (the engine construct, and why it is or is not
+    exact), `when` (the condition, where a kind has several cases). A soft or substitute
+    expression may name `expected_failures`, metric patterns (fnmatch, as in
+    `Expectation.metric`) it is expected to push beyond the gates wherever the element
+    occurs, with the physical `reason`: one strict declaration, met when at least one
+    metric it covers fails."""
+
+    level: str
+    how: str
+    when: str = ""
+    expected_failures: tuple[str, ...] = ()
+    reason: str = ""
+
+    def __post_init__(self) -> None:
+        if self.level not in LEVELS:
+            raise ValueError(f"level {self.level!r} is not one of {LEVELS}")
+        if self.expected_failures and (self.level not in (SOFT, SUBSTITUTE) or not self.reason):
+            raise ValueError("only a soft or substitute expression, with its reason, "
+                             "declares expected failures")
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One engine setting (contract point 4). `allowed` is either the tuple of admitted
+    values or the type of the value (a type or a tuple of types): ``float`` admits ints
+    too, ``list`` a list of numbers, ``type(None)`` null; booleans are never numbers."""
+
+    default: object
+    allowed: object
+    note: str
+
+    def check(self, engine: str, key: str, value: object) -> None:
+        """Raise `ValueError` when `value` is not admitted."""
+        if not _is_types(self.allowed):
+            if value not in self.allowed:
+                raise ValueError(f"{engine} setting {key} must be one of "
+                                 f"{', '.join(map(repr, self.allowed))}; got {value!r}")
+            return
+        types = self.allowed if isinstance(self.allowed, tuple) else (self.allowed,)
+        if not any(_has_type(value, t) for t in types):
+            names = " or ".join("null" if t is type(None) else t.__name__ for t in types)
+            raise ValueError(f"{engine} setting {key} must be {names}; got {value!r}")
+
+
+def _is_types(allowed: object) -> bool:
+    return isinstance(allowed, type) or (
+        isinstance(allowed, tuple) and all(isinstance(a, type) for a in allowed))
+
+
+def _has_type(value: object, kind: type) -> bool:
+    if kind is bool:
+        return isinstance(value, bool)
+    if isinstance(value, bool):
+        return False
+    if kind is float:
+        return isinstance(value, (int, float))
+    if kind is list:
+        return isinstance(value, (list, tuple)) and all(_has_type(v, float) for v in value)
+    return isinstance(value, kind)
 
 
 @dataclass(frozen=True)
@@ -83,6 +172,11 @@ class Linearization:
 
 class Backend(ABC):
     id: str = ""
+    #: every setting the backend uses (contract point 4), in the order they are reported
+    SETTINGS: ClassVar[Mapping[str, Setting]] = {}
+    #: per element kind, the cases the backend can build (contract point 5); a kind that
+    #: is missing is unsupported
+    EXPRESSIONS: ClassVar[Mapping[str, tuple[Expression, ...]]] = {}
 
     @abstractmethod
     def available(self) -> tuple[bool, str]:
@@ -92,14 +186,43 @@ class Backend(ABC):
     def version(self) -> str:
         """See the contract in the module docstring."""
 
-    @abstractmethod
     def default_settings(self) -> dict:
-        """See the contract in the module docstring."""
+        """Every setting's default, from `SETTINGS` (fresh copies: callers may mutate)."""
+        return {key: copy.deepcopy(s.default) for key, s in self.SETTINGS.items()}
 
     def setting_notes(self) -> dict[str, str]:
-        return {}
+        """Per setting, which engine default it replaces and why, from `SETTINGS`."""
+        return {key: s.note for key, s in self.SETTINGS.items()}
+
+    def expression(self, mechanism: Mechanism, element) -> Expression:
+        """How this backend expresses one element of the (numeric) mechanism."""
+        kind = element_kind(element)
+        cases = self.EXPRESSIONS.get(kind, ())
+        if not cases:
+            return Expression(UNSUPPORTED, f"{self.id} has no translation of a {kind}")
+        return cases[0] if len(cases) == 1 else self.choose(mechanism, kind, element, cases)
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        """The case of `kind` that `element` takes, for kinds declared with several."""
+        raise NotImplementedError(f"{self.id} declares several cases of {kind} but does "
+                                  "not choose among them")
+
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        """Why the engine's structure cannot hold the mechanism although no single element
+        is unsupported (empty string: it can)."""
+        return ""
 
     def support(self, mechanism: Mechanism) -> Support:
+        """Contract point 5: from the description's checks, the engine's structure and the
+        declared expression of every element."""
+        reason = description_reason(mechanism) or self.translation_reason(mechanism)
+        if reason:
+            return Support(False, reason)
+        for kind, element in elements(mechanism):
+            e = self.expression(mechanism, element)
+            if e.level == UNSUPPORTED:
+                return Support(False, f"{kind} {element.name}: {e.how}")
         return Support(True)
 
     @abstractmethod
@@ -114,10 +237,30 @@ class Backend(ABC):
 
     # helpers shared by backends
     def resolve_settings(self, settings: Mapping | None) -> dict:
-        merged = dict(self.default_settings())
+        """The defaults with the user's overrides, each checked against `SETTINGS`."""
+        merged = self.default_settings()
         for key, value in (settings or {}).items():
-            if key not in merged:
+            if key not in self.SETTINGS:
                 raise ValueError(
                     f"unknown {self.id} setting {key!r}; valid: {', '.join(sorted(merged))}")
+            self.SETTINGS[key].check(self.id, key, value)
             merged[key] = value
         return merged
+
+
+def expected_failures(backend: Backend, mechanism: Mechanism) -> tuple[tuple[Expectation, ...], ...]:
+    """The strict expected failures that the backend's declarations imply for a
+    (numeric, supported) mechanism: per distinct soft or substitute expression of its
+    elements that names metric patterns, one declaration (a tuple of `Expectation`s,
+    kind "xfail", one per pattern, with the expression's reason), met when at least one
+    metric it covers fails."""
+    out: list[tuple[Expectation, ...]] = []
+    seen: set[tuple] = set()
+    for _, element in elements(mechanism):
+        e = backend.expression(mechanism, element)
+        key = (e.expected_failures, e.reason)
+        if e.expected_failures and key not in seen:
+            seen.add(key)
+            out.append(tuple(Expectation(backend.id, pattern, "xfail", e.reason)
+                             for pattern in e.expected_failures))
+    return tuple(out)

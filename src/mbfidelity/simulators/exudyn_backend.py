@@ -65,14 +65,8 @@ from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
     CoordinateForce,
     LinearCoupling,
@@ -82,10 +76,29 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
-    compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    ROLLING_CONTACT,
+    TIME_LOAD,
+    ForceLaw,
+    constrained_bodies,
+    coordinate_map,
+    num,
+    rot,
+)
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -104,36 +117,10 @@ _SOLVER_ORDER = {
 _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
-def _num(x) -> float:
-    value = sp.sympify(x)
-    if value.free_symbols:
-        raise ValueError(f"expression {value} still has free symbols")
-    return float(value)
-
-
-def _rot2(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s], [s, c]])
-
-
 def _rot3(angle: float) -> np.ndarray:
     out = np.eye(3)
-    out[:2, :2] = _rot2(angle)
+    out[:2, :2] = rot(angle)
     return out
-
-
-def _affine(expr, x: sp.Symbol, v: sp.Symbol) -> tuple[float, float, float] | None:
-    """(a0, ax, av) when expr == a0 + ax x + av v with numbers only (no TIME), else None."""
-    expr = sp.sympify(expr)
-    if TIME in expr.free_symbols:
-        return None
-    ax, av = sp.diff(expr, x), sp.diff(expr, v)
-    if ax.free_symbols or av.free_symbols:
-        return None
-    a0 = expr.xreplace({x: 0, v: 0})
-    if a0.free_symbols:
-        return None
-    return float(a0), float(ax), float(av)
 
 
 @dataclass
@@ -170,7 +157,7 @@ class _Geometry:
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
-        return self.com[body] + _rot2(-self.beta[body]) @ np.asarray(point, dtype=float)
+        return self.com[body] + rot(-self.beta[body]) @ np.asarray(point, dtype=float)
 
     def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
@@ -187,52 +174,115 @@ def _geometry(mech: Mechanism) -> _Geometry:
     rotations: list[float] = []
     beta: dict[str, float] = {WORLD: 0.0}
     com: dict[str, np.ndarray] = {WORLD: np.zeros(2)}
-    angle_rows: dict[str, tuple[np.ndarray, float]] = {WORLD: (np.zeros(n), 0.0)}
-    T = np.zeros((n, n))
-    c = np.zeros(n)
+    cmap = coordinate_map(mech)
     for i, j in enumerate(mech.joints):
         p = j.parent
         parents.append(link_of[p] if p != WORLD else -1)
         link_of[j.child] = i
-        parent_anchor = np.array([_num(v) for v in j.parent_anchor])
-        child_anchor = np.array([_num(v) for v in j.child_anchor])
-        offset = _num(j.angle_offset)
-        row_p, const_p = angle_rows[p]
+        parent_anchor = np.array([num(v) for v in j.parent_anchor])
+        child_anchor = np.array([num(v) for v in j.child_anchor])
+        offset = num(j.angle_offset)
         # the joint point in the parent's link frame
-        offsets.append(com[p] + _rot2(-beta[p]) @ parent_anchor)
-        e_i = np.zeros(n)
-        e_i[i] = 1.0
+        offsets.append(com[p] + rot(-beta[p]) @ parent_anchor)
         if isinstance(j, Revolute):
             types.append("R")
             rotations.append(offset - beta[p])
             beta[j.child] = 0.0
-            angle_rows[j.child] = (row_p + e_i, const_p + offset)
-            sign = -1.0 if j.clockwise else 1.0  # clockwise: the coordinate is -angle
-            if j.absolute:  # sign q = theta_child - offset = theta_parent + u
-                T[i] = sign * (row_p + e_i)
-                c[i] = sign * const_p
-            else:
-                T[i] = sign * e_i
-        elif isinstance(j, Prismatic):
+        else:
             types.append("P")
-            axis = np.array([_num(v) for v in j.axis])
-            length = float(np.hypot(*axis))
+            axis = np.array([num(v) for v in j.axis])
             alpha = math.atan2(axis[1], axis[0])
             rotations.append(alpha - beta[p])
             beta[j.child] = alpha - offset
-            angle_rows[j.child] = (row_p.copy(), const_p + offset)
-            T[i] = e_i / length  # the engine slides by u = |axis| q
-        else:  # pragma: no cover - the Joint union is closed
-            raise TypeError(j)
-        com[j.child] = -_rot2(-beta[j.child]) @ child_anchor
-    mass = {b.name: _num(b.mass) for b in mech.bodies}
-    inertia = {b.name: _num(b.inertia) for b in mech.bodies}
+        com[j.child] = -rot(-beta[j.child]) @ child_anchor
+    mass = {b.name: num(b.mass) for b in mech.bodies}
+    inertia = {b.name: num(b.inertia) for b in mech.bodies}
+    angle_rows = {body: (cmap.angle_v[body], cmap.angle_v0[body]) for body in cmap.angle_v}
     return _Geometry(n, link_of, parents, types, offsets, rotations, beta, com, mass, inertia,
-                     T, c, angle_rows, _num(mech.gravity))
+                     cmap.T, cmap.c, angle_rows, num(mech.gravity))
 
 
 class ExudynBackend(Backend):
     id = "exudyn"
+    SETTINGS = {
+        "solver": Setting(
+            "RK44", tuple(_SOLVER_ORDER),
+            "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 (classical "
+            "Runge-Kutta, order 4) works on the kinematic tree without Newton iterations; "
+            "also offered: RK44, RK67, RK33, ExplicitMidpoint, ExplicitEuler, "
+            "GeneralizedAlpha, TrapezoidalIndex2 (integrator_order reports the order of "
+            "the one used)."),
+        "constrained_solver": Setting(
+            "GeneralizedAlpha", _CONSTRAINT_SOLVERS,
+            "Mechanisms with closure constraints (exact index-3 constraints: Exudyn's "
+            "explicit solvers stop with 'contains constraints that cannot be solved'): "
+            "GeneralizedAlpha (Exudyn's default, order 2) or TrapezoidalIndex2 (order 2, "
+            "index-2 velocity constraints; positions drift slowly); 'solver' applies to "
+            "unconstrained mechanisms only."),
+        "constrained_spectral_radius": Setting(
+            0.9, float,
+            "GeneralizedAlpha on constrained mechanisms: Exudyn's default 0.9 kept; rho = "
+            "1 (no numerical damping) lets the index-3 multipliers oscillate (measured: "
+            "scotch yoke slot force error 1e4, slotted bar arctan damper failed Newton); "
+            "0.8-0.99 changed trajectory errors by < 10 %."),
+        "automatic_step_size": Setting(
+            False, bool,
+            "Exudyn default True lets error-controlled explicit solvers change the step; "
+            "False keeps the fixed step dt the contract asks for."),
+        "ga_spectral_radius": Setting(
+            1.0, float,
+            "GeneralizedAlpha as 'solver' (unconstrained mechanisms). Exudyn default 0.9 "
+            "adds numerical damping (energy decays); 1.0 removes it (no constraints, so "
+            "rho = 1 is stable). Constrained: constrained_spectral_radius."),
+        "ga_adaptive_step": Setting(
+            False, bool,
+            "Implicit solvers only. Exudyn default True silently reduces the step after a "
+            "failed Newton solve; False keeps dt fixed (a failure is raised instead)."),
+        "newton_relative_tolerance": Setting(
+            1e-13, float,
+            "Implicit solvers only. Exudyn default 1e-8 limits the accuracy of small "
+            "motions; tightened."),
+        "newton_absolute_tolerance": Setting(
+            1e-14, float,
+            "Implicit solvers only. Exudyn default 1e-10; tightened for small amplitudes."),
+        "modified_newton": Setting(
+            False, bool,
+            "Implicit solvers only. Exudyn default True reuses an old Jacobian; full "
+            "Newton converges to the tight tolerances."),
+        "end_of_step_accelerations": Setting(
+            True, bool,
+            "Exudyn default True (kept): explicit solvers recompute the accelerations at "
+            "the end of each step, so the sampled centre-of-mass accelerations (used for "
+            "reactions) belong to the sampled state; False leaves last-stage "
+            "accelerations."),
+        "native_linear_laws": Setting(
+            True, bool,
+            "Backend choice: laws affine in the length/coordinate and its rate (no TIME) "
+            "use Exudyn's built-in spring-damper and the tree's PD terms (C++); False "
+            "sends every law through Python user functions (same model, slower)."),
+        "write_solution_file": Setting(
+            False, bool,
+            "Exudyn default True writes coordinatesSolution.txt every 0.01 s (disk I/O "
+            "inside the timed loop); the backend samples with in-memory sensors at every "
+            "step instead (sensor write period dt replaces the 0.01 s default)."),
+        "linearization_relative_epsilon": Setting(
+            1e-4, float,
+            "linearize(): relative step of Exudyn's numerical Jacobian (K, D), a forward "
+            "difference. Exudyn default 1e-7 balances truncation and round-off at "
+            "~1e-7..1e-6 absolute error in K and D; with linearization_richardson, 1e-4 "
+            "gives ~1e-10 relative."),
+        "linearization_richardson": Setting(
+            True, bool,
+            "linearize(): True evaluates Exudyn's Jacobian at eps and eps/2 and "
+            "extrapolates (2 J(eps/2) - J(eps), error O(eps^2)); False is Exudyn's single "
+            "forward difference (what ComputeODE2Eigenvalues uses)."),
+        "linearization_constraint_step": Setting(
+            1e-5, float,
+            "linearize() with closure constraints: step (engine coordinate units) of the "
+            "central differences of Exudyn's constraint Jacobian that give the constraint "
+            "stiffness d(C lam)/du at a loaded equilibrium; Exudyn's "
+            "ComputeODE2Eigenvalues leaves this term out."),
+    }
 
     # --- identity --------------------------------------------------------------------------
     def available(self) -> tuple[bool, str]:
@@ -248,147 +298,55 @@ class ExudynBackend(Backend):
 
         return str(exudyn.__version__)
 
-    def default_settings(self) -> dict:
-        return {
-            "solver": "RK44",
-            "constrained_solver": "GeneralizedAlpha",
-            "constrained_spectral_radius": 0.9,
-            "automatic_step_size": False,
-            "ga_spectral_radius": 1.0,
-            "ga_adaptive_step": False,
-            "newton_relative_tolerance": 1e-13,
-            "newton_absolute_tolerance": 1e-14,
-            "modified_newton": False,
-            "end_of_step_accelerations": True,
-            "native_linear_laws": True,
-            "write_solution_file": False,
-            "linearization_relative_epsilon": 1e-4,
-            "linearization_richardson": True,
-            "linearization_constraint_step": 1e-5,
-        }
-
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "solver": "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 "
-                      "(classical Runge-Kutta, order 4) works on the kinematic tree without "
-                      "Newton iterations; also offered: " + ", ".join(_SOLVER_ORDER)
-                      + " (integrator_order reports the order of the one used).",
-            "constrained_solver": "Mechanisms with closure constraints (exact index-3 "
-                                  "constraints: Exudyn's explicit solvers stop with "
-                                  "'contains constraints that cannot be solved'): "
-                                  "GeneralizedAlpha (Exudyn's default, order 2) or "
-                                  "TrapezoidalIndex2 (order 2, index-2 velocity "
-                                  "constraints; positions drift slowly); 'solver' applies "
-                                  "to unconstrained mechanisms only.",
-            "constrained_spectral_radius": "GeneralizedAlpha on constrained mechanisms: "
-                                           "Exudyn's default 0.9 kept; rho = 1 (no "
-                                           "numerical damping) lets the index-3 multipliers "
-                                           "oscillate (measured: scotch yoke slot force "
-                                           "error 1e4, slotted bar arctan damper failed "
-                                           "Newton); 0.8-0.99 changed trajectory errors by "
-                                           "< 10 %.",
-            "automatic_step_size": "Exudyn default True lets error-controlled explicit "
-                                   "solvers change the step; False keeps the fixed step dt "
-                                   "the contract asks for.",
-            "ga_spectral_radius": "GeneralizedAlpha as 'solver' (unconstrained mechanisms). "
-                                  "Exudyn default 0.9 adds numerical damping (energy "
-                                  "decays); 1.0 removes it (no constraints, so rho = 1 is "
-                                  "stable). Constrained: constrained_spectral_radius.",
-            "ga_adaptive_step": "Implicit solvers only. Exudyn default True silently reduces "
-                                "the step after a failed Newton solve; False keeps dt fixed "
-                                "(a failure is raised instead).",
-            "newton_relative_tolerance": "Implicit solvers only. Exudyn default 1e-8 limits "
-                                         "the accuracy of small motions; tightened.",
-            "newton_absolute_tolerance": "Implicit solvers only. Exudyn default 1e-10; "
-                                         "tightened for small amplitudes.",
-            "modified_newton": "Implicit solvers only. Exudyn default True reuses an old "
-                               "Jacobian; full Newton converges to the tight tolerances.",
-            "end_of_step_accelerations": "Exudyn default True (kept): explicit solvers "
-                                         "recompute the accelerations at the end of each "
-                                         "step, so the sampled centre-of-mass accelerations "
-                                         "(used for reactions) belong to the sampled state; "
-                                         "False leaves last-stage accelerations.",
-            "native_linear_laws": "Backend choice: laws affine in the length/coordinate and "
-                                  "its rate (no TIME) use Exudyn's built-in spring-damper and "
-                                  "the tree's PD terms (C++); False sends every law through "
-                                  "Python user functions (same model, slower).",
-            "write_solution_file": "Exudyn default True writes coordinatesSolution.txt every "
-                                   "0.01 s (disk I/O inside the timed loop); the backend "
-                                   "samples with in-memory sensors at every step instead "
-                                   "(sensor write period dt replaces the 0.01 s default).",
-            "linearization_relative_epsilon": "linearize(): relative step of Exudyn's "
-                                              "numerical Jacobian (K, D), a forward "
-                                              "difference. Exudyn default 1e-7 balances "
-                                              "truncation and round-off at ~1e-7..1e-6 "
-                                              "absolute error in K and D; with "
-                                              "linearization_richardson, 1e-4 gives ~1e-10 "
-                                              "relative.",
-            "linearization_richardson": "linearize(): True evaluates Exudyn's Jacobian at "
-                                        "eps and eps/2 and extrapolates (2 J(eps/2) - "
-                                        "J(eps), error O(eps^2)); False is Exudyn's single "
-                                        "forward difference (what ComputeODE2Eigenvalues "
-                                        "uses).",
-            "linearization_constraint_step": "linearize() with closure constraints: step "
-                                             "(engine coordinate units) of the central "
-                                             "differences of Exudyn's constraint Jacobian "
-                                             "that give the constraint stiffness "
-                                             "d(C lam)/du at a loaded equilibrium; Exudyn's "
-                                             "ComputeODE2Eigenvalues leaves this term out.",
-        }
-
     # --- support ---------------------------------------------------------------------------
-    def support(self, mechanism: Mechanism) -> Support:
-        try:
-            _num(mechanism.gravity)
-            for b in mechanism.bodies:
-                _num(b.mass), _num(b.inertia)
-            for j in mechanism.joints:
-                if not isinstance(j, (Revolute, Prismatic)):
-                    return Support(False, f"joint {j.name}: type {type(j).__name__} not mapped")
-                for v in (*j.parent_anchor, *j.child_anchor, j.angle_offset):
-                    _num(v)
-                if isinstance(j, Prismatic) and np.hypot(*[_num(v) for v in j.axis]) == 0:
-                    return Support(False, f"joint {j.name}: zero prismatic axis")
-        except ValueError as exc:
-            return Support(False, f"mechanism is not numeric: {exc}")
-        constrained_bodies: set[str] = set()
-        try:
-            for c in mechanism.constraints:
-                if isinstance(c, PointOnPoint):
-                    [_num(v) for v in (*c.point_a, *c.point_b)]
-                    constrained_bodies |= set(c.bodies)
-                elif isinstance(c, PointOnLine):
-                    [_num(v) for v in (*c.point, *c.line_point)]
-                    if np.hypot(*[_num(v) for v in c.direction]) == 0:
-                        return Support(False, f"constraint {c.name}: zero slot direction")
-                    constrained_bodies |= set(c.bodies)
-                elif isinstance(c, LinearCoupling):
-                    coefs = [_num(v) for _, v in c.coefficients]
-                    _num(c.constant)
-                    if not any(coefs):
-                        return Support(False, f"constraint {c.name}: all coefficients are 0")
-                    constrained_bodies |= {mechanism.joints[mechanism.coordinates.index(n)].child
-                                           for n, v in zip((n for n, _ in c.coefficients), coefs)
-                                           if v}
-                else:
-                    return Support(False, f"constraint {c.name}: type {type(c).__name__} "
-                                          "not mapped")
-        except ValueError as exc:
-            return Support(False, f"constraint is not numeric: {exc}")
-        for f in mechanism.forces:
-            if not isinstance(f, (PointToPoint, CoordinateForce)):
-                return Support(False, f"force {f.name}: type {type(f).__name__} not mapped")
+    EXPRESSIONS = {
+        BODY: (Expression(EXACT, "a link of the ObjectKinematicTree with its mass, centre of "
+                                 "mass and inertia"),),
+        MASSLESS_BODY: (
+            Expression(EXACT, "a zero-mass link: the mass matrix stays regular while a "
+                              "massive descendant carries its coordinates, or a closure "
+                              "constraint holds it (augmented matrix [M C^T; C 0])",
+                       when="a massive body below it, or a constraint on its subtree"),
+            Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
+                                    "kinematic tree's mass matrix would be singular",
+                       when="only massless bodies below it, none constrained"),
+        ),
+        REVOLUTE: (Expression(EXACT, "RevoluteZ link of the kinematic tree"),),
+        PRISMATIC: (Expression(EXACT, "PrismaticX link, the joint frame turned to the axis"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, "ObjectConnectorSpringDamper with its own "
+                                                  "stiffness, damping and force (C++)"),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "ObjectConnectorSpringDamper with a "
+                                                  "springForceUserFunction, called at every "
+                                                  "integrator stage"),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "the tree's PD terms and joint force "
+                                                    "vector (C++) where the coordinate is one "
+                                                    "engine coordinate, otherwise the tree's "
+                                                    "forceUserFunction"),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "the tree's forceUserFunction, called at "
+                                                    "every integrator stage"),),
+        TIME_LOAD: (Expression(EXACT, "a user function, called at every integrator stage "
+                                      "with the stage time"),),
+        POINT_ON_POINT: (Expression(EXACT, "ObjectJointRevolute2D: index-3 algebraic "
+                                           "equations, met to round-off"),),
+        POINT_ON_LINE: (Expression(EXACT, "ObjectJointPrismatic2D with the rotation free: an "
+                                          "exact pin in slot"),),
+        LINEAR_COUPLING: (Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
+                                            "coordinates (affine in the description's, so "
+                                            "the coupling stays linear)"),),
+        ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
+                                                  "Exudyn holds the rolling coupling exactly "
+                                                  "(LinearCoupling)"),),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
         # a massless body with nothing massive below it makes the tree's mass matrix
         # singular; with closure constraints the implicit solver's augmented matrix
         # [M C_q^T; C_q 0] can still be regular when a constraint fixes that subtree
-        for b in mechanism.bodies:
-            sub = mechanism.subtree(b.name)
-            if b.massless and all(mechanism.body(x).massless for x in sub):
-                if constrained_bodies & set(sub):
-                    continue
-                return Support(False, f"massless body {b.name} carries no mass: the kinematic "
-                                      "tree's mass matrix would be singular")
-        return Support(True)
+        sub = mechanism.subtree(element.name)
+        if not all(mechanism.body(x).massless for x in sub):
+            return cases[0]
+        return cases[0] if constrained_bodies(mechanism) & set(sub) else cases[1]
 
     # --- model building --------------------------------------------------------------------
     def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict):
@@ -427,7 +385,8 @@ class ExudynBackend(Backend):
             i = mech.coordinates.index(f.coordinate)
             row = geo.T[i]
             single = np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0
-            aff = _affine(f.force, COORD, COORD_RATE) if settings["native_linear_laws"] else None
+            law = ForceLaw.of(f)
+            aff = law.linear if settings["native_linear_laws"] else None
             if aff is not None and single:
                 s = row[i]  # q_i = s u_i, so Q_u = s F(s u, s u_t)
                 a0, ax, av = aff
@@ -435,7 +394,7 @@ class ExudynBackend(Backend):
                 P[i] += -s * s * ax
                 D[i] += -s * s * av
             else:
-                python_laws.append((i, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+                python_laws.append((i, law.law))
 
         tree_args = dict(
             nodeNumber=node, gravity=[0.0, -geo.gravity, 0.0], baseOffset=[0.0, 0.0, 0.0],
@@ -465,7 +424,7 @@ class ExudynBackend(Backend):
                 continue  # acts on nothing
             markers = []
             for body, point in ((f.body_a, f.point_a), (f.body_b, f.point_b)):
-                pt = [_num(v) for v in point]
+                pt = [num(v) for v in point]
                 if body == WORLD:
                     if ground is None:
                         ground = mbs.AddObject(ObjectGround())
@@ -475,18 +434,17 @@ class ExudynBackend(Backend):
                     markers.append(mbs.AddMarker(MarkerKinematicTreeRigid(
                         objectNumber=tree, linkNumber=geo.link_of[body],
                         localPosition=[*geo.local_point(body, pt), 0.0])))
-            aff = (_affine(f.tension, LENGTH, LENGTH_RATE)
-                   if settings["native_linear_laws"] else None)
+            law = ForceLaw.of(f)
+            aff = law.linear if settings["native_linear_laws"] else None
             if aff is not None:
                 b0, bl, bv = aff  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
                 conn = ObjectConnectorSpringDamper(markerNumbers=markers, referenceLength=0.0,
                                                    stiffness=bl, damping=bv, force=b0)
             else:
-                law = compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))
                 # referenceLength 0, so deltaL is the length itself
                 conn = ObjectConnectorSpringDamper(
                     markerNumbers=markers, referenceLength=0.0,
-                    springForceUserFunction=self._tension_user_function(law))
+                    springForceUserFunction=self._tension_user_function(law.law))
             connectors[f.name] = mbs.AddObject(conn)
         return exu, mbs, SC, node, tree, geo, connectors
 
@@ -508,7 +466,7 @@ class ExudynBackend(Backend):
         ground: list[int] = []
 
         def rigid_marker(body: str, point) -> int:
-            pt = [_num(v) for v in point]
+            pt = [num(v) for v in point]
             if body == WORLD:
                 if not ground:
                     ground.append(mbs.AddObject(ObjectGround()))
@@ -526,10 +484,10 @@ class ExudynBackend(Backend):
                     rigid_marker(c.body_a, c.point_a), rigid_marker(c.body_b, c.point_b)]))
                 items.append(_ClosureItem(c.name, "point", obj))
             elif isinstance(c, PointOnLine):
-                d = np.array([_num(v) for v in c.direction])
+                d = np.array([num(v) for v in c.direction])
                 d = d / float(np.hypot(*d))
                 normal = np.array([-d[1], d[0]])  # the slot normal of the description
-                normal_local = _rot2(-geo.beta[c.line_body]) @ normal
+                normal_local = rot(-geo.beta[c.line_body]) @ normal
                 # Exudyn: (p1 - p0) . A1 n1 = 0, p0 the pin, p1 the slot point
                 obj = mbs.AddObject(ObjectJointPrismatic2D(
                     markerNumbers=[rigid_marker(c.body, c.point),
@@ -540,9 +498,9 @@ class ExudynBackend(Backend):
             elif isinstance(c, LinearCoupling):
                 a = np.zeros(geo.n)
                 for name, coef in c.coefficients:
-                    a[mech.coordinates.index(name)] += _num(coef)
+                    a[mech.coordinates.index(name)] += num(coef)
                 row = a @ geo.T                      # Phi = row . u + offset
-                offset = float(a @ geo.c) - _num(c.constant)
+                offset = float(a @ geo.c) - num(c.constant)
                 if node_marker is None:
                     node_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
                     ground_node = mbs.AddNode(NodePointGround())
@@ -700,12 +658,7 @@ class ExudynBackend(Backend):
     @staticmethod
     def _solver_for(mechanism: Mechanism, cfg: dict) -> str:
         """The solver this mechanism runs: 'solver' without closure constraints,
-        'constrained_solver' with them (both settings are validated either way)."""
-        for key, valid in (("solver", tuple(_SOLVER_ORDER)),
-                           ("constrained_solver", _CONSTRAINT_SOLVERS)):
-            if str(cfg[key]) not in valid:
-                raise ValueError(f"unknown exudyn {key} {cfg[key]!r}; valid: "
-                                 f"{', '.join(valid)}")
+        'constrained_solver' with them."""
         return str(cfg["constrained_solver" if mechanism.constraints else "solver"])
 
     @staticmethod
@@ -768,7 +721,7 @@ class ExudynBackend(Backend):
                 i = mech.coordinates.index(f.coordinate)
                 if mech.joints[i] is not joint or isinstance(joint, Revolute):
                     continue
-                law = compile_law(f.force, (COORD, COORD_RATE, TIME))
+                law = ForceLaw.of(f).law
                 force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])
                 total -= ExudynBackend._slide_force(geo, joint, u, force)
         for c in mech.constraints:
@@ -783,7 +736,7 @@ class ExudynBackend(Backend):
                     total -= f_c if in_1 else -f_c
             elif isinstance(c, LinearCoupling) and isinstance(joint, Prismatic):
                 # a generalized force on the joint's own slide acts between parent and child
-                coef = sum(_num(v) for name, v in c.coefficients if name == joint.coordinate)
+                coef = sum(num(v) for name, v in c.coefficients if name == joint.coordinate)
                 if coef:
                     total -= ExudynBackend._slide_force(geo, joint, u, coef * f_c[:, 0])
         return total
@@ -795,7 +748,7 @@ class ExudynBackend(Backend):
         coordinate (virtual power: F axis / |axis|^2, axis turned with the parent)."""
         row, const = geo.angle_rows[joint.parent]
         th_parent = u @ row + const
-        axis = np.array([_num(v) for v in joint.axis])
+        axis = np.array([num(v) for v in joint.axis])
         axis = axis / float(axis @ axis)
         ax_world = np.stack([np.cos(th_parent) * axis[0] - np.sin(th_parent) * axis[1],
                              np.sin(th_parent) * axis[0] + np.cos(th_parent) * axis[1]],

@@ -36,8 +36,9 @@ Translation (generic over the description, see `to_mjcf`):
   regularisation (relative to each world-axis row's diagonal) soften the row across a
   rotating slot; ``LinearCoupling`` -> a fixed tendon ``sum(w_j v_j)`` over the engine joint
   values (w = A^-T c, any number of coordinates) held by a tendon equality (exact linear
-  relation). With ``rolling="contact"`` a rolling coupling of a disc inside a ring is built
-  as friction contact instead (`_rolling_geometry`). Massless bodies that cannot be folded
+  relation); ``RollingContact`` (a variant's stand-in for a rolling coupling) -> friction
+  contact of a sphere disc on a ring of boxes, the arm's length freed by a radial slide
+  (`_contact_geometry`). Massless bodies that cannot be folded
   (several child joints, or loaded by a constraint or a point force) become substitute
   bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
   Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
@@ -61,18 +62,11 @@ from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
     Circle,
     CoordinateForce,
-    LinearCoupling,
     Mechanism,
     PointOnLine,
     PointOnPoint,
@@ -80,49 +74,60 @@ from ..systems.model import (
     Prismatic,
     Rectangle,
     Revolute,
+    RollingContact,
     Segment,
-    compile_law,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import (
+    EXACT,
+    SOFT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    ROLLING_CONTACT,
+    TIME_LOAD,
+    ForceLaw,
+    coordinate_map,
+    coupled,
+    num,
+    rot,
+)
+
+#: what MuJoCo's soft equalities cost (SIMULATORS.md; each measured, the numbers per
+#: mechanism are in the results)
+SOFT_EQUALITY = (
+    "MuJoCo's equality constraints are soft: the impedance is capped at 0.9999 (solimp) and "
+    "the reference time constant at 2 dt, so each constraint force falls about 1e-4 of "
+    "itself short and a small violation (1e-9 to 1e-7 m) makes up the rest; constraint "
+    "forces are then off by 1e-4 to 2e-3 and trajectories by 1e-6 to 1e-5, against RK4 "
+    "gates near 1e-7. No solref/solimp choice removes the floor (measured).")
+#: the metrics a soft closure is expected to push beyond the RK4 gates: its own force and
+#: the contact forces read from it, the motion and the energy the motion carries
+SOFT_EQUALITY_METRICS = ("*.trajectory_*", "*.energy_drift", "*.constraint_*", "*.contact_*")
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
-def _num(x) -> float:
-    return float(sp.sympify(x))
-
-
 def _fmt(*xs: float) -> str:
     return " ".join(format(float(x), ".17g") for x in xs)
-
-
-def _rot(th: float) -> np.ndarray:
-    c, s = math.cos(th), math.sin(th)
-    return np.array([[c, -s], [s, c]])
-
-
-def _linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
-    """(a, b, c) with law = a + b x + c xd, or None when the law is not of that form."""
-    expr = sp.sympify(expr)
-    if not expr.free_symbols <= {x, xd} or not expr.is_polynomial(x, xd):
-        return None
-    if expr.free_symbols and sp.Poly(expr, x, xd).total_degree() > 1:
-        return None
-    a = float(expr.xreplace({x: 0, xd: 0}))
-    return a, float(sp.diff(expr, x)), float(sp.diff(expr, xd))
-
-
-def _vector_law(expr, args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
-    """A law evaluated on arrays (post-processing of reactions)."""
-    fn = sp.lambdify(args, sp.sympify(expr), modules="numpy")
-
-    def call(*arrays: np.ndarray) -> np.ndarray:
-        out = np.asarray(fn(*arrays), dtype=float)
-        return np.broadcast_to(out, np.shape(arrays[0])).astype(float)
-
-    return call
 
 
 @dataclass
@@ -161,7 +166,7 @@ class _Closure:
     inertia: float = 0.0
     gravcomp: bool = False
     coef: np.ndarray | None = None  # LinearCoupling: coefficients over the coordinates
-    contact: dict = field(default_factory=dict)  # rolling='contact': see _rolling_geometry
+    contact: dict = field(default_factory=dict)  # RollingContact: see _contact_geometry
 
 
 #: radius of gyration of the substitute bodies (their inertia is mass * GYRATION**2)
@@ -224,90 +229,17 @@ def _foldable(mech: Mechanism) -> set[str]:
     return out
 
 
-def _rolling_geometry(mech: Mechanism, angle_c: dict, foldable: set, c: LinearCoupling,
-                      coef: np.ndarray) -> dict | str:
-    """The friction-contact variant of a rolling coupling: a disc (a body with a Circle
-    centred on its hinge, radius r) carried by a massless arm hinged at the centre of a
-    Circle of radius R on a track body, at distance R - r (rolling inside). The coupling
-    must be the no-slip condition of that geometry, (R - r) a_arm + r a_disc - R a_track
-    (absolute angles). Returns the geometry or the reason it does not apply."""
-    names = [nm for nm, _ in c.coefficients]
-    for jd in mech.joints:
-        if jd.coordinate not in names or not isinstance(jd, Revolute):
-            continue
-        disc = mech.body(jd.child)
-        ca = [_num(v) for v in jd.child_anchor]
-        circles = [sh for sh in disc.shapes if isinstance(sh, Circle)
-                   and [_num(v) for v in sh.center] == ca]
-        if not circles or jd.parent == WORLD:
-            continue
-        r = _num(circles[0].radius)
-        arm = jd.parent
-        ja = mech.joint_of_child(arm)
-        if not isinstance(ja, Revolute) or arm not in foldable or ja.parent == WORLD:
-            return (f"the disc {disc.name}'s arm {arm} must be a massless body hinged on "
-                    "the track")
-        track = mech.body(ja.parent)
-        centre = [_num(v) for v in ja.parent_anchor]
-        rings = [sh for sh in track.shapes if isinstance(sh, Circle)
-                 and [_num(v) for v in sh.center] == centre]
-        if not rings:
-            return f"no Circle on {track.name} centred at the arm's hinge"
-        R = _num(rings[0].radius)
-        arm_len = math.dist([_num(v) for v in ja.child_anchor], [_num(v) for v in jd.parent_anchor])
-        if not (R > r and abs(arm_len - (R - r)) <= 1e-9 * R):
-            return f"the arm length {arm_len} is not R - r = {R - r} (rolling inside the ring)"
-        g = (R - r) * angle_c[arm] + r * angle_c[disc.name] - R * angle_c[track.name]
-        cn, gn = coef / np.linalg.norm(coef), g / np.linalg.norm(g)
-        if min(np.linalg.norm(cn - gn), np.linalg.norm(cn + gn)) > 1e-9:
-            return "the coupling is not the no-slip condition of the disc in the ring"
-        return {"disc": disc.name, "arm_joint": ja.name, "disc_joint": jd.name,
-                "track": track.name, "centre": centre, "R": R, "r": r,
-                "j": mech.joints.index(jd)}
-    return "no disc (a body with a Circle centred on its hinge) among the coupled coordinates"
-
-
-def _check(mech: Mechanism) -> str:
-    """Empty string when the mechanism can be translated, else the reason."""
-    for b in mech.bodies:
-        for x in (b.mass, b.inertia):
-            if sp.sympify(x).free_symbols:
-                return f"body {b.name}: parameters are not numeric (use numeric_mechanism)"
-        m, inertia = _num(b.mass), _num(b.inertia)
-        if not b.massless and (m <= 0 or inertia <= 0):
-            return (f"body {b.name}: mass {m} and inertia {inertia} must both be > 0 "
-                    "(MuJoCo rejects moving bodies with zero mass or inertia)")
-    if all(b.massless for b in mech.bodies):
-        return "every body is massless (no mass scale for the substitute bodies)"
-    if sp.sympify(mech.gravity).free_symbols:
-        return "gravity is not numeric"
-    placeholders = {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}
-    for f in mech.forces:
-        if not isinstance(f, (PointToPoint, CoordinateForce)):
-            return f"force element {f!r} is not supported"
-        law = f.tension if isinstance(f, PointToPoint) else f.force
-        if sp.sympify(law).free_symbols - placeholders:
-            return f"force element {f.name}: law has non-numeric parameters"
-    for j in mech.joints:
-        if isinstance(j, Prismatic) and math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0:
-            return f"joint {j.name}: zero axis"
-    for c in mech.constraints:
-        if isinstance(c, LinearCoupling):
-            nums = [v for _, v in c.coefficients] + [c.constant]
-        elif isinstance(c, PointOnPoint):
-            nums = [*c.point_a, *c.point_b]
-        elif isinstance(c, PointOnLine):
-            nums = [*c.point, *c.line_point, *c.direction]
-        else:
-            return (f"constraint {c!r}: unknown constraint type (MuJoCo translates "
-                    "PointOnPoint, PointOnLine and LinearCoupling)")
-        if any(sp.sympify(x).free_symbols for x in nums):
-            return f"constraint {c.name}: parameters are not numeric (use numeric_mechanism)"
-        if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
-            return f"constraint {c.name}: zero slot direction"
-        if isinstance(c, LinearCoupling) and not any(_num(v) for _, v in c.coefficients):
-            return f"constraint {c.name}: every coefficient is zero"
-    return ""
+def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict:
+    """Where a RollingContact sits in the MJCF: the disc's hub joint, the arm's hinge on
+    the track (the ring's centre, track frame) and the radii. The arm must fold into the
+    disc's MJCF body, which then also carries the radial slide that frees its length."""
+    if c.arm not in foldable:
+        raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
+                         "link that carries the disc only")
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    return {"disc": c.disc, "arm_joint": hinge.name, "disc_joint": hub.name,
+            "track": c.track, "centre": [num(v) for v in hinge.parent_anchor],
+            "R": num(c.track_radius), "r": num(c.disc_radius), "j": mech.joints.index(hub)}
 
 
 def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
@@ -316,30 +248,9 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     substitute_gravcomp, solref, solimp); defaults when None."""
     opts = dict(opts or {})
     n = len(mech.joints)
-    # body angle = angle_c . q + angle_d (affine in the description coordinates)
-    angle_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
-    angle_d: dict[str, float] = {WORLD: 0.0}
-    A = np.zeros((n, n))
-    b = np.zeros(n)
-    for i, j in enumerate(mech.joints):
-        cp, dp = angle_c[j.parent], angle_d[j.parent]
-        off = _num(j.angle_offset)
-        if isinstance(j, Revolute):
-            sign = -1.0 if getattr(j, "clockwise", False) else 1.0
-            if j.absolute:
-                angle_c[j.child] = sign * np.eye(n)[i]
-                angle_d[j.child] = off
-                A[i] = sign * np.eye(n)[i] - cp  # v = theta_child - theta_parent - offset
-                b[i] = -dp
-            else:
-                angle_c[j.child] = cp + sign * np.eye(n)[i]
-                angle_d[j.child] = dp + off
-                A[i, i] = sign
-        else:
-            angle_c[j.child] = cp.copy()
-            angle_d[j.child] = dp + off
-            A[i, i] = math.hypot(_num(j.axis[0]), _num(j.axis[1]))  # MuJoCo normalizes axes
-    Ainv = np.linalg.inv(A)
+    cmap = coordinate_map(mech)
+    A, b, Ainv = cmap.A, cmap.b, cmap.T
+    angle_c, angle_d = cmap.angle_c, cmap.angle_d
 
     foldable = _foldable(mech)
     carrier: dict[str, str] = {}
@@ -359,7 +270,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
 
     plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
     plan.opts = opts
-    m_min = min(_num(bd.mass) for bd in mech.bodies if not bd.massless)
+    m_min = min(num(bd.mass) for bd in mech.bodies if not bd.massless)
     # massless bodies that cannot be folded: a pure kinematic link (several children, no
     # constraint or point force on it) carries no load of its own and can be very light;
     # a massless body that a constraint or a point force loads must be heavier, because
@@ -385,11 +296,11 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             pins.setdefault(c.body, []).append(c)
     slider_mass: dict[str, float] = {}
     for body, cons in pins.items():
-        pts = [np.array([_num(c.point[0]), _num(c.point[1])]) for c in cons]
+        pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
         if body == WORLD:
             for c in cons:
                 lb = c.line_body
-                ml = m_min if lb == WORLD or mech.body(lb).massless else _num(mech.body(lb).mass)
+                ml = m_min if lb == WORLD or mech.body(lb).massless else num(mech.body(lb).mass)
                 slider_mass[c.name] = ratio * ml
             continue
         bd = mech.body(body)
@@ -398,7 +309,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             for c in cons:
                 slider_mass[c.name] = ratio * ms
             continue
-        mp, ip = _num(bd.mass), _num(bd.inertia)
+        mp, ip = num(bd.mass), num(bd.inertia)
         # the largest point masses at the pins that leave a positive inertia
         bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
         masses = [ratio * bound for _ in cons]
@@ -422,16 +333,14 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
         else:
             coef = np.zeros(n)
             for name, value in c.coefficients:
-                coef[mech.coordinates.index(name)] += _num(value)
+                coef[mech.coordinates.index(name)] += num(value)
             w = Ainv.T @ coef  # c . q = c . A^-1 (v - b)
             weights = {mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
-            offset = _num(c.constant) + float(coef @ Ainv @ b)
-            if opts.get("rolling", "coupling") == "contact":
-                geo = _rolling_geometry(mech, angle_c, foldable, c, coef)
-                if isinstance(geo, str):
-                    raise ValueError(f"mujoco rolling='contact' cannot build {c.name}: {geo}")
+            offset = num(c.constant) + float(coef @ Ainv @ b)
+            if isinstance(c, RollingContact):
                 plan.closures.append(_Closure(c, "contact", slider=f"{c.name}:radial",
-                                              weights=weights, offset=offset, contact=geo,
+                                              weights=weights, offset=offset,
+                                              contact=_contact_geometry(mech, c, foldable),
                                               coef=coef))
             else:
                 plan.closures.append(_Closure(c, "tendon", weights=weights, offset=offset,
@@ -439,9 +348,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     joint_native: dict[int, list[float]] = {}
     for f in mech.forces:
         if isinstance(f, PointToPoint):
-            if autonomous and TIME in sp.sympify(f.tension).free_symbols:
+            law = ForceLaw.of(f)
+            if autonomous and law.time_dependent:
                 continue
-            lin = _linear_law(f.tension, LENGTH, LENGTH_RATE) if native else None
+            lin = law.linear if native else None
             spec = None
             if lin is not None:
                 a, k, c = lin
@@ -449,13 +359,13 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
                     spec = (k, -a / k + 0.0, c)
                 elif k == 0 and a == 0 and c >= 0:
                     spec = (0.0, 0.0, c)
-            plan.p2p.append(_P2P(f, f.name, spec,
-                                 compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))))
+            plan.p2p.append(_P2P(f, f.name, spec, law.law))
         else:
-            if autonomous and f.time_dependent:
+            law = ForceLaw.of(f)
+            if autonomous and law.time_dependent:
                 continue
             i = mech.coordinates.index(f.coordinate)
-            lin = _linear_law(f.force, COORD, COORD_RATE) if native else None
+            lin = law.linear if native else None
             spec = None
             single = np.count_nonzero(A[i]) == 1 and b[i] == 0
             if lin is not None and single:
@@ -464,7 +374,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
                 spec = (a / s, kq / s**2, cq / s**2)
                 acc = joint_native.setdefault(i, [0.0, 0.0, 0.0])
                 acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-            plan.coord.append(_Coord(f, i, spec, compile_law(f.force, (COORD, COORD_RATE, TIME))))
+            plan.coord.append(_Coord(f, i, spec, law.law))
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
     # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
     for i, (a, k, c) in joint_native.items():
@@ -484,35 +394,35 @@ def _poses(plan: _Plan, q: np.ndarray) -> tuple[dict, dict]:
     joints = {}
     for i, j in enumerate(mech.joints):
         pp, thp = poses[j.parent]
-        Rp = _rot(thp)
+        Rp = rot(thp)
         th = float(plan.angle_c[j.child] @ q + plan.angle_d[j.child])
-        pa = np.array([_num(j.parent_anchor[0]), _num(j.parent_anchor[1])])
-        ca = np.array([_num(j.child_anchor[0]), _num(j.child_anchor[1])])
+        pa = np.array([num(j.parent_anchor[0]), num(j.parent_anchor[1])])
+        ca = np.array([num(j.child_anchor[0]), num(j.child_anchor[1])])
         if isinstance(j, Revolute):
             anchor = pp + Rp @ pa
             joints[j.name] = (anchor, None)
         else:
-            axis = np.array([_num(j.axis[0]), _num(j.axis[1])])
+            axis = np.array([num(j.axis[0]), num(j.axis[1])])
             anchor = pp + Rp @ (pa + q[i] * axis)
             joints[j.name] = (anchor, Rp @ axis)
-        poses[j.child] = (anchor - _rot(th) @ ca, th)
+        poses[j.child] = (anchor - rot(th) @ ca, th)
     return poses, joints
 
 
 def _shape_geoms(shape) -> str:
     if isinstance(shape, Segment):
-        a = [_num(v) for v in shape.a]
-        b = [_num(v) for v in shape.b]
-        r = _num(shape.width) / 2
+        a = [num(v) for v in shape.a]
+        b = [num(v) for v in shape.b]
+        r = num(shape.width) / 2
         if a == b:
             return f'<geom type="sphere" size="{_fmt(r)}" pos="{_fmt(a[0], a[1], 0)}"/>'
         return f'<geom type="capsule" size="{_fmt(r)}" fromto="{_fmt(a[0], a[1], 0, b[0], b[1], 0)}"/>'
     if isinstance(shape, Circle):
-        c = [_num(v) for v in shape.center]
-        return f'<geom type="sphere" size="{_fmt(_num(shape.radius))}" pos="{_fmt(c[0], c[1], 0)}"/>'
+        c = [num(v) for v in shape.center]
+        return f'<geom type="sphere" size="{_fmt(num(shape.radius))}" pos="{_fmt(c[0], c[1], 0)}"/>'
     if isinstance(shape, Rectangle):
-        c = [_num(v) for v in shape.center]
-        w, h = _num(shape.width), _num(shape.height)
+        c = [num(v) for v in shape.center]
+        w, h = num(shape.width), num(shape.height)
         return (f'<geom type="box" size="{_fmt(w / 2, h / 2, min(w, h) / 4)}" '
                 f'pos="{_fmt(c[0], c[1], 0)}"/>')
     return ""
@@ -528,7 +438,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         f = e.element
         for tag, body, pt in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
             sites.setdefault(body, []).append(
-                f'<site name="{f.name}:{tag}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+                f'<site name="{f.name}:{tag}" pos="{_fmt(num(pt[0]), num(pt[1]), 0)}"/>')
     gravcomp = ' gravcomp="1"' if plan.opts.get("substitute_gravcomp", True) else ""
     sliders: dict[str, list[str]] = {}
     for cl in plan.closures:
@@ -537,11 +447,11 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
             for site, body, pt in ((cl.site1, c.body_a, c.point_a),
                                    (cl.site2, c.body_b, c.point_b)):
                 sites.setdefault(body, []).append(
-                    f'<site name="{site}" pos="{_fmt(_num(pt[0]), _num(pt[1]), 0)}"/>')
+                    f'<site name="{site}" pos="{_fmt(num(pt[0]), num(pt[1]), 0)}"/>')
         elif cl.kind == "slider":
             sites.setdefault(c.body, []).append(
-                f'<site name="{cl.site1}" pos="{_fmt(_num(c.point[0]), _num(c.point[1]), 0)}"/>')
-            lp, dr = [_num(v) for v in c.line_point], [_num(v) for v in c.direction]
+                f'<site name="{cl.site1}" pos="{_fmt(num(c.point[0]), num(c.point[1]), 0)}"/>')
+            lp, dr = [num(v) for v in c.line_point], [num(v) for v in c.direction]
             # the slot body's MJCF frame is its description frame (slot bodies are never
             # folded): the slider starts at line_point, its joint value is the distance
             # along the unit slot direction
@@ -565,7 +475,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         if cl.kind != "contact":
             continue
         geo = cl.contact
-        disc_c = [_num(v) for v in mech.joint(geo["disc_joint"]).child_anchor]
+        disc_c = [num(v) for v in mech.joint(geo["disc_joint"]).child_anchor]
         contact_geoms.setdefault(plan.carrier[geo["disc"]], []).append(
             f'<geom name="{cl.element.name}:disc" type="sphere" size="{_fmt(geo["r"])}" '
             f'pos="{_fmt(disc_c[0], disc_c[1], 0)}" contype="2" conaffinity="0"{cparams}/>')
@@ -585,12 +495,12 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         ind = "  " * depth
         p, th = poses[name]
         pp, thp = poses[plan.mj_parent[name]]
-        rel = _rot(thp).T @ (p - pp)
+        rel = rot(thp).T @ (p - pp)
         ang = th - thp
         body = mech.body(name)
         lines = [f'{ind}<body name="{name}" pos="{_fmt(rel[0], rel[1], 0)}" '
                  f'quat="{_fmt(math.cos(ang / 2), 0, 0, math.sin(ang / 2))}">']
-        RbT = _rot(th).T
+        RbT = rot(th).T
         for i in plan.chains[name]:
             j = mech.joints[i]
             anchor, axis = janchor[j.name]
@@ -614,7 +524,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
                     u = RbT @ ((hub - anchor) / np.linalg.norm(hub - anchor))
                     lines.append(f'{ind}  <joint name="{cl.slider}" type="slide" '
                                  f'axis="{_fmt(u[0], u[1], 0)}"/>')
-        m, inertia = _num(body.mass), _num(body.inertia)
+        m, inertia = num(body.mass), num(body.inertia)
         com = (0.0, 0.0)
         if name in plan.substitutes:
             m, inertia = plan.substitutes[name]
@@ -634,7 +544,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         lines.append(f"{ind}</body>")
         return lines
 
-    g = _num(mech.gravity)
+    g = num(mech.gravity)
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
@@ -795,7 +705,7 @@ class _Compiled:
                 j = cl.contact["j"]
                 forces.append(np.array([Q[j] / cl.coef[j]]))
                 q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
-                viol[i] = cl.coef @ q - _num(cl.element.constant)
+                viol[i] = cl.coef @ q - num(cl.element.constant)
                 k_contact += 1
             elif cl.kind == "tendon":
                 # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
@@ -915,6 +825,118 @@ class _PassiveInstalled:
 
 class MujocoBackend(Backend):
     id = "mujoco"
+    SETTINGS = {
+        "integrator": Setting(
+            "RK4", tuple(_INTEGRATORS),
+            "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) phase "
+            "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
+            "every custom and time-dependent force, is evaluated at each stage at the "
+            "stage time). Also accepted: Euler, implicit, implicitfast (order 1). With "
+            "Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
+        "native_springs": Setting(
+            True, bool,
+            "true: force laws linear in length/coordinate and rate (no time) use MuJoCo's "
+            "own tendon stiffness/springlength/damping and joint "
+            "stiffness/springref/damping (exact for the description, free length 0 "
+            "included); false: every law goes through the passive callback. Only the "
+            "implicit integrators see the difference (they differentiate native damping "
+            "but not callback forces, mujoco #2433)."),
+        "linearization": Setting(
+            "inverseFD", _LINEARIZATIONS,
+            "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD (finite "
+            "differences of mj_inverse), central differences by combining +eps and -eps; "
+            "eigenvalues of the first-order system. 'transitionFD': mjd_transitionFD "
+            "discrete A on a copy of the model with the Euler integrator when the run "
+            "uses RK4 (RK4 is not supported there), mapped with ln(lambda)/dt; carries "
+            "the step's own O(h) error."),
+        "fd_eps": Setting(
+            1e-6, float,
+            "Finite-difference step of mjd_inverseFD / mjd_transitionFD."),
+        "autoreset": Setting(
+            False, bool,
+            "false replaces MuJoCo's default (autoreset on), which silently resets the "
+            "state to qpos0 when an acceleration is NaN or huge and would show a "
+            "divergence as a jump back to the start; off, it shows as NaN/inf."),
+        "constraint_timeconst_steps": Setting(
+            2.0, float,
+            "Closure equalities: solref time constant in time steps (solref[0] = steps * "
+            "dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. MuJoCo clamps "
+            "it to 2 dt unless refsafe is off; measured on the scotch yoke with RK4: 2 is "
+            "best (1: same trajectory, 20x the force error; 0.5: 15x worse; 0.3: "
+            "unstable)."),
+        "constraint_dampratio": Setting(
+            1.0, float,
+            "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
+            "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
+        "constraint_solimp": Setting(
+            [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
+            "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
+            "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
+            "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
+            "trajectory error 10x larger."),
+        "refsafe": Setting(
+            True, bool,
+            "MuJoCo's default (on): solref time constants below 2 dt are raised to 2 dt. "
+            "Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
+        "diagexact": Setting(
+            True, bool,
+            "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint regularisation "
+            "uses the exact diagonal of J M^-1 J^T instead of the body_invweight0 "
+            "estimate; with the estimate the scotch yoke's slot force was 6 % low at t = "
+            "0 and its violation 3e-6 m (5e-9 m exact)."),
+        "slider_mass_ratio": Setting(
+            0.3, float,
+            "Mass of each point-on-line slider as a fraction of the largest point mass "
+            "its pin body can give up (the rest keeps a positive inertia); it is taken "
+            "out of the pin body (exact while the constraint holds). Lighter sliders pass "
+            "less inertial force through the soft connect but condition it worse across "
+            "rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
+        "massless_mass_ratio": Setting(
+            3e-4, float,
+            "Substitute mass of a massless body that a constraint or point force loads "
+            "(e.g. a massless pin in a slot), times the lightest body's mass; weight "
+            "cancelled. Not compensated: it adds inertia, while a lighter one softens the "
+            "constraints through it (their stiffness scales with the mass they move). "
+            "Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give similar "
+            "trajectories (~5e-3), 1e-3 three times the frequency error (6e-4), 1e-2 and "
+            "1e-4 2x-8x worse trajectories."),
+        "link_mass_ratio": Setting(
+            1e-9, float,
+            "Substitute mass of a massless kinematic link that cannot be folded (several "
+            "child joints, no constraint on it), times the lightest body's mass; its tree "
+            "children carry the inertia, so it can be tiny (belt arm: 1e-3 gave 3e-6 "
+            "trajectory error, 1e-9 gives 8e-10)."),
+        "substitute_gravcomp": Setting(
+            True, bool,
+            "Cancel the weight of substitute bodies whose mass is not taken from a body "
+            "of the description (MuJoCo body gravcomp=1)."),
+        "contact_timeconst_steps": Setting(
+            2.0, float,
+            "RollingContact: solref[0] of the contacts in steps."),
+        "contact_dampratio": Setting(
+            1.0, float,
+            "RollingContact: solref[1] of the contacts."),
+        "contact_solimp": Setting(
+            [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
+            "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
+            "energy: 0.215 rad error in SIMULATORS.md)."),
+        "contact_friction": Setting(
+            1.0, float,
+            "RollingContact: sliding friction coefficient of the disc."),
+        "contact_cone": Setting(
+            "pyramidal", ("pyramidal", "elliptic"),
+            "RollingContact: MuJoCo friction cone, pyramidal or elliptic."),
+        "impratio": Setting(
+            1.0, float,
+            "RollingContact: MuJoCo impratio (friction-to-normal impedance)."),
+        "noslip_iterations": Setting(
+            0, int,
+            "RollingContact: MuJoCo's noslip post-processing iterations (0 = off, "
+            "MuJoCo's default); they remove the regularised friction's creep."),
+        "ring_segments": Setting(
+            720, int,
+            "RollingContact: number of boxes forming the ring."),
+    }
 
     def available(self) -> tuple[bool, str]:
         try:
@@ -928,153 +950,82 @@ class MujocoBackend(Backend):
 
         return mujoco.__version__
 
-    def default_settings(self) -> dict:
-        return {
-            "integrator": "RK4",
-            "native_springs": True,
-            "linearization": "inverseFD",
-            "fd_eps": 1e-6,
-            "autoreset": False,
-            "constraint_timeconst_steps": 2.0,
-            "constraint_dampratio": 1.0,
-            "constraint_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
-            "refsafe": True,
-            "diagexact": True,
-            "slider_mass_ratio": 0.3,
-            "massless_mass_ratio": 3e-4,
-            "link_mass_ratio": 1e-9,
-            "substitute_gravcomp": True,
-            "rolling": "coupling",
-            "contact_timeconst_steps": 2.0,
-            "contact_dampratio": 1.0,
-            "contact_solimp": [0.9999, 0.9999, 0.001, 0.5, 2.0],
-            "contact_friction": 1.0,
-            "contact_cone": "pyramidal",
-            "impratio": 1.0,
-            "noslip_iterations": 0,
-            "ring_segments": 720,
-        }
+    EXPRESSIONS = {
+        BODY: (
+            Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
+                              "explicit <inertial> (planar inertia on z, the same on x and y)",
+                       when="mass and inertia > 0"),
+            Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass or inertia",
+                       when="mass or inertia 0, not both"),
+        ),
+        MASSLESS_BODY: (
+            Expression(EXACT, "folded: its joints become a chain of joints of its single "
+                              "child's MJCF body, anchors and axes at the reference "
+                              "configuration",
+                       when="one child joint, and no constraint or point force on it"),
+            Expression(SUBSTITUTE, "a body of small mass (link_mass_ratio of the lightest "
+                                   "body for a kinematic link, massless_mass_ratio where a "
+                                   "constraint or a point force loads it), weight cancelled: "
+                                   "MuJoCo rejects massless moving bodies",
+                       when="several child joints, or loaded by a constraint or point force"),
+        ),
+        REVOLUTE: (Expression(EXACT, "hinge about z on the relative angle (absolute and "
+                                     "clockwise coordinates through v = A q + b)"),),
+        PRISMATIC: (Expression(EXACT, "slide joint in the x-y plane (limits are admissible "
+                                      "intervals, not stops)"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, "spatial tendon with its own stiffness, "
+                                                  "springlength and damping (native_springs; "
+                                                  "otherwise the passive callback)"),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "spatial tendon, -T dL/dq from the passive "
+                                                  "callback at every integrator stage"),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "joint stiffness, springref and damping "
+                                                    "where the coordinate is one engine joint, "
+                                                    "otherwise the passive callback"),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "passive callback (set_mjcb_passive) at "
+                                                    "every integrator stage"),),
+        TIME_LOAD: (Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
+                                      "stage time"),),
+        POINT_ON_POINT: (Expression(SOFT, "connect equality between two sites",
+                                    expected_failures=SOFT_EQUALITY_METRICS,
+                                    reason=SOFT_EQUALITY),),
+        POINT_ON_LINE: (Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
+                                               "the slot body (slide joint along the slot) "
+                                               "connected to the pin, its mass taken out of "
+                                               "the pin body (exact while the constraint "
+                                               "holds); the connect is soft",
+                                   expected_failures=SOFT_EQUALITY_METRICS,
+                                   reason=SOFT_EQUALITY),),
+        LINEAR_COUPLING: (Expression(SOFT, "fixed tendon sum(w_j v_j) over the engine joint "
+                                           "values held by a tendon equality (an exact linear "
+                                           "relation; soft like every equality)",
+                                     expected_failures=SOFT_EQUALITY_METRICS,
+                                     reason=SOFT_EQUALITY),),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
+                                                 "of ring_segments boxes (soft, regularised "
+                                                 "friction; the arm's length freed by a "
+                                                 "radial slide); its force is the contacts' "
+                                                 "generalized force on the disc's coordinate "
+                                                 "over its coefficient, its violation the "
+                                                 "slip; linearize uses the coupling"),),
+    }
 
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "integrator": (
-                "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) "
-                "phase error on a pendulum) by 'RK4' (fourth order; the passive callback, "
-                "hence every custom and time-dependent force, is evaluated at each stage at "
-                "the stage time). Also accepted: Euler, implicit, implicitfast (order 1). "
-                "With Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
-            "native_springs": (
-                "true: force laws linear in length/coordinate and rate (no time) use "
-                "MuJoCo's own tendon stiffness/springlength/damping and joint "
-                "stiffness/springref/damping (exact for the description, free length 0 "
-                "included); false: every law goes through the passive callback. Only the "
-                "implicit integrators see the difference (they differentiate native "
-                "damping but not callback forces, mujoco #2433)."),
-            "linearization": (
-                "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD "
-                "(finite differences of mj_inverse), central differences by combining "
-                "+eps and -eps; eigenvalues of the first-order system. 'transitionFD': "
-                "mjd_transitionFD discrete A on a copy of the model with the Euler "
-                "integrator when the run uses RK4 (RK4 is not supported there), mapped "
-                "with ln(lambda)/dt; carries the step's own O(h) error."),
-            "fd_eps": "Finite-difference step of mjd_inverseFD / mjd_transitionFD.",
-            "autoreset": (
-                "false replaces MuJoCo's default (autoreset on), which silently resets the "
-                "state to qpos0 when an acceleration is NaN or huge and would show a "
-                "divergence as a jump back to the start; off, it shows as NaN/inf."),
-            "constraint_timeconst_steps": (
-                "Closure equalities: solref time constant in time steps (solref[0] = "
-                "steps * dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. "
-                "MuJoCo clamps it to 2 dt unless refsafe is off; measured on the scotch "
-                "yoke with RK4: 2 is best (1: same trajectory, 20x the force error; 0.5: "
-                "15x worse; 0.3: unstable)."),
-            "constraint_dampratio": (
-                "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
-                "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
-            "constraint_solimp": (
-                "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
-                "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
-                "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
-                "trajectory error 10x larger."),
-            "refsafe": (
-                "MuJoCo's default (on): solref time constants below 2 dt are raised to "
-                "2 dt. Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
-            "diagexact": (
-                "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint "
-                "regularisation uses the exact diagonal of J M^-1 J^T instead of the "
-                "body_invweight0 estimate; with the estimate the scotch yoke's slot force "
-                "was 6 % low at t = 0 and its violation 3e-6 m (5e-9 m exact)."),
-            "slider_mass_ratio": (
-                "Mass of each point-on-line slider as a fraction of the largest point mass "
-                "its pin body can give up (the rest keeps a positive inertia); it is taken "
-                "out of the pin body (exact while the constraint holds). Lighter sliders "
-                "pass less inertial force through the soft connect but condition it worse "
-                "across rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
-            "massless_mass_ratio": (
-                "Substitute mass of a massless body that a constraint or point force "
-                "loads (e.g. a massless pin in a slot), times the lightest body's mass; "
-                "weight cancelled. Not compensated: it adds inertia, while a lighter one "
-                "softens the constraints through it (their stiffness scales with the mass "
-                "they move). Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give "
-                "similar trajectories (~5e-3), 1e-3 three times the frequency error "
-                "(6e-4), 1e-2 and 1e-4 2x-8x worse trajectories."),
-            "link_mass_ratio": (
-                "Substitute mass of a massless kinematic link that cannot be folded "
-                "(several child joints, no constraint on it), times the lightest body's "
-                "mass; its tree children carry the inertia, so it can be tiny (belt arm: "
-                "1e-3 gave 3e-6 trajectory error, 1e-9 gives 8e-10)."),
-            "substitute_gravcomp": (
-                "Cancel the weight of substitute bodies whose mass is not taken from a "
-                "body of the description (MuJoCo body gravcomp=1)."),
-            "rolling": (
-                "'coupling' (default): a rolling LinearCoupling is a tendon equality (an "
-                "exact linear relation, soft like every equality). 'contact': a disc "
-                "inside a ring is built as friction contact (sphere disc, ring of "
-                "ring_segments boxes, the arm's length freed by a radial slide so that "
-                "the contact's normal force holds the disc); the coupling's force is the "
-                "contacts' generalized force on the disc's coordinate over its "
-                "coefficient, its violation the accumulated slip c.q - const. "
-                "linearize always uses the coupling."),
-            "contact_timeconst_steps": "rolling='contact': solref[0] of the contacts in steps.",
-            "contact_dampratio": "rolling='contact': solref[1] of the contacts.",
-            "contact_solimp": (
-                "rolling='contact': solimp of the contacts (MuJoCo's default 0.9 0.95 "
-                "lost energy: 0.215 rad error in SIMULATORS.md)."),
-            "contact_friction": "rolling='contact': sliding friction coefficient of the disc.",
-            "contact_cone": "rolling='contact': MuJoCo friction cone, pyramidal or elliptic.",
-            "impratio": "rolling='contact': MuJoCo impratio (friction-to-normal impedance).",
-            "noslip_iterations": (
-                "rolling='contact': MuJoCo's noslip post-processing iterations (0 = off, "
-                "MuJoCo's default); they remove the regularised friction's creep."),
-            "ring_segments": "rolling='contact': number of boxes forming the ring.",
-        }
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == BODY:
+            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+        return cases[0] if element.name in _foldable(mechanism) else cases[1]
 
-    def support(self, mechanism: Mechanism) -> Support:
-        reason = _check(mechanism)
-        return Support(not reason, reason)
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        if all(b.massless for b in mechanism.bodies):
+            return "every body is massless (no mass scale for the substitute bodies)"
+        return ""
 
     # --- translation ---------------------------------------------------------------------
-    def _resolve(self, settings: Mapping | None) -> dict:
-        s = self.resolve_settings(settings)
-        if s["integrator"] not in _INTEGRATORS:
-            raise ValueError(f"mujoco setting integrator must be one of {list(_INTEGRATORS)}, "
-                             f"got {s['integrator']!r}")
-        if s["linearization"] not in _LINEARIZATIONS:
-            raise ValueError(f"mujoco setting linearization must be one of {_LINEARIZATIONS}, "
-                             f"got {s['linearization']!r}")
-        if s["rolling"] not in ("coupling", "contact"):
-            raise ValueError(f"mujoco setting rolling must be 'coupling' or 'contact', "
-                             f"got {s['rolling']!r}")
-        if s["contact_cone"] not in ("pyramidal", "elliptic"):
-            raise ValueError(f"mujoco setting contact_cone must be 'pyramidal' or 'elliptic', "
-                             f"got {s['contact_cone']!r}")
-        return s
-
     def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
               dt: float | None = None) -> _Plan:
-        reason = _check(mechanism)
-        if reason:
-            raise ValueError(f"mujoco cannot express this mechanism: {reason}")
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
         steps = float(settings["constraint_timeconst_steps"])
         opts = {
             "slider_mass_ratio": float(settings["slider_mass_ratio"]),
@@ -1088,7 +1039,6 @@ class MujocoBackend(Backend):
             "solimp": tuple(float(x) for x in settings["constraint_solimp"]),
             "refsafe": bool(settings["refsafe"]),
             "diagexact": bool(settings["diagexact"]),
-            "rolling": settings["rolling"],
             "contact_timeconst_steps": float(settings["contact_timeconst_steps"]),
             "contact_dampratio": float(settings["contact_dampratio"]),
             "contact_solref": (float(settings["contact_timeconst_steps"]) * (dt or 0.002),
@@ -1107,7 +1057,7 @@ class MujocoBackend(Backend):
         """The MJCF text of the translated mechanism (with the integrator setting and,
         when given, the time step), to save and load with ``MjModel.from_xml_path``.
         Laws that need the passive callback are not in the file."""
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         xml = self._plan(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
@@ -1130,7 +1080,7 @@ class MujocoBackend(Backend):
                  reaction_joints: Sequence[str] = ()) -> RunResult:
         import mujoco
 
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         plan = self._plan(mechanism, s, dt=dt)
         for name in reaction_joints:
             mechanism.joint(name)  # KeyError for an unknown joint
@@ -1242,23 +1192,21 @@ class MujocoBackend(Backend):
                 in_a, in_b = f.body_a in inside, f.body_b in inside
                 if in_a == in_b or e.native is not None:
                     continue
-                tension = _vector_law(f.tension, (LENGTH, LENGTH_RATE, TIME))(
-                    ten[:, i, 0], ten[:, i, 1], t)
+                tension = ForceLaw.of(f).vector_law(ten[:, i, 0], ten[:, i, 1], t)
                 ab = spos[:, i, 1] - spos[:, i, 0]
                 unit = ab / np.linalg.norm(ab, axis=1)[:, None]
                 on_inside = tension[:, None] * unit * (1.0 if in_a else -1.0)
                 r -= on_inside
             if isinstance(joint, Prismatic):
                 ji = mech.joints.index(joint)
-                axis = np.array([_num(joint.axis[0]), _num(joint.axis[1])])
+                axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
                 th = q @ plan.angle_c[joint.parent] + plan.angle_d[joint.parent]
                 c, s_ = np.cos(th), np.sin(th)
                 axis_w = np.stack([c * axis[0] - s_ * axis[1], s_ * axis[0] + c * axis[1]], 1)
                 axis_w /= float(axis @ axis)  # force F on q is F axis/|axis|^2 in space
                 for e in plan.coord:
                     if e.j == ji:
-                        F = _vector_law(e.element.force, (COORD, COORD_RATE, TIME))(
-                            q[:, ji], qd[:, ji], t)
+                        F = ForceLaw.of(e.element).vector_law(q[:, ji], qd[:, ji], t)
                         r -= F[:, None] * axis_w
             out[name] = r
         return out
@@ -1341,8 +1289,8 @@ class MujocoBackend(Backend):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         import mujoco
 
-        s = self._resolve(settings)
-        s["rolling"] = "coupling"  # a contact has no linearization: the exact coupling
+        s = self.resolve_settings(settings)
+        mechanism = coupled(mechanism)  # a contact has no linearization: the exact coupling
         plan = self._plan(mechanism, s, autonomous=True, dt=dt)
         n, eps = plan.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)

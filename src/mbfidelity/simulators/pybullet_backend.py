@@ -28,8 +28,11 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   values are refused by `support`. Massless bodies that carry nothing but are held by a
   constraint get a small substitute mass. Constraint frames are centre-of-mass frames
   (= body frames). The violation of each closure is measured at every sample
-  (``RunResult.constraint_violation``). Settings "point_on_line" = "slider" and "rolling" =
-  "contact" select the alternative substitutes (see `setting_notes`).
+  (``RunResult.constraint_violation``). The setting "point_on_line" = "slider" selects
+  the alternative substitute (see `setting_notes`). ``RollingContact`` (a variant's
+  stand-in for a rolling coupling): the hub rides on a massless radial slider, a sphere
+  of the disc's radius touches a ring of boxes on massless fixed links of the track
+  (`_contact_shapes`); the coupling's Phi is then the measured slip.
 - createMultiBody stores links in depth-first order of the tree; the backend maps its
   creation order to the engine's indices through the joint names ("joint<k+1>").
 - ``CoordinateForce``: joint forces through ``setJointMotorControlArray(TORQUE_CONTROL)``
@@ -68,39 +71,57 @@ from dataclasses import dataclass, replace
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
-    Circle,
     CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
     PointOnPoint,
-    PointToPoint,
-    Prismatic,
     Revolute,
-    compile_law,
+    RollingContact,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import Backend, Linearization, RunResult, Support
+from .base import (
+    EXACT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    ROLLING_CONTACT,
+    TIME_LOAD,
+    ForceLaw,
+    constrained_bodies,
+    coordinate_map,
+    num,
+)
 
+_POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
+                "states at the start of the step (the single stage of its semi-implicit "
+                "Euler)")
+_JOINT_FORCE = ("joint force through setJointMotorControlArray(TORQUE_CONTROL) every step, "
+                "tau = A^-T Q")
 _REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
-_ROLLING = ("coupling", "contact")
 _POINT_ON_LINE = ("prismatic", "slider")
 #: createMultiBody keeps the first 127 links and drops the rest without an error (measured)
 _MAX_LINKS = 127
-
-
-def _num(x) -> float:
-    """A number from a numeric description entry (sympy or float)."""
-    return float(sp.sympify(x))
 
 
 def _quat_z(angle: float) -> list[float]:
@@ -208,8 +229,8 @@ def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
     w . jv = const + c . A^-1 b with w = A^-T c. Returns (c, const, w, rhs)."""
     cvec = np.zeros(len(coords))
     for name, coef in c.coefficients:
-        cvec[coords.index(name)] += _num(coef)
-    const = _num(c.constant)
+        cvec[coords.index(name)] += num(coef)
+    const = num(c.constant)
     w = Ainv.T @ cvec
     w[np.abs(w) < 1e-14 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
     return cvec, const, w, const + float(cvec @ Ainv @ bvec)
@@ -231,59 +252,18 @@ class _Contact:
     radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
 
 
-def _rolling_contact(mech: Mechanism) -> _Contact | None:
-    """Find a LinearCoupling that describes rolling of a disc inside a circular track:
-    the disc's joint (the hub) sits on an arm whose own revolute joint is on the track at
-    the centre of the track's circle, the disc's circle is centred on the hub, the hub is
-    R - r from the arm's pivot (they touch), and the coupling involves the hub's
-    coordinate. None if there is no such coupling."""
-    def circles(body):
-        return [s for s in mech.body(body).shapes if isinstance(s, Circle)]
-
-    for c in mech.constraints:
-        if not isinstance(c, LinearCoupling):
-            continue
-        used = {name for name, coef in c.coefficients if _num(coef) != 0}
-        for hub_i, hub in enumerate(mech.joints):
-            if hub.coordinate not in used or not isinstance(hub, Revolute) \
-                    or hub.parent == WORLD:
-                continue
-            arm_joint = mech.joint_of_child(hub.parent)
-            if not isinstance(arm_joint, Revolute) or arm_joint.parent == WORLD:
-                continue
-            pa = np.array([_num(v) for v in arm_joint.parent_anchor])
-            ca = np.array([_num(v) for v in arm_joint.child_anchor])
-            ha = np.array([_num(v) for v in hub.parent_anchor])
-            hc = np.array([_num(v) for v in hub.child_anchor])
-            for outer in circles(arm_joint.parent):
-                oc = np.array([_num(v) for v in outer.center])
-                R = _num(outer.radius)
-                if np.linalg.norm(oc - pa) > 1e-9 * max(R, 1.0):
-                    continue
-                for inner in circles(hub.child):
-                    ic = np.array([_num(v) for v in inner.center])
-                    r = _num(inner.radius)
-                    arm = ha - ca
-                    if (r < R and np.linalg.norm(ic - hc) <= 1e-9 * max(r, 1.0)
-                            and abs(np.linalg.norm(arm) - (R - r)) <= 1e-9 * R):
-                        u = arm / np.linalg.norm(arm)
-                        return _Contact(c.name, arm_joint.parent, hub.child, R, r,
-                                        (float(oc[0]), float(oc[1])),
-                                        (float(ic[0]), float(ic[1])), hub_i,
-                                        (float(u[0]), float(u[1])))
-    return None
-
-
-def _constraint_bodies(mech: Mechanism) -> set[str]:
-    """Bodies a closure constraint acts on (couplings: the children of their joints)."""
-    out: set[str] = set()
-    for c in mech.constraints:
-        if isinstance(c, (PointOnPoint, PointOnLine)):
-            out |= set(c.bodies)
-        elif isinstance(c, LinearCoupling):
-            out |= {mech.joints[mech.coordinates.index(name)].child
-                    for name, _ in c.coefficients}
-    return out - {WORLD}
+def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
+    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
+    the track, the disc's circle at its hub, and the radial slider runs along the arm
+    from that hinge to the hub."""
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    centre = tuple(num(v) for v in hinge.parent_anchor)
+    arm = (np.array([num(v) for v in hub.parent_anchor])
+           - np.array([num(v) for v in hinge.child_anchor]))
+    u = arm / np.linalg.norm(arm)
+    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
+                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
+                    (float(u[0]), float(u[1])))
 
 
 class _Plan:
@@ -294,61 +274,43 @@ class _Plan:
     PointOnLine constraint); `creation_order` puts parents first."""
 
     def __init__(self, mech: Mechanism, massless_mass: float,
-                 opts: Mapping | None = None, compile_forces: bool = True,
+                 opts: Mapping | None = None,
                  contact: _Contact | None = None) -> None:
         opts = dict(opts or {})
         self.mech = mech
         self.coords = mech.coordinates
-        n = self.n = len(self.coords)
-        self.gravity = _num(mech.gravity)
-        masses = [_num(b.mass) for b in mech.bodies]
-        inertias = [_num(b.inertia) for b in mech.bodies]
+        self.n = len(self.coords)
+        self.gravity = num(mech.gravity)
+        masses = [num(b.mass) for b in mech.bodies]
+        inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
         self.i_min = min((i for i in inertias if i > 0), default=1.0)
         parents = {j.parent for j in mech.joints}
-        constrained = _constraint_bodies(mech)
+        constrained = constrained_bodies(mech)
         leaf_ratio = float(opts.get("massless_leaf_mass_ratio", 1e-6))
         #: massless bodies that carry nothing but are held by a constraint: singular for
         #: the articulated-body algorithm, given a small substitute mass (named setting)
         self.leaf_substitutes: list[str] = []
         link_of: dict[str, int] = {WORLD: -1}
         anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
-        # body angle = ang_c . q + ang_d (affine in the coordinates)
-        ang_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
-        ang_d: dict[str, float] = {WORLD: 0.0}
-        A = np.zeros((n, n))
-        b = np.zeros(n)
+        cmap = self.map = coordinate_map(mech)
         self.links: list[_Link] = []
         for i, j in enumerate(mech.joints):
             body = mech.body(j.child)
-            pa = (_num(j.parent_anchor[0]), _num(j.parent_anchor[1]))
-            ca = (_num(j.child_anchor[0]), _num(j.child_anchor[1]))
-            off = _num(j.angle_offset)
+            pa = (num(j.parent_anchor[0]), num(j.parent_anchor[1]))
+            ca = (num(j.child_anchor[0]), num(j.child_anchor[1]))
+            off = num(j.angle_offset)
             panchor = anchor_of[j.parent]
-            e_i = np.eye(n)[i]
             axis_parent = np.zeros(2)
             if isinstance(j, Revolute):
                 axis = [0.0, 0.0, 1.0]
-                turn = -e_i if getattr(j, "clockwise", False) else e_i
-                if j.absolute:
-                    ang_c[j.child], ang_d[j.child] = turn.copy(), off
-                    A[i] = turn - ang_c[j.parent]
-                    b[i] = -ang_d[j.parent]
-                else:
-                    ang_c[j.child], ang_d[j.child] = ang_c[j.parent] + turn, ang_d[j.parent] + off
-                    A[i] = turn
-            elif isinstance(j, Prismatic):
-                ax = np.array([_num(j.axis[0]), _num(j.axis[1])])
-                length = float(np.hypot(*ax))
-                axis_parent = ax / length
+            else:
+                ax = np.array([num(j.axis[0]), num(j.axis[1])])
+                axis_parent = ax / cmap.A[i, i]
                 c, s = math.cos(-off), math.sin(-off)
                 axis = [c * axis_parent[0] - s * axis_parent[1],
                         s * axis_parent[0] + c * axis_parent[1], 0.0]
-                ang_c[j.child], ang_d[j.child] = ang_c[j.parent].copy(), ang_d[j.parent] + off
-                A[i] = length * e_i
-            else:  # guarded by support()
-                raise TypeError(f"unsupported joint {j!r}")
-            mass, inertia = _num(body.mass), _num(body.inertia)
+            mass, inertia = num(body.mass), num(body.inertia)
             if body.massless:
                 mass, inertia = massless_mass, 0.0
                 if body.name not in parents and body.name in constrained:
@@ -365,11 +327,11 @@ class _Plan:
             link_of[j.child] = i
             anchor_of[j.child] = ca
         self.link_of = link_of
-        self.ang_c, self.ang_d = ang_c, ang_d
-        self.A, self.b = A, b
-        self.Ainv = np.linalg.inv(A)
+        self.ang_c, self.ang_d = cmap.angle_c, cmap.angle_d
+        self.A, self.b = cmap.A, cmap.b
+        self.Ainv = cmap.T
         self.AinvT = self.Ainv.T
-        self.identity_map = bool(np.array_equal(A, np.eye(n)) and not b.any())
+        self.identity_map = cmap.identity
 
         # rolling contact variant: the disc's hub rides on a massless radial slider on the
         # arm, so that the contact, not the arm, carries the normal force
@@ -397,13 +359,13 @@ class _Plan:
             if isinstance(c, PointOnPoint):
                 la, lb = link_of[c.body_a], link_of[c.body_b]
                 self.closures.append(_Closure(
-                    c, "p2p", la, (_num(c.point_a[0]), _num(c.point_a[1])),
-                    lb, (_num(c.point_b[0]), _num(c.point_b[1])), force_links=(la, lb)))
+                    c, "p2p", la, (num(c.point_a[0]), num(c.point_a[1])),
+                    lb, (num(c.point_b[0]), num(c.point_b[1])), force_links=(la, lb)))
             elif isinstance(c, PointOnLine):
-                u = np.array([_num(c.direction[0]), _num(c.direction[1])])
+                u = np.array([num(c.direction[0]), num(c.direction[1])])
                 u = u / float(np.hypot(*u))
-                lp = (_num(c.line_point[0]), _num(c.line_point[1]))
-                pp = (_num(c.point[0]), _num(c.point[1]))
+                lp = (num(c.line_point[0]), num(c.line_point[1]))
+                pp = (num(c.point[0]), num(c.point[1]))
                 lpin, lline = link_of[c.body], link_of[c.line_body]
                 k = len(self.links)
                 geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
@@ -430,7 +392,7 @@ class _Plan:
                         c, "prismatic", k, (0.0, 0.0), lline, lp,
                         row_normal=_slider_row_normal(u), force_links=(k, lline), **geo))
             elif isinstance(c, LinearCoupling):
-                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, b)
+                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, self.b)
                 nz = np.flatnonzero(w)
                 if len(nz) != 2:  # guarded by support()
                     raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
@@ -444,22 +406,17 @@ class _Plan:
 
         self.coord_forces: list[_CoordForce] = []
         self.point_forces: list[_PointForce] = []
-        if not compile_forces:
-            self.point_links = []
-            return
         for f in mech.forces:
+            law = ForceLaw.of(f)
             if isinstance(f, CoordinateForce):
-                law = compile_law(f.force, (COORD, COORD_RATE, TIME))
                 self.coord_forces.append(_CoordForce(
-                    self.coords.index(f.coordinate), law,
-                    TIME in sp.sympify(f.force).free_symbols))
-            elif isinstance(f, PointToPoint):
-                law = compile_law(f.tension, (LENGTH, LENGTH_RATE, TIME))
+                    self.coords.index(f.coordinate), law.law, law.time_dependent))
+            else:
                 self.point_forces.append(_PointForce(
                     f.name, link_of[f.body_a],
-                    (_num(f.point_a[0]), _num(f.point_a[1])),
-                    link_of[f.body_b], (_num(f.point_b[0]), _num(f.point_b[1])),
-                    law, f.body_a, f.body_b, TIME in sp.sympify(f.tension).free_symbols))
+                    (num(f.point_a[0]), num(f.point_a[1])),
+                    link_of[f.body_b], (num(f.point_b[0]), num(f.point_b[1])),
+                    law.law, f.body_a, f.body_b, law.time_dependent))
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
@@ -477,14 +434,14 @@ class _Plan:
 
     # --- coordinate maps -------------------------------------------------------------
     def joint_values(self, q: np.ndarray) -> np.ndarray:
-        return self.A @ np.asarray(q, dtype=float) + self.b
+        return self.map.engine_values(q)
 
     def coordinates(self, jv: np.ndarray) -> np.ndarray:
         """Rows of engine joint values -> description coordinates."""
-        return (np.asarray(jv) - self.b) @ self.AinvT
+        return self.map.coordinates(jv)
 
     def rates(self, jvd: np.ndarray) -> np.ndarray:
-        return np.asarray(jvd) @ self.AinvT
+        return self.map.rates(jvd)
 
     def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
         """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
@@ -498,6 +455,131 @@ class _Plan:
 
 class PyBulletBackend(Backend):
     id = "pybullet"
+    SETTINGS = {
+        "joint_velocity_motors": Setting(
+            False, bool,
+            "False: every joint's default velocity motor (target 0) is switched off with "
+            "VELOCITY_CONTROL force=0. PyBullet's default (True here) locks the joints "
+            "(bullet3 #2463)."),
+        "linear_damping": Setting(
+            0.0, float,
+            "Replaces the engine default 0.04 (a velocity-proportional plus quadratic "
+            "drag on every link: -15 % period on a 2 rad swing). Set with its own "
+            "changeDynamics call: PyBullet's body-level setters (linearDamping, "
+            "angularDamping, maxJointVelocity) reset the link index to -1, so "
+            "mass/inertia passed in the same call land on the base (it becomes a floating "
+            "base)."),
+        "angular_damping": Setting(
+            0.0, float,
+            "Replaces the engine default 0.04 (see linear_damping)."),
+        "max_joint_velocity": Setting(
+            1.0e6, float,
+            "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate."),
+        "explicit_inertia": Setting(
+            True, bool,
+            "True: the description's mass and central inertia are set on every link with "
+            "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
+            "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
+            "No collision shapes are created, so there are no contacts between links."),
+        "sleeping": Setting(
+            False, bool,
+            "False: deactivation disabled. PyBullet multibodies created without "
+            "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared joint "
+            "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
+        "massless_link_mass": Setting(
+            0.0, float,
+            "Mass given to the description's massless link bodies; 0 (default) is exact: "
+            "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
+            "child. A positive value is a substitute whose effect shows in the error."),
+        "reaction_method": Setting(
+            "inverse_dynamics", _REACTION_METHODS,
+            "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
+            "massless prismatic joints in front of each reaction joint, at the engine's "
+            "state and acceleration of the same step. 'joint_sensor': "
+            "enableJointForceTorqueSensor (world-space feedback); exact on a single link, "
+            "wrong on chains in motion (its constraint pass re-adds Coriolis terms)."),
+        "linearize_step": Setting(
+            1e-6, float,
+            "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
+            "calculateInverseDynamics and of the applied force elements."),
+        "constraint_erp": Setting(
+            1.0, float,
+            "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
+            "PRISMATIC constraints obey). The constraint solve is velocity-level, J(q_k) "
+            "v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error and "
+            "leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; erp "
+            "0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
+            "eccentric cam). Set only for constrained mechanisms."),
+        "gear_erp": Setting(
+            0.0, float,
+            "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
+            "coupling solved at velocity level keeps its initial value exactly once the "
+            "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
+            "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
+            "solver's early exit (solver_residual_threshold), not from a missing erp. "
+            "When > 0, relativePositionTarget is set to the coupling's constant."),
+        "constraint_max_force": Setting(
+            1.0e12, float,
+            "maxForce of every constraint; the engine default 500 N would clip the "
+            "constraint forces (e.g. the start of a fast run)."),
+        "solver_iterations": Setting(
+            50, int,
+            "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
+            "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
+        "solver_residual_threshold": Setting(
+            0.0, float,
+            "solverResidualThreshold; the engine default 1e-7 ends the sweeps early (that "
+            "is why the iteration count 'had no effect'): it left a 1e-5 m drift of the "
+            "rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep (belt "
+            "and rolling couplings then hold to 1e-15; same wall time)."),
+        "point_on_line": Setting(
+            "prismatic", _POINT_ON_LINE,
+            "'prismatic' (default): a rotor link (revolute, no mass, inertia "
+            "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
+            "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
+            "under the pin before every step (changeConstraint(jointChildPivot)): the "
+            "engine evaluates the Jacobian at a fixed body point, and with the pivot at "
+            "the slot's line point a slot turning about that point receives no torque "
+            "(measured on the slotted bar). One normal row: well conditioned. 'slider': a "
+            "slider link (prismatic along the slot, mass slider_mass_ratio x the smallest "
+            "body mass) and a POINT2POINT pin -> slider; its two world-axis rows have "
+            "effective masses 1/m_slider along the slot and O(1) across it, which "
+            "Gauss-Seidel cannot separate when the slot is oblique (the slotted bar "
+            "diverges); fine for slots along x or y."),
+        "rotor_inertia_ratio": Setting(
+            1e-6, float,
+            "Inertia of the rotor links of point_on_line='prismatic', relative to the "
+            "smallest body inertia. The rotor turns with the slot body, so its inertia is "
+            "the substitute's only error; results were identical from 1e-3 to 1e-12."),
+        "slider_mass_ratio": Setting(
+            1e-6, float,
+            "Mass of the slider links of point_on_line='slider', relative to the smallest "
+            "body mass (it moves with the pin: an added point mass)."),
+        "massless_leaf_mass_ratio": Setting(
+            1e-6, float,
+            "Mass (and, on a revolute joint, inertia) given to a massless body that "
+            "carries nothing but is held by a closure constraint (e.g. a pin on its own "
+            "guide): zero would make the articulated-body algorithm singular. Relative to "
+            "the smallest body mass/inertia; results are the same from 1e-3 to 1e-7, 1e-8 "
+            "diverged (slotted link)."),
+        "contact_friction": Setting(
+            1.0, float,
+            "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
+            "Contact variant only."),
+        "contact_erp": Setting(
+            0.2, float,
+            "contactERP and frictionERP of the contact variant (engine 0.2)."),
+        "contact_ring_boxes": Setting(
+            720, int,
+            "Boxes in the ring of the contact variant (16 per fixed link: "
+            "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
+            "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
+        "contact_breaking_threshold": Setting(
+            0.02, float,
+            "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
+            "Smaller values lowered the trajectory error of the contact variant and "
+            "raised its slip (see the report)."),
+    }
 
     # --- contract points 1-5 ---------------------------------------------------------
     def available(self) -> tuple[bool, str]:
@@ -515,188 +597,69 @@ class PyBulletBackend(Backend):
             import pybullet
             return f"api {pybullet.getAPIVersion()}"
 
-    def default_settings(self) -> dict:
-        return {
-            "joint_velocity_motors": False,
-            "linear_damping": 0.0,
-            "angular_damping": 0.0,
-            "max_joint_velocity": 1.0e6,
-            "explicit_inertia": True,
-            "sleeping": False,
-            "massless_link_mass": 0.0,
-            "reaction_method": "inverse_dynamics",
-            "linearize_step": 1.0e-6,
-            # closure constraints (used only by mechanisms that have them)
-            "constraint_erp": 1.0,
-            "gear_erp": 0.0,
-            "constraint_max_force": 1.0e12,
-            "solver_iterations": 50,
-            "solver_residual_threshold": 0.0,
-            "point_on_line": "prismatic",
-            "rotor_inertia_ratio": 1.0e-6,
-            "slider_mass_ratio": 1.0e-6,
-            "massless_leaf_mass_ratio": 1.0e-6,
-            "rolling": "coupling",
-            "contact_friction": 1.0,
-            "contact_erp": 0.2,
-            "contact_ring_boxes": 720,
-            "contact_breaking_threshold": 0.02,
-        }
+    EXPRESSIONS = {
+        BODY: (Expression(EXACT, "a link of the reduced-coordinate multibody with the "
+                                 "explicit mass and central inertia (changeDynamics), "
+                                 "no collision shape"),),
+        MASSLESS_BODY: (
+            Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body "
+                              "algorithm inverts only each joint's articulated inertia, "
+                              "which its child carries", when="it carries a child"),
+            Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of "
+                                   "the smallest body's), since zero would make the "
+                                   "articulated-body algorithm singular",
+                       when="it carries nothing but a closure constraint holds it"),
+            Expression(UNSUPPORTED, "a massless link that carries nothing is singular for "
+                                    "the articulated-body algorithm",
+                       when="it carries nothing and no constraint holds it"),
+        ),
+        REVOLUTE: (Expression(EXACT, "revolute link about z, the joint frame turned by "
+                                     "angle_offset"),),
+        PRISMATIC: (Expression(EXACT, "prismatic link along the unit axis (its length in "
+                                      "v = A q + b)"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, _POINT_FORCE),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _POINT_FORCE),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _JOINT_FORCE),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _JOINT_FORCE),),
+        TIME_LOAD: (Expression(EXACT, "evaluated at the time of the start of each step, the "
+                                      "single stage of the semi-implicit Euler step"),),
+        POINT_ON_POINT: (Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
+                                           "erp 1 (no regularisation; the position error of "
+                                           "a step is removed in the next)"),),
+        POINT_ON_LINE: (Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
+                                               "inertia rotor_inertia_ratio of the smallest) "
+                                               "and a JOINT_PRISMATIC rotor -> slot body whose "
+                                               "pivot follows the pin: the rotor's inertia is "
+                                               "the only substitute (point_on_line='slider': "
+                                               "a slider link of small mass)"),),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
+                                                 "of contact_ring_boxes boxes (velocity-level "
+                                                 "contact with erp; the hub on a massless "
+                                                 "radial slider); its force is the tangential "
+                                                 "contact force, its violation the slip"),),
+        LINEAR_COUPLING: (
+            Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, "
+                              "solved at velocity level (exact for a linear constraint)",
+                       when="two engine joint values"),
+            Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
+                                    "(jv_a + ratio jv_b = target); its gearAuxLink only adds "
+                                    "that joint's current velocity as a target, it is not a "
+                                    "three-term constraint, and a one-joint coupling would be "
+                                    "a lock", when="one, or three or more, engine joint values"),
+        ),
+    }
 
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "joint_velocity_motors": (
-                "False: every joint's default velocity motor (target 0) is switched off with "
-                "VELOCITY_CONTROL force=0. PyBullet's default (True here) locks the joints "
-                "(bullet3 #2463)."),
-            "linear_damping": (
-                "Replaces the engine default 0.04 (a velocity-proportional plus quadratic drag "
-                "on every link: -15 % period on a 2 rad swing). Set with its own changeDynamics "
-                "call: PyBullet's body-level setters (linearDamping, angularDamping, "
-                "maxJointVelocity) reset the link index to -1, so mass/inertia passed in the "
-                "same call land on the base (it becomes a floating base)."),
-            "angular_damping": "Replaces the engine default 0.04 (see linear_damping).",
-            "max_joint_velocity": (
-                "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate."),
-            "explicit_inertia": (
-                "True: the description's mass and central inertia are set on every link with "
-                "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
-                "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
-                "No collision shapes are created, so there are no contacts between links."),
-            "sleeping": (
-                "False: deactivation disabled. PyBullet multibodies created without "
-                "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared joint "
-                "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
-            "massless_link_mass": (
-                "Mass given to the description's massless link bodies; 0 (default) is exact: "
-                "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
-                "child. A positive value is a substitute whose effect shows in the error."),
-            "reaction_method": (
-                "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
-                "massless prismatic joints in front of each reaction joint, at the engine's "
-                "state and acceleration of the same step. 'joint_sensor': "
-                "enableJointForceTorqueSensor (world-space feedback); exact on a single link, "
-                "wrong on chains in motion (its constraint pass re-adds Coriolis terms)."),
-            "linearize_step": (
-                "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
-                "calculateInverseDynamics and of the applied force elements."),
-            "constraint_erp": (
-                "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
-                "PRISMATIC constraints obey). The constraint solve is velocity-level, "
-                "J(q_k) v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error "
-                "and leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; "
-                "erp 0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
-                "eccentric cam). Set only for constrained mechanisms."),
-            "gear_erp": (
-                "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
-                "coupling solved at velocity level keeps its initial value exactly once the "
-                "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
-                "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
-                "solver's early exit (solver_residual_threshold), not from a missing erp. "
-                "When > 0, relativePositionTarget is set to the coupling's constant."),
-            "constraint_max_force": (
-                "maxForce of every constraint; the engine default 500 N would clip the "
-                "constraint forces (e.g. the start of a fast run)."),
-            "solver_iterations": (
-                "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
-                "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
-            "solver_residual_threshold": (
-                "solverResidualThreshold; the engine default 1e-7 ends the sweeps early "
-                "(that is why the iteration count 'had no effect'): it left a 1e-5 m drift "
-                "of the rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep "
-                "(belt and rolling couplings then hold to 1e-15; same wall time)."),
-            "point_on_line": (
-                "'prismatic' (default): a rotor link (revolute, no mass, inertia "
-                "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
-                "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
-                "under the pin before every step (changeConstraint(jointChildPivot)): the "
-                "engine evaluates the Jacobian at a fixed body point, and with the pivot "
-                "at the slot's line point a slot turning about that point receives no "
-                "torque (measured on the slotted bar). One normal row: well conditioned. "
-                "'slider': a slider link (prismatic along the slot, mass slider_mass_ratio "
-                "x the smallest body mass) and a POINT2POINT pin -> slider; its two world-"
-                "axis rows have effective masses 1/m_slider along the slot and O(1) across "
-                "it, which Gauss-Seidel cannot separate when the slot is oblique (the "
-                "slotted bar diverges); fine for slots along x or y."),
-            "rotor_inertia_ratio": (
-                "Inertia of the rotor links of point_on_line='prismatic', relative to the "
-                "smallest body inertia. The rotor turns with the slot body, so its inertia "
-                "is the substitute's only error; results were identical from 1e-3 to "
-                "1e-12."),
-            "slider_mass_ratio": (
-                "Mass of the slider links of point_on_line='slider', relative to the "
-                "smallest body mass (it moves with the pin: an added point mass)."),
-            "massless_leaf_mass_ratio": (
-                "Mass (and, on a revolute joint, inertia) given to a massless body that "
-                "carries nothing but is held by a closure constraint (e.g. a pin on its "
-                "own guide): zero would make the articulated-body algorithm singular. "
-                "Relative to the smallest body mass/inertia; results are the same from "
-                "1e-3 to 1e-7, 1e-8 diverged (slotted link)."),
-            "rolling": (
-                "'coupling' (default): a LinearCoupling becomes a JOINT_GEAR on the two "
-                "engine joint values it involves (exact at velocity level). 'contact': a "
-                "rolling coupling of a disc on a radius arm inside a circular track is "
-                "replaced by friction contact: the hub rides on a massless radial slider, a "
-                "sphere of the disc's radius touches a ring of contact_ring_boxes boxes "
-                "(polygon with the track circle as incircle) on massless fixed links of the "
-                "track; the coupling's Phi is then the measured slip."),
-            "contact_friction": (
-                "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
-                "Contact variant only."),
-            "contact_erp": "contactERP and frictionERP of the contact variant (engine 0.2).",
-            "contact_ring_boxes": (
-                "Boxes in the ring of the contact variant (16 per fixed link: "
-                "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
-                "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
-            "contact_breaking_threshold": (
-                "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
-                "Smaller values lowered the trajectory error of the contact variant and "
-                "raised its slip (see the report)."),
-        }
-
-    def support(self, mechanism: Mechanism) -> Support:
-        for j in mechanism.joints:
-            if not isinstance(j, (Revolute, Prismatic)):
-                return Support(False, f"joint type {type(j).__name__} not supported")
-            if isinstance(j, Prismatic):
-                try:
-                    if math.hypot(_num(j.axis[0]), _num(j.axis[1])) == 0.0:
-                        return Support(False, f"prismatic joint {j.name} has a zero axis")
-                except TypeError:
-                    return Support(False, "mechanism is not numeric (substitute parameters)")
-        for f in mechanism.forces:
-            if not isinstance(f, (PointToPoint, CoordinateForce)):
-                return Support(False, f"force element {type(f).__name__} not supported")
-        parents = {j.parent for j in mechanism.joints}
-        constrained = _constraint_bodies(mechanism)
-        for body in mechanism.bodies:
-            if body.massless and body.name not in parents and body.name not in constrained:
-                return Support(False, f"massless body {body.name} carries nothing: singular")
-        if mechanism.constraints:
-            try:
-                plan = _Plan(replace(mechanism, constraints=(), independent=None), 0.0,
-                             compile_forces=False)
-            except TypeError:
-                return Support(False, "mechanism is not numeric (substitute parameters)")
-            except np.linalg.LinAlgError:
-                return Support(False, "singular map between coordinates and joint values")
-            for c in mechanism.constraints:
-                if not isinstance(c, (PointOnPoint, PointOnLine, LinearCoupling)):
-                    return Support(False, f"constraint {c.name}: type {type(c).__name__} "
-                                          "not translated")
-                if isinstance(c, PointOnLine) and math.hypot(*map(_num, c.direction)) == 0:
-                    return Support(False, f"constraint {c.name}: zero slot direction")
-                if isinstance(c, LinearCoupling):
-                    _, _, w, _ = _gear_terms(c, plan.coords, plan.Ainv, plan.b)
-                    k = int(np.count_nonzero(w))
-                    if k != 2:
-                        return Support(False, (
-                            f"coupling {c.name} involves {k} engine joint value(s): "
-                            "PyBullet's JOINT_GEAR constrains exactly two joints "
-                            "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
-                            "joint's current velocity as a target, it is not a three-term "
-                            "constraint, and a one-joint coupling would be a lock"))
-        return Support(True)
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == MASSLESS_BODY:
+            if any(j.parent == element.name for j in mechanism.joints):
+                return cases[0]
+            return cases[1] if element.name in constrained_bodies(mechanism) else cases[2]
+        cmap = coordinate_map(mechanism)
+        _, _, w, _ = _gear_terms(element, mechanism.coordinates, cmap.T, cmap.b)
+        k = int(np.count_nonzero(w))
+        return cases[0] if k == 2 else replace(
+            cases[1], how=f"it involves {k} engine joint value(s): {cases[1].how}")
 
     # --- model building ----------------------------------------------------------------
     def _build(self, p, cid: int, plan: _Plan, settings: dict,
@@ -1025,26 +988,16 @@ class PyBulletBackend(Backend):
         import pybullet as p
 
         cfg = self.resolve_settings(settings)
-        if cfg["reaction_method"] not in _REACTION_METHODS:
-            raise ValueError(f"reaction_method must be one of {_REACTION_METHODS}")
-        if cfg["rolling"] not in _ROLLING:
-            raise ValueError(f"rolling must be one of {_ROLLING}")
-        if cfg["point_on_line"] not in _POINT_ON_LINE:
-            raise ValueError(f"point_on_line must be one of {_POINT_ON_LINE}")
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
         contact = None
-        coupling = None
-        if cfg["rolling"] == "contact" and mechanism.constraints:
-            contact = _rolling_contact(mechanism)
-            if contact is None:
-                raise ValueError(
-                    "rolling='contact' needs a LinearCoupling of a disc (Circle) on a radius "
-                    "arm about the centre of a circular track (Circle) it touches")
-            coupling = next(c for c in mechanism.constraints if c.name == contact.coupling)
+        rolling = [c for c in mechanism.constraints if isinstance(c, RollingContact)]
+        if rolling:
+            contact = _contact_of(mechanism, rolling[0])
+            coupling = rolling[0].coupling
             mechanism = replace(mechanism, constraints=tuple(
-                c for c in mechanism.constraints if c.name != contact.coupling))
+                c for c in mechanism.constraints if c is not rolling[0]))
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
         n, steps = plan.n, int(round(t_end / dt))
         n_all = len(plan.links)
@@ -1320,8 +1273,8 @@ class PyBulletBackend(Backend):
         ct = plan.contact
         cvec = np.zeros(plan.n)
         for name, coef in coupling.coefficients:
-            cvec[plan.coords.index(name)] += _num(coef)
-        const = _num(coupling.constant)
+            cvec[plan.coords.index(name)] += num(coef)
+        const = num(coupling.constant)
         arm = plan.mech.joints[ct.hub].parent
         th = q @ plan.ang_c[arm] + plan.ang_d[arm]
         ux0, uy0 = ct.radial
@@ -1409,7 +1362,7 @@ class PyBulletBackend(Backend):
                 # the force f_closure[key] acts on link la, its opposite on link lb
                 in_a = la >= 0 and plan.links[la].body in inside
                 in_b = lb >= 0 and plan.links[lb].body in inside
-                F = np.nan_to_num(f_closure[key])
+                F = np.nan_tonum(f_closure[key])
                 if in_a and not in_b:
                     R -= F
                 elif in_b and not in_a:

@@ -5,7 +5,7 @@ Translation of the description (conventions of `mbfidelity.systems.model`):
 * every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the
   description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
   substitute is compensated, below); the world is ``space.static_body`` (at the origin,
-  angle 0). No shapes are created (except for the optional contact variant of rolling),
+  angle 0). No shapes are created (except for a RollingContact's circles),
   so nothing can collide.
 * ``Revolute`` -> ``PivotJoint`` at the two local anchors.
 * ``Prismatic`` -> ``GrooveJoint`` whose slot is the path of the child's centre of mass
@@ -52,10 +52,10 @@ Translation of the description (conventions of `mbfidelity.systems.model`):
     solve (pre-solve callback, at the position-updated configuration): its tangential
     row is the coupling, its normal row is implied by the carrier (redundant), and the
     coupling's position error is put into the tangential anchor gap so that Chipmunk's
-    own error correction removes it. With ``rolling = "contact"`` the pitch circles,
-    when the description draws them as circle shapes, become colliding shapes instead (a
-    Circle in a ring of ``contact_segments`` Segments) with friction ``contact_friction``,
-    and the massless carrier arm is removed (the contact holds the disc).
+    own error correction removes it. A ``RollingContact`` (a variant's stand-in for such
+    a coupling) makes the pitch circles colliding shapes instead (a Circle in a ring of
+    ``contact_segments`` Segments) with friction ``contact_friction``, and the massless
+    carrier arm is removed (the contact holds the disc).
     Other couplings (three bodies without a common carrier, prismatic coordinates) are
     refused with the reason.
 * Force elements are applied as body forces and torques, evaluated every step by one
@@ -95,8 +95,6 @@ from ..systems.model import (
     LENGTH_RATE,
     TIME,
     WORLD,
-    Circle,
-    CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -104,15 +102,47 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
+    RollingContact,
     as_column,
     rotation,
 )
-from .base import Backend, Linearization, RunResult, Support
+from .base import (
+    EXACT,
+    SUBSTITUTE,
+    UNSUPPORTED,
+    Backend,
+    Expression,
+    Linearization,
+    RunResult,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRISMATIC,
+    REVOLUTE,
+    ROLLING_CONTACT,
+    TIME_LOAD,
+    body_states,
+    coupled,
+    description_reason,
+    num,
+    point_state,
+    rot,
+)
 
+_ELEMENT_FORCE = ("body forces and torques from one compiled function of the body states, "
+                  "evaluated at the position-updated state x + h v (element_forces): a "
+                  "consistent semi-implicit Euler step")
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
-#: how a rolling coupling with drawn pitch circles is built
-_ROLLING = ("coupling", "contact")
 
 
 @dataclass(frozen=True)
@@ -243,24 +273,12 @@ class _Compiled:
     balance: object = None  # lazily built momentum-balance solver
 
 
-def _num(x) -> float:
-    return float(sp.sympify(x))
-
-
-def _is_number(x) -> bool:
-    return not sp.sympify(x).free_symbols
-
-
 def _cross(r: sp.Matrix, f: sp.Matrix) -> sp.Expr:
     return r[0] * f[1] - r[1] * f[0]
 
 
 def _vec(v) -> np.ndarray:
-    return np.array([_num(v[0]), _num(v[1])])
-
-
-def _rot(th: float) -> np.ndarray:
-    return np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+    return np.array([num(v[0]), num(v[1])])
 
 
 def _through_origin(base: np.ndarray, direction: np.ndarray) -> bool:
@@ -288,7 +306,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
     out: list[_Groove] = []
 
     def ends(j: Prismatic) -> tuple[float | None, float | None]:
-        return tuple(None if v is None else _num(v) for v in j.limits)  # type: ignore[return-value]
+        return tuple(None if v is None else num(v) for v in j.limits)  # type: ignore[return-value]
 
     folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
     for j in mech.joints:
@@ -296,19 +314,19 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
             continue
         # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
         # with the rotation locked the pin can be the child's centre of mass
-        base = _vec(j.parent_anchor) - _rot(_num(j.angle_offset)) @ _vec(j.child_anchor)
+        base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
         axis = _vec(j.axis)
         if j.parent != WORLD and not _through_origin(base, axis):
             return (f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                     f"parent's centre of mass. {_GROOVE_LIMIT}")
         out.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *ends(j), (0.0, 0.0),
-                           _num(j.angle_offset)))
+                           num(j.angle_offset)))
     for fold in folds.values():
         if isinstance(fold.inner, Revolute):
             # the link turns with its child: the pivot (a point of the parent) slides on a
             # line of the child, base + q direction in the child's frame
             rev, pri = fold.inner, fold.outer
-            back = _rot(-_num(pri.angle_offset))
+            back = rot(-num(pri.angle_offset))
             base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
             direction = -back @ _vec(pri.axis)
             anchor = _vec(rev.parent_anchor)
@@ -318,7 +336,7 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
             # the link turns with its parent: the pin (a point of the child) slides on a
             # line of the parent
             pri, rev = fold.inner, fold.outer
-            base = _vec(pri.parent_anchor) + _rot(_num(pri.angle_offset)) @ (
+            base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
                 _vec(rev.parent_anchor) - _vec(pri.child_anchor))
             direction = _vec(pri.axis)
             anchor = _vec(rev.child_anchor)
@@ -400,7 +418,7 @@ def _component(mech: Mechanism, group: set[str], real: set[str],
         for j in joints:
             if not isinstance(j, Prismatic):
                 continue
-            off = _num(j.angle_offset)
+            off = num(j.angle_offset)
             if j.parent in known and j.child not in known:
                 angles.append((j.child, j.parent, off))
                 known.add(j.child)
@@ -425,22 +443,24 @@ def _component(mech: Mechanism, group: set[str], real: set[str],
 
 
 def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
-              massless: set[str]):
+              massless: set[str], contact: bool = False):
     """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch), or why the coupling cannot
-    be expressed."""
+    be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
+    circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
+    contact replaces."""
     k: dict[str, float] = {}
-    k0 = _num(c.constant)
+    k0 = num(c.constant)
     for name, coef in c.coefficients:
         j = mech.joints[mech.coordinates.index(name)]
         if isinstance(j, Prismatic):
             return (f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
                     "only angles (GearJoint)")
         s = -1.0 if j.clockwise else 1.0
-        coef = _num(coef)
+        coef = num(coef)
         k[j.child] = k.get(j.child, 0.0) + coef * s
         if not j.absolute:
             k[j.parent] = k.get(j.parent, 0.0) - coef * s
-        k0 += coef * s * _num(j.angle_offset)
+        k0 += coef * s * num(j.angle_offset)
     scale = max((abs(v) for v in k.values()), default=0.0)
     bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
     if not bodies:
@@ -480,50 +500,32 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             continue
         lam = ka / (ka + kb)
         wrap = 2 * math.pi * abs(k[K]) if K in massless else 0.0
-        contact = _pitch_circles(mech, A, hubs[A][0], abs(lam) * d, B, hubs[B][0],
-                                 abs(lam - 1) * d, not 0.0 < lam < 1.0)
-        if contact is not None and K not in massless:
-            contact = None  # the carrier's hinges would keep the distance: see _build
+        circles = None
+        if contact:
+            if K not in massless:  # the carrier's hinges would keep the distance: see _build
+                return (f"contact {c.name}: the disc and the track must be hinged on a "
+                        "massless carrier arm, which the contact replaces")
+            circles = (A, hubs[A][0], abs(lam) * d, B, hubs[B][0], abs(lam - 1) * d,
+                       not 0.0 < lam < 1.0)
         return "pitch", _Pitch(c.name, A, B, hubs[A][0], hubs[B][0], d, lam, ka + kb, wrap, K,
-                               contact)
+                               circles)
     return (f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
             "couples the absolute angles of two bodies, and a coupling of three is "
             "expressible here only as two bodies hinged on a common carrier (gear pair, "
             "belt, rolling: a pivot at the pitch point)")
 
 
-def _pitch_circles(mech: Mechanism, a: str, hub_a, rho_a: float, b: str, hub_b, rho_b: float,
-                   internal: bool):
-    """The drawn circles of a and b that are the pitch circles (centred at the hubs, with
-    the pitch radii), or None."""
-    def find(body, hub, rho):
-        if body == WORLD:
-            return None
-        for s in mech.body(body).shapes:
-            if isinstance(s, Circle) and _is_number(s.radius):
-                centre = _vec(s.center)
-                if (np.allclose(centre, hub, rtol=0, atol=1e-9 * max(rho, 1.0))
-                        and abs(_num(s.radius) - rho) <= 1e-9 * max(rho, 1.0)):
-                    return True
-        return None
-
-    if find(a, hub_a, rho_a) and find(b, hub_b, rho_b):
-        return (a, hub_a, rho_a, b, hub_b, rho_b, internal)
-    return None
-
-
 def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
     """The engine layout (bodies, folded links, pivots, grooves, substitutes), or the
     reason the mechanism cannot be expressed."""
     cfg = cfg or {}
-    if not _is_number(mech.gravity):
-        return "gravity is not numeric (pass a numeric mechanism)"
+    reason = description_reason(mech)
+    if reason:
+        return reason
     dynamic: list[str] = []
     massless: list[str] = []
     for b in mech.bodies:
-        if not (_is_number(b.mass) and _is_number(b.inertia)):
-            return f"body {b.name}: mass/inertia not numeric (pass a numeric mechanism)"
-        m, i = _num(b.mass), _num(b.inertia)
+        m, i = num(b.mass), num(b.inertia)
         if m == 0 and i == 0:
             massless.append(b.name)
         elif m > 0 and i > 0:
@@ -531,39 +533,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
         else:
             return (f"body {b.name}: mass {m} and inertia {i}; Chipmunk needs both > 0 "
                     "(or both 0 for a massless link that can be eliminated)")
-    for j in mech.joints:
-        if not isinstance(j, (Revolute, Prismatic)):
-            return f"joint {j.name}: type {type(j).__name__} not supported"
-        values = [*j.parent_anchor, *j.child_anchor, j.angle_offset]
-        if isinstance(j, Prismatic):
-            values += [*j.axis, *(v for v in j.limits if v is not None)]
-        if not all(_is_number(v) for v in values):
-            return f"joint {j.name}: geometry not numeric (pass a numeric mechanism)"
-        if isinstance(j, Prismatic) and _num(j.axis[0]) ** 2 + _num(j.axis[1]) ** 2 == 0:
-            return f"joint {j.name}: zero prismatic axis"
-    constraints = tuple(getattr(mech, "constraints", ()))
-    for c in constraints:
-        if isinstance(c, LinearCoupling):
-            values = [v for _, v in c.coefficients] + [c.constant]
-        elif isinstance(c, PointOnPoint):
-            values = [*c.point_a, *c.point_b]
-        elif isinstance(c, PointOnLine):
-            values = [*c.point, *c.line_point, *c.direction]
-        else:
-            return f"constraint {getattr(c, 'name', c)}: type {type(c).__name__} not supported"
-        if not all(_is_number(v) for v in values):
-            return f"constraint {c.name}: geometry not numeric (pass a numeric mechanism)"
-        if isinstance(c, PointOnLine) and not _vec(c.direction).any():
-            return f"constraint {c.name}: zero slot direction"
-    for f in mech.forces:
-        if not isinstance(f, (PointToPoint, CoordinateForce)):
-            return f"force element {f.name}: type {type(f).__name__} not supported"
-        law = f.tension if isinstance(f, PointToPoint) else f.force
-        if sp.sympify(law).free_symbols - {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}:
-            return f"force element {f.name}: law has free parameters (pass a numeric mechanism)"
-        if isinstance(f, PointToPoint) and not all(
-                _is_number(v) for v in (*f.point_a, *f.point_b)):
-            return f"force element {f.name}: points not numeric"
+    constraints = mech.constraints
 
     # --- massless bodies: fold (revolute + prismatic), arm (revolutes), free group ------
     geometric = [c for c in constraints if isinstance(c, (PointOnPoint, PointOnLine))]
@@ -659,7 +629,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 else:  # slot carrier glued to the slot body, its centre on the line
                     foot = base - float(base @ direction) * direction
                     host = mech.body(slot)
-                    m, inertia = _num(host.mass), _num(host.inertia)
+                    m, inertia = num(host.mass), num(host.inertia)
                     mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(foot)))
                     name = f"_slot_carrier_{c.name}"
                     layout.carriers.append(_Carrier(name, slot, "slot", tuple(foot), mass,
@@ -672,7 +642,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                     layout.infinite.add(pin)
                 else:  # pin slider: a point mass pinned to the pin point
                     host = mech.body(pin)
-                    m, inertia = _num(host.mass), _num(host.inertia)
+                    m, inertia = num(host.mass), num(host.inertia)
                     mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(point)))
                     name = f"_pin_slider_{c.name}"
                     layout.carriers.append(_Carrier(name, pin, "pin", tuple(point), mass,
@@ -682,31 +652,27 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
             layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -half, half,
                                           tuple(anchor), None))
         else:
-            out = _coupling(mech, c, engine_ok, mset)
+            rolling = isinstance(c, RollingContact)
+            out = _coupling(mech, c.coupling if rolling else c, engine_ok, mset, rolling)
             if isinstance(out, str):
                 return out
             kind, value = out
-            if kind == "gear":
-                layout.gears.append(value)
-            else:
-                if cfg.get("rolling", "coupling") == "contact" and value.contact is None:
-                    return (f"rolling = 'contact': coupling {c.name} has no drawn pitch "
-                            "circles (Circle shapes centred at the hubs with the pitch radii) "
-                            "on a massless carrier (an arm the contact can replace) to "
-                            "collide; use rolling = 'coupling'")
-                layout.pitches.append(value)
+            if kind == "gear" and rolling:
+                return (f"contact {c.name}: the disc and the track must be hinged on a "
+                        "massless carrier arm, which the contact replaces")
+            (layout.gears if kind == "gear" else layout.pitches).append(value)
 
     # --- engine masses; compensation of the slider substitutes -------------------------
     for name in dynamic:
         b = mech.body(name)
-        layout.engine_mass[name] = (_num(b.mass),
-                                    math.inf if name in layout.infinite else _num(b.inertia))
+        layout.engine_mass[name] = (num(b.mass),
+                                    math.inf if name in layout.infinite else num(b.inertia))
     for car in layout.carriers:
         layout.engine_mass[car.name] = (car.mass, car.moment)
     if layout.carriers and cfg.get("slider_compensation", True):
         for host in dict.fromkeys(car.host for car in layout.carriers):
             cars = [car for car in layout.carriers if car.host == host]
-            m, inertia = _num(mech.body(host).mass), _num(mech.body(host).inertia)
+            m, inertia = num(mech.body(host).mass), num(mech.body(host).inertia)
             m1 = m - sum(car.mass for car in cars)
             first = sum(car.mass * np.array(car.point) for car in cars)
             c1 = -first / m1 if m1 > 0 else np.zeros(2)
@@ -726,7 +692,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 if not ok and body in layout.cog:
                     del layout.cog[body]
                     b = mech.body(body)
-                    layout.engine_mass[body] = (_num(b.mass), _num(b.inertia))
+                    layout.engine_mass[body] = (num(b.mass), num(b.inertia))
                     layout.notes.append(f"slider substitutes on {body} not compensated (its "
                                         "centre of gravity must stay on a groove)")
     for g in layout.grooves:
@@ -994,12 +960,12 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
     coords = [kin.coordinate(j) for j in mech.joints]
     coords_np = sp.lambdify(state, coords + [kin.rate(c) for c in coords],
                             modules="numpy", cse=True)
-    masses = {b.name: _num(b.mass) for b in mech.bodies}
+    masses = {b.name: num(b.mass) for b in mech.bodies}
     pitch_phi = []
     for pitch in layout.pitches:
         c = next(c for c in mech.constraints if c.name == pitch.name)
-        phi = sum((_num(coef) * coords[mech.coordinates.index(name)]
-                   for name, coef in c.coefficients), sp.Integer(0)) - _num(c.constant)
+        phi = sum((num(coef) * coords[mech.coordinates.index(name)]
+                   for name, coef in c.coefficients), sp.Integer(0)) - num(c.constant)
         pitch_phi.append(sp.lambdify(kin.P, phi, modules="math", cse=True))
     compiled = _Compiled(layout, kin, loads, loaded, loads_math, external_np, coords_np, masses,
                          pitch_phi)
@@ -1088,49 +1054,96 @@ class _Balance:
         self.external = sp.lambdify([*state, H, TIME], flat, modules="numpy", cse=True)
 
 
-def _initial_states(mech: Mechanism, q0, qd0) -> dict[str, tuple[float, ...]]:
-    """(x, y, theta, vx, vy, omega) of every description body's frame at (q0, qd0), by
-    planar forward kinematics in joint order (conventions 3-5)."""
-    st: dict[str, tuple[float, ...]] = {WORLD: (0.0,) * 6}
-
-    def rot(th: float, v) -> tuple[float, float]:
-        c, s = math.cos(th), math.sin(th)
-        return c * v[0] - s * v[1], s * v[0] + c * v[1]
-
-    for j, q, qd in zip(mech.joints, q0, qd0):
-        x, y, th_p, vx, vy, w_p = st[j.parent]
-        pa = (_num(j.parent_anchor[0]), _num(j.parent_anchor[1]))
-        ca = (_num(j.child_anchor[0]), _num(j.child_anchor[1]))
-        off = _num(j.angle_offset)
-        if isinstance(j, Revolute):
-            if j.clockwise:
-                q, qd = -q, -qd
-            th = (0.0 if j.absolute else th_p) + q + off
-            w = (0.0 if j.absolute else w_p) + qd
-            r = rot(th_p, pa)
-            va = (vx - w_p * r[1], vy + w_p * r[0])
-        else:
-            th, w = th_p + off, w_p
-            axis = (_num(j.axis[0]), _num(j.axis[1]))
-            r = rot(th_p, (pa[0] + q * axis[0], pa[1] + q * axis[1]))
-            slide = rot(th_p, axis)
-            va = (vx - w_p * r[1] + qd * slide[0], vy + w_p * r[0] + qd * slide[1])
-        a = (x + r[0], y + r[1])
-        rc = rot(th, ca)
-        st[j.child] = (a[0] - rc[0], a[1] - rc[1], th, va[0] + w * rc[1], va[1] - w * rc[0], w)
-    return st
-
-
-def _point_state(st: tuple[float, ...], local) -> tuple[float, float, float, float]:
-    """World position and velocity of a body point, from the body frame's state."""
-    x, y, th, vx, vy, w = st
-    c, s = math.cos(th), math.sin(th)
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return x + rx, y + ry, vx - w * ry, vy + w * rx
-
-
 class PymunkBackend(Backend):
     id = "pymunk"
+    SETTINGS = {
+        "error_bias": Setting(
+            0.0, float,
+            "Fraction of a joint's position error left after 1 s, on every constraint. "
+            "Pymunk's default (1-0.1)^60 = 1.8e-3 removes only part of the error per step "
+            "and its correction velocity enters the real velocity: measured on the 2 rad "
+            "compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory error and "
+            "5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error in the next "
+            "step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad."),
+        "iterations": Setting(
+            50, int,
+            "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk default "
+            "10). A single joint is solved in one iteration; a chain is not: on the small "
+            "double-pendulum swing the reaction error was 1.8e-3 (relative) with 10 and "
+            "1.4e-4 with 20 or more (20, 30, 50, 100 identical; trajectories identical "
+            "from 10 on, reactions 65 % off with 1). 50 keeps a margin at negligible "
+            "cost. Closed loops with slider substitutes need it: the scotch yoke diverged "
+            "with 10 at slider_mass_fraction 0.1."),
+        "start_iterations": Setting(
+            1000, int,
+            "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
+            "step from the previous step's impulses; the first step has none, and a "
+            "closed loop or a slider substitute then leaves it unconverged: with 50 "
+            "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
+            "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
+            "unchanged (they converge from the warm start). Tree mechanisms were already "
+            "converged (bit-identical results)."),
+        "damping": Setting(
+            1.0, float,
+            "space.damping, the fraction of velocity kept after 1 s. Pymunk's default is "
+            "already 1 (no damping); stated explicitly so it is recorded."),
+        "sleep_time_threshold": Setting(
+            None, (float, type(None)),
+            "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
+            "Sleeping froze a small oscillation when enabled (SIMULATORS.md)."),
+        "element_forces": Setting(
+            "position_updated", _FORCE_MODES,
+            "When force elements are evaluated in a step. Chipmunk moves positions (x += "
+            "h v) before it applies body.force, so a force computed from the sampled "
+            "state before space.step() ('step_start', what user code usually does) makes "
+            "the step explicit Euler for that force: energy grew by 114 % (elastic "
+            "pendulum) and 90 % (sliding block) in 10 s at h = 1e-3. 'position_updated' "
+            "(default) evaluates the laws at x + h v and t + h, the configuration at "
+            "which Chipmunk pre-steps its constraints and its own DampedSpring: a "
+            "consistent semi-implicit Euler step (energy drift 0.4-0.5 %). No engine "
+            "default is replaced: Pymunk has no hook for laws of length rate or time, so "
+            "the backend applies body forces and torques."),
+        "groove_half_length": Setting(
+            1000.0, float,
+            "Chipmunk grooves are finite segments: a prismatic side without a limit (and "
+            "every point-on-line slot) is given this extent in m (the groove ends act as "
+            "stops). Finite limits of the description are used as the groove ends."),
+        "slider_mass_fraction": Setting(
+            0.5, float,
+            "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
+            "exact (pin off the pin body's centre of mass, or slot line off the slot "
+            "body's): a 'pin slider' (point mass pinned to the pin point) and/or a 'slot "
+            "carrier' (glued to the slot body, centre on the slot line) runs in an exact "
+            "groove. Its mass is this fraction of the host body's effective mass at that "
+            "point, m I / (I + m d^2). Chipmunk has no such substitute and no massless "
+            "bodies. With compensation (below) the fraction does not enter the dynamics "
+            "(scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and 0.5), only the "
+            "convergence of the Gauss-Seidel solve, since a light body between heavy ones "
+            "converges slowly: from the cold start (no cached impulses) the slot force at "
+            "samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at 0.5 with 50 iterations; the "
+            "rhombus loop diverged at 0.05 with 50 iterations (exact with 500). Must stay "
+            "below 1 (the host keeps a positive moment)."),
+        "slider_compensation": Setting(
+            True, bool,
+            "true: the substitute's mass (and a slot carrier's moment) is taken out of "
+            "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
+            "host + substitute have exactly the described inertia; false: the substitute "
+            "adds its mass to the mechanism (teaching mode: shows the dynamic effect of a "
+            "slider mass; measured with fraction 0.05, 10 s: trajectory error 0.33-1.9 of "
+            "the amplitude on the scotch yoke, 0.37-140 on the slotted link, against "
+            "3-10e-3 compensated)."),
+        "contact_friction": Setting(
+            10.0, float,
+            "Friction coefficient of a RollingContact; Chipmunk "
+            "multiplies the two shapes' coefficients, this one goes on the inner shape "
+            "and 1 on the ring. Must exceed |friction| / normal force at all times or the "
+            "disc slides."),
+        "contact_segments": Setting(
+            720, int,
+            "Number of Segment shapes of a RollingContact's ring, inscribed in the "
+            "pitch circle; space.collision_slop is set to the chord's sagitta so that the "
+            "polygon's penetration is not 'corrected' against the carrier joint."),
+    }
     #: of the last constrained run: relative residual of the momentum balance behind the
     #: constraint forces (0 when the engine's constraints are exactly the description's),
     #: and notes on substitutes that could not be compensated
@@ -1148,122 +1161,78 @@ class PymunkBackend(Backend):
 
         return f"{pymunk.version} (Chipmunk {pymunk.chipmunk_version.split('-')[0]})"
 
-    def default_settings(self) -> dict:
-        return {
-            "error_bias": 0.0,
-            "iterations": 50,
-            "start_iterations": 1000,
-            "damping": 1.0,
-            "sleep_time_threshold": None,
-            "element_forces": "position_updated",
-            "groove_half_length": 1000.0,
-            "slider_mass_fraction": 0.5,
-            "slider_compensation": True,
-            "rolling": "coupling",
-            "contact_friction": 10.0,
-            "contact_segments": 720,
-        }
+    EXPRESSIONS = {
+        BODY: (
+            Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
+                              "(centre of gravity at its origin), no shapes",
+                       when="mass and inertia > 0"),
+            Expression(UNSUPPORTED, "Chipmunk needs mass and moment > 0 (or both 0 for a "
+                                    "massless link that can be eliminated)",
+                       when="mass or inertia 0, not both"),
+        ),
+        MASSLESS_BODY: (Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
+                                          "folded into one GrooveJoint (a revolute and a "
+                                          "prismatic joint), an arm PinJoint (revolute joints "
+                                          "at two points), or a free group whose positions "
+                                          "solve its joint equations; other shapes are "
+                                          "refused (support)"),),
+        REVOLUTE: (Expression(EXACT, "PivotJoint at the two anchors"),),
+        PRISMATIC: (Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and a "
+                                      "GearJoint locking the rotation; refused (support) "
+                                      "unless the path passes through the parent's centre "
+                                      "of mass or the parent is the world. " + _GROOVE_LIMIT),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
+        TIME_LOAD: (Expression(EXACT, _ELEMENT_FORCE + ", at t + h"),),
+        POINT_ON_POINT: (Expression(EXACT, "PivotJoint"),),
+        POINT_ON_LINE: (
+            Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot "
+                                                  "body's centre of mass (or the slot is on "
+                                                  "the world or a body whose rotation is "
+                                                  "fixed) and the pin is the pin body's"),
+            Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
+                                   "carrier (glued to the slot body, centred on the line) in "
+                                   "an exact GrooveJoint, their mass taken out of the host "
+                                   "(slider_compensation). " + _GROOVE_LIMIT,
+                       when="otherwise"),
+        ),
+        ROLLING_CONTACT: (Expression(SUBSTITUTE, "the pitch circles collide (a Circle "
+                                                 "inside a ring of contact_segments Segments) "
+                                                 "with Coulomb friction, the carrier arm "
+                                                 "removed: what a game-physics user would "
+                                                 "build. Measured on rolling_disc_track: "
+                                                 "trajectory error 2-10 % of the amplitude "
+                                                 "(coupling 2-2.6e-3), slip up to 3e-4 m, "
+                                                 "single-step losses of contact from one "
+                                                 "chord to the next"),),
+        LINEAR_COUPLING: (
+            Expression(EXACT, "GearJoint on the absolute angles of two bodies",
+                       when="two body angles"),
+            Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
+                              "moved to the pitch point before every solve: its tangential "
+                              "row is the coupling (gear pair, belt, rolling); other "
+                              "couplings are refused (support)",
+                       when="three body angles, two hinged on a carrier"),
+        ),
+    }
 
-    def setting_notes(self) -> dict[str, str]:
-        return {
-            "error_bias": (
-                "Fraction of a joint's position error left after 1 s, on every constraint. "
-                "Pymunk's default (1-0.1)^60 = 1.8e-3 removes only part of the error per "
-                "step and its correction velocity enters the real velocity: measured on the "
-                "2 rad compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory "
-                "error and 5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error "
-                "in the next step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad."),
-            "iterations": (
-                "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk "
-                "default 10). A single joint is solved in one iteration; a chain is not: "
-                "on the small double-pendulum swing the reaction error was 1.8e-3 "
-                "(relative) with 10 and 1.4e-4 with 20 or more (20, 30, 50, 100 identical; "
-                "trajectories identical from 10 on, reactions 65 % off with 1). 50 keeps a "
-                "margin at negligible cost. Closed loops with slider substitutes need it: "
-                "the scotch yoke diverged with 10 at slider_mass_fraction 0.1."),
-            "start_iterations": (
-                "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
-                "step from the previous step's impulses; the first step has none, and a "
-                "closed loop or a slider substitute then leaves it unconverged: with 50 "
-                "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
-                "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
-                "unchanged (they converge from the warm start). Tree mechanisms were already "
-                "converged (bit-identical results)."),
-            "damping": (
-                "space.damping, the fraction of velocity kept after 1 s. Pymunk's default "
-                "is already 1 (no damping); stated explicitly so it is recorded."),
-            "sleep_time_threshold": (
-                "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
-                "Sleeping froze a small oscillation when enabled (SIMULATORS.md)."),
-            "element_forces": (
-                "When force elements are evaluated in a step. Chipmunk moves positions "
-                "(x += h v) before it applies body.force, so a force computed from the "
-                "sampled state before space.step() ('step_start', what user code usually "
-                "does) makes the step explicit Euler for that force: energy grew by 114 % "
-                "(elastic pendulum) and 90 % (sliding block) in 10 s at h = 1e-3. "
-                "'position_updated' (default) evaluates the laws at x + h v and t + h, the "
-                "configuration at which Chipmunk pre-steps its constraints and its own "
-                "DampedSpring: a consistent semi-implicit Euler step (energy drift 0.4-0.5 %). "
-                "No engine default is replaced: Pymunk has no hook for laws of length "
-                "rate or time, so the backend applies body forces and torques."),
-            "groove_half_length": (
-                "Chipmunk grooves are finite segments: a prismatic side without a limit "
-                "(and every point-on-line slot) is given this extent in m (the groove ends "
-                "act as stops). Finite limits of the description are used as the groove "
-                "ends."),
-            "slider_mass_fraction": (
-                "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
-                "exact (pin off the pin body's centre of mass, or slot line off the slot "
-                "body's): a 'pin slider' (point mass pinned to the pin point) and/or a "
-                "'slot carrier' (glued to the slot body, centre on the slot line) runs in "
-                "an exact groove. Its mass is this fraction of the host body's effective "
-                "mass at that point, m I / (I + m d^2). Chipmunk has no such substitute and "
-                "no massless bodies. With compensation (below) the fraction does not enter "
-                "the dynamics (scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and "
-                "0.5), only the convergence of the Gauss-Seidel solve, since a light body "
-                "between heavy ones converges slowly: from the cold start (no cached "
-                "impulses) the slot force at samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at "
-                "0.5 with 50 iterations; the rhombus loop diverged at 0.05 with 50 "
-                "iterations (exact with 500). Must stay below 1 (the host keeps a positive "
-                "moment)."),
-            "slider_compensation": (
-                "true: the substitute's mass (and a slot carrier's moment) is taken out of "
-                "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
-                "host + substitute have exactly the described inertia; false: the "
-                "substitute adds its mass to the mechanism (teaching mode: shows the "
-                "dynamic effect of a slider mass; measured with fraction 0.05, 10 s: "
-                "trajectory error 0.33-1.9 of the amplitude on the scotch yoke, 0.37-140 on "
-                "the slotted link, against 3-10e-3 compensated)."),
-            "rolling": (
-                "'coupling' (default): a LinearCoupling of two bodies hinged on a carrier "
-                "(gear pair, belt, disc rolling in a moving track) is a PivotJoint between "
-                "them at the pitch point, re-anchored before every solve (exact rows, the "
-                "coupling's position error corrected by Chipmunk's own error correction). "
-                "'contact': where the description draws the pitch circles (Circle shapes), "
-                "they collide instead (a Circle inside a ring of Segments, or two Circles) "
-                "with Coulomb friction and the carrier arm removed (the contact holds the "
-                "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
-                "its friction, at zero): what a game-physics user would build. Measured on "
-                "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
-                "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
-                "the disc passes from one chord to the next (normal impulse 0, then twice), "
-                "3-6 s per 10 s run (coupling 0.4 s)."),
-            "contact_friction": (
-                "Friction coefficient of the rolling contact (rolling = 'contact'); "
-                "Chipmunk multiplies the two shapes' coefficients, this one goes on the "
-                "inner shape and 1 on the ring. Must exceed |friction| / normal force at all "
-                "times or the disc slides."),
-            "contact_segments": (
-                "Number of Segment shapes of a ring (rolling = 'contact'), inscribed in the "
-                "pitch circle; space.collision_slop is set to the chord's sagitta so that "
-                "the polygon's penetration is not 'corrected' against the carrier joint."),
-        }
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        if kind == BODY:
+            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+        layout = _plan(mechanism, self.default_settings())
+        if isinstance(layout, str):  # refused as a whole: see translation_reason
+            return cases[0]
+        if kind == POINT_ON_LINE:
+            substituted = any(car.constraint == element.name for car in layout.carriers)
+            return cases[1] if substituted else cases[0]
+        return cases[1] if any(p.name == element.name for p in layout.pitches) else cases[0]
 
-    def support(self, mechanism: Mechanism) -> Support:
-        plan = _plan(mechanism, self.default_settings())
-        if isinstance(plan, str):
-            return Support(False, plan)
-        return Support(True)
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        layout = _plan(mechanism, self.default_settings())
+        return layout if isinstance(layout, str) else ""
 
     # --- building ------------------------------------------------------------------------
     @staticmethod
@@ -1272,12 +1241,12 @@ class PymunkBackend(Backend):
 
         layout = comp.layout
         space = pymunk.Space()
-        space.gravity = (0.0, -_num(mech.gravity))
+        space.gravity = (0.0, -num(mech.gravity))
         space.damping = float(cfg["damping"])
         space.iterations = int(cfg["iterations"])
         sleep = cfg["sleep_time_threshold"]
         space.sleep_time_threshold = math.inf if sleep is None else float(sleep)
-        state = _initial_states(mech, q0, qd0)
+        state = body_states(mech, q0, qd0)
         bodies: dict[str, pymunk.Body] = {WORLD: space.static_body}
         for name in layout.engine:
             m, inertia = layout.engine_mass[name]
@@ -1287,13 +1256,13 @@ class PymunkBackend(Backend):
                 cog = layout.cog.get(name)
             else:
                 car = next(c for c in layout.carriers if c.name == name)
-                x, y, vx, vy = _point_state(state[car.host], car.point)
+                x, y, vx, vy = point_state(state[car.host], car.point)
                 th, w = (state[car.host][2], state[car.host][5]) if car.kind == "slot" else (0.0, 0.0)
                 cog = None
             body.angle = th  # before the position: pymunk places the frame with the angle
             if cog:
                 body.center_of_gravity = cog
-                _, _, vx, vy = _point_state((x, y, th, vx, vy, w), cog)
+                _, _, vx, vy = point_state((x, y, th, vx, vy, w), cog)
             body.position = (x, y)
             body.velocity = (vx, vy)  # of the centre of gravity
             body.angular_velocity = w
@@ -1307,11 +1276,10 @@ class PymunkBackend(Backend):
         constraints: list = []
         for parent, child, pa, ca in layout.pivots:
             constraints.append(pymunk.PivotJoint(bodies[parent], bodies[child], pa, ca))
-        contact = cfg["rolling"] == "contact"
         # a rolling contact holds the disc itself: the arm that stood for it goes (kept, the
         # distance would be enforced twice and Gauss-Seidel may leave the contact's normal
         # impulse, hence its friction, at zero)
-        replaced = {p.carrier for p in layout.pitches if contact and p.contact is not None}
+        replaced = {p.carrier for p in layout.pitches if p.contact is not None}
         for a, b, pa, pb, _, link in layout.pins:
             if link not in replaced:
                 constraints.append(pymunk.PinJoint(bodies[a], bodies[b], pa, pb))
@@ -1327,7 +1295,7 @@ class PymunkBackend(Backend):
         for a, b, phase, ratio in layout.gears:
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
         for i, (pitch, phi) in enumerate(zip(layout.pitches, comp.pitch_phi)):
-            if contact and pitch.contact is not None:
+            if pitch.contact is not None:
                 PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
             else:
                 constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch, phi))
@@ -1378,7 +1346,7 @@ class PymunkBackend(Backend):
 
     @staticmethod
     def _contact_shapes(space, bodies, pitch: _Pitch, index: int, cfg: dict) -> None:
-        """The pitch circles as colliding shapes with friction (rolling = 'contact')."""
+        """The pitch circles as colliding shapes with friction (a RollingContact)."""
         import pymunk
 
         a, hub_a, rho_a, b, hub_b, rho_b, internal = pitch.contact
@@ -1424,13 +1392,12 @@ class PymunkBackend(Backend):
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
         cfg = self.resolve_settings(settings)
-        if cfg["element_forces"] not in _FORCE_MODES:
-            raise ValueError(f"element_forces must be one of {_FORCE_MODES}")
-        if cfg["rolling"] not in _ROLLING:
-            raise ValueError(f"rolling must be one of {_ROLLING}")
         layout = _plan(mechanism, cfg)
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
+        # a RollingContact's force is balanced as the coupling it stands for (the layout
+        # holds the contact itself)
+        mechanism = coupled(mechanism)
         comp = _compile(mechanism, layout)
         q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
         space, bodies = self._build(mechanism, comp, q0, qd0, cfg)
@@ -1507,7 +1474,7 @@ class PymunkBackend(Backend):
         transient at sample 1: the first step also builds the steady O(h^2) joint gap of
         the position update, and its impulse contains that correction."""
         j = mech.joint(joint)
-        g = _num(mech.gravity)
+        g = num(mech.gravity)
         dynamic = comp.layout.dynamic
         total = np.zeros((len(t) - 1, 2))
         for name in mech.subtree(j.child):
@@ -1552,7 +1519,7 @@ class PymunkBackend(Backend):
         A = np.stack(arrays(bal.A(*pos)), axis=-1).reshape(m_steps, nrow, ncol)
         centres = arrays(bal.centres(*pos))
         rhs = np.zeros((m_steps, nrow))
-        g = _num(mech.gravity)
+        g = num(mech.gravity)
         carriers = {c.name: c for c in layout.carriers}
         for k, name in enumerate(layout.engine):
             host = name if name in layout.dynamic else carriers[name].host
@@ -1562,7 +1529,7 @@ class PymunkBackend(Backend):
             fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
-                inertia = _num(mech.body(name).inertia) if name in layout.dynamic else 0.0
+                inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
             rx, ry = S[1:, 6 * k] - centres[2 * i], S[1:, 6 * k + 1] - centres[2 * i + 1]
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from types import SimpleNamespace
 from typing import Callable, Mapping
@@ -115,15 +115,19 @@ class ContactOutput:
 @dataclass(frozen=True)
 class Variant:
     """Another way some engines can build the mechanism (say rolling by friction contact
-    instead of the coupling constraint): the same description, scenarios and references,
-    engine settings per engine. The gates belong to the description; a variant's distance
-    from them is the variant's own error, measured and reported (status "measured"), with
-    `reason` saying why it differs."""
+    instead of the coupling constraint), as description data: `constraints` (a function
+    of the parameter symbols, like `System.build`) gives the elements that take the place
+    of the description's constraints of the same name; the scenarios and references stay
+    the description's. `settings`: the engines that build it, each with its own settings.
+    The gates belong to the description; a variant's distance from them is the variant's
+    own error, measured and reported (status "measured"), with `reason` saying why it
+    differs."""
 
     name: str
     settings: Mapping[str, Mapping[str, object]]  # engine id -> settings
     description: str
     reason: str
+    constraints: Callable[[SimpleNamespace], tuple] = lambda P: ()
 
 
 @dataclass(frozen=True)
@@ -215,8 +219,17 @@ class System:
     def subs(self, values: Mapping[str, float]) -> dict[sp.Symbol, float]:
         return {getattr(self.symbols, k): v for k, v in values.items()}
 
-    def numeric_mechanism(self, values: Mapping[str, float]) -> Mechanism:
-        return self.mechanism.substitute(self.subs(values))
+    def numeric_mechanism(self, values: Mapping[str, float],
+                          variant: str | None = None) -> Mechanism:
+        """The mechanism with numbers for the parameters; with `variant`, the variant's
+        constraints in place of the description's of the same name (what an engine
+        builds for the variant)."""
+        mech = self.mechanism
+        if variant:
+            instead = {c.name: c for c in self.variant(variant).constraints(self.symbols)}
+            mech = replace(mech, constraints=tuple(instead.get(c.name, c)
+                                                   for c in mech.constraints))
+        return mech.substitute(self.subs(values))
 
     def scenario(self, name: str) -> Scenario:
         for s in self.scenarios:

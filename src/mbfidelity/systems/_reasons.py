@@ -1,13 +1,6 @@
 """Physical reasons for expected failures shared by several mechanisms (each measured;
 the numbers per mechanism are in the results)."""
 
-MUJOCO_SOFT_EQUALITY = (
-    "MuJoCo's equality constraints are soft: the impedance is capped at 0.9999 (solimp) and "
-    "the reference time constant at 2 dt, so each constraint force falls about 1e-4 of "
-    "itself short and a small violation (1e-9 to 1e-7 m) makes up the rest; constraint "
-    "forces are then off by 1e-4 to 2e-3 and trajectories by 1e-6 to 1e-5, against RK4 "
-    "gates near 1e-7. No solref/solimp choice removes the floor (measured).")
-
 MUJOCO_MASSLESS_PIN = (
     "MuJoCo rejects massless moving bodies, so the massless pin P carries a substitute mass "
     "(3e-4 of the lightest body) held by soft equalities; the added inertia and the soft "

@@ -41,8 +41,7 @@ angle relative to the arm without changing the potential).
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from . import PrintedFormula, System, coordinate_symbols
 from .model import (COORD_RATE, Body, Circle, CoordinateForce, LinearCoupling, Mechanism,
                     Parameter, Revolute, Scenario, Segment)
 
@@ -139,10 +138,4 @@ SYSTEM = System(
     ),
     notes="phi1 is cyclic: every theta = 0 (theta = pi) with any phi1 is an equilibrium; "
           "the linearization has one zero frequency.",
-    expectations=(
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        # near rest the soft equality's lag (time constant 2 dt) dominates RK4's error: it
-        # falls 4-8x, not 16x, when dt halves (measured at 1e-3 and 5e-4)
-        Expectation("mujoco", "*small.trajectory_max", "xfail", MUJOCO_SOFT_EQUALITY),
-    ),
 )

@@ -30,7 +30,7 @@ Variant (§4.2): viscous friction c in the block's guide, reduced force -c (e si
 import sympy as sp
 
 from . import ContactOutput, Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY, VELOCITY_LEVEL_STARTUP
+from ._reasons import VELOCITY_LEVEL_STARTUP
 from .model import (COORD_RATE, LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, PointToPoint, Prismatic, Rectangle, Revolute, Scenario)
 
@@ -153,10 +153,6 @@ SYSTEM = System(
                              "about 34 rad/s at the defaults): a real block would lift off"),
     ),
     expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.contact_*", "xfail", MUJOCO_SOFT_EQUALITY),
         Expectation("pymunk", "rotating.constraint_*", "xfail", VELOCITY_LEVEL_STARTUP),
         Expectation("pymunk", "rotating.contact_*", "xfail", VELOCITY_LEVEL_STARTUP),
         Expectation("pybullet", "rotating.constraint_*", "xfail", VELOCITY_LEVEL_STARTUP),

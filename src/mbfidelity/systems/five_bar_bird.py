@@ -76,7 +76,7 @@ eq. 116 tests.
 import sympy as sp
 
 from . import Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY, SEMI_IMPLICIT_DRIFT
+from ._reasons import SEMI_IMPLICIT_DRIFT
 from .model import Body, Circle, Mechanism, Parameter, PointOnPoint, Revolute, Scenario, Segment
 
 PARAMETERS = (
@@ -212,9 +212,6 @@ SYSTEM = System(
                              "the hinges Q, Q' at least 0.08 m apart"),
     ),
     expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
         Expectation("pybullet", "large.trajectory_*", "xfail", SEMI_IMPLICIT_DRIFT),
         Expectation("pybullet", "large.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),
     ),

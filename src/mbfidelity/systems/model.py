@@ -241,7 +241,39 @@ class LinearCoupling:
     constant: Expr = 0
 
 
-Constraint = Union[PointOnPoint, PointOnLine, LinearCoupling]
+@dataclass(frozen=True)
+class RollingContact:
+    """Rolling by friction contact, which a variant puts in place of the rolling
+    `LinearCoupling` of the same name (`systems.Variant.constraints`): the disc body
+    `disc`, hinged at its centre on the massless arm `arm`, touches from inside the
+    circle of radius `track_radius` of `track` centred at the arm's hinge on it;
+    `disc_radius` is the disc's. The arm no longer holds the disc at track_radius -
+    disc_radius (engines free it along its length): the contact's normal force does, and
+    its friction stands for the coupling, whose no-slip condition (`coefficients`,
+    `constant`, as in `LinearCoupling`) then measures the slip. Its force is reported as
+    the coupling's (-multiplier: the friction force of the track on the disc)."""
+
+    name: str
+    disc: str
+    arm: str
+    track: str
+    disc_radius: Expr
+    track_radius: Expr
+    coefficients: tuple[tuple[str, Expr], ...]
+    constant: Expr = 0
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """(the disc, on which its force is reported; the track)."""
+        return self.disc, self.track
+
+    @property
+    def coupling(self) -> LinearCoupling:
+        """The rolling constraint this contact stands for."""
+        return LinearCoupling(self.name, self.coefficients, self.constant)
+
+
+Constraint = Union[PointOnPoint, PointOnLine, LinearCoupling, RollingContact]
 
 
 def linear_spring_damper(k: Expr, l0: Expr, c: Expr = 0) -> dict:
@@ -296,14 +328,21 @@ class Mechanism:
             if isinstance(f, CoordinateForce) and f.coordinate not in coords:
                 raise ValueError(f"force {f.name}: unknown coordinate {f.coordinate}")
         for c in self.constraints:
-            used = ([name for name, _ in c.coefficients] if isinstance(c, LinearCoupling)
-                    else [])
-            for b in (() if isinstance(c, LinearCoupling) else c.bodies):
+            used = ([name for name, _ in c.coefficients]
+                    if isinstance(c, (LinearCoupling, RollingContact)) else [])
+            touched = (() if isinstance(c, LinearCoupling) else
+                       (*c.bodies, c.arm) if isinstance(c, RollingContact) else c.bodies)
+            for b in touched:
                 if b != WORLD and b not in names:
                     raise ValueError(f"constraint {c.name}: unknown body {b!r}")
             for name in used:
                 if name not in coords:
                     raise ValueError(f"constraint {c.name}: unknown coordinate {name!r}")
+            if isinstance(c, RollingContact) and not (
+                    self.joint_of_child(c.disc).parent == c.arm
+                    and self.joint_of_child(c.arm).parent == c.track):
+                raise ValueError(f"contact {c.name}: the disc must be hinged on the arm, the "
+                                 "arm on the track")
         if self.independent is not None:
             unknown = set(self.independent) - set(coords)
             if unknown:
@@ -382,10 +421,13 @@ class Mechanism:
             return replace(obj, **changes)
 
         def ev_constraint(c):
-            if isinstance(c, LinearCoupling):
-                return replace(c, coefficients=tuple((n, ev(v)) for n, v in c.coefficients),
-                               constant=ev(c.constant))
-            return ev_obj(c)
+            if isinstance(c, (LinearCoupling, RollingContact)):
+                c = replace(c, coefficients=tuple((n, ev(v)) for n, v in c.coefficients),
+                            constant=ev(c.constant))
+            if isinstance(c, RollingContact):
+                return replace(c, disc_radius=ev(c.disc_radius),
+                               track_radius=ev(c.track_radius))
+            return c if isinstance(c, LinearCoupling) else ev_obj(c)
 
         return Mechanism(
             bodies=tuple(ev_obj(b) for b in self.bodies),

@@ -53,8 +53,7 @@ spring of zero length) are singular and are not crossed by the scenarios.
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from . import PrintedFormula, System, coordinate_symbols
 from .model import (Body, Mechanism, Parameter, PointOnLine, PointOnPoint, PointToPoint,
                     Revolute, Scenario, Segment, linear_spring_damper)
 
@@ -160,9 +159,4 @@ SYSTEM = System(
     ),
     notes="spring free length sqrt2 l - 4 m g/k (tension 4 m g at 45 deg), reconstructed "
           "from eq. 34; MECHANISMS.md's 'relaxed at 45 deg' contradicts every printed formula",
-    expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
-    ),
 )

@@ -67,10 +67,9 @@ reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
 import sympy as sp
 
-from . import ContactOutput, Expectation, PrintedFormula, System, Variant, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from . import ContactOutput, PrintedFormula, System, Variant, coordinate_symbols
 from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, LinearCoupling,
-                    Mechanism, Parameter, Revolute, Scenario, Segment)
+                    Mechanism, Parameter, Revolute, RollingContact, Scenario, Segment)
 
 PARAMETERS = (
     Parameter("m_p", 4.0, "kg", "mass of the track", "MECHANISMS.md E; Fig. 39"),
@@ -96,6 +95,11 @@ PARAMETERS = (
 )
 
 
+def _no_slip(P):
+    """Phi = R theta + R phi + r psi: metres of slip at J (module docstring)."""
+    return ("theta", P.R), ("phi", P.R), ("psi", P.r)
+
+
 def build(P) -> Mechanism:
     track = Body("track", P.m_p, P.I_p, (Circle((0, P.e), P.R), Segment((-P.R, P.e), (0, P.e))))
     arm = Body("arm", 0, 0, (Segment((0, 0), (0, -(P.R - P.r))),))
@@ -108,7 +112,7 @@ def build(P) -> Mechanism:
             Revolute("centre", "track", "arm", "phi", parent_anchor=(0, P.e), absolute=True),
             Revolute("hub", "arm", "disc", "psi", parent_anchor=(0, -(P.R - P.r))),
         ),
-        constraints=(LinearCoupling("rolling", (("theta", P.R), ("phi", P.R), ("psi", P.r))),),
+        constraints=(LinearCoupling("rolling", _no_slip(P)),),
         independent=("theta", "phi"),
         forces=(
             CoordinateForce("torsion_spring", "theta", -(P.M0 + P.k_t * COORD),
@@ -209,7 +213,7 @@ SYSTEM = System(
     notes="The printed E_c takes the disc's spin as phi'; rolling gives "
           "-(R theta' + (R - r) phi')/r (see the module docstring).",
     variants=(
-        Variant("contact", {e: {"rolling": "contact"} for e in ("mujoco", "pybullet", "pymunk")},
+        Variant("contact", {e: {} for e in ("mujoco", "pybullet", "pymunk")},
                 description="rolling by friction contact (friction coefficient 1): the disc "
                             "touches a ring of boxes (MuJoCo, PyBullet) or segments (Pymunk); "
                             "the arm becomes a free radial slider, so the contact carries the "
@@ -218,13 +222,10 @@ SYSTEM = System(
                        "response with a time constant of a few steps) on a faceted ring: "
                        "the normal force chatters from facet to facet, the disc creeps "
                        "(micro-slip) and the contact dissipates; the description's gates are "
-                       "those of an ideal rolling constraint"),
-    ),
-    expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        # from rest at the equilibrium (forced) the soft coupling's lag stays below the gate
-        *(Expectation("mujoco", f"{sc}.contact_*", "xfail", MUJOCO_SOFT_EQUALITY)
-          for sc in ("small", "large", "undamped")),
+                       "those of an ideal rolling constraint",
+                constraints=lambda P: (RollingContact(
+                    "rolling", disc="disc", arm="arm", track="track", disc_radius=P.r,
+                    track_radius=P.R,
+                    coefficients=_no_slip(P)),)),
     ),
 )

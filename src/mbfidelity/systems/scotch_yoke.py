@@ -21,8 +21,7 @@ through their sum, eq. 49 (the reference configurations differ, as the text says
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_SOFT_EQUALITY
+from . import PrintedFormula, System, coordinate_symbols
 from .model import (LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter, PointOnLine,
                     PointToPoint, Prismatic, Rectangle, Revolute, Scenario, COORD_RATE)
 
@@ -127,10 +126,5 @@ SYSTEM = System(
         Scenario("damped", {"phi": 0.5}, overrides={"c": 0.5},
                  checks=("trajectory", "constraint_force"),
                  description="guide friction c = 0.5 (§7), from 0.5 rad"),
-    ),
-    expectations=(
-        Expectation("mujoco", "*.trajectory_*", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.energy_drift", "xfail", MUJOCO_SOFT_EQUALITY),
-        Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_SOFT_EQUALITY),
     ),
 )

@@ -1,0 +1,429 @@
+"""The engine-neutral numeric plan of a mechanism, written once for every backend.
+
+A backend receives a numeric `Mechanism` (parameters substituted) and translates it into
+its engine. What that translation needs before any engine enters is the same for all of
+them and lives here:
+
+- numbers from description entries (`num`), planar rotations (`rot`);
+- the element kinds of the description (`ELEMENT_KINDS`, `elements`): the vocabulary in
+  which each backend declares how exactly it expresses an element (`base.Expression`);
+- the checks that a description can be translated at all (`description_reason`: every
+  entry numeric, no zero axis, slot direction or coupling);
+- the force laws, compiled once, with their classification (`ForceLaw`): linear (a
+  spring of stiffness -b and free length -a/b, a damper of coefficient c, or a constant
+  force, ``a + b x + c x'`` with no TIME) or custom;
+- the map between the description coordinates q and the engine joint values v
+  (`CoordinateMap`): every engine joint is relative (v = theta_child - theta_parent -
+  angle_offset for a hinge, the slide along the unit axis for a prismatic joint), so
+  ``v = A q + b`` with the inverse ``q = T v + c``, and the body angles are affine in
+  both.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from functools import cached_property, singledispatch
+from typing import Callable, Iterator
+
+import numpy as np
+import sympy as sp
+
+from ..systems.model import (
+    COORD,
+    COORD_RATE,
+    LENGTH,
+    LENGTH_RATE,
+    TIME,
+    WORLD,
+    Body,
+    CoordinateForce,
+    LinearCoupling,
+    Mechanism,
+    PointOnLine,
+    PointOnPoint,
+    PointToPoint,
+    Prismatic,
+    Revolute,
+    RollingContact,
+    compile_law,
+)
+
+
+class NotNumeric(TypeError, ValueError):
+    """A description entry still holds a parameter symbol."""
+
+
+def num(x) -> float:
+    """A float from a numeric description entry (number or SymPy expression)."""
+    value = sp.sympify(x)
+    if value.free_symbols:
+        raise NotNumeric(f"expression {value} still has free symbols")
+    return float(value)
+
+
+def rot(theta: float) -> np.ndarray:
+    """The planar rotation matrix R(theta) (body frame to world axes)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
+    """(a, b, c) with law = a + b x + c xd (numbers, no TIME), or None when the law is not
+    of that form."""
+    expr = sp.sympify(expr)
+    if not expr.free_symbols <= {x, xd} or not expr.is_polynomial(x, xd):
+        return None
+    if expr.free_symbols and sp.Poly(expr, x, xd).total_degree() > 1:
+        return None
+    a = float(expr.xreplace({x: 0, xd: 0}))
+    return a, float(sp.diff(expr, x)), float(sp.diff(expr, xd))
+
+
+# --- element kinds ---------------------------------------------------------------------
+
+BODY = "body"
+MASSLESS_BODY = "massless body"
+REVOLUTE = "Revolute"
+PRISMATIC = "Prismatic"
+POINT_TO_POINT_LINEAR = "PointToPoint, linear law"
+POINT_TO_POINT_CUSTOM = "PointToPoint, custom law"
+COORDINATE_FORCE_LINEAR = "CoordinateForce, linear law"
+COORDINATE_FORCE_CUSTOM = "CoordinateForce, custom law"
+TIME_LOAD = "time load"
+POINT_ON_POINT = "PointOnPoint"
+POINT_ON_LINE = "PointOnLine"
+LINEAR_COUPLING = "LinearCoupling"
+ROLLING_CONTACT = "RollingContact"
+
+#: every kind of element a description holds, in the order backends declare them
+ELEMENT_KINDS = (BODY, MASSLESS_BODY, REVOLUTE, PRISMATIC, POINT_TO_POINT_LINEAR,
+                 POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR, COORDINATE_FORCE_CUSTOM,
+                 TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING, ROLLING_CONTACT)
+
+
+@singledispatch
+def element_kind(element) -> str:
+    """The kind of one element of a numeric description."""
+    raise TypeError(f"no element kind for {type(element).__name__}")
+
+
+@element_kind.register
+def _(element: Body) -> str:
+    return MASSLESS_BODY if element.massless else BODY
+
+
+@element_kind.register
+def _(element: Revolute) -> str:
+    return REVOLUTE
+
+
+@element_kind.register
+def _(element: Prismatic) -> str:
+    return PRISMATIC
+
+
+@element_kind.register
+def _(element: PointToPoint) -> str:
+    return ForceLaw.of(element).kind
+
+
+@element_kind.register
+def _(element: CoordinateForce) -> str:
+    return ForceLaw.of(element).kind
+
+
+@element_kind.register
+def _(element: PointOnPoint) -> str:
+    return POINT_ON_POINT
+
+
+@element_kind.register
+def _(element: PointOnLine) -> str:
+    return POINT_ON_LINE
+
+
+@element_kind.register
+def _(element: LinearCoupling) -> str:
+    return LINEAR_COUPLING
+
+
+@element_kind.register
+def _(element: RollingContact) -> str:
+    return ROLLING_CONTACT
+
+
+def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
+    """(kind, element) for every element of the description, in description order."""
+    for group in (mech.bodies, mech.joints, mech.forces, mech.constraints):
+        for element in group:
+            yield element_kind(element), element
+
+
+# --- force laws ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ForceLaw:
+    """A force element's law, classified and compiled once: `linear` is (a, b, c) with
+    law = a + b x + c x' when the law has that form and no TIME (None: custom law);
+    `law` is the compiled scalar function of (x, x', t), with x, x' the length and its
+    rate (PointToPoint) or the coordinate and its rate (CoordinateForce)."""
+
+    element: PointToPoint | CoordinateForce
+
+    @staticmethod
+    def of(element: PointToPoint | CoordinateForce) -> "ForceLaw":
+        return _force_law(element)
+
+    @property
+    def expr(self) -> sp.Expr:
+        e = self.element
+        return sp.sympify(e.tension if isinstance(e, PointToPoint) else e.force)
+
+    @property
+    def args(self) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+        if isinstance(self.element, PointToPoint):
+            return LENGTH, LENGTH_RATE, TIME
+        return COORD, COORD_RATE, TIME
+
+    @cached_property
+    def time_dependent(self) -> bool:
+        return TIME in self.expr.free_symbols
+
+    @cached_property
+    def linear(self) -> tuple[float, float, float] | None:
+        return linear_law(self.expr, *self.args[:2])
+
+    @property
+    def kind(self) -> str:
+        point = isinstance(self.element, PointToPoint)
+        if self.time_dependent:
+            return TIME_LOAD
+        if self.linear is not None:
+            return POINT_TO_POINT_LINEAR if point else COORDINATE_FORCE_LINEAR
+        return POINT_TO_POINT_CUSTOM if point else COORDINATE_FORCE_CUSTOM
+
+    @cached_property
+    def law(self) -> Callable[[float, float, float], float]:
+        return compile_law(self.expr, self.args)
+
+    @cached_property
+    def vector_law(self) -> Callable[..., np.ndarray]:
+        """The law evaluated on arrays of samples (read-outs after a run)."""
+        fn = sp.lambdify(self.args, self.expr, modules="numpy")
+
+        def call(*arrays: np.ndarray) -> np.ndarray:
+            out = np.asarray(fn(*arrays), dtype=float)
+            return np.broadcast_to(out, np.shape(arrays[0])).astype(float)
+
+        return call
+
+
+_LAWS: dict[object, ForceLaw] = {}
+
+
+def _force_law(element) -> ForceLaw:
+    """One `ForceLaw` per element (its classification and compiled law are reused by
+    every run of the same numeric mechanism)."""
+    law = _LAWS.get(element)
+    if law is None:
+        if len(_LAWS) > 512:
+            _LAWS.clear()
+        law = _LAWS[element] = ForceLaw(element)
+    return law
+
+
+def coupled(mech: Mechanism) -> Mechanism:
+    """The mechanism with each RollingContact replaced by the rolling coupling it stands
+    for (what an engine linearizes, or balances forces against)."""
+    return replace(mech, constraints=tuple(
+        c.coupling if isinstance(c, RollingContact) else c for c in mech.constraints))
+
+
+def constrained_bodies(mech: Mechanism) -> set[str]:
+    """The bodies a closure constraint acts on: the two bodies of a PointOnPoint or
+    PointOnLine, the children of the joints whose coordinates a LinearCoupling involves
+    (with a non-zero coefficient); the world excluded."""
+    out: set[str] = set()
+    for c in mech.constraints:
+        if isinstance(c, LinearCoupling):
+            out |= {mech.joints[mech.coordinates.index(name)].child
+                    for name, coef in c.coefficients if num(coef)}
+        else:
+            out |= set(c.bodies)
+    return out - {WORLD}
+
+
+# --- whether a description can be translated at all ------------------------------------
+
+
+def description_reason(mech: Mechanism) -> str:
+    """Why the description cannot be translated by any backend (a parameter left
+    symbolic, a zero axis, slot direction or coupling), or the empty string."""
+    placeholders = {LENGTH, LENGTH_RATE, COORD, COORD_RATE, TIME}
+    try:
+        num(mech.gravity)
+        for b in mech.bodies:
+            num(b.mass), num(b.inertia)
+        for j in mech.joints:
+            for v in (*j.parent_anchor, *j.child_anchor, j.angle_offset):
+                num(v)
+            if isinstance(j, Prismatic):
+                for v in j.limits:
+                    if v is not None:
+                        num(v)
+                if math.hypot(num(j.axis[0]), num(j.axis[1])) == 0.0:
+                    return f"joint {j.name}: zero prismatic axis"
+        for f in mech.forces:
+            law = ForceLaw.of(f).expr
+            if law.free_symbols - placeholders:
+                return (f"force element {f.name}: law has non-numeric parameters "
+                        f"{sorted(map(str, law.free_symbols - placeholders))}")
+            if isinstance(f, PointToPoint):
+                for v in (*f.point_a, *f.point_b):
+                    num(v)
+        for c in mech.constraints:
+            if isinstance(c, (LinearCoupling, RollingContact)):
+                num(c.constant)
+                if not any(num(v) for _, v in c.coefficients):
+                    return f"constraint {c.name}: every coefficient is zero"
+                if isinstance(c, RollingContact) and not 0 < num(c.disc_radius) < num(
+                        c.track_radius):
+                    return f"constraint {c.name}: the disc must be smaller than the track"
+            elif isinstance(c, PointOnPoint):
+                for v in (*c.point_a, *c.point_b):
+                    num(v)
+            else:
+                for v in (*c.point, *c.line_point):
+                    num(v)
+                if math.hypot(num(c.direction[0]), num(c.direction[1])) == 0.0:
+                    return f"constraint {c.name}: zero slot direction"
+    except NotNumeric as exc:
+        return f"the mechanism is not numeric (use numeric_mechanism): {exc}"
+    return ""
+
+
+# --- description coordinates and engine joint values -----------------------------------
+
+
+@dataclass(frozen=True)
+class CoordinateMap:
+    """Description coordinates q and engine joint values v of a numeric mechanism:
+    ``v = A q + b`` and ``q = T v + c`` (T = A^-1; A is lower triangular with +-1 or the
+    axis length on the diagonal: absolute angles subtract the parent's angle, clockwise
+    coordinates change sign, slides run along the unit axis). Body angles are affine in
+    both: ``theta = angle_c[body] . q + angle_d[body] = angle_v[body] . v +
+    angle_v0[body]``. Generalized forces map with the transposes (tau = T^T Q)."""
+
+    A: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    angle_c: dict[str, np.ndarray]
+    angle_d: dict[str, float]
+    angle_v: dict[str, np.ndarray]
+    angle_v0: dict[str, float]
+
+    @cached_property
+    def T(self) -> np.ndarray:
+        return np.linalg.inv(self.A)
+
+    @cached_property
+    def identity(self) -> bool:
+        """Whether the engine joint values are the description coordinates."""
+        n = len(self.b)
+        return bool(np.array_equal(self.A, np.eye(n)) and not self.b.any())
+
+    def engine_values(self, q: np.ndarray) -> np.ndarray:
+        return self.A @ np.asarray(q, dtype=float) + self.b
+
+    def coordinates(self, v: np.ndarray) -> np.ndarray:
+        """Engine joint values (one row per sample, or one vector) -> coordinates."""
+        return (np.asarray(v) - self.b) @ self.T.T
+
+    def rates(self, vd: np.ndarray) -> np.ndarray:
+        return np.asarray(vd) @ self.T.T
+
+    def angle(self, body: str, q: np.ndarray) -> np.ndarray:
+        """The body's angle at q (rows of q give one angle per row)."""
+        return q @ self.angle_c[body] + self.angle_d[body]
+
+
+def coordinate_map(mech: Mechanism) -> CoordinateMap:
+    """The `CoordinateMap` of a numeric mechanism."""
+    n = len(mech.joints)
+    angle_c: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
+    angle_d: dict[str, float] = {WORLD: 0.0}
+    angle_v: dict[str, np.ndarray] = {WORLD: np.zeros(n)}
+    angle_v0: dict[str, float] = {WORLD: 0.0}
+    A = np.zeros((n, n))
+    b = np.zeros(n)
+    c = np.zeros(n)
+    for i, j in enumerate(mech.joints):
+        cp, dp = angle_c[j.parent], angle_d[j.parent]
+        off = num(j.angle_offset)
+        e_i = np.eye(n)[i]
+        if isinstance(j, Revolute):
+            sign = -1.0 if j.clockwise else 1.0
+            angle_v[j.child] = angle_v[j.parent] + e_i
+            if j.absolute:
+                angle_c[j.child] = sign * e_i
+                angle_d[j.child] = off
+                A[i] = sign * e_i - cp  # v = theta_child - theta_parent - offset
+                b[i] = -dp
+                c[i] = sign * angle_v0[j.parent]  # sign q = theta_parent + v
+            else:
+                angle_c[j.child] = cp + sign * e_i
+                angle_d[j.child] = dp + off
+                A[i, i] = sign
+        else:
+            angle_v[j.child] = angle_v[j.parent].copy()
+            angle_c[j.child] = cp.copy()
+            angle_d[j.child] = dp + off
+            A[i, i] = math.hypot(num(j.axis[0]), num(j.axis[1]))  # the slide along the unit axis
+        angle_v0[j.child] = angle_v0[j.parent] + off
+    return CoordinateMap(A, b, c, angle_c, angle_d, angle_v, angle_v0)
+
+
+# --- forward kinematics ----------------------------------------------------------------
+
+
+def body_states(mech: Mechanism, q, qd) -> dict[str, tuple[float, ...]]:
+    """(x, y, theta, vx, vy, omega) of every description body's frame at (q, qd), by
+    planar forward kinematics in joint order (conventions 3-5 of `systems.model`)."""
+    st: dict[str, tuple[float, ...]] = {WORLD: (0.0,) * 6}
+
+    def turn(th: float, v) -> tuple[float, float]:
+        c, s = math.cos(th), math.sin(th)
+        return c * v[0] - s * v[1], s * v[0] + c * v[1]
+
+    for j, qj, qdj in zip(mech.joints, q, qd):
+        x, y, th_p, vx, vy, w_p = st[j.parent]
+        pa = (num(j.parent_anchor[0]), num(j.parent_anchor[1]))
+        ca = (num(j.child_anchor[0]), num(j.child_anchor[1]))
+        off = num(j.angle_offset)
+        if isinstance(j, Revolute):
+            if j.clockwise:
+                qj, qdj = -qj, -qdj
+            th = (0.0 if j.absolute else th_p) + qj + off
+            w = (0.0 if j.absolute else w_p) + qdj
+            r = turn(th_p, pa)
+            va = (vx - w_p * r[1], vy + w_p * r[0])
+        else:
+            th, w = th_p + off, w_p
+            axis = (num(j.axis[0]), num(j.axis[1]))
+            r = turn(th_p, (pa[0] + qj * axis[0], pa[1] + qj * axis[1]))
+            slide = turn(th_p, axis)
+            va = (vx - w_p * r[1] + qdj * slide[0], vy + w_p * r[0] + qdj * slide[1])
+        a = (x + r[0], y + r[1])
+        rc = turn(th, ca)
+        st[j.child] = (a[0] - rc[0], a[1] - rc[1], th, va[0] + w * rc[1], va[1] - w * rc[0], w)
+    return st
+
+
+def point_state(st: tuple[float, ...], local) -> tuple[float, float, float, float]:
+    """World position and velocity of a body point, from the body frame's state
+    (x, y, theta, vx, vy, omega)."""
+    x, y, th, vx, vy, w = st
+    c, s = math.cos(th), math.sin(th)
+    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
+    return x + rx, y + ry, vx - w * ry, vy + w * rx
