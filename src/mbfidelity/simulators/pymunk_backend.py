@@ -1420,10 +1420,8 @@ class PymunkBackend(Backend):
         space.add(*shapes)
 
     # --- running -------------------------------------------------------------------------
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        cfg = self.resolve_settings(settings)
+    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict):
+        """Validate and build: (layout, compiled functions, space, engine bodies)."""
         if cfg["element_forces"] not in _FORCE_MODES:
             raise ValueError(f"element_forces must be one of {_FORCE_MODES}")
         if cfg["rolling"] not in _ROLLING:
@@ -1432,12 +1430,13 @@ class PymunkBackend(Backend):
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
         comp = _compile(mechanism, layout)
-        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
         space, bodies = self._build(mechanism, comp, q0, qd0, cfg)
-        n_steps = int(round(t_end / dt))
-        h = float(dt)
-        # loads at x + h v and t + h (see setting notes), or at the sampled state
-        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        return layout, comp, space, bodies
+
+    @staticmethod
+    def _reader(layout: _Layout, bodies: list) -> Callable[[], list[float]]:
+        """A function returning the state row of the engine bodies: per body, the centre
+        of gravity (x, y), angle, its velocity (vx, vy) and angular velocity."""
         cogs = [layout.cog.get(n) for n in layout.engine]
 
         def read() -> list[float]:
@@ -1449,6 +1448,52 @@ class PymunkBackend(Backend):
                 row.append(b.angular_velocity)
             return row
 
+        return read
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The space of `simulate` stepped with only its element forces: those need the
+        state at the start of each step, the rest runs step after step."""
+        cfg = self.resolve_settings(settings)
+        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
+        layout, comp, space, bodies = self._prepare(mechanism, q0, qd0, cfg)
+        n_steps = int(round(t_end / dt))
+        h = float(dt)
+        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        step = space.step
+        loads = comp.loads_math
+        targets = [bodies[k] for k in comp.loaded]
+        iterations = int(cfg["iterations"])
+        space.iterations = max(iterations, int(cfg["start_iterations"]))
+        start = time.process_time()
+        if loads is None:
+            for k in range(n_steps):
+                step(h)
+                if k == 0:
+                    space.iterations = iterations
+        else:
+            read = self._reader(layout, bodies)
+            for k in range(n_steps):
+                out = loads(*read(), H, (k + shift) * h)
+                for i, b in enumerate(targets):
+                    b.force = (out[3 * i], out[3 * i + 1])
+                    b.torque = out[3 * i + 2]
+                step(h)
+                if k == 0:
+                    space.iterations = iterations
+        return time.process_time() - start
+
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        cfg = self.resolve_settings(settings)
+        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
+        layout, comp, space, bodies = self._prepare(mechanism, q0, qd0, cfg)
+        n_steps = int(round(t_end / dt))
+        h = float(dt)
+        # loads at x + h v and t + h (see setting notes), or at the sampled state
+        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        read = self._reader(layout, bodies)
         rows = [read()]
         step = space.step
         loads = comp.loads_math
@@ -1456,7 +1501,7 @@ class PymunkBackend(Backend):
         iterations = int(cfg["iterations"])
         # the first step has no cached impulses to start from (see start_iterations)
         space.iterations = max(iterations, int(cfg["start_iterations"]))
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         if loads is None:
             for k in range(n_steps):
                 step(h)
@@ -1473,6 +1518,7 @@ class PymunkBackend(Backend):
                 rows.append(read())
                 if k == 0:
                     space.iterations = iterations
+        cpu = time.process_time() - cpu_start
         wall = time.perf_counter() - start
 
         S = np.array(rows)
@@ -1493,7 +1539,7 @@ class PymunkBackend(Backend):
                          for j in reaction_joints}
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=1, settings=cfg, steps=n_steps,
-                         constraint_forces=constraint_forces)
+                         constraint_forces=constraint_forces, cpu_time=cpu)
 
     @staticmethod
     def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
