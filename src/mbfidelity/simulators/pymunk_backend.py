@@ -1434,12 +1434,18 @@ class PymunkBackend(Backend):
         return layout, comp, space, bodies
 
     @staticmethod
-    def _reader(layout: _Layout, bodies: list) -> Callable[[], list[float]]:
+    def _reader(space, layout: _Layout, bodies: list) -> Callable[[], list[float]]:
         """A function returning the state row of the engine bodies: per body, the centre
-        of gravity (x, y), angle, its velocity (vx, vy) and angular velocity."""
+        of gravity (x, y), angle, its velocity (vx, vy) and angular velocity. The row is
+        read for all bodies by one `pymunk.batch` call when the space lists them in
+        `bodies` order and none can fall asleep (which would reorder them); the position
+        of a body whose centre of gravity is off its frame origin is then read again as
+        `local_to_world(cog)`, as the body-by-body read does."""
+        import pymunk.batch
+
         cogs = [layout.cog.get(n) for n in layout.engine]
 
-        def read() -> list[float]:
+        def read_each() -> list[float]:
             row: list[float] = []
             for b, cog in zip(bodies, cogs):
                 row.extend(b.local_to_world(cog) if cog else b.position)
@@ -1448,7 +1454,26 @@ class PymunkBackend(Backend):
                 row.append(b.angular_velocity)
             return row
 
-        return read
+        fields = pymunk.batch.BodyFields
+        buffer = pymunk.batch.Buffer()
+        get = pymunk.batch.get_space_bodies
+        get(space, fields.BODY_ID, buffer)
+        ids = list(memoryview(buffer.int_buf()).cast("P"))
+        if space.sleep_time_threshold != math.inf or ids[:len(bodies)] != [b.id for b in bodies]:
+            return read_each
+        wanted = fields.POSITION | fields.ANGLE | fields.VELOCITY | fields.ANGULAR_VELOCITY
+        width = 6 * len(bodies)
+        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
+
+        def read_batch() -> list[float]:
+            buffer.clear()
+            get(space, wanted, buffer)
+            row = memoryview(buffer.float_buf()).cast("d")[:width].tolist()
+            for i, b, cog in off_origin:
+                row[i:i + 2] = b.local_to_world(cog)
+            return row
+
+        return read_batch
 
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
@@ -1472,7 +1497,7 @@ class PymunkBackend(Backend):
                 if k == 0:
                     space.iterations = iterations
         else:
-            read = self._reader(layout, bodies)
+            read = self._reader(space, layout, bodies)
             for k in range(n_steps):
                 out = loads(*read(), H, (k + shift) * h)
                 for i, b in enumerate(targets):
@@ -1493,7 +1518,7 @@ class PymunkBackend(Backend):
         h = float(dt)
         # loads at x + h v and t + h (see setting notes), or at the sampled state
         H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
-        read = self._reader(layout, bodies)
+        read = self._reader(space, layout, bodies)
         rows = [read()]
         step = space.step
         loads = comp.loads_math
