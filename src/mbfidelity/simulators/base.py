@@ -43,7 +43,8 @@ conventions 1-8) into one engine and runs it. The contract:
      in physical terms at the same samples: PointOnPoint, the force on body_a from
      body_b (world x, y); PointOnLine, the force of the slot on the pin (world x, y);
      LinearCoupling, its generalized force (k = 1), with the sign of -multiplier;
-   - ``wall_time``: seconds spent stepping only (build excluded);
+   - ``wall_time``: seconds spent stepping only (build excluded), and ``cpu_time``: the
+     CPU seconds (``time.process_time``) of the same stepping, comparable with point 9;
    - ``integrator_order``: the order of the scheme actually used (tolerances use it).
    Applied loads that depend on time are evaluated at the time of each integrator stage
    where the engine allows it.
@@ -53,11 +54,19 @@ conventions 1-8) into one engine and runs it. The contract:
    Discrete-time eigenvalues are mapped with ln(lambda)/dt.
 8. Backends never change the mechanism: a substitute (an intermediate slider body of
    small mass, a penalty spring) is named in the settings and its own error is measured.
-9. Shared steps: what every backend needs before its engine enters is computed once, in
-   `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
-   map between description coordinates and engine joint values, forward kinematics),
-   and settings are validated here; a backend translates the plan into its engine,
-   steps it and reads out.
+9. `bare_loop(mechanism, q0, qd0, t_end, dt, settings)` builds the same model as
+   `simulate` with the same arguments, sets the same initial state and runs the engine's
+   loop for the same round(t_end/dt) steps with nothing per step beyond what the engine
+   needs to step (the force laws it calls back, the loads and moving anchors it must be
+   given before a step): no read-out, no samples. It returns the CPU seconds
+   (``time.process_time``) of that loop, build excluded: the floor against which
+   ``RunResult.cpu_time`` is measured (benchmarks/cost.py). Read-outs belong in
+   `simulate`, batched so that its stepping costs little more than this loop.
+10. Shared steps: what every backend needs before its engine enters is computed once, in
+    `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
+    map between description coordinates and engine joint values, forward kinematics),
+    and settings are validated here; a backend translates the plan into its engine,
+    steps it and reads out.
 """
 from __future__ import annotations
 
@@ -157,6 +166,7 @@ class RunResult:
     settings: dict
     steps: int = 0
     constraint_forces: dict[str, np.ndarray] = field(default_factory=dict)
+    cpu_time: float = 0.0
 
     def __post_init__(self) -> None:
         if self.q.shape != self.qd.shape or self.q.shape[0] != len(self.t):
@@ -229,6 +239,11 @@ class Backend(ABC):
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
+        """See the contract in the module docstring."""
+
+    @abstractmethod
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
         """See the contract in the module docstring."""
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,

@@ -570,10 +570,7 @@ class ExudynBackend(Backend):
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
         cfg = self.resolve_settings(settings)
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
-        solver = self._solver_for(mechanism, cfg)
+        solver = self._checked_solver(mechanism, cfg)
         steps = int(round(t_end / dt))
         t_run = steps * dt
         exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
@@ -604,29 +601,11 @@ class ExudynBackend(Backend):
             objectNumber=c.obj, outputVariableType=ovt.ForceLocal if c.kind == "line"
             else ovt.Force, **sens)) for c in closures}
         mbs.Assemble()
-        solver_type = getattr(exu.DynamicSolverType, solver)
-        sim = self._simulation_settings(exu, cfg, t_run, steps)
-        sim.timeIntegration.solverType = solver_type
-        if closures:
-            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
-                cfg["constrained_spectral_radius"])
         # constrained runs: the implicit solver's sample at t = 0 holds its consistent
         # initial accelerations (computeInitialAccelerations)
         acc0 = (self._initial_accelerations(exu, mbs, cfg, s_acc)
                 if s_acc and not closures else {})
-
-        import exudyn.solver as exu_solver
-
-        # Python user functions allocate on every call; Exudyn then prints a speed hint
-        # after the run. The hint is expected here, so it is silenced for this call only.
-        threshold = exu_solver.solverCheckMemoryAllocationsThreshold
-        exu_solver.solverCheckMemoryAllocationsThreshold = float("inf")
-        try:
-            start = time.perf_counter()
-            mbs.SolveDynamic(sim, solverType=solver_type)
-            wall = time.perf_counter() - start
-        finally:
-            exu_solver.solverCheckMemoryAllocationsThreshold = threshold
+        wall, cpu = self._solve(exu, mbs, cfg, solver, bool(closures), t_run, steps)
 
         U = np.asarray(mbs.GetSensorStoredData(s_u))
         Ut = np.asarray(mbs.GetSensorStoredData(s_ut))
@@ -653,7 +632,46 @@ class ExudynBackend(Backend):
                                                  conn_force, constraint_forces)
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=_SOLVER_ORDER[solver], settings=cfg, steps=steps,
-                         constraint_forces=constraint_forces)
+                         constraint_forces=constraint_forces, cpu_time=cpu)
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The system of `simulate` without its sensors, solved by the same solver."""
+        cfg = self.resolve_settings(settings)
+        solver = self._checked_solver(mechanism, cfg)
+        steps = int(round(t_end / dt))
+        exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
+        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
+        mbs.Assemble()
+        return self._solve(exu, mbs, cfg, solver, bool(closures), steps * dt, steps)[1]
+
+    def _checked_solver(self, mechanism: Mechanism, cfg: dict) -> str:
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
+        return self._solver_for(mechanism, cfg)
+
+    def _solve(self, exu, mbs, cfg: dict, solver: str, constrained: bool, t_run: float,
+               steps: int) -> tuple[float, float]:
+        """SolveDynamic over `steps` steps of the assembled system; (wall, CPU) seconds."""
+        import exudyn.solver as exu_solver
+
+        solver_type = getattr(exu.DynamicSolverType, solver)
+        sim = self._simulation_settings(exu, cfg, t_run, steps)
+        sim.timeIntegration.solverType = solver_type
+        if constrained:
+            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
+                cfg["constrained_spectral_radius"])
+        # Python user functions allocate on every call; Exudyn then prints a speed hint
+        # after the run. The hint is expected here, so it is silenced for this call only.
+        threshold = exu_solver.solverCheckMemoryAllocationsThreshold
+        exu_solver.solverCheckMemoryAllocationsThreshold = float("inf")
+        try:
+            start, cpu_start = time.perf_counter(), time.process_time()
+            mbs.SolveDynamic(sim, solverType=solver_type)
+            return time.perf_counter() - start, time.process_time() - cpu_start
+        finally:
+            exu_solver.solverCheckMemoryAllocationsThreshold = threshold
 
     @staticmethod
     def _solver_for(mechanism: Mechanism, cfg: dict) -> str:

@@ -1088,18 +1088,19 @@ class MujocoBackend(Backend):
         m, d = comp.model, comp.data
         steps = int(round(t_end / dt))
         comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
-        nq, nv = m.nq, m.nv
-        qpos = np.empty((steps + 1, nq))
-        qvel = np.empty((steps + 1, nv))
-        qpos[0], qvel[0] = d.qpos, d.qvel
-        step = mujoco.mj_step
+        # every sample is one row (qpos, qvel), written by one mj_getState call per step
+        spec = int(mujoco.mjtState.mjSTATE_QPOS) | int(mujoco.mjtState.mjSTATE_QVEL)
+        states = np.empty((steps + 1, mujoco.mj_stateSize(m, spec)))
+        step, get_state = mujoco.mj_step, mujoco.mj_getState
+        get_state(m, d, states[0], spec)
         with _PassiveInstalled(comp.callback):
-            start = time.perf_counter()
-            for k in range(1, steps + 1):
+            start, cpu_start = time.perf_counter(), time.process_time()
+            for row in states[1:]:
                 step(m, d)
-                qpos[k] = d.qpos
-                qvel[k] = d.qvel
+                get_state(m, d, row, spec)
+            cpu = time.process_time() - cpu_start
             wall = time.perf_counter() - start
+            qpos, qvel = states[:, :m.nq], states[:, m.nq:]
             t = dt * np.arange(steps + 1)
             reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
             forces, violation = self._closures(comp, qpos, qvel, t)
@@ -1109,11 +1110,28 @@ class MujocoBackend(Backend):
         qd = VD @ plan.Ainv.T
         run = RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                         integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
-                        steps=steps, constraint_forces=forces)
+                        steps=steps, constraint_forces=forces, cpu_time=cpu)
         # the substitute's own error: each closure's violation at every sample (not part
         # of the contract; read by the reports when present)
         run.constraint_violation = violation
         return run
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The model of `simulate`, stepped by one mj_step(nstep=N) call (the passive
+        callback installed, as MuJoCo calls it at every stage)."""
+        import mujoco
+
+        s = self._resolve(settings)
+        comp = _Compiled(self._plan(mechanism, s, dt=dt), s["integrator"], dt,
+                         bool(s["autoreset"]))
+        comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
+        steps = int(round(t_end / dt))
+        with _PassiveInstalled(comp.callback):
+            start = time.process_time()
+            if steps:
+                mujoco.mj_step(comp.model, comp.data, nstep=steps)
+            return time.process_time() - start
 
     def _closures(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
                   t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:

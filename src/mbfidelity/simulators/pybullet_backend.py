@@ -453,6 +453,20 @@ class _Plan:
         return self.AinvT @ Q
 
 
+@dataclass
+class _World:
+    """A PyBullet client with the mechanism built and its initial state set
+    (`PyBulletBackend._open`)."""
+
+    cid: int
+    body: int
+    eidx: list[int]  # engine link index of each plan link
+    plan: _Plan
+    cids: list[int]  # the PyBullet constraint of each closure
+    contact: _Contact | None
+    coupling: LinearCoupling | None  # the rolling coupling a contact stands for
+
+
 class PyBulletBackend(Backend):
     id = "pybullet"
     SETTINGS = {
@@ -981,17 +995,16 @@ class PyBulletBackend(Backend):
         tension = pf.law(length, rate, t)
         return -tension * ux, -tension * uy, ax, ay, bx, by
 
-    # --- contract point 6 --------------------------------------------------------------
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        import pybullet as p
-
-        cfg = self.resolve_settings(settings)
+    # --- contract points 6 and 9 ---------------------------------------------------------
+    def _open(self, p, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, dt: float,
+              cfg: dict, sensor_joints: Sequence[int] = ()) -> _World:
+        """Connect a DIRECT client, build the mechanism and set the state (q0, qd0);
+        enable the joint force/torque sensor on the joints `sensor_joints` (description
+        joint indices). The caller disconnects the client."""
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
-        contact = None
+        contact = coupling = None
         rolling = [c for c in mechanism.constraints if isinstance(c, RollingContact)]
         if rolling:
             contact = _contact_of(mechanism, rolling[0])
@@ -999,17 +1012,9 @@ class PyBulletBackend(Backend):
             mechanism = replace(mechanism, constraints=tuple(
                 c for c in mechanism.constraints if c is not rolling[0]))
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
-        n, steps = plan.n, int(round(t_end / dt))
-        n_all = len(plan.links)
-        closures = plan.closures
-        joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
-        use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
-        # one extra step gives the reaction/acceleration (and the constraint forces) of
-        # the last sample
-        total = steps + 1 if (reaction_joints or closures or contact) else steps
-
+        n = plan.n
         cid = self._connect(p, cfg, dt, plan.gravity,
-                            constrained=bool(closures) or contact is not None)
+                            constrained=bool(plan.closures) or contact is not None)
         try:
             shapes, ring = (self._contact_shapes(p, cid, plan, cfg) if contact is not None
                             else (None, None))
@@ -1019,15 +1024,135 @@ class PyBulletBackend(Backend):
             for i in range(n):
                 p.resetJointState(body, eidx[i], float(jv0[i]), float(jvd0[i]),
                                   physicsClientId=cid)
-            if n_all > n:
+            if len(plan.links) > n:
                 self._place_aux(p, cid, body, eidx, plan)
             cids = self._add_constraints(p, cid, body, eidx, plan, cfg)
             if contact is not None:
                 self._contact_dynamics(p, cid, body, eidx, plan, cfg)
-            if use_sensor:
-                for i in joint_ids:
-                    p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
+            for i in sensor_joints:
+                p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
+        except BaseException:
+            p.disconnect(physicsClientId=cid)
+            raise
+        return _World(cid, body, eidx, plan, cids, contact, coupling)
 
+    def _inputs(self, p, world: _World, dt: float
+                ) -> Callable[[int, list, list], tuple[np.ndarray | None, list | None]] | None:
+        """What the engine must be given before step k, or None when nothing: the joint
+        forces of the CoordinateForce laws (from the joint values and rates at the start
+        of the step, `jv` and `jvd` over at least the n coordinate links) and the
+        point-to-point forces (from the engine's link states), both at t = k dt, and the
+        PRISMATIC pivots moved under the pins (see `_pivot_under_pin`). The function
+        returns the joint forces and the (x, y) force on point b of each point-to-point
+        element (None where there are none)."""
+        plan, cid, body, eidx = world.plan, world.cid, world.body, world.eidx
+        n = plan.n
+        has_cf = bool(plan.coord_forces)
+        n_pf = len(plan.point_forces)
+        moving = [(world.cids[r], c) for r, c in enumerate(plan.closures)
+                  if c.kind == "prismatic"]
+        if not (has_cf or n_pf or moving):
+            return None
+        set_motors = p.setJointMotorControlArray
+        get_links = p.getLinkStates
+        apply_force = p.applyExternalForce
+        change = p.changeConstraint
+        torque_mode, world_frame = p.TORQUE_CONTROL, p.WORLD_FRAME
+        links = eidx[:n]
+        point_links = [eidx[k] for k in plan.point_links]
+        pos_of = {k: m for m, k in enumerate(plan.point_links)}
+        Ainv, bvec = plan.Ainv, plan.b
+        identity = plan.identity_map
+        moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
+                               if lk >= 0})
+        moving_eidx = [eidx[lk] for lk in moving_links]
+        slot_of = {lk: m for m, lk in enumerate(moving_links)}
+
+        def apply(k: int, jv: list, jvd: list) -> tuple[np.ndarray | None, list | None]:
+            t = k * dt
+            tau = forces = None
+            if has_cf:
+                if identity:
+                    tau = plan.coordinate_torques(jv[:n], jvd[:n], t)
+                else:
+                    q = Ainv @ (np.asarray(jv[:n]) - bvec)
+                    qd = Ainv @ np.asarray(jvd[:n])
+                    tau = plan.coordinate_torques(q, qd, t)
+                set_motors(body, links, torque_mode, forces=tau.tolist(), physicsClientId=cid)
+            if n_pf:
+                ls = get_links(body, point_links, computeLinkVelocity=1,
+                               computeForwardKinematics=1, physicsClientId=cid)
+                ls_by_link = {lk: ls[pos_of[lk]] for lk in plan.point_links}
+                forces = []
+                for pf in plan.point_forces:
+                    fx, fy, ax, ay, bx, by = self._tension_force(
+                        pf, self._points(ls_by_link, pf), t)
+                    forces.append((fx, fy))
+                    if pf.link_b >= 0:
+                        apply_force(body, eidx[pf.link_b], [fx, fy, 0.0], [bx, by, 0.0],
+                                    world_frame, physicsClientId=cid)
+                    if pf.link_a >= 0:
+                        apply_force(body, eidx[pf.link_a], [-fx, -fy, 0.0], [ax, ay, 0.0],
+                                    world_frame, physicsClientId=cid)
+            if moving:
+                ls = get_links(body, moving_eidx, physicsClientId=cid)
+                for uid, c in moving:
+                    change(uid, jointChildPivot=self._pivot_under_pin(ls, slot_of, c),
+                           physicsClientId=cid)
+            return tau, forces
+
+        apply.needs_state = has_cf  # type: ignore[attr-defined]
+        return apply
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
+        import pybullet as p
+
+        world = self._open(p, mechanism, q0, qd0, dt, self.resolve_settings(settings))
+        try:
+            steps = int(round(t_end / dt))
+            apply = self._inputs(p, world, dt)
+            step, cid = p.stepSimulation, world.cid
+            if apply is None:
+                start = time.process_time()
+                for _ in range(steps):
+                    step(physicsClientId=cid)
+            elif not apply.needs_state:
+                start = time.process_time()
+                for k in range(steps):
+                    apply(k, [], [])
+                    step(physicsClientId=cid)
+            else:
+                get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
+                start = time.process_time()
+                for k in range(steps):
+                    js = get_states(body, links, physicsClientId=cid)
+                    apply(k, [s[0] for s in js], [s[1] for s in js])
+                    step(physicsClientId=cid)
+            return time.process_time() - start
+        finally:
+            p.disconnect(physicsClientId=world.cid)
+
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        import pybullet as p
+
+        cfg = self.resolve_settings(settings)
+        joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
+        use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
+        world = self._open(p, mechanism, q0, qd0, dt, cfg,
+                           sensor_joints=joint_ids if use_sensor else ())
+        cid, body, eidx, plan, cids = world.cid, world.body, world.eidx, world.plan, world.cids
+        contact, coupling = world.contact, world.coupling
+        n, steps = plan.n, int(round(t_end / dt))
+        n_all = len(plan.links)
+        closures = plan.closures
+        # one extra step gives the reaction/acceleration (and the constraint forces) of
+        # the last sample
+        total = steps + 1 if (reaction_joints or closures or contact) else steps
+        try:
             JV = np.empty((total + 1, n_all))
             JVD = np.empty((total + 1, n_all))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
@@ -1040,70 +1165,29 @@ class PyBulletBackend(Backend):
 
             step = p.stepSimulation
             get_states = p.getJointStates
-            set_motors = p.setJointMotorControlArray
-            get_links = p.getLinkStates
             get_cstate = p.getConstraintState
             get_contacts = p.getContactPoints
-            apply_force = p.applyExternalForce
-            torque_mode, world = p.TORQUE_CONTROL, p.WORLD_FRAME
-            links = eidx[:n]
             all_links = eidx
-            has_cf = bool(plan.coord_forces)
-            point_links = [eidx[k] for k in plan.point_links]
-            pos_of = {k: m for m, k in enumerate(plan.point_links)}
-            Ainv, bvec = plan.Ainv, plan.b
-            identity = plan.identity_map
             sensor_slots = [eidx[i] for i in joint_ids]
             n_cs = len(cids)
-            # PRISMATIC rows are evaluated at the child's pivot, a fixed point of the slot
-            # body: it is moved under the pin before each step (see `_pivot_under_pin`)
-            moving = [(cids[r], c) for r, c in enumerate(closures) if c.kind == "prismatic"]
-            moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
-                                   if lk >= 0})
-            moving_eidx = [eidx[lk] for lk in moving_links]
-            slot_of = {lk: m for m, lk in enumerate(moving_links)}
-            change = p.changeConstraint
+            apply = self._inputs(p, world, dt)
             if contact is not None:
                 ring_links = set(plan.fixed_links)
                 disc_link = eidx[plan.link_of[contact.inner]]
 
             js = get_states(body, all_links, physicsClientId=cid)
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             for k in range(total):
-                t = k * dt
                 jv = [s[0] for s in js]
                 jvd = [s[1] for s in js]
                 JV[k] = jv
                 JVD[k] = jvd
-                if has_cf:
-                    if identity:
-                        tau = plan.coordinate_torques(jv[:n], jvd[:n], t)
-                    else:
-                        q = Ainv @ (np.asarray(jv[:n]) - bvec)
-                        qd = Ainv @ np.asarray(jvd[:n])
-                        tau = plan.coordinate_torques(q, qd, t)
-                    tau_applied[k] = tau
-                    set_motors(body, links, torque_mode, forces=tau.tolist(),
-                               physicsClientId=cid)
-                if n_pf:
-                    ls = get_links(body, point_links, computeLinkVelocity=1,
-                                   computeForwardKinematics=1, physicsClientId=cid)
-                    ls_by_link = {lk: ls[pos_of[lk]] for lk in plan.point_links}
-                    for e, pf in enumerate(plan.point_forces):
-                        fx, fy, ax, ay, bx, by = self._tension_force(
-                            pf, self._points(ls_by_link, pf), t)
-                        f_point[k, e] = fx, fy
-                        if pf.link_b >= 0:
-                            apply_force(body, eidx[pf.link_b], [fx, fy, 0.0], [bx, by, 0.0],
-                                        world, physicsClientId=cid)
-                        if pf.link_a >= 0:
-                            apply_force(body, eidx[pf.link_a], [-fx, -fy, 0.0], [ax, ay, 0.0],
-                                        world, physicsClientId=cid)
-                if moving:
-                    ls = get_links(body, moving_eidx, physicsClientId=cid)
-                    for uid, c in moving:
-                        change(uid, jointChildPivot=self._pivot_under_pin(ls, slot_of, c),
-                               physicsClientId=cid)
+                if apply is not None:
+                    tau, forces = apply(k, jv, jvd)
+                    if tau is not None:
+                        tau_applied[k] = tau
+                    if forces is not None:
+                        f_point[k] = forces
                 step(physicsClientId=cid)
                 js = get_states(body, all_links, physicsClientId=cid)
                 # constraint and contact forces read after a step belong to the state
@@ -1120,6 +1204,7 @@ class PyBulletBackend(Backend):
                     for r, slot in enumerate(sensor_slots):
                         rf = js[slot][2]
                         sensor[k, r] = rf[0], rf[1]
+            cpu = time.process_time() - c0
             wall = time.perf_counter() - t0
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
@@ -1167,7 +1252,7 @@ class PyBulletBackend(Backend):
             violation[contact.coupling] = contact_report.pop("slip")
         run = RunResult(t=np.arange(steps + 1) * dt, q=q, qd=qd, reactions=reactions,
                         wall_time=wall, integrator_order=1, settings=cfg, steps=steps,
-                        constraint_forces=forces)
+                        constraint_forces=forces, cpu_time=cpu)
         # the substitutes' own error: each closure's violation at every sample (not part
         # of the contract; read by the reports when present)
         run.constraint_violation = violation

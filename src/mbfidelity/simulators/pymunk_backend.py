@@ -1388,10 +1388,9 @@ class PymunkBackend(Backend):
         space.add(*shapes)
 
     # --- running -------------------------------------------------------------------------
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        cfg = self.resolve_settings(settings)
+    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict):
+        """Build: (layout, compiled functions, space, engine bodies, the mechanism as
+        balanced: a RollingContact stands for its coupling)."""
         layout = _plan(mechanism, cfg)
         if isinstance(layout, str):
             raise ValueError(f"pymunk cannot express this mechanism: {layout}")
@@ -1399,15 +1398,22 @@ class PymunkBackend(Backend):
         # holds the contact itself)
         mechanism = coupled(mechanism)
         comp = _compile(mechanism, layout)
-        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
         space, bodies = self._build(mechanism, comp, q0, qd0, cfg)
-        n_steps = int(round(t_end / dt))
-        h = float(dt)
-        # loads at x + h v and t + h (see setting notes), or at the sampled state
-        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        return layout, comp, space, bodies, mechanism
+
+    @staticmethod
+    def _reader(space, layout: _Layout, bodies: list) -> Callable[[], list[float]]:
+        """A function returning the state row of the engine bodies: per body, the centre
+        of gravity (x, y), angle, its velocity (vx, vy) and angular velocity. The row is
+        read for all bodies by one `pymunk.batch` call when the space lists them in
+        `bodies` order and none can fall asleep (which would reorder them); the position
+        of a body whose centre of gravity is off its frame origin is then read again as
+        `local_to_world(cog)`, as the body-by-body read does."""
+        import pymunk.batch
+
         cogs = [layout.cog.get(n) for n in layout.engine]
 
-        def read() -> list[float]:
+        def read_each() -> list[float]:
             row: list[float] = []
             for b, cog in zip(bodies, cogs):
                 row.extend(b.local_to_world(cog) if cog else b.position)
@@ -1416,6 +1422,71 @@ class PymunkBackend(Backend):
                 row.append(b.angular_velocity)
             return row
 
+        fields = pymunk.batch.BodyFields
+        buffer = pymunk.batch.Buffer()
+        get = pymunk.batch.get_space_bodies
+        get(space, fields.BODY_ID, buffer)
+        ids = list(memoryview(buffer.int_buf()).cast("P"))
+        if space.sleep_time_threshold != math.inf or ids[:len(bodies)] != [b.id for b in bodies]:
+            return read_each
+        wanted = fields.POSITION | fields.ANGLE | fields.VELOCITY | fields.ANGULAR_VELOCITY
+        width = 6 * len(bodies)
+        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
+
+        def read_batch() -> list[float]:
+            buffer.clear()
+            get(space, wanted, buffer)
+            row = memoryview(buffer.float_buf()).cast("d")[:width].tolist()
+            for i, b, cog in off_origin:
+                row[i:i + 2] = b.local_to_world(cog)
+            return row
+
+        return read_batch
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The space of `simulate` stepped with only its element forces: those need the
+        state at the start of each step, the rest runs step after step."""
+        cfg = self.resolve_settings(settings)
+        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
+        layout, comp, space, bodies, _ = self._prepare(mechanism, q0, qd0, cfg)
+        n_steps = int(round(t_end / dt))
+        h = float(dt)
+        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        step = space.step
+        loads = comp.loads_math
+        targets = [bodies[k] for k in comp.loaded]
+        iterations = int(cfg["iterations"])
+        space.iterations = max(iterations, int(cfg["start_iterations"]))
+        start = time.process_time()
+        if loads is None:
+            for k in range(n_steps):
+                step(h)
+                if k == 0:
+                    space.iterations = iterations
+        else:
+            read = self._reader(space, layout, bodies)
+            for k in range(n_steps):
+                out = loads(*read(), H, (k + shift) * h)
+                for i, b in enumerate(targets):
+                    b.force = (out[3 * i], out[3 * i + 1])
+                    b.torque = out[3 * i + 2]
+                step(h)
+                if k == 0:
+                    space.iterations = iterations
+        return time.process_time() - start
+
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        cfg = self.resolve_settings(settings)
+        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
+        layout, comp, space, bodies, mechanism = self._prepare(mechanism, q0, qd0, cfg)
+        n_steps = int(round(t_end / dt))
+        h = float(dt)
+        # loads at x + h v and t + h (see setting notes), or at the sampled state
+        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        read = self._reader(space, layout, bodies)
         rows = [read()]
         step = space.step
         loads = comp.loads_math
@@ -1423,7 +1494,7 @@ class PymunkBackend(Backend):
         iterations = int(cfg["iterations"])
         # the first step has no cached impulses to start from (see start_iterations)
         space.iterations = max(iterations, int(cfg["start_iterations"]))
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         if loads is None:
             for k in range(n_steps):
                 step(h)
@@ -1440,6 +1511,7 @@ class PymunkBackend(Backend):
                 rows.append(read())
                 if k == 0:
                     space.iterations = iterations
+        cpu = time.process_time() - cpu_start
         wall = time.perf_counter() - start
 
         S = np.array(rows)
@@ -1460,7 +1532,7 @@ class PymunkBackend(Backend):
                          for j in reaction_joints}
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=1, settings=cfg, steps=n_steps,
-                         constraint_forces=constraint_forces)
+                         constraint_forces=constraint_forces, cpu_time=cpu)
 
     @staticmethod
     def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
