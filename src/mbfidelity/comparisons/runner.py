@@ -205,6 +205,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
         result.supported = False
         result.reason = support.reason if not support.ok else unsupported.reason
         return result
+    _refuse_unstable_step(system, backend, mech, merged, base_values, dt)
     every = [(sc, None) for sc in system.scenarios] + near_equilibrium_scenarios(system,
                                                                                 base_values)
     by_name = {sc.name: (sc, eq) for sc, eq in every}
@@ -225,6 +226,21 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
             if m.status != "pass":
                 m.status, m.reason = "measured", chosen_variant.reason
     return result
+
+
+def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) -> None:
+    """ValueError (one line) when the engine's scheme cannot be stable at this step on the
+    fastest mode of the operating point's linearization (before any reference solve,
+    which a stiff system would make endless)."""
+    scheme = backend.scheme(mech, settings)
+    if scheme is None or scheme.stability_limit is None:
+        return
+    eq = operating_equilibrium(system, values)
+    w = float(np.max(np.abs(eq.eigenvalues))) if len(eq.eigenvalues) else 0.0
+    refusal = tolerances.stability_refusal(w, dt, f"{backend.id}'s {scheme.name}",
+                                           scheme.stability_limit)
+    if refusal:
+        raise ValueError(refusal)
 
 
 #: start of the generated checks near the other stable equilibria: this far from the

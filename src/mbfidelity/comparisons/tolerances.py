@@ -55,13 +55,13 @@ faster forcing).
   the reference's; a frequency error of MAX_FREQUENCY_TOLERANCE = 0.05) is unresolved too:
   a pass would mean nothing.
 * Stability. An explicit scheme diverges on a mode with w h above its stability limit on
-  the imaginary axis (RK4: 2 sqrt 2; semi-implicit Euler: 2); a comparison refuses such a
-  step before stepping (`stability_refusal`).
+  the imaginary axis (RK4: 2 sqrt 2; semi-implicit Euler: 2; each backend names its
+  scheme and limit, simulators/base.py point 10); a comparison refuses such a step
+  before any work (`stability_refusal`).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-import math
 
 FD_FREQUENCY = 1e-6
 FIT_RESOLUTION = 1e-5
@@ -110,11 +110,6 @@ def stability_refusal(w: float, h: float, scheme: str, limit: float | None) -> s
         return ""
     return (f"dt = {h:g} s cannot be stable with {scheme}: w h = {w * h:.3g} at the fastest "
             f"mode (w = {w:.4g} rad/s) exceeds the scheme's stability limit {limit:.3g}")
-
-
-#: stability limits on the imaginary axis of the explicit schemes the engines use
-RK4_STABILITY = 2 * math.sqrt(2)
-SEMI_IMPLICIT_EULER_STABILITY = 2.0
 
 
 def trajectory_tolerance(w: float, h: float, order: int, t_end: float, zeta: float = 0.0) -> float:

@@ -62,7 +62,11 @@ conventions 1-8) into one engine and runs it. The contract:
    (``time.process_time``) of that loop, build excluded: the floor against which
    ``RunResult.cpu_time`` is measured (benchmarks/cost.py). Read-outs belong in
    `simulate`, batched so that its stepping costs little more than this loop.
-10. Shared steps: what every backend needs before its engine enters is computed once, in
+10. `scheme(mechanism, settings)` names the integration scheme the run will use, its
+    order and its stability limit (the largest stable w h on an undamped mode; None for an
+    unconditionally stable implicit scheme), known before any stepping, so that a step
+    that cannot be stable is refused up front.
+11. Shared steps: what every backend needs before its engine enters is computed once, in
     `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
     map between description coordinates and engine joint values, forward kinematics),
     and settings are validated here; a backend translates the plan into its engine,
@@ -71,6 +75,7 @@ conventions 1-8) into one engine and runs it. The contract:
 from __future__ import annotations
 
 import copy
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import ClassVar, Mapping, Sequence
@@ -153,6 +158,21 @@ def _has_type(value: object, kind: type) -> bool:
 class Support:
     ok: bool
     reason: str = ""
+
+
+#: stability limits on the imaginary axis (largest stable w h on an undamped mode)
+RK4_STABILITY = 2 * math.sqrt(2)
+RK3_STABILITY = math.sqrt(3)
+SEMI_IMPLICIT_EULER_STABILITY = 2.0
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """The integration scheme of a run (contract point 10)."""
+
+    name: str
+    order: int
+    stability_limit: float | None
 
 
 @dataclass
@@ -245,6 +265,10 @@ class Backend(ABC):
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
         """See the contract in the module docstring."""
+
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme | None:
+        """See the contract in the module docstring (None: not known before stepping)."""
+        return None
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:

@@ -78,7 +78,7 @@ from ..systems.model import (
     Revolute,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
+from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
 from .plan import (
     BODY,
     COORDINATE_FORCE_CUSTOM,
@@ -564,6 +564,13 @@ class ExudynBackend(Backend):
             settings["linearization_relative_epsilon"])
         s.linearSolver.ignoreSingularJacobian = False
         return s
+
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
+        solver = self._solver_for(mechanism, self.resolve_settings(settings))
+        # implicit solvers are unconditionally stable; of the explicit ones only the
+        # Runge-Kutta schemes with a stable stretch of the imaginary axis get a limit
+        limits = {"RK44": RK4_STABILITY, "RK33": RK3_STABILITY}
+        return Scheme(solver, _SOLVER_ORDER[solver], limits.get(solver))
 
     # --- simulation ------------------------------------------------------------------------
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,

@@ -79,6 +79,9 @@ from ..systems.model import (
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import (
+    RK4_STABILITY,
+    Scheme,
+    SEMI_IMPLICIT_EULER_STABILITY,
     EXACT,
     SOFT,
     SUBSTITUTE,
@@ -1073,6 +1076,13 @@ class MujocoBackend(Backend):
             attrs, rest = tail.split("/>", 1)
             xml = f"{head}<flag {attrs} {' '.join(flags)}/>{rest}"
         return xml
+
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
+        integrator = str(self.resolve_settings(settings)["integrator"])
+        if integrator == "RK4":
+            return Scheme("RK4", 4, RK4_STABILITY)
+        # Euler, implicit and implicitfast: semi-implicit Euler (implicit in damping only)
+        return Scheme(f"semi-implicit Euler ({integrator})", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
     # --- simulation ----------------------------------------------------------------------
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,

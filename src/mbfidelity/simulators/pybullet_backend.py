@@ -84,6 +84,8 @@ from ..systems.model import (
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import (
+    SEMI_IMPLICIT_EULER_STABILITY,
+    Scheme,
     EXACT,
     SUBSTITUTE,
     UNSUPPORTED,
@@ -1133,6 +1135,9 @@ class PyBulletBackend(Backend):
             return time.process_time() - start
         finally:
             p.disconnect(physicsClientId=world.cid)
+
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
+        return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,

@@ -107,6 +107,8 @@ from ..systems.model import (
     rotation,
 )
 from .base import (
+    SEMI_IMPLICIT_EULER_STABILITY,
+    Scheme,
     EXACT,
     SUBSTITUTE,
     UNSUPPORTED,
@@ -1475,6 +1477,9 @@ class PymunkBackend(Backend):
                 if k == 0:
                     space.iterations = iterations
         return time.process_time() - start
+
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
+        return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
