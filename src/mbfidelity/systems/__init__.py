@@ -246,8 +246,12 @@ class System:
                                  f"on each other")
             for name in ready:
                 args, law = self._formulas[name]
-                value = float(law(*(values[a] for a in args)))
-                known[name].validate(value)
+                try:
+                    value = float(law(*(values[a] for a in args)))
+                    known[name].validate(value)
+                except (ValueError, ArithmeticError) as exc:
+                    raise ValueError(f"{self.id}: default of {name} = {known[name].default}: "
+                                     f"{exc}") from None
                 values[name] = value
             pending = [n for n in pending if n not in ready]
         values = {name: values[name] for name in known}
