@@ -28,10 +28,11 @@ def _random_values(system_id, seed):
     s = get_system(system_id)
     rng = np.random.default_rng(seed)
     valid = getattr(HAND[system_id], "valid", lambda v: True)
+    base = s.parameter_values()
     while True:
-        values = {p.name: p.default * rng.uniform(0.5, 2.0) if p.default else p.default
-                  for p in s.all_parameters}
-        if valid(values):
+        # every parameter drawn, those with formula defaults too (given explicitly)
+        values = {name: v * rng.uniform(0.5, 2.0) if v else v for name, v in base.items()}
+        if s.is_valid(values) and valid(values):
             return values
 
 
@@ -166,7 +167,7 @@ def test_compound_pendulum_pivot_reaction_by_newton():
     qd = rng.uniform(-3, 3, (20, 1))
     t = np.zeros(20)
     qdd = model.accelerations(q, qd, t)
-    m, l, g = v["m"], v["L"] / 2, v["g"]
+    m, l, g = v["m"], v["l"], v["g"]
     phi, w, a = q[:, 0], qd[:, 0], qdd[:, 0]
     ax = m * l * (a * np.cos(phi) - w**2 * np.sin(phi))
     ay = m * l * (a * np.sin(phi) + w**2 * np.cos(phi)) + m * g
@@ -265,6 +266,8 @@ def test_unknown_parameter_and_bad_values_are_rejected():
         s.parameter_values({"mass": 2.0})
     with pytest.raises(ValueError, match="must be > 0"):
         s.parameter_values({"L": -1.0})
+    with pytest.raises(ValueError, match="must be finite"):
+        s.parameter_values({"m": float("inf")})
 
 
 @pytest.mark.parametrize("system_id", SYSTEMS)

@@ -30,6 +30,9 @@ def test_analyze_json_contract_and_param_override():
     for key in ("system", "parameters", "equilibria", "linearization", "modes"):
         assert key in doc
     assert doc["parameters"]["L"] == 2
+    # l = L/2 and I_O = m L^2/3 follow L (formula defaults)
+    assert doc["derived_parameters"] == ["l", "I_O"]
+    assert doc["parameters"]["l"] == 1 and doc["parameters"]["I_O"] == pytest.approx(4 / 3)
     stable = [e for e in doc["equilibria"] if e["stable"]]
     assert len(stable) == 1 and {"q", "stable", "modes"} <= set(stable[0])
     f = doc["modes"][0]["frequency_hz"]
@@ -37,6 +40,23 @@ def test_analyze_json_contract_and_param_override():
     assert np.array(doc["linearization"]["M"]).shape == (1, 1)
     unstable = [e for e in doc["equilibria"] if not e["stable"]]
     assert unstable and "eigenvalues" in unstable[0]
+
+
+def test_analyze_double_pendulum_bars_follow_mass_and_length():
+    """Fig. 37 with two uniform bars (I = m (2l)^2/12 = m l^2/3): det(K - w^2 M) = 0 with
+    M = m l^2 [[16/3, 2], [2, 4/3]], K = m g l diag(3, 1) gives, with x = w^2 l/g,
+    28 x^2 - 84 x + 27 = 0, x = 3/2 -+ 3/sqrt(7): independent of m; with the inertia of
+    the default bar (1/12) instead, the frequencies would differ."""
+    doc = _json(["analyze", "double_pendulum", "--param", "m=2", "--param", "l=0.3", "--json"])
+    assert doc["derived_parameters"] == ["I"]
+    assert doc["parameters"]["I"] == pytest.approx(2 * 0.6**2 / 12, rel=1e-12)
+    g, l = 9.81, 0.3
+    want = [np.sqrt(g / l * (1.5 + sign * 3 / np.sqrt(7))) / (2 * np.pi) for sign in (-1, 1)]
+    got = [mode["frequency_hz"] for mode in doc["modes"]]
+    assert got == pytest.approx(want, rel=1e-9)
+    explicit = _json(["analyze", "double_pendulum", "--param", "m=2", "--param", "l=0.3",
+                      "--param", "I=0.05", "--json"])
+    assert explicit["derived_parameters"] == [] and explicit["parameters"]["I"] == 0.05
 
 
 def test_analyze_json_damped_modes():
@@ -53,6 +73,13 @@ def test_analyze_json_damped_modes():
     (["analyze", "compound_pendulum", "--param", "L=-1"], "must be > 0"),
     (["analyze", "compound_pendulum", "--param", "L"], "NAME=VALUE"),
     (["compare", "compound_pendulum", "--sim", "gazebo"], "valid:"),
+    (["analyze", "compound_pendulum", "--param", "m=inf"], "must be finite"),
+    (["analyze", "compound_pendulum", "--param", "L=nan"], "must be finite"),
+    (["analyze", "scotch_yoke", "--param", "b=0.3"], "violate h - b - r > 0"),
+    (["analyze", "scotch_yoke", "--param", "r=0.5"], "violate h - b - r > 0"),
+    (["compare", "scotch_yoke", "--sim", "pymunk", "--param", "b=0.3"], "violate h - b - r > 0"),
+    (["compare", "scotch_yoke", "--sim", "pymunk", "--param", "m=-inf"], "must be finite"),
+    (["analyze", "compound_pendulum", "--param", "l=0.7"], "violate I_O > m*l**2"),
 ])
 def test_bad_input_gets_one_line_error(args, needle):
     res = runner.invoke(app, args)

@@ -41,9 +41,14 @@ def _system(system_id: str):
         _fail(exc.args[0])
 
 
-def _values(system, params):
+def _values(system, params, scenarios=()):
+    """(values, names of the parameters derived from their default's formula); every
+    parameter set the command will use (with each scenario's values) is checked first:
+    a bad one ends the command with one line (exit 2)."""
     try:
-        return system.parameter_values(params)
+        for sc in scenarios:
+            system.parameter_values(params, scenario=sc)
+        return system.resolve_parameters(params)
     except (KeyError, ValueError) as exc:
         _fail(exc.args[0])
 
@@ -109,7 +114,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     from .analytic.linear import find_equilibria, operating_equilibrium
 
     system = _system(system_id)
-    values = _values(system, _parse_params(param))
+    values, derived = _values(system, _parse_params(param))
     coords = list(system.coordinates)
     try:
         eqs = find_equilibria(system, values)
@@ -127,7 +132,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         equilibria.append(item)
     doc = {
         "system": system.id, "title": system.title, "source": system.source,
-        "coordinates": coords, "parameters": values,
+        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
         "equilibria": equilibria,
         "operating_point": dict(zip(coords, op.q.tolist())),
         "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C, "K": op.K},
@@ -140,6 +145,9 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         return
     typer.echo(f"{system.id}: {system.title} ({system.source})")
     typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in values.items()))
+    formulas = {p.name: p.default for p in system.all_parameters}
+    if derived:
+        typer.echo("derived: " + ", ".join(f"{k} = {formulas[k]}" for k in derived))
     for e in equilibria:
         typer.echo(f"equilibrium {e['q']}: {'stable' if e['stable'] else 'unstable'}")
     typer.echo(f"at {doc['operating_point']}:")
@@ -182,7 +190,7 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
 
     system = _system(system_id)
     params = _parse_params(param)
-    _values(system, params)
+    _values(system, params, system.scenarios)
     try:
         get_backend(sim)
     except KeyError as exc:

@@ -1,4 +1,5 @@
-"""Fig. 7, eq. 5: I_O phi'' + m g l phi = 0 with I_O = m L^2/3, l = L/2."""
+"""Fig. 7, eq. 5: I_O phi'' + m g l phi = 0 (for the uniform bar, the defaults, I_O =
+m L^2/3 and l = L/2)."""
 import numpy as np
 
 EQUILIBRIA = (2, 1)  # phi = 0 (stable), pi (unstable)
@@ -6,4 +7,4 @@ MISPRINTS = set()
 
 
 def frequencies(v):
-    return [np.sqrt(v["m"] * v["g"] * v["L"] / 2 / (v["m"] * v["L"] ** 2 / 3))]
+    return [np.sqrt(v["m"] * v["g"] * v["l"] / v["I_O"])]

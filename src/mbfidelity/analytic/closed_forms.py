@@ -15,8 +15,8 @@ import scipy.special
 def compound_pendulum(values: Mapping[str, float], q0, qd0, t: np.ndarray):
     """Libration of I_O phi'' + m g l sin(phi) = 0 (Fig. 7, eq. 4), any amplitude < pi:
     sin(phi/2) = k sn(w0 t + u0 | k^2), k = sin(phi_max/2), w0 = sqrt(m g l / I_O)."""
-    m, L, g = values["m"], values["L"], values["g"]
-    w0 = np.sqrt(m * g * (L / 2) / (m * L**2 / 3))
+    m, l, I_O, g = values["m"], values["l"], values["I_O"], values["g"]
+    w0 = np.sqrt(m * g * l / I_O)
     phi0, dphi0 = float(q0[0]), float(qd0[0])
     k = np.sqrt(np.sin(phi0 / 2) ** 2 + (dphi0 / (2 * w0)) ** 2)
     if not k < 1:

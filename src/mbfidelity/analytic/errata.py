@@ -88,11 +88,14 @@ class Erratum:
 
 
 def _parameter_sets(system: System, rng) -> list[dict[str, float]]:
-    """The defaults and one random perturbation (+-30 %) that keeps the mechanism
-    assembled with an equilibrium near its operating point (redrawn otherwise)."""
+    """The defaults and one random perturbation (+-30 %) that keeps the geometry valid
+    and the mechanism assembled with an equilibrium near its operating point (redrawn
+    otherwise)."""
     base = system.parameter_values()
     for _ in range(50):
         perturbed = {k: (v * rng.uniform(0.7, 1.3) if v != 0 else v) for k, v in base.items()}
+        if not system.is_valid(perturbed):
+            continue
         try:
             operating_equilibrium(system, perturbed)
         except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError):

@@ -131,6 +131,19 @@ class Variant:
 
 
 @dataclass(frozen=True)
+class Condition:
+    """A condition on the parameters without which the geometry does not exist: a spring
+    length that must stay positive over the motion, a pin that must stay in its slot, a
+    loop that must be able to close. `relation` is a SymPy relation of parameter names
+    (conditions over the motion are written at their worst case, e.g. the cot spring's
+    length h - b - r sin(phi) over a turn: ``"h - b - r > 0"``); `meaning` says what it
+    guarantees. Parameter sets that violate one are refused before any work."""
+
+    relation: str
+    meaning: str
+
+
+@dataclass(frozen=True)
 class Expectation:
     """An exception as data (scikit-learn's common-check pattern).
 
@@ -164,6 +177,8 @@ class System:
     contacts: Callable[[SimpleNamespace], tuple[ContactOutput, ...]] = lambda P: ()
     expectations: tuple[Expectation, ...] = ()
     variants: tuple[Variant, ...] = ()
+    #: conditions on the parameters for the geometry to exist (checked on every set)
+    validity: tuple[Condition, ...] = ()
     #: name of an exact solution in mbfidelity.analytic.closed_forms, if one exists
     exact_solution: str | None = None
     notes: str = ""
@@ -202,19 +217,103 @@ class System:
 
     def parameter_values(self, overrides: Mapping[str, float] | None = None,
                          scenario: Scenario | None = None) -> dict[str, float]:
-        """Defaults, then the scenario's values, then the user's overrides (validated)."""
+        """Defaults, then the scenario's values, then the user's overrides (validated),
+        then the defaults given by formulas that neither set; the set must meet the
+        system's `validity` conditions (ValueError naming the violated one)."""
+        return self.resolve_parameters(overrides, scenario)[0]
+
+    def derived_parameters(self, overrides: Mapping[str, float] | None = None,
+                           scenario: Scenario | None = None) -> tuple[str, ...]:
+        """Names of the parameters whose value comes from their default's formula (not
+        set by the scenario or the user)."""
+        return self.resolve_parameters(overrides, scenario)[1]
+
+    def resolve_parameters(self, overrides: Mapping[str, float] | None = None,
+                           scenario: Scenario | None = None
+                           ) -> tuple[dict[str, float], tuple[str, ...]]:
+        """(values, names of the derived parameters): see `parameter_values`."""
         known = {p.name: p for p in self.all_parameters}
-        values = {name: float(p.default) for name, p in known.items()}
+        given: dict[str, float] = {}
         if scenario is not None:
-            values.update({k: float(v) for k, v in scenario.overrides.items()})
+            given.update({k: float(v) for k, v in scenario.overrides.items()})
         for name, value in (overrides or {}).items():
             if name not in known:
                 raise KeyError(
                     f"unknown parameter {name!r} for {self.id}; valid: {', '.join(known)}"
                 )
             known[name].validate(float(value))
-            values[name] = float(value)
-        return values
+            given[name] = float(value)
+        values = {name: float(p.default) for name, p in known.items() if not p.derived}
+        values.update(given)
+        pending = [name for name, p in known.items() if p.derived and name not in given]
+        derived = tuple(pending)
+        while pending:  # a formula may use another derived parameter
+            ready = [n for n in pending if set(self._formulas[n][0]) <= set(values)]
+            if not ready:
+                raise ValueError(f"{self.id}: the formulas of {', '.join(pending)} depend "
+                                 f"on each other")
+            for name in ready:
+                args, law = self._formulas[name]
+                try:
+                    value = float(law(*(values[a] for a in args)))
+                    known[name].validate(value)
+                except (ValueError, ArithmeticError) as exc:
+                    raise ValueError(f"{self.id}: default of {name} = {known[name].default}: "
+                                     f"{exc}") from None
+                values[name] = value
+            pending = [n for n in pending if n not in ready]
+        values = {name: values[name] for name in known}
+        self.check_validity(values)
+        return values, derived
+
+    def check_validity(self, values: Mapping[str, float]) -> None:
+        """Raise ValueError (one line, the first violated condition) when `values` leave
+        the geometry's domain."""
+        for condition, lhs, rhs, op in self._conditions:
+            a = float(lhs(*(values[n] for n in lhs.names)))
+            b = float(rhs(*(values[n] for n in rhs.names)))
+            if not _RELATIONS[op](a, b):
+                raise ValueError(f"{self.id}: the parameters violate {condition.relation} "
+                                 f"({a:.6g} {op} {b:.6g} is false): {condition.meaning}")
+
+    def is_valid(self, values: Mapping[str, float]) -> bool:
+        try:
+            self.check_validity(values)
+        except ValueError:
+            return False
+        return True
+
+    @cached_property
+    def _formulas(self) -> dict[str, tuple[tuple[str, ...], Callable[..., float]]]:
+        """name -> (the parameters its formula uses, the compiled formula)."""
+        names = {p.name for p in self.all_parameters}
+        out = {}
+        for p in self.all_parameters:
+            if not p.derived:
+                continue
+            expr = sp.sympify(p.default, locals=vars(self.symbols))
+            args = tuple(sorted(str(x) for x in expr.free_symbols))
+            if not set(args) <= names - {p.name}:
+                raise ValueError(f"{self.id}: default of {p.name} ({p.default}) must be a "
+                                 f"formula of the other parameters")
+            out[p.name] = (args, sp.lambdify([getattr(self.symbols, a) for a in args], expr,
+                                             modules="math"))
+        return out
+
+    @cached_property
+    def _conditions(self):
+        out = []
+        for c in self.validity:
+            rel = sp.sympify(c.relation, locals=vars(self.symbols), evaluate=False)
+            if not isinstance(rel, sp.core.relational.Relational):
+                raise ValueError(f"{self.id}: validity condition {c.relation!r} is not a "
+                                 f"relation")
+            if rel.rel_op not in _RELATIONS:
+                raise ValueError(f"{self.id}: validity condition {c.relation!r} must be an "
+                                 f"inequality")
+            out.append((c, _compiled(rel.lhs, self.symbols), _compiled(rel.rhs, self.symbols),
+                        rel.rel_op))
+        return tuple(out)
 
     def subs(self, values: Mapping[str, float]) -> dict[sp.Symbol, float]:
         return {getattr(self.symbols, k): v for k, v in values.items()}
@@ -257,6 +356,17 @@ class System:
 
         op = self.operating_point(self.symbols)
         return np.array([self.evaluate(op.get(c, 0), values) for c in self.coordinates])
+
+
+_RELATIONS = {">": float.__gt__, ">=": float.__ge__, "<": float.__lt__, "<=": float.__le__}
+
+
+def _compiled(expr, symbols: SimpleNamespace):
+    """An expression of parameters as a fast function; `.names` lists its arguments."""
+    names = tuple(sorted(str(x) for x in sp.sympify(expr).free_symbols))
+    law = sp.lambdify([getattr(symbols, n) for n in names], expr, modules="math")
+    law.names = names
+    return law
 
 
 def _discover() -> dict[str, System]:

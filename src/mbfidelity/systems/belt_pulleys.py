@@ -41,7 +41,7 @@ angle relative to the arm without changing the potential).
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import (COORD_RATE, Body, Circle, CoordinateForce, LinearCoupling, Mechanism,
                     Parameter, Revolute, Scenario, Segment)
 
@@ -127,6 +127,8 @@ SYSTEM = System(
     build=build,
     operating_point=lambda P: {"theta": 0, "phi1": 0, "phi2": 0},
     printed=printed,
+    validity=(Condition("r1 + r2 < l", "the pulleys, whose centres are l apart, must not "
+                                       "overlap"),),
     scenarios=(
         Scenario("small", {"theta": 0.05}, checks=_CHECKS,
                  description="0.05 rad from the stable equilibrium theta = 0, from rest"),

@@ -8,32 +8,38 @@ Geometry (φ from the downward vertical, counter-clockwise positive)::
            G
             \\
 
-The bar frame has its y axis along G->O, so the pivot is the body point (0, L/2) and
-G = (l sin φ, -l cos φ). I_O = m L^2/3 (uniform bar). The exact motion from rest at any
+The bar frame has its y axis along G->O, so the pivot is the body point (0, l) and
+G = (l sin φ, -l cos φ); the bar's central inertia is I_O - m l^2. The defaults of l and
+I_O are the uniform bar's formulas, l = L/2 and I_O = m L^2/3 (MECHANISMS.md), evaluated
+at the user's m and L unless l or I_O are given too. The exact motion from rest at any
 amplitude below π is given by Jacobi's elliptic functions.
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 PARAMETERS = (
     Parameter("m", 1.0, "kg", "mass of the bar", "MECHANISMS.md A; Fig. 7"),
     Parameter("L", 1.0, "m", "length of the bar (pinned at one end)", "MECHANISMS.md A"),
+    Parameter("l", "L/2", "m", "distance from the pivot O to the centre of mass (default: "
+              "uniform bar, L/2)", "MECHANISMS.md A; Fig. 7"),
+    Parameter("I_O", "m*L**2/3", "kg m^2", "moment of inertia about the pivot O (default: "
+              "uniform bar, m L^2/3)", "MECHANISMS.md A; eq. 5"),
     Parameter("phi0", 0.05, "rad", "initial angle, released from rest", "MECHANISMS.md A",
               domain="real"),
 )
 
 
 def build(P) -> Mechanism:
-    bar = Body("bar", P.m, P.m * P.L**2 / 12, (Segment((0, P.L / 2), (0, -P.L / 2)),))
-    pivot = Revolute("pivot", "world", "bar", "phi", child_anchor=(0, P.L / 2))
+    bar = Body("bar", P.m, P.I_O - P.m * P.l**2, (Segment((0, P.l), (0, P.l - P.L)),))
+    pivot = Revolute("pivot", "world", "bar", "phi", child_anchor=(0, P.l))
     return Mechanism(bodies=(bar,), joints=(pivot,))
 
 
 def printed(P):
     phi, phi_d, phi_dd = coordinate_symbols("phi")
-    I_O, l = P.m * P.L**2 / 3, P.L / 2
+    I_O, l = P.I_O, P.l
     return (
         PrintedFormula("Fig. 7, eq. 4", "eom", [I_O * phi_dd + P.m * P.g * l * sp.sin(phi)]),
         PrintedFormula("Fig. 7, eq. 5 (inertia)", "M", sp.Matrix([[I_O]])),
@@ -60,5 +66,10 @@ SYSTEM = System(
                  description="released from rest at 2.0 rad (strongly nonlinear)"),
     ),
     reaction_joints=("pivot",),
+    validity=(
+        Condition("I_O > m*l**2", "the bar's central moment of inertia, I_O - m l^2, must be "
+                                  "positive"),
+        Condition("l <= L", "the centre of mass must lie on the bar"),
+    ),
     exact_solution="compound_pendulum",
 )

@@ -29,7 +29,8 @@ Variant (§4.2): viscous friction c in the block's guide, reduced force -c (e si
 """
 import sympy as sp
 
-from . import ContactOutput, Expectation, PrintedFormula, System, coordinate_symbols
+from . import (Condition, ContactOutput, Expectation, PrintedFormula, System,
+               coordinate_symbols)
 from ._reasons import VELOCITY_LEVEL_STARTUP
 from .model import (COORD_RATE, LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, PointToPoint, Prismatic, Rectangle, Revolute, Scenario)
@@ -139,6 +140,15 @@ SYSTEM = System(
     operating_point=lambda P: {"phi": 0, "y": P.R - P.e + BLOCK_HALF_HEIGHT},
     printed=printed,
     contacts=contacts,
+    validity=(
+        Condition("I_O > m_e*e**2", "the disc's central moment of inertia, I_O - m_e e^2, "
+                                    "must be positive"),
+        Condition("e < R", "the pivot O must lie inside the disc"),
+        Condition("Abs(r - e) <= R", "the spring's end A (r below O at phi = 0) must be a "
+                                     "point of the disc"),
+        Condition("h > r", "the spring's length, from h - r at phi = 0 to h + r, must stay "
+                           "positive over a turn"),
+    ),
     scenarios=(
         Scenario("small", {"phi": 0.05}, checks=("trajectory", "constraint_force"),
                  description="0.05 rad from the stable equilibrium phi = 0"),

@@ -31,6 +31,7 @@ Conventions (all backends and the analytic layer honour them):
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Callable, Mapping, Sequence, Union
 
@@ -51,15 +52,25 @@ STANDARD_GRAVITY = 9.81
 
 @dataclass(frozen=True)
 class Parameter:
-    """A named, overridable parameter (names as in MECHANISMS.md, ASCII spelling)."""
+    """A named, overridable parameter (names as in MECHANISMS.md, ASCII spelling).
+
+    `default` is a number, or a formula: an expression of the other parameters in SymPy
+    syntax (e.g. ``"m*(2*l)**2/12"``, the inertia of a uniform bar), evaluated after the
+    scenario's and the user's values, so that a default defined by a formula follows the
+    parameters it depends on; a value given explicitly still wins."""
 
     name: str
-    default: float
+    default: float | str
     unit: str
     meaning: str
     source: str = "MECHANISMS.md"
-    #: "positive", "nonnegative" or "real": checked when a user overrides the value.
+    #: "positive", "nonnegative" or "real": checked on every value (given or derived).
     domain: str = "positive"
+
+    @property
+    def derived(self) -> bool:
+        """Whether the default is a formula of other parameters."""
+        return isinstance(self.default, str)
 
     @property
     def symbol(self) -> sp.Symbol:
@@ -70,6 +81,8 @@ class Parameter:
         return sp.Symbol(self.name, real=True)
 
     def validate(self, value: float) -> None:
+        if not math.isfinite(value):
+            raise ValueError(f"parameter {self.name} must be finite, got {value}")
         if self.domain == "positive" and not value > 0:
             raise ValueError(f"parameter {self.name} must be > 0, got {value}")
         if self.domain == "nonnegative" and not value >= 0:

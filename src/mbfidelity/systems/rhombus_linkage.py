@@ -60,7 +60,8 @@ from .model import (Body, Mechanism, Parameter, PointOnLine, PointOnPoint, Point
 PARAMETERS = (
     Parameter("m", 1.0, "kg", "mass of each bar", "MECHANISMS.md A; Fig. 13"),
     Parameter("l", 0.25, "m", "half length of each bar (bars are 2l long)", "MECHANISMS.md A"),
-    Parameter("I_G", 1.0 / 48.0, "kg m^2", "central moment of inertia of each bar, m(2l)^2/12",
+    Parameter("I_G", "m*(2*l)**2/12", "kg m^2",
+              "central moment of inertia of each bar (default: uniform bar, m(2l)^2/12)",
               "MECHANISMS.md A"),
     Parameter("k", 400.0, "N/m",
               "spring constant (free length sqrt2 l - 4 m g/k: tension 4 m g at 45 deg)",

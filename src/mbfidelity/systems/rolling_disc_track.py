@@ -67,7 +67,8 @@ reaches equation 1). The matrix equation with e(t) = {T_m, 0} repeats M, C, K.
 """
 import sympy as sp
 
-from . import ContactOutput, PrintedFormula, System, Variant, coordinate_symbols
+from . import (Condition, ContactOutput, PrintedFormula, System, Variant,
+               coordinate_symbols)
 from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, LinearCoupling,
                     Mechanism, Parameter, Revolute, RollingContact, Scenario, Segment)
 
@@ -79,11 +80,13 @@ PARAMETERS = (
               "MECHANISMS.md E"),
     Parameter("m_d", 1.0, "kg", "mass of the disc", "MECHANISMS.md E"),
     Parameter("r", 0.1, "m", "radius of the disc", "MECHANISMS.md E"),
-    Parameter("I_d", 0.005, "kg m^2", "central moment of inertia of the disc", "MECHANISMS.md E"),
+    Parameter("I_d", "m_d*r**2/2", "kg m^2",
+              "central moment of inertia of the disc (default: uniform disc, m_d r^2/2)",
+              "MECHANISMS.md E"),
     Parameter("k_t", 50.0, "N m/rad", "torsional spring constant on theta", "MECHANISMS.md E"),
-    Parameter("M0", 24.525, "N m",
-              "spring moment at theta = 0, against theta; default (m_p + m_d) g R so that "
-              "theta = 0 is the equilibrium", "MECHANISMS.md E; Fig. 39", domain="real"),
+    Parameter("M0", "(m_p + m_d)*g*R", "N m",
+              "spring moment at theta = 0, against theta (default: (m_p + m_d) g R, so that "
+              "theta = 0 is the equilibrium)", "MECHANISMS.md E; Fig. 39", domain="real"),
     Parameter("c_O", 0.5, "N m s", "viscous moment at the pivot O, on theta'",
               "MECHANISMS.md E", domain="nonnegative"),
     Parameter("c_J", 0.05, "N m s", "viscous rolling resistance on theta' + phi'",
@@ -197,6 +200,7 @@ SYSTEM = System(
     operating_point=lambda P: {"theta": 0, "phi": 0, "psi": 0},
     printed=printed,
     contacts=contacts,
+    validity=(Condition("r < R", "the disc must fit inside the track"),),
     scenarios=(
         Scenario("small", {"theta": 0.05, "phi": 0.1}, checks=_CHECKS,
                  description="near the equilibrium (0, 0): theta = 0.05, phi = 0.1 rad, from rest"),

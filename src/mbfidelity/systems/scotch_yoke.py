@@ -21,9 +21,13 @@ through their sum, eq. 49 (the reference configurations differ, as the text says
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import (LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter, PointOnLine,
                     PointToPoint, Prismatic, Rectangle, Revolute, Scenario, COORD_RATE)
+
+#: length of the block's slot (the drawn block's width): the pin, at x = -r cos(phi), must
+#: stay in it
+BLOCK_WIDTH = 0.3
 
 PARAMETERS = (
     Parameter("I_O", 0.005, "kg m^2", "moment of inertia of the disc about O", "MECHANISMS.md A; Fig. 14"),
@@ -32,7 +36,7 @@ PARAMETERS = (
     Parameter("h", 0.2, "m", "depth of the spring's fixed end below O", "MECHANISMS.md A; Fig. 16"),
     Parameter("b", 0.1, "m", "distance from the slot to the spring's end on the block", "MECHANISMS.md A"),
     Parameter("l0", 0.2, "m", "free length of the cot spring", "MECHANISMS.md A"),
-    Parameter("F0", 9.81, "N", "spring constant of eq. 43 (default m g)", "MECHANISMS.md A"),
+    Parameter("F0", "m*g", "N", "spring constant of eq. 43 (default: m g)", "MECHANISMS.md A"),
     Parameter("c", 0.0, "N s/m", "viscous friction of the block's guide (§7 variant: 0.5)",
               "MECHANISMS.md A; §7", domain="nonnegative"),
 )
@@ -42,7 +46,8 @@ def build(P) -> Mechanism:
     # the disc's mass is not given; its centre of mass is on the axis, so it does not
     # enter the motion (only the pivot reaction): 0.5 kg for the engines
     disc = Body("disc", 0.5, P.I_O, (Circle((0, 0), 1.4 * P.r),))
-    block = Body("block", P.m, P.m * (0.3**2 + 0.05**2) / 12, (Rectangle((0, 0), 0.3, 0.05),))
+    block = Body("block", P.m, P.m * (BLOCK_WIDTH**2 + 0.05**2) / 12,
+                 (Rectangle((0, 0), BLOCK_WIDTH, 0.05),))
     cot_law = -P.F0 * sp.cot(sp.pi * LENGTH / (2 * P.l0))
     return Mechanism(
         bodies=(disc, block),
@@ -126,5 +131,16 @@ SYSTEM = System(
         Scenario("damped", {"phi": 0.5}, overrides={"c": 0.5},
                  checks=("trajectory", "constraint_force"),
                  description="guide friction c = 0.5 (§7), from 0.5 rad"),
+    ),
+    validity=(
+        # l = h - b - r sin(phi) over a turn spans [h - b - r, h - b + r]; the cot law is
+        # finite only for 0 < l < 2 l0
+        Condition("h - b - r > 0", "the cot spring's length h - b - r sin(phi) must stay "
+                                   "positive over a turn"),
+        Condition("h - b + r < 2*l0", "the cot spring's length h - b - r sin(phi) must stay "
+                                      "below 2 l0 over a turn (the cot law's force is "
+                                      "infinite there)"),
+        Condition(f"2*r < {BLOCK_WIDTH}", f"the pin, at radius r, must stay in the block's "
+                                          f"slot ({BLOCK_WIDTH} m long) over a turn"),
     ),
 )

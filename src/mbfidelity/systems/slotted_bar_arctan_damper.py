@@ -29,7 +29,7 @@ that the motion never reaches from phi = 0 (|phi| = pi/2 would need x infinite).
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
+from . import Condition, Expectation, PrintedFormula, System, coordinate_symbols
 from ._reasons import SEMI_IMPLICIT_DRIFT
 from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Rectangle, Revolute, Scenario, Segment,
@@ -117,6 +117,8 @@ SYSTEM = System(
     build=build,
     operating_point=lambda P: {"phi": 0, "x": 0},
     printed=printed,
+    validity=(Condition("I_O > m1*l**2", "the bar's central moment of inertia, I_O - m1 l^2, "
+                                        "must be positive"),),
     scenarios=(
         Scenario("small", {"phi": 0.05}, checks=("trajectory", "constraint_force"),
                  description="0.05 rad from phi = 0: the damper acts in its linear range"),

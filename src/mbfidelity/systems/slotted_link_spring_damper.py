@@ -51,7 +51,7 @@ eq. 101 too. With the eq. 99 potential the positive root is a saddle and the neg
 """
 import sympy as sp
 
-from . import Expectation, PrintedFormula, System, coordinate_symbols
+from . import Condition, Expectation, PrintedFormula, System, coordinate_symbols
 from ._reasons import MUJOCO_MASSLESS_PIN, SEMI_IMPLICIT_DRIFT
 from .model import (COORD, COORD_RATE, Body, Circle, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Revolute, Scenario, Segment)
@@ -202,6 +202,12 @@ SYSTEM = System(
     operating_point=lambda P: {"x": 0, "y": y_of(P, phi_stable(P)), "phi": phi_stable(P),
                                "s": P.l0 - P.m * P.g / P.k},
     printed=printed,
+    validity=(
+        Condition("l < b", "the equilibrium of eq. 101, cos^3(phi) = l/b, the operating "
+                           "point, exists only for l < b"),
+        Condition("k*l0 > m*g", "the spring's length at rest, l0 - m g/k (the height of P "
+                                "above the spring's anchor), must be positive"),
+    ),
     scenarios=(
         Scenario("small", {"phi": f"{PHI_S} + 0.05", "y": f"l0 - m*g/k - l*tan({PHI_S}) + 0.005"},
                  checks=("trajectory", "constraint_force"),
