@@ -290,7 +290,7 @@ def _worst(c, prefixes) -> str:
         return "-"
     worst = max(ms, key=lambda m: m.value / m.tolerance if m.tolerance else m.value)
     flag = {"pass": "", "xfail": " (xfail)", "fail": " FAIL", "xpass": " XPASS",
-            "measured": " (measured)"}[worst.status]
+            "measured": " (measured)", "unresolved": " (unresolved)"}[worst.status]
     return f"{worst.value:.1e}/{worst.tolerance:.0e}{flag}"
 
 

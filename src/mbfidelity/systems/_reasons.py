@@ -17,3 +17,19 @@ VELOCITY_LEVEL_STARTUP = (
     "at the start of a fast spin (40 rad/s): the contact force misses m_b e w^2 on the "
     "first step(s) and overshoots on the next, an error that does not shrink with dt; after "
     "that the force follows the reference within the gate.")
+
+FIRST_ORDER_BOUND_TOO_WIDE = (
+    "At the default step (1e-3 s) the error bound of semi-implicit Euler, (w h) + (w h)^2 "
+    "(1 + w T) + zeta (w h) w T, exceeds 0.1 of the amplitude on this scenario (damped modes "
+    "over its duration, comparisons/tolerances.py): a gate that wide cannot tell a right "
+    "motion from a wrong one, so the error is measured and shown, not judged. A step a few "
+    "times smaller brings the bound back under 0.1.")
+
+
+def coarse_first_order(*patterns: str, engines: tuple[str, ...] = ("pybullet", "pymunk")):
+    """'unresolved' declarations of the metrics `patterns` for the semi-implicit Euler
+    engines (FIRST_ORDER_BOUND_TOO_WIDE)."""
+    from . import Expectation
+
+    return tuple(Expectation(e, p, "unresolved", FIRST_ORDER_BOUND_TOO_WIDE)
+                 for e in engines for p in patterns)
