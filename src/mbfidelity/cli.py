@@ -101,6 +101,13 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
             typer.echo(f"  variant {name}: {', '.join(v['simulators'])}")
 
 
+def _use_cache(off: bool) -> None:
+    if off:
+        from .analytic import cache
+
+        cache.disable()
+
+
 def _modes(eq):
     return [m.as_dict() for m in eq.modes]
 
@@ -108,11 +115,15 @@ def _modes(eq):
 @app.command()
 def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
-            as_json: bool = typer.Option(False, "--json")) -> None:
+            as_json: bool = typer.Option(False, "--json"),
+            no_cache: bool = typer.Option(False, "--no-cache", help="recompute the derivations "
+                                          "instead of reading the persistent cache"),
+            ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
     from .analytic.errata import errata
     from .analytic.linear import find_equilibria, operating_equilibrium
 
+    _use_cache(no_cache)
     system = _system(system_id)
     values, derived = _values(system, _parse_params(param))
     coords = list(system.coordinates)
@@ -183,11 +194,18 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                     None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
                 variant: Optional[str] = typer.Option(
                     None, "--variant", help="build the system's named variant (e.g. contact)"),
-                as_json: bool = typer.Option(False, "--json")) -> None:
-    """One comparison: metrics, tolerances, pass/fail."""
-    from .comparisons.runner import compare
+                as_json: bool = typer.Option(False, "--json"),
+                timeout: float = typer.Option(
+                    900.0, "--timeout", help="wall-clock budget of the comparison, s"),
+                no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
+                                              "derivations instead of reading the cache"),
+                ) -> None:
+    """One comparison: metrics, tolerances, pass/fail (the engine runs in a worker
+    process: a crash or a run past --timeout is reported, exit 1)."""
+    from .comparisons.runner import isolated_compare
     from .simulators import get_backend
 
+    _use_cache(no_cache)
     system = _system(system_id)
     params = _parse_params(param)
     _values(system, params, system.scenarios)
@@ -198,8 +216,8 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     if not dt > 0 or (t_end is not None and not t_end > 0):
         _fail("--dt and --t-end must be positive")
     try:
-        result = compare(system.id, sim, params, dt=dt, t_end=t_end, settings=_settings(setting),
-                         variant=variant)
+        result = isolated_compare(system.id, sim, params, dt=dt, t_end=t_end, timeout=timeout,
+                                  settings=_settings(setting), variant=variant)
     except ValueError as exc:
         _fail(str(exc))
     doc = result.as_dict()
@@ -215,6 +233,9 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             extra = f"  ({m.reason})" if m.reason and m.reason not in said else ""
             said.add(m.reason)
             typer.echo(f"  {m.name:34s} {m.value:10.3e} <= {m.tolerance:9.3e}  {m.status}{extra}")
+        for i in result.incidents:
+            at = f" at t = {i['t_reached']:.6g} s" if i.get("t_reached") is not None else ""
+            typer.echo(f"  {i['scenario']}: {i['outcome']}{at}: {i['message']}")
         typer.echo("PASSED" if result.passed else "FAILED")
     raise typer.Exit(0 if result.passed else 1)
 
@@ -226,9 +247,12 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         dt: float = typer.Option(1e-3, "--dt"),
         variants: bool = typer.Option(False, "--variants/--no-variants",
                                       help="also run each system's variants (e.g. rolling by "
-                                           "friction contact) on the engines that build them")
+                                           "friction contact) on the engines that build them"),
+        no_cache: bool = typer.Option(False, "--no-cache", help="recompute the derivations "
+                                      "instead of reading the persistent cache"),
         ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
+    _use_cache(no_cache)
     from rich.progress import Progress
 
     from .comparisons.matrix import run_matrix, write_results
@@ -269,9 +293,12 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                witnesses: bool = typer.Option(True, "--witnesses/--no-witnesses",
                                               help="run the engines on misprinted equations"),
                out: Optional[Path] = typer.Option(
-                   None, "--out", help="also write errata.html and errata.json there")
+                   None, "--out", help="also write errata.html and errata.json there"),
+               no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
+                                             "derivations instead of reading the cache"),
                ) -> None:
     """Every printed formula coded, compared with the derivation; engines as witnesses."""
+    _use_cache(no_cache)
     from .analytic.errata import errata, witness
     from .systems import all_systems
 

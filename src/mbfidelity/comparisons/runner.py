@@ -21,6 +21,7 @@ from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
 from . import metrics, tolerances
+from .isolation import WorkerCrashed, WorkerTimedOut, isolated
 
 DEFAULT_DT = 1e-3
 
@@ -241,6 +242,27 @@ def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) ->
                                            scheme.stability_limit)
     if refusal:
         raise ValueError(refusal)
+
+
+def isolated_compare(system_id: str, simulator: str,
+                     params: Mapping[str, float] | None = None, *, timeout: float | None = None,
+                     **kwargs) -> Comparison:
+    """`compare` in a worker process (comparisons/isolation.py): a worker that dies or
+    exceeds `timeout` seconds gives a failed comparison with the incident (crashed,
+    timed_out) instead of taking the caller down; a ValueError (bad input) is raised."""
+    try:
+        return isolated(compare, system_id, simulator, params, timeout=timeout, **kwargs)
+    except (WorkerCrashed, WorkerTimedOut) as exc:
+        system, backend = get_system(system_id), get_backend(simulator)
+        result = Comparison(system.id, simulator, backend.version(), {},
+                            system.parameter_values(params), kwargs.get("dt", DEFAULT_DT),
+                            variant=kwargs.get("variant") or "")
+        outcome = "timed_out" if isinstance(exc, WorkerTimedOut) else "crashed"
+        result.incidents.append({"scenario": "*", "outcome": outcome, "t_reached": None,
+                                 "message": str(exc)})
+        result.metrics.append(Metric("run.completed", 0.0, 1.0, False, "fail", str(exc),
+                                     unit="fraction of the run"))
+        return result
 
 
 #: start of the generated checks near the other stable equilibria: this far from the
