@@ -114,3 +114,33 @@ def test_unknown_variant_is_a_clear_error():
     res = runner.invoke(app, ["compare", "rolling_disc_track", "--sim", "pymunk",
                               "--variant", "levitating"])
     assert res.exit_code == 2 and "no variant 'levitating'" in res.output
+
+
+# --- issue 8: gates that can fail, steps that cannot be stable, failures contained -----
+
+
+def test_unstable_step_is_refused_before_any_work():
+    # w = sqrt(k/m) = 3.16e4 rad/s: RK4 is stable only for w h <= 2 sqrt 2
+    res = runner.invoke(app, ["compare", "mass_spring_damper", "--sim", "mujoco",
+                              "--param", "k=1e9"])
+    assert res.exit_code == 2, res.output
+    assert "stability limit 2.83" in res.output and "w h = 31.6" in res.output
+    assert "Traceback" not in res.output
+
+
+def test_coarse_step_cannot_pass():
+    # w h = 0.2 x 7 rad/s: far outside semi-implicit Euler's asymptotic range (w h <= 0.2)
+    res = runner.invoke(app, ["compare", "double_pendulum", "--sim", "pymunk", "--dt", "0.2",
+                              "--t-end", "4", "--json"])
+    assert res.exit_code == 1, res.output
+    doc = json.loads(res.stdout)
+    statuses = {m["status"] for m in doc["metrics"]}
+    assert "pass" not in statuses and "unresolved" in statuses
+
+
+def test_engine_failure_is_recorded_not_raised():
+    # Exudyn's generalized-alpha Newton iteration gives up on the large swing at h = 0.1
+    res = runner.invoke(app, ["compare", "five_bar_bird", "--sim", "exudyn", "--dt", "0.1",
+                              "--t-end", "3"])
+    assert res.exit_code == 1, res.output
+    assert "crashed" in res.output and "Traceback" not in res.output

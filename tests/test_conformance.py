@@ -64,7 +64,11 @@ def test_conformance(system_id, simulator, check):
     bad = [f"{m.name}: {m.value:.3e} > {m.tolerance:.3e}" for m in metrics if m.status == "fail"]
     xpassed = [f"{m.name}: passed ({m.value:.3e} <= {m.tolerance:.3e}) but declared xfail: "
                f"{m.reason}" for m in metrics if m.status == "xpass"]
+    unresolved = [f"{m.name}: {m.reason}" for m in metrics
+                  if m.status == "unresolved" and not m.expected]
     assert not bad, "gates failed:\n" + "\n".join(bad)
+    assert not unresolved, ("gates that cannot judge (declare them, with the measured "
+                            "reason):\n" + "\n".join(unresolved))
     assert not xpassed, "unexpected passes (strict expected failures):\n" + "\n".join(xpassed)
 
 
