@@ -13,8 +13,8 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .. import __version__
-from ..analytic.linear import (companion_matrix, find_equilibria, operating_equilibrium,
-                               wrap_angles)
+from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria,
+                               operating_equilibrium, wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
@@ -488,7 +488,7 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
             metric.detail = {"reference_hz": m.frequency_hz, "method": lin.method,
                              "engine_hz": got[i].frequency_hz if i < len(got) else None}
             result.metrics.append(metric)
-            if m.damping_ratio > 0:
+            if m.damping_ratio > ZERO_REAL_PART:  # not round-off of an undamped mode
                 result.metrics.append(_judge(system, backend.id,
                                              f"damping.linearization_mode{i + 1}", dz, tol,
                                              unit="absolute"))
