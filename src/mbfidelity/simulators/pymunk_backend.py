@@ -1244,7 +1244,7 @@ class PymunkBackend(Backend):
                 "with Coulomb friction and the carrier arm removed (the contact holds the "
                 "disc; with both, Gauss-Seidel may leave the contact's normal impulse, and so "
                 "its friction, at zero): what a game-physics user would build. Measured on "
-                "rolling_disc_track (720 segments): trajectory error 2-10 % of the amplitude "
+                "the disc of Fig. 39 (720 segments): trajectory error 2-10 % of the amplitude "
                 "(coupling: 2-2.6e-3), slip up to 3e-4 m, single-step losses of contact where "
                 "the disc passes from one chord to the next (normal impulse 0, then twice), "
                 "3-6 s per 10 s run (coupling 0.4 s)."),

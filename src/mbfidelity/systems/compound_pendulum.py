@@ -60,5 +60,5 @@ SYSTEM = System(
                  description="released from rest at 2.0 rad (strongly nonlinear)"),
     ),
     reaction_joints=("pivot",),
-    exact_solution="compound_pendulum",
+    exact_solution="uniform_rod_pendulum_elliptic",
 )

@@ -73,5 +73,5 @@ SYSTEM = System(
         Scenario("forced_15", {"x": "x0"}, overrides={"Omega": 15.0},
                  description="from rest, F0 sin(15 t): above resonance"),
     ),
-    exact_solution="mass_spring_damper",
+    exact_solution="forced_linear_oscillator",
 )
