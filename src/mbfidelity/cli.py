@@ -264,15 +264,10 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                    None, "--out", help="also write errata.html and errata.json there")
                ) -> None:
     """Every printed formula coded, compared with the derivation; engines as witnesses."""
-    from .analytic.errata import errata, witness
+    from .comparisons.witnesses import witnessed_errata
     from .systems import all_systems
 
-    entries = []
-    for system in all_systems().values():
-        for e in errata(system):
-            if witnesses and e.verdict != "agrees":
-                e.witnesses = witness(system, e)
-            entries.append(e.as_dict())
+    entries = witnessed_errata(all_systems().values(), witnesses)
     if out is not None:
         from .comparisons.runner import provenance
         from .reports.html import write_errata_page
