@@ -43,9 +43,9 @@ PHASES = {
     "exudyn linearize": ("exudyn_backend.py", "linearize"),
     "pymunk simulate": ("pymunk_backend.py", "simulate"),
     "pymunk linearize": ("pymunk_backend.py", "linearize"),
-    "report: errata": ("errata.py", "errata"),
-    "report: mechanism drawing": ("html.py", "draw_mechanism"),
-    "report: trajectory figures": ("html.py", "_figures"),
+    "report data: errata": ("errata.py", "errata"),
+    "report data: geometry": ("results_folder.py", "mechanism_geometry"),
+    "report data: series": ("results_folder.py", "save_series"),
 }
 
 
@@ -67,9 +67,10 @@ def serial(systems, prof_path):
     for s in systems:
         pr = cProfile.Profile()
         t0 = time.perf_counter()
-        pr.enable()
-        _one_system((s, sims, 1e-3, False, True))
-        pr.disable()
+        with tempfile.TemporaryDirectory() as tmp:
+            pr.enable()
+            _one_system((s, sims, 1e-3, False, Path(tmp)))
+            pr.disable()
         stats = pstats.Stats(pr)
         rows[s] = {"wall": time.perf_counter() - t0, **_phase_times(stats)}
         total = stats if total is None else total.add(stats)
@@ -87,13 +88,12 @@ def _timed_job(args):
     from mbfidelity.comparisons import matrix
 
     t0, c0 = time.time(), time.process_time()
-    res = matrix._one_system(args)
+    res, _ = matrix._one_system(args)
     return os.getpid(), args[0], t0, time.time(), time.process_time() - c0, res
 
 
 def timeline(workers):
     """The pool as run_matrix runs it, with each job's start, end and CPU time."""
-    import inspect
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     from mbfidelity.comparisons import matrix
@@ -104,24 +104,23 @@ def timeline(workers):
     start = time.time()
     sims = list(all_backends())
     systems = list(all_systems())
-    order = matrix.schedule(systems) if hasattr(matrix, "schedule") else systems
-    prerender = "prerender" in inspect.signature(matrix.run_matrix).parameters
-    args = [(s, sims, 1e-3, False) + ((True,) if prerender else ()) for s in order]
+    order = matrix.schedule(systems)
     batches, cpu = {}, 0.0
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_timed_job, a) for a in args]
-        for fut in as_completed(futures):
-            pid, s, t0, t1, c, res = fut.result()
-            cpu += c
-            print(f"pid {pid:7d} {s:28s} {t0 - start:6.1f} -> {t1 - start:6.1f} "
-                  f"({t1 - t0:5.1f} s wall, {c:5.1f} s CPU)", flush=True)
-            batches[s] = res
-    results = [r for s in systems for r in batches[s]]
-    t_pool = time.time()
     with tempfile.TemporaryDirectory() as tmp:
-        doc = matrix.write_results(results, Path(tmp))
+        args = [(s, sims, 1e-3, False, Path(tmp)) for s in order]
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = [pool.submit(_timed_job, a) for a in args]
+            for fut in as_completed(futures):
+                pid, s, t0, t1, c, res = fut.result()
+                cpu += c
+                print(f"pid {pid:7d} {s:28s} {t0 - start:6.1f} -> {t1 - start:6.1f} "
+                      f"({t1 - t0:5.1f} s wall, {c:5.1f} s CPU)", flush=True)
+                batches[s] = res
+        results = [r for s in systems for r in batches[s]]
+        t_pool = time.time()
+        matrix.write_results(results, Path(tmp))
         t_res = time.time()
-        write_report(results, doc["provenance"], Path(tmp))
+        write_report(Path(tmp))
         t_rep = time.time()
     print(f"pool {t_pool - start:.1f} s (jobs' CPU {cpu:.1f} s); write_results "
           f"{t_res - t_pool:.1f} s; write_report {t_rep - t_res:.1f} s; total "

@@ -18,6 +18,8 @@ PHASES = [
     ("errata: other", "errata (mbfidelity/analytic/errata.py"),
     ("report: trajectory figures", "_figures (mbfidelity/reports/html.py"),
     ("report: mechanism drawing", "draw_mechanism (mbfidelity/reports/html.py"),
+    ("report data: mechanism geometry", "mechanism_geometry (mbfidelity/comparisons/results_folder.py"),
+    ("report data: series files", "save_series (mbfidelity/comparisons/results_folder.py"),
     ("reference: DOP853", "_dop853 (mbfidelity/analytic/reference.py"),
     ("reference: dependent coordinates", "_full_states (mbfidelity/analytic/reference.py"),
     ("reference: accelerations, multipliers, reactions", "_reference (mbfidelity/analytic/reference.py"),

@@ -135,7 +135,7 @@ def test_closed_form_solves_the_derived_equations(system_id):
         v = s.parameter_values(scenario=sc)
         q0, qd0 = s.initial_state(sc, v)
         t = np.linspace(0, sc.t_end, 2001)
-        q, qd = SOLUTIONS[system_id](v, q0, qd0, t)
+        q, qd = SOLUTIONS[s.exact_solution](v, q0, qd0, t)
         sol = solve_ivp(numeric_model(system_id, v).ode_rhs, (0, sc.t_end), np.r_[q0, qd0],
                         method="DOP853", rtol=1e-13, atol=1e-13, t_eval=t)
         np.testing.assert_allclose(q[:, 0], sol.y[0], atol=1e-10)

@@ -236,7 +236,7 @@ def test_five_bar_eq116_engine_witness_sides_with_the_derivation():
     linearizes, are closer to the derived model than to the printed one."""
     import pytest
 
-    from mbfidelity.analytic.errata import witness
+    from mbfidelity.comparisons.witnesses import witness
     from mbfidelity.simulators import all_backends
 
     if not any(b.available()[0] for b in all_backends().values()):
@@ -300,7 +300,7 @@ def test_singular_printed_equations_get_a_residual_witness():
     equations: an engine's motion must satisfy the derived ones far better."""
     import pytest
 
-    from mbfidelity.analytic.errata import witness
+    from mbfidelity.comparisons.witnesses import witness
     from mbfidelity.simulators import all_backends
 
     if not any(b.available()[0] for b in all_backends().values()):

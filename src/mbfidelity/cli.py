@@ -273,9 +273,10 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
 
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
-        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants)
-    doc = write_results(results, out)
-    index = write_report(results, doc["provenance"], out)
+        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
+                             out=out)
+    write_results(results, out)
+    index = write_report(out)
     elapsed = time.perf_counter() - start
     failed = [f"{c.system}/{c.simulator}" for c in results if c.supported and not c.passed]
     typer.echo(f"{len(results)} comparisons in {elapsed:.1f} s; "
@@ -299,20 +300,16 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                ) -> None:
     """Every printed formula coded, compared with the derivation; engines as witnesses."""
     _use_cache(no_cache)
-    from .analytic.errata import errata, witness
+    from .comparisons.witnesses import witnessed_errata
     from .systems import all_systems
 
-    entries = []
-    for system in all_systems().values():
-        for e in errata(system):
-            if witnesses and e.verdict != "agrees":
-                e.witnesses = witness(system, e)
-            entries.append(e.as_dict())
+    entries = witnessed_errata(all_systems().values(), witnesses)
     if out is not None:
-        from .comparisons.runner import provenance
+        from .comparisons.results_folder import save_errata
         from .reports.html import write_errata_page
 
-        page = write_errata_page(entries, provenance(), out)
+        save_errata(entries, out)
+        page = write_errata_page(out)
         if not as_json:
             typer.echo(f"errata page: {page.resolve()}")
     if as_json:

@@ -1,7 +1,8 @@
 """Exact solutions, independent of the symbolic derivation and of any ODE solver.
 
-Each takes the parameter values, the initial state and sample times, and returns
-(q, qd) arrays of shape (N, n).
+Each is named by its mathematics; a system names the one that solves its equations in
+its `exact_solution`. Each takes the parameter values (by the parameter names it
+documents), the initial state and sample times, and returns (q, qd) arrays of shape (N, n).
 """
 from __future__ import annotations
 
@@ -12,9 +13,10 @@ import scipy.linalg
 import scipy.special
 
 
-def compound_pendulum(values: Mapping[str, float], q0, qd0, t: np.ndarray):
-    """Libration of I_O phi'' + m g l sin(phi) = 0 (Fig. 7, eq. 4), any amplitude < pi:
-    sin(phi/2) = k sn(w0 t + u0 | k^2), k = sin(phi_max/2), w0 = sqrt(m g l / I_O)."""
+def rigid_pendulum_elliptic(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """Libration of a rigid pendulum about its pivot O (mass m, centre of mass at l from
+    O, moment of inertia I_O about O), I_O phi'' + m g l sin(phi) = 0 (Fig. 7, eq. 4),
+    any amplitude < pi: sin(phi/2) = k sn(w0 t + u0 | k^2), k = sin(phi_max/2), w0 = sqrt(m g l / I_O)."""
     m, l, I_O, g = values["m"], values["l"], values["I_O"], values["g"]
     w0 = np.sqrt(m * g * l / I_O)
     phi0, dphi0 = float(q0[0]), float(qd0[0])
@@ -38,7 +40,7 @@ def compound_pendulum(values: Mapping[str, float], q0, qd0, t: np.ndarray):
     return phi[:, None], dphi[:, None]
 
 
-def mass_spring_damper(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+def forced_linear_oscillator(values: Mapping[str, float], q0, qd0, t: np.ndarray):
     """m x'' + c x' + k x = F0 sin(Omega t) (eq. 79): the particular solution from the
     complex frequency response plus the homogeneous one by the exact matrix exponential."""
     m, k, c = values["m"], values["k"], values["c"]
@@ -59,6 +61,6 @@ def mass_spring_damper(values: Mapping[str, float], q0, qd0, t: np.ndarray):
 
 
 SOLUTIONS: dict[str, Callable] = {
-    "compound_pendulum": compound_pendulum,
-    "mass_spring_damper": mass_spring_damper,
+    "rigid_pendulum_elliptic": rigid_pendulum_elliptic,
+    "forced_linear_oscillator": forced_linear_oscillator,
 }

@@ -2,9 +2,9 @@
 
 Every comparison is numeric at many random states and at two parameter sets (the defaults
 and a random perturbation of them), so that no agreement is a coincidence of the default
-values; verdicts are "agrees" or "misprint". The simulators witness a misprint: the
-engines' trajectories are compared with the printed model and with the derived one
-(`printed_model_trajectory`).
+values; verdicts are "agrees" or "misprint". The printed models themselves are here too
+(`printed_model_trajectory`, `printed_multiplier_trajectory`, `printed_model_frequencies`):
+the engines run against them as witnesses of a misprint in `comparisons/witnesses.py`.
 
 Formulas with Lagrange multipliers and constraints (monograph §10, eq. 110-116), judged
 independently of how the monograph normalises, orders or signs them:
@@ -27,22 +27,16 @@ independently of how the monograph normalises, orders or signs them:
   generalized force that has no potential (dampers, friction, motors, time loads); the
   constraint forces do no work on consistent velocities.
 
-Witnesses of a misprinted "eom" with multipliers (`_multiplier_witness`; the system row
-and every row of it cite the same one): the printed rows, linear in (q'', lam_p), are
-written A(q, q', t) [q''; lam_p] + b(q, q', t) = 0 and closed with the DERIVED
-acceleration-level constraint Phi_q q'' = gamma, so the printed dynamics evolve on the
-true constraint manifold; integrated in the independent coordinates with the dependent
-ones completed by Newton (as the reference does), `printed_multiplier_trajectory`. Each
-engine's trajectory on the largest scenario (its first `MULTIPLIER_WITNESS_SECONDS`) is
-compared with the derived and with this printed one. Modes too where the engines
-linearize: the printed system at the derived equilibrium (printed static multipliers
-fitted there), its multipliers eliminated with the left null space N of their
-coefficients and the motion restricted to the manifold with the velocity basis S:
-N^T M_p S s^2 + N^T C_p S s + N^T K_p S (`printed_model_frequencies`).
+The printed equations with multipliers as a model of their own (for the witnesses): the
+printed rows, linear in (q'', lam_p), are written A(q, q', t) [q''; lam_p] + b(q, q', t) = 0
+and closed with the DERIVED acceleration-level constraint Phi_q q'' = gamma, so the printed
+dynamics evolve on the true constraint manifold (`printed_multiplier_trajectory`); their
+modes at the derived equilibrium (printed static multipliers fitted there), the
+multipliers eliminated with the left null space N of their coefficients and the motion
+restricted to the manifold with the velocity basis S: N^T M_p S s^2 + N^T C_p S s +
+N^T K_p S (`printed_model_frequencies`).
 """
 from __future__ import annotations
-
-import warnings
 
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -59,11 +53,6 @@ from .linear import linearize, operating_equilibrium
 from .numeric import _lambdify, numeric_model
 
 AGREEMENT = 1e-9  # relative; round-off of the numeric comparison is ~1e-14
-#: the witness of printed equations with multipliers integrates the printed model on the
-#: true manifold (Newton completion at every step, like the reference): the first seconds
-#: of the scenario keep `mbfidelity errata` quick, and a misprinted inertia separates the
-#: printed motion from the derived one within a fraction of a second
-MULTIPLIER_WITNESS_SECONDS = 3.0
 #: condition number of the printed augmented matrix [A; Phi_q 0] beyond which the printed
 #: model does not determine (q'', lam_p): singular printed model, no trajectory witness
 SINGULAR_CONDITION = 1e10
@@ -686,232 +675,3 @@ def printed_model_frequencies(system: System, pf: PrintedFormula,
     else:
         return None
     return np.sort(np.abs([s for s in quadratic_eigenvalues(M, C, K) if s.imag >= 0]))
-
-
-def _witness_engines(mech):
-    """(id, backend) of every installed engine that can express the mechanism."""
-    from ..simulators import all_backends
-
-    for sim, backend in all_backends().items():
-        if backend.available()[0] and backend.support(mech).ok:
-            yield sim, backend
-
-
-@lru_cache(maxsize=None)
-def _trajectory_witness(system_id: str) -> dict:
-    """Engines on the largest-amplitude scenario, against the derived model and against
-    the printed equations of motion integrated as printed (independent coordinates)."""
-    from ..systems import get_system
-    from .reference import reference
-
-    system = get_system(system_id)
-    full = [pf for pf in system.printed(system.symbols) if pf.kind == "eom"
-            and not pf.multipliers]
-    if not full:
-        return {}
-    scenario = system.scenarios[-1]
-    values = system.parameter_values(scenario=scenario)
-    dt = 1e-3
-    ref = reference(system, scenario, values, dt)
-    ind = numeric_model(system.id, values).independent
-    printed_q = printed_model_trajectory(system, full[0], values, ref.q[0], ref.qd[0], ref.t)
-    if printed_q is None:
-        return _residual_witness(system, full[0], scenario, values, dt)
-    mech = system.numeric_mechanism(values)
-    out = {}
-    for sim, backend in _witness_engines(mech):
-        run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt)
-        n = min(len(run.t), len(ref.t))
-        to_derived = float(np.max(np.abs(run.q[:n, ind] - ref.q[:n, ind])))
-        to_printed = float(np.max(np.abs(run.q[:n, ind] - printed_q[:n])))
-        side = "derivation" if to_derived < to_printed else "printed"
-        out[sim] = {"scenario": scenario.name, "max_error_to_derived": to_derived,
-                    "max_error_to_printed": to_printed,
-                    "verdict": f"sides with the {side} (max |dq| {to_derived:.2e} to the derived "
-                               f"model, {to_printed:.2e} to the printed one)"}
-    return out
-
-
-#: every this many samples of an engine's run enter the residual witness
-RESIDUAL_STRIDE = 10
-
-
-def _residual_witness(system: System, pf: PrintedFormula, scenario, values, dt: float) -> dict:
-    """For printed equations that cannot be integrated (singular on the motion): each
-    engine's motion, with accelerations by central differences of its velocities (error
-    (w h)^2, far below the misprints' O(1e-2..1)), put into the derived equations
-    (relative acceleration error) and into each printed row (residual over the sum of
-    its terms' magnitudes). An engine sides with the equations its motion satisfies."""
-    from .reference import reference
-
-    ref = reference(system, scenario, values, dt)
-    model = numeric_model(system.id, values)
-    ind = model.independent
-    syms = [s for c in system.coordinates for s in coordinate_symbols(c)]
-    rows = [sp.sympify(r).xreplace(system.subs(values)) for r in pf.expr]
-    mech = system.numeric_mechanism(values)
-    out = {}
-    for sim, backend in _witness_engines(mech):
-        run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt)
-        qdd = np.gradient(run.qd, dt, axis=0)
-        picks = range(1, len(run.t) - 1, RESIDUAL_STRIDE)
-        derived, printed = 0.0, np.zeros(len(rows))
-        acc_scale = max(float(np.max(np.abs(qdd[:, ind]))), 1e-300)
-        for k in picks:
-            q, qd, t = run.q[k], run.qd[k], float(run.t[k])
-            a = model.acceleration(q, qd, t)
-            derived = max(derived, float(np.max(np.abs(a[ind] - qdd[k, ind]))) / acc_scale)
-            env = dict(zip(syms, [v for trio in zip(q, qd, qdd[k]) for v in trio]))
-            env[TIME] = t
-            printed = np.maximum(printed, [abs(_num(r, env)) / _term_scale(r, env)
-                                           for r in rows])
-        side = "derivation" if derived < 0.1 * float(np.min(printed)) else "printed"
-        out[sim] = {"scenario": scenario.name, "sides_with": side,
-                    "derived_relative_residual": derived,
-                    "printed_relative_residuals": printed.tolist(),
-                    "verdict": f"sides with the {side} (its motion satisfies the derived "
-                               f"equations to {derived:.1e}; the printed rows leave "
-                               f"{', '.join(f'{x:.2g}' for x in printed)}; the printed "
-                               "equations cannot be integrated: singular on the motion)"}
-    return out
-
-
-def _modal_witness(system: System, pf: PrintedFormula) -> dict:
-    """Each engine's own linearization at the equilibrium, against the modes of the
-    derived model and of the model with the printed formula in place."""
-    from .linear import modes_from_eigenvalues
-
-    values = _with_relations(system, system.parameter_values(), pf)
-    printed = printed_model_frequencies(system, pf, values)
-    if printed is None:
-        return {}
-    eq = _equilibrium_at(system, values, pf)
-    derived = np.sort([abs(m.eigenvalue) for m in eq.modes])
-    if np.allclose(printed, derived, rtol=1e-9):
-        return {}  # the misprint does not change the modes: no modal witness
-    mech = system.numeric_mechanism(values).without_time_loads()
-    out = {}
-    for sim, backend in _witness_engines(mech):
-        lin = backend.linearize(mech, eq.q)
-        if lin is None:
-            continue
-        got = np.sort([abs(m.eigenvalue) for m in modes_from_eigenvalues(lin.eigenvalues)])
-        k = min(len(got), len(derived), len(printed))
-        to_derived = float(np.max(np.abs(got[:k] - derived[:k]) / derived[:k]))
-        to_printed = float(np.max(np.abs(got[:k] - printed[:k]) / printed[:k]))
-        side = "derivation" if to_derived < to_printed else "printed"
-        out[sim] = {"max_error_to_derived": to_derived, "max_error_to_printed": to_printed,
-                    "verdict": f"sides with the {side} (modes {to_derived:.1e} from the derived "
-                               f"model, {to_printed:.1e} from the printed one)"}
-    return out
-
-
-def _constrained_trajectory_witness(system: System, pf: PrintedFormula) -> tuple[dict, str]:
-    """({engine: distances}, note): engines on the first `MULTIPLIER_WITNESS_SECONDS` of
-    the largest-amplitude scenario against the derived model and against the printed
-    equations with multipliers integrated on the derived manifold. The note says why
-    there is no trajectory witness (singular printed model), else it is empty."""
-    from .reference import reference
-
-    scenario = system.scenarios[-1]
-    values = system.parameter_values(scenario=scenario)
-    dt = 1e-3
-    t_end = min(scenario.t_end, MULTIPLIER_WITNESS_SECONDS)
-    ref = reference(system, scenario, values, dt, t_end=t_end)
-    try:
-        printed_q, drift = printed_multiplier_trajectory(system, pf, values, ref.q[0],
-                                                         ref.qd[0], ref.t)
-    except SingularPrintedModel as err:
-        return {}, f"no trajectory witness: {err}"
-    ind = numeric_model(system.id, values).independent
-    mech = system.numeric_mechanism(values)
-    out = {}
-    for sim, backend in _witness_engines(mech):
-        run = backend.simulate(mech, ref.q[0], ref.qd[0], t_end, dt)
-        n = min(len(run.t), len(ref.t))
-        to_derived = float(np.max(np.abs(run.q[:n, ind] - ref.q[:n, ind])))
-        to_printed = float(np.max(np.abs(run.q[:n, ind] - printed_q[:n, ind])))
-        out[sim] = {"scenario": scenario.name, "t_end": t_end,
-                    "max_error_to_derived": to_derived, "max_error_to_printed": to_printed,
-                    "derived_to_printed": float(np.max(np.abs(ref.q[:n, ind]
-                                                              - printed_q[:n, ind]))),
-                    "printed_constraint_drift": drift}
-    return out, ""
-
-
-@lru_cache(maxsize=None)
-def _multiplier_witness(system_id: str, label: str) -> dict:
-    """The engines on printed equations with multipliers (module docstring): trajectories
-    and, where the engine linearizes, modes; one entry per engine, its verdict saying which
-    model it sides with (both measures when they agree, "split" when they do not)."""
-    from ..systems import get_system
-
-    system = get_system(system_id)
-    (pf,) = [pf for pf in system.printed(system.symbols) if pf.label == label]
-    trajectories, note = _constrained_trajectory_witness(system, pf)
-    modes = _modal_witness(system, pf)
-    out = {}
-    for sim in list(trajectories) + [s for s in modes if s not in trajectories]:
-        entry, sides, said = {}, [], []
-        if sim in trajectories:
-            w = trajectories[sim]
-            entry.update(w)
-            sides.append("derivation" if w["max_error_to_derived"] < w["max_error_to_printed"]
-                         else "printed")
-            said.append(f"trajectory: max |dq| {w['max_error_to_derived']:.2e} to the derived "
-                        f"model, {w['max_error_to_printed']:.2e} to the printed one "
-                        f"({w['scenario']} scenario, {w['t_end']:g} s)")
-        elif note:
-            said.append(note)
-        if sim in modes:
-            w = modes[sim]
-            entry.update(modes_error_to_derived=w["max_error_to_derived"],
-                         modes_error_to_printed=w["max_error_to_printed"])
-            sides.append("derivation" if w["max_error_to_derived"] < w["max_error_to_printed"]
-                         else "printed")
-            said.append(f"modes: {w['max_error_to_derived']:.1e} from the derived model, "
-                        f"{w['max_error_to_printed']:.1e} from the printed one")
-        if len(set(sides)) == 1:
-            entry["sides_with"] = sides[0]
-            entry["verdict"] = f"sides with the {sides[0]} ({'; '.join(said)})"
-        else:
-            entry["sides_with"] = "split"
-            entry["verdict"] = "split: " + "; ".join(
-                f"{x} sides with the {y}" for x, y in zip(said, sides))
-        out[sim] = entry
-    return out
-
-
-def _multiplier_formula(system: System, label: str | None) -> PrintedFormula | None:
-    """The printed "eom" with multipliers an erratum label refers to (its system row or
-    one of its rows); the first one when label is None."""
-    for pf in system.printed(system.symbols):
-        if pf.kind != "eom" or not pf.multipliers:
-            continue
-        if label is None or label == pf.label or label.startswith(
-                (f"{pf.label} (", f"{pf.label}, row ")):
-            return pf
-    return None
-
-
-def witness(system: System, erratum: Erratum | None = None) -> dict:
-    """The engines' verdict on a misprint: trajectories for equations of motion (with
-    multipliers: on the derived manifold, and modes), their own linearizations for
-    matrices, energies and frequencies."""
-    # a printed model may divide by zero on the motion (then it has no trajectory
-    # witness, said in the result): numpy's warnings would only repeat that on stderr
-    with np.errstate(all="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return _witness(system, erratum)
-
-
-def _witness(system: System, erratum: Erratum | None) -> dict:
-    if erratum is None or erratum.kind == "eom":
-        pf = _multiplier_formula(system, None if erratum is None else erratum.label)
-        if pf is not None and (erratum is not None or not _trajectory_witness(system.id)):
-            return _multiplier_witness(system.id, pf.label)
-        return _trajectory_witness(system.id)
-    for pf in _one_equation_each(system.printed(system.symbols)):
-        if pf.label == erratum.label:
-            return _modal_witness(system, pf)
-    return {}

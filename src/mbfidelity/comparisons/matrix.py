@@ -5,11 +5,15 @@ from __future__ import annotations
 import csv
 import json
 import os
+import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable, Iterable, Mapping
+
+import numpy as np
 
 from ..systems import get_system
+from . import results_folder
 from .runner import DEFAULT_DT, Comparison, compare, provenance
 
 ROW_FIELDS = ("system", "variant", "simulator", "engine_version", "metric", "value", "tolerance", "unit",
@@ -17,80 +21,92 @@ ROW_FIELDS = ("system", "variant", "simulator", "engine_version", "metric", "val
               "python", "platform")
 
 
-def _one_system(args) -> list[Comparison]:
+def _one_system(args) -> tuple[list[Comparison], float]:
     """Every engine on one system, in one process: the references are solved once
     (cached) and shared by all engines; with `variants`, also each variant of the system
-    on the engines that build it. With `prerender`, the system's report figures and
-    errata are made here too (`reports.html.prerender`), in parallel and on the
-    derivation and models this process already built, instead of serially in the parent
-    by `write_report`."""
-    system, sims, dt, variants, *rest = args
-    prerender = bool(rest and rest[0])
-    out = [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
+    on the engines that build it. With `out`, what the report shows of the system is
+    saved there (`results_folder`): each comparison's series (then dropped from the
+    returned comparisons), the mechanism's drawing and the errata entries, made here in
+    parallel on the derivation and models this process already built. Returns the
+    comparisons and the job's CPU seconds."""
+    system, sims, dt, variants, out = args
+    start = time.process_time()
+    found = [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
     if variants:
         for v in get_system(system).variants:
             # engines that do not build the variant give an "unsupported" row, with why
-            out += [compare(system, sim, dt=dt, keep_series=True, variant=v.name)
-                    for sim in sims]
-    if prerender:
-        from ..reports.html import prerender as prerender_report
-
-        prerender_report(out)
-    return out
-
-
-#: relative cost of each system's job (CPU seconds of `_one_system` with the four engines,
-#: report prerendering included, measured on the 2-core reference machine): the jobs are
-#: dispatched longest first, so that the last job to finish is a short one. Unknown
-#: systems count as the longest (they start first). Only the order depends on these.
-JOB_COST = {
-    "rhombus_linkage": 33.9, "rolling_disc_track": 19.9, "five_bar_bird": 18.5,
-    "slotted_link_spring_damper": 15.9, "scotch_yoke": 13.5, "eccentric_cam": 11.7,
-    "pendulum_sliding_block": 8.7, "elastic_pendulum": 8.7, "slotted_bar_arctan_damper": 7.8,
-    "belt_pulleys": 6.0, "double_pendulum": 3.5, "mass_spring_damper": 3.4,
-    "compound_pendulum": 2.4,
-}
+            found += [compare(system, sim, dt=dt, keep_series=True, variant=v.name)
+                      for sim in sims]
+    if out is not None:
+        for row, comps in results_folder.rows_of(found).items():
+            results_folder.save_series(out, row, comps)
+        for c in found:
+            c.series = {}
+        results_folder.save_system(out, system)
+    return found, time.process_time() - start
 
 
-def _cost(system: str) -> float:
-    return JOB_COST.get(system, max(JOB_COST.values()) + 1.0)
+def estimated_cost(system_id: str) -> float:
+    """A job's cost from the description, for systems never run into the folder:
+    coordinates x (coordinates + constraint rows) x simulated seconds of the scenarios
+    (the size of what is derived and solved, times the time stepped). In arbitrary
+    units; only the order of the jobs depends on it."""
+    system = get_system(system_id)
+    n = len(system.coordinates)
+    constraint_rows = n - len(system.mechanism.independent_coordinates)
+    return float(n * (n + constraint_rows) * sum(sc.t_end for sc in system.scenarios))
 
 
-def schedule(systems: Iterable[str]) -> list[str]:
-    """The systems in dispatch order: longest job first (stable for equal costs)."""
-    return sorted(systems, key=_cost, reverse=True)
+def schedule(systems: Iterable[str], measured: Mapping[str, float] | None = None) -> list[str]:
+    """The systems in dispatch order, longest job first (stable for equal costs), so that
+    the last job to finish is a short one: by their `measured` CPU seconds (the last run's
+    `job_costs.json`); a system without one by `estimated_cost`, scaled to seconds by the
+    median ratio of measured to estimated costs of the others."""
+    systems = list(systems)
+    measured = {s: c for s, c in (measured or {}).items() if s in systems}
+    estimate = {s: estimated_cost(s) for s in systems if s not in measured}
+    ratios = [c / estimated_cost(s) for s, c in measured.items()]
+    to_seconds = float(np.median(ratios)) if ratios else 1.0
+    cost = {**{s: e * to_seconds for s, e in estimate.items()}, **measured}
+    return sorted(systems, key=cost.__getitem__, reverse=True)
 
 
 def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
                workers: int | None = None,
                progress: Callable[[Comparison], None] | None = None,
-               variants: bool = False, prerender: bool = True) -> list[Comparison]:
+               variants: bool = False, out: Path | None = None) -> list[Comparison]:
     """Every system on every simulator, in `systems` order. With several workers the
-    systems are dispatched longest first (`schedule`) to a process pool; each system is
-    one job (its references and derivation are shared by its engines). `prerender`:
-    also make each system's report figures and errata in its job (see `_one_system`)."""
+    systems are dispatched longest first (`schedule`, with the job costs of the last run
+    into `out`) to a process pool; each system is one job (its references and derivation
+    are shared by its engines). With `out`, each job also saves what the report shows of
+    its system there (see `_one_system`), and the jobs' CPU seconds are saved for the
+    next run's order."""
     systems = list(systems)
     sims = list(simulators)
     workers = workers or min(2, os.cpu_count() or 1)
     workers = max(1, min(workers, len(systems)))
     batches: dict[int, list[Comparison]] = {}
+    costs: dict[str, float] = {}
 
-    def collect(i, batch):
-        batches[i] = batch
+    def collect(i, job):
+        batches[i], costs[systems[i]] = job
         if progress:
-            for res in batch:
+            for res in batches[i]:
                 progress(res)
 
     if workers <= 1:
         for i, s in enumerate(systems):
-            collect(i, _one_system((s, sims, dt, variants, prerender)))
+            collect(i, _one_system((s, sims, dt, variants, out)))
     else:
-        order = sorted(range(len(systems)), key=lambda i: _cost(systems[i]), reverse=True)
+        rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
+        order = sorted(range(len(systems)), key=lambda i: rank[systems[i]])
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(_one_system, (systems[i], sims, dt, variants, prerender)): i
+            futures = {pool.submit(_one_system, (systems[i], sims, dt, variants, out)): i
                        for i in order}
             for fut in as_completed(futures):
                 collect(futures[fut], fut.result())
+    if out is not None:
+        results_folder.save_job_costs(out, costs)
     # in the order of `systems`, whatever order the jobs finished in
     return [res for i in range(len(systems)) for res in batches[i]]
 

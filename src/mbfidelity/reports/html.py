@@ -1,11 +1,15 @@
-"""HTML report rendered from saved comparison results: summary table, trajectory overlays,
-error-against-time figures, frequency table, errata."""
+"""HTML report rendered from a results folder (`comparisons/results_folder.py`): summary
+table, trajectory overlays, error-against-time figures, frequency table, errata. It renders
+saved results only: every number, series and shape on the pages was computed upstream and
+saved; from the descriptions it reads only titles, coordinate names and the declared
+expected failures."""
 from __future__ import annotations
 
 import html
-from collections import defaultdict
-from types import SimpleNamespace
+import os
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from types import SimpleNamespace
 
 import jinja2
 import matplotlib
@@ -13,7 +17,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.patches import Circle as CirclePatch  # noqa: E402
+from matplotlib.patches import Polygon  # noqa: E402
 
+from ..comparisons.results_folder import (base_id, load_errata, load_results,  # noqa: E402
+                                          load_series, load_system, row_id, rows_of,
+                                          series_path)
 from ..systems import get_system  # noqa: E402
 
 #: why an engine deviates, in words a student can follow (SIMULATORS.md)
@@ -119,7 +128,7 @@ def _envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS):
 def _figures(system_id: str, comps, out: Path) -> list[str]:
     names = []
     scenarios = {name for c in comps for name in c.series}
-    coords = get_system(_base(system_id)).coordinates
+    coords = get_system(base_id(system_id)).coordinates
     for scenario in sorted(scenarios):
         with_contacts = any(c.series.get(scenario, {}).get("contacts") for c in comps)
         fig, axes = plt.subplots(3 if with_contacts else 2, 1,
@@ -166,11 +175,11 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
     return names
 
 
-def write_report(results, prov: dict, out: Path, errata: list[dict] | None = None) -> Path:
-    out.mkdir(parents=True, exist_ok=True)
-    by_system = defaultdict(list)
-    for c in results:
-        by_system[shown_id(c)].append(c)
+def write_report(out: Path, workers: int | None = None) -> Path:
+    """index.html, summary.md and the figures, from the results saved in `out`; the
+    figures are drawn by a pool of `workers` processes (default: up to 2)."""
+    prov, results = load_results(out)
+    by_system = rows_of(results)
     sims = list(dict.fromkeys(c.simulator for c in results))
     systems = list(by_system)
     cells = {s: {c.simulator: _cell(c) for c in comps} for s, comps in by_system.items()}
@@ -180,13 +189,10 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
                     for s, comps in by_system.items()}
     unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
                    for s, comps in by_system.items()}
-    figures = {s: _prerendered_figures(comps, out)
-               or [draw_mechanism(_base(s), out)] + _figures(s, comps, out)
-               for s, comps in by_system.items()}
+    figures = _render_figures(out, by_system, workers)
     frequencies = frequency_table(results)
-    if errata is None:
-        errata = [e for s in dict.fromkeys(map(_base, systems))
-                  for e in _errata_of(s, results)]
+    errata = [e for s in dict.fromkeys(map(base_id, systems))
+              for e in load_system(out, s)["errata"]]
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
     liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
@@ -199,6 +205,40 @@ def write_report(results, prov: dict, out: Path, errata: list[dict] | None = Non
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def _render_figures(out: Path, rows: dict[str, list], workers: int | None) -> dict[str, list]:
+    """row -> its figure files (the mechanism's drawing first), drawn from the saved
+    series and geometry; in a process pool, the rows with the most data first."""
+    drawings = list(dict.fromkeys(map(base_id, rows)))
+
+    def data_size(row: str) -> int:
+        path = series_path(out, row)
+        return path.stat().st_size if path.exists() else 0
+
+    order = sorted(rows, key=data_size, reverse=True)
+    workers = max(1, min(workers or min(2, os.cpu_count() or 1), len(order)))
+    if workers == 1:
+        drawn = {s: _draw_saved(out, s) for s in drawings}
+        plotted = {row: _plot_saved(out, row, rows[row]) for row in order}
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            plotting = {row: pool.submit(_plot_saved, out, row, rows[row]) for row in order}
+            drawing = {s: pool.submit(_draw_saved, out, s) for s in drawings}
+            plotted = {row: f.result() for row, f in plotting.items()}
+            drawn = {s: f.result() for s, f in drawing.items()}
+    return {row: [drawn[base_id(row)]] + plotted[row] for row in rows}
+
+
+def _draw_saved(out: Path, system_id: str) -> str:
+    return draw_mechanism(load_system(out, system_id)["drawing"], out)
+
+
+def _plot_saved(out: Path, row: str, comps) -> list[str]:
+    series = load_series(out, row)
+    for c in comps:
+        c.series = series.get(c.simulator, {})
+    return _figures(row, comps, out)
 
 
 ERRATA_TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">
@@ -220,36 +260,18 @@ their own linearization) is compared with the printed and with the derived model
 </table></body></html>""")
 
 
-def write_errata_page(entries: list[dict], prov: dict, out: Path) -> Path:
-    """errata.html and errata.json: every printed formula, its verdict and witnesses."""
-    import json
-
-    from ..simulators import all_backends
-
-    out.mkdir(parents=True, exist_ok=True)
-    versions = {}
-    for sim, backend in all_backends().items():
-        ok, _ = backend.available()
-        if ok:
-            versions[sim] = backend.version()
-    (out / "errata.json").write_text(json.dumps({"provenance": prov, "engines": versions,
-                                                 "errata": entries}, indent=1, default=float))
+def write_errata_page(out: Path) -> Path:
+    """errata.html from the errata.json saved in `out`: every printed formula, its verdict
+    and witnesses."""
+    doc = load_errata(out)
     page = out / "errata.html"
-    page.write_text(ERRATA_TEMPLATE.render(entries=entries, prov=prov, versions=versions))
+    page.write_text(ERRATA_TEMPLATE.render(entries=doc["errata"], prov=doc["provenance"],
+                                           versions=doc["engines"]))
     return page
 
 
-def shown_id(c) -> str:
-    """A comparison's row name: the system id, with the variant in brackets."""
-    return f"{c.system}[{c.variant}]" if getattr(c, "variant", "") else c.system
-
-
-def _base(shown: str) -> str:
-    return shown.split("[", 1)[0]
-
-
 def _title(shown: str) -> str:
-    system = get_system(_base(shown))
+    system = get_system(base_id(shown))
     if shown == system.id:
         return system.title
     v = system.variant(shown[len(system.id) + 1:-1])
@@ -257,7 +279,7 @@ def _title(shown: str) -> str:
 
 
 def _expected(shown: str) -> list:
-    system = get_system(_base(shown))
+    system = get_system(base_id(shown))
     if shown == system.id:
         return list(system.expectations)
     v = system.variant(shown[len(system.id) + 1:-1])
@@ -300,11 +322,11 @@ def error_table(results) -> list[str]:
              "|---|---|---|---|---|---|---|"]
     for c in results:
         if not c.supported:
-            lines.append(f"| {shown_id(c)} | {c.simulator} | {c.engine_version} | unsupported: "
+            lines.append(f"| {row_id(c)} | {c.simulator} | {c.engine_version} | unsupported: "
                          f"{c.reason} | | | |")
             continue
         lines.append(
-            f"| {shown_id(c)} | {c.simulator} | {c.engine_version} | "
+            f"| {row_id(c)} | {c.simulator} | {c.engine_version} | "
             f"{_worst(c, ('trajectory_max',))} | {_worst(c, ('.reaction_', '.constraint_', '.contact_'))} | "
             f"{_worst(c, ('frequency.',))} | {c.wall_time:.2f} |")
     return lines
@@ -320,9 +342,9 @@ def _markdown(results, prov: dict) -> str:
               "|---|---|---|---|---|---|"]
     for c in results:
         if not c.supported:
-            lines.append(f"| {shown_id(c)} | {c.simulator} | * | | | unsupported: {c.reason} |")
+            lines.append(f"| {row_id(c)} | {c.simulator} | * | | | unsupported: {c.reason} |")
         for m in c.metrics:
-            lines.append(f"| {shown_id(c)} | {c.simulator} | {m.name} | {m.value:.3e} | "
+            lines.append(f"| {row_id(c)} | {c.simulator} | {m.name} | {m.value:.3e} | "
                          f"{m.tolerance:.3e} | {m.status} |")
     return "\n".join(lines) + "\n"
 
@@ -335,115 +357,40 @@ def frequency_table(results) -> dict:
             if not m.name.startswith("frequency.") or not m.detail:
                 continue
             mode = m.name.split("mode")[-1]
-            rows = table.setdefault(shown_id(c), {})
+            rows = table.setdefault(row_id(c), {})
             row = rows.setdefault(mode, {"reference_hz": m.detail["reference_hz"], "engines": {}})
             kind = "linearization" if "linearization" in m.name else "fit"
             row["engines"].setdefault(c.simulator, {})[kind] = m.detail.get("engine_hz")
     return table
 
 
-def draw_mechanism(system_id: str, out: Path) -> str:
-    """The mechanism at its operating equilibrium, drawn from the description's shapes."""
-    import sympy as sp
-    from matplotlib.patches import Circle as CirclePatch
-    from matplotlib.patches import Polygon
-
-    from ..analytic.linear import operating_equilibrium
-    from ..analytic.numeric import numeric_model
-    from ..systems.model import WORLD, Circle, Rectangle, Segment
-
-    system = get_system(system_id)
-    values = system.parameter_values()
-    eq = operating_equilibrium(system, values)
-    model = numeric_model(system_id, values)
-    d = model.derivation
-    env = {**model.subs, **dict(zip(d.q, eq.q))}
-
-    def world(body: str, p) -> np.ndarray:
-        pt = sp.Matrix(p) if body == WORLD else d.point(body, p)
-        return np.array([float(sp.sympify(c).xreplace(env)) for c in pt])
-
+def draw_mechanism(geometry: dict, out: Path) -> str:
+    """The mechanism at its operating equilibrium, from its saved geometry
+    (`results_folder.mechanism_geometry`)."""
+    system_id = geometry["system"]
     fig, ax = plt.subplots(figsize=(4, 4))
-    mech = system.numeric_mechanism(values)
-    for b in mech.bodies:
-        for shape in b.shapes:
-            if isinstance(shape, Segment):
-                a, c = world(b.name, shape.a), world(b.name, shape.b)
-                ax.plot([a[0], c[0]], [a[1], c[1]], "-", lw=4, color="tab:blue", alpha=0.7)
-            elif isinstance(shape, Circle):
-                ax.add_patch(CirclePatch(world(b.name, shape.center), float(shape.radius),
-                                         fill=False, lw=2, color="tab:green"))
-            elif isinstance(shape, Rectangle):
-                cx, cy = (float(v) for v in shape.center)
-                w, h = float(shape.width) / 2, float(shape.height) / 2
-                corners = [world(b.name, (cx + sx * w, cy + sy * h))
-                           for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-                ax.add_patch(Polygon(corners, closed=True, fill=False, lw=2, color="tab:orange"))
-        if float(b.mass) > 0:
-            ax.plot(*world(b.name, (0, 0)), "k+", ms=8)
-    for j in mech.joints:
-        ax.plot(*world(j.parent, j.parent_anchor), "o", color="k", ms=5, mfc="white")
+    for item in geometry["items"]:
+        kind = item["kind"]
+        if kind == "segment":
+            a, c = item["points"]
+            ax.plot([a[0], c[0]], [a[1], c[1]], "-", lw=4, color="tab:blue", alpha=0.7)
+        elif kind == "circle":
+            ax.add_patch(CirclePatch(item["center"], item["radius"], fill=False, lw=2,
+                                     color="tab:green"))
+        elif kind == "polygon":
+            ax.add_patch(Polygon(item["points"], closed=True, fill=False, lw=2,
+                                 color="tab:orange"))
+        elif kind == "centre_of_mass":
+            ax.plot(*item["at"], "k+", ms=8)
+        elif kind == "joint":
+            ax.plot(*item["at"], "o", color="k", ms=5, mfc="white")
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.2)
-    at = ", ".join(f"{c} = {v:.4g}" for c, v in zip(system.coordinates, eq.q))
+    at = ", ".join(f"{c} = {v:.4g}" for c, v in zip(geometry["coordinates"],
+                                                     geometry["operating_point"]))
     ax.set_title(f"{system_id} at {at}", fontsize=7)
     name = f"{system_id}-drawing.png"
     fig.savefig(out / name, dpi=80)
     plt.close(fig)
     return name
-
-
-# --- the report's expensive parts made ahead, in the matrix runner's worker processes ---
-
-
-def prerender(comps) -> None:
-    """The figures (PNG bytes) and the errata of one system's comparisons (its engines and
-    variants), attached to the comparisons: `write_report` then writes them instead of
-    making them, so these run in parallel, in the worker that already holds the system's
-    derivation and models. Same content as `write_report` makes itself."""
-    import tempfile
-
-    from ..analytic.errata import errata as compute
-
-    groups = defaultdict(list)
-    for c in comps:
-        groups[shown_id(c)].append(c)
-    with tempfile.TemporaryDirectory() as tmp:
-        where = Path(tmp)
-        for s, group in groups.items():
-            names = [draw_mechanism(_base(s), where)] + _figures(s, group, where)
-            group[0].prerendered_figures = (_group_key(group),
-                                            [(n, (where / n).read_bytes()) for n in names])
-    for base in dict.fromkeys(c.system for c in comps):
-        first = next(c for c in comps if c.system == base)
-        first.prerendered_errata = [e.as_dict() for e in compute(get_system(base))]
-
-
-def _prerendered_figures(comps, out: Path) -> list[str] | None:
-    """The figure files of a report row made by `prerender` for exactly these
-    comparisons, written to `out` (None: not prerendered)."""
-    pre = getattr(comps[0], "prerendered_figures", None)
-    if pre is None:
-        return None
-    key, files = pre
-    if key != _group_key(comps):
-        return None  # made for another selection of these comparisons
-    for name, data in files:
-        (out / name).write_bytes(data)
-    return [name for name, _ in files]
-
-
-def _group_key(comps) -> tuple:
-    return tuple((c.system, getattr(c, "variant", ""), c.simulator) for c in comps)
-
-
-def _errata_of(system_id: str, results) -> list[dict]:
-    """The system's errata entries: made by `prerender` if it ran, else here."""
-    pre = next((c.prerendered_errata for c in results if c.system == system_id
-                and getattr(c, "prerendered_errata", None) is not None), None)
-    if pre is not None:
-        return pre
-    from ..analytic.errata import errata as compute
-
-    return [e.as_dict() for e in compute(get_system(system_id))]

@@ -900,7 +900,7 @@ class MujocoBackend(Backend):
             "(e.g. a massless pin in a slot), times the lightest body's mass; weight "
             "cancelled. Not compensated: it adds inertia, while a lighter one softens the "
             "constraints through it (their stiffness scales with the mass they move). "
-            "Measured on slotted_link_spring_damper: 3e-4 and 1e-3 give similar "
+            "Measured on the slotted link of Fig. 34: 3e-4 and 1e-3 give similar "
             "trajectories (~5e-3), 1e-3 three times the frequency error (6e-4), 1e-2 and "
             "1e-4 2x-8x worse trajectories."),
         "link_mass_ratio": Setting(

@@ -71,5 +71,5 @@ SYSTEM = System(
                                   "positive"),
         Condition("l <= L", "the centre of mass must lie on the bar"),
     ),
-    exact_solution="compound_pendulum",
+    exact_solution="rigid_pendulum_elliptic",
 )

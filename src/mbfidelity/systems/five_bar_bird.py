@@ -64,7 +64,7 @@ Printed formulas (all in `printed`, judged by `mbfidelity errata`):
   "(I + m b^2 + )" is a stray plus sign: both eq. 115 and the geometry give I + m b^2
   (wing 2 carries no body), nothing is missing. As a system the printed equations admit
   no multipliers that reproduce the motion (the errata's least-squares fit).
-  Engine witness (analytic/errata.py, `_multiplier_witness`): eq. 116 closed with the
+  Engine witness (comparisons/witnesses.py, `_multiplier_witness`): eq. 116 closed with the
   derived Phi_q q'' = gamma and integrated on the true manifold (all four angles: the
   printed motion swings the bars inwards to Q = Q', where the phi1, phi2 chart fails)
   leaves the derived motion by ~0.5 rad within 3 s of the "large" scenario, and its

@@ -75,5 +75,5 @@ SYSTEM = System(
                  description="from rest, F0 sin(15 t): above resonance"),
     ),
     expectations=coarse_first_order("forced_*.trajectory_*"),
-    exact_solution="mass_spring_damper",
+    exact_solution="forced_linear_oscillator",
 )

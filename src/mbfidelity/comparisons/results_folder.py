@@ -1,0 +1,275 @@
+"""The results folder: everything the report pages show, computed here and saved, and
+read back by `reports` (which computes nothing of its own).
+
+Layout of a folder written by `mbfidelity run --out DIR` (and `mbfidelity errata --out`):
+
+    results.json, results.csv   every metric of every comparison (`matrix.write_results`)
+    job_costs.json              CPU seconds of each system's job in the last run into this
+                                folder (the dispatch order of the next run, `matrix.schedule`)
+    report_data/<row>.npz       the series the figures draw, per scenario: the reference
+                                once (t, q_ref, contact forces), and per engine q, scale,
+                                tolerance, contact forces
+    report_data/<system>.json   the mechanism at its operating equilibrium as drawn
+                                (world-frame geometry) and the system's errata entries
+    errata.json                 every printed formula, its verdict and the engines'
+                                witnesses (`mbfidelity errata --out`)
+
+A row is the system id, with the variant in brackets for a variant's comparisons.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+import sympy as sp
+
+from ..analytic.errata import errata
+from ..analytic.linear import operating_equilibrium
+from ..analytic.numeric import numeric_model
+from ..simulators import all_backends
+from ..systems import get_system
+from ..systems.model import WORLD, Circle, Rectangle, Segment
+from .runner import Comparison, Metric, provenance
+
+RESULTS = "results.json"
+JOB_COSTS = "job_costs.json"
+REPORT_DATA = "report_data"
+ERRATA = "errata.json"
+
+#: separates a scenario's name from the array's name in a series file (scenario names
+#: and contact names are identifiers, so they never contain it)
+KEY_SEPARATOR = "/"
+
+
+def row_id(c) -> str:
+    """A comparison's row name: the system id, with the variant in brackets."""
+    return f"{c.system}[{c.variant}]" if getattr(c, "variant", "") else c.system
+
+
+def base_id(row: str) -> str:
+    """The system id of a row."""
+    return row.split("[", 1)[0]
+
+
+def series_path(out: Path, row: str) -> Path:
+    """Where the series of a row's comparisons are saved."""
+    return out / REPORT_DATA / f"{row}.npz"
+
+
+# --- series ----------------------------------------------------------------------------
+
+#: the reference's arrays of a scenario's series, shared by the row's engines
+REFERENCE_ARRAYS = ("t", "q_ref")
+
+
+def save_series(out: Path, row: str, comps: Iterable[Comparison]) -> None:
+    """The series of a row's comparisons (`compare(..., keep_series=True)`), the arrays
+    the figures draw, as one compressed file: per scenario the reference once (its
+    samples t, q_ref and reference contact forces, as long as the longest engine run;
+    each engine's are a prefix of them), and per engine q, scale, tolerance and the
+    engine's contact forces. An engine whose reference arrays are not such a prefix
+    keeps its own."""
+    comps = [c for c in comps if c.series]
+    arrays: dict[str, np.ndarray] = {}
+    for scenario in dict.fromkeys(name for c in comps for name in c.series):
+        runs = [c for c in comps if scenario in c.series]
+        longest = max(runs, key=lambda c: len(c.series[scenario]["t"])).series[scenario]
+        shared = _reference_arrays(longest)
+        for name, a in shared.items():
+            arrays[_key(scenario, "reference", name)] = a
+        for c in runs:
+            s = c.series[scenario]
+            own = _reference_arrays(s)
+            for name, a in own.items():
+                if not np.array_equal(a, shared[name][:len(a)], equal_nan=True):
+                    arrays[_key(scenario, c.simulator, name)] = a
+            arrays[_key(scenario, c.simulator, "q")] = s["q"]
+            arrays[_key(scenario, c.simulator, "scale")] = np.asarray(s["scale"])
+            arrays[_key(scenario, c.simulator, "tolerance")] = np.asarray(s["tolerance"])
+            for contact, (_, f_run) in s["contacts"].items():
+                arrays[_key(scenario, c.simulator, _contact("engine", contact))] = f_run
+    path = series_path(out, row)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, **arrays)
+
+
+def _reference_arrays(s: dict) -> dict[str, np.ndarray]:
+    out = {name: s[name] for name in REFERENCE_ARRAYS}
+    for contact, (f_ref, _) in s["contacts"].items():
+        out[_contact("reference", contact)] = f_ref
+    return out
+
+
+def _contact(side: str, name: str) -> str:
+    return f"{side}_contact{KEY_SEPARATOR}{name}"
+
+
+def _key(scenario: str, owner: str, name: str) -> str:
+    return KEY_SEPARATOR.join((scenario, owner, name))
+
+
+def load_series(out: Path, row: str) -> dict[str, dict]:
+    """simulator -> scenario -> {"t", "q_ref", "q", "scale", "tolerance", "contacts":
+    name -> (reference, engine)}, as `save_series` saved them (empty when none were)."""
+    path = series_path(out, row)
+    if not path.exists():
+        return {}
+    with np.load(path) as data:
+        saved: dict[str, dict[str, dict]] = {}
+        for key in data.files:
+            scenario, owner, name = key.split(KEY_SEPARATOR, 2)
+            saved.setdefault(owner, {}).setdefault(scenario, {})[name] = data[key]
+    shared = saved.pop("reference", {})
+    series: dict[str, dict] = {}
+    for simulator, scenarios in saved.items():
+        for scenario, own in scenarios.items():
+            n = len(own["q"])
+            ref = {name: a[:n] for name, a in shared[scenario].items()}
+            ref.update({name: a for name, a in own.items() if name in ref})
+            s = {"t": ref["t"], "q_ref": ref["q_ref"], "q": own["q"], "scale": own["scale"],
+                 "tolerance": float(own["tolerance"]), "contacts": {}}
+            prefix = _contact("engine", "")
+            for name, f_run in own.items():
+                if name.startswith(prefix):
+                    contact = name[len(prefix):]
+                    s["contacts"][contact] = (ref[_contact("reference", contact)], f_run)
+            series.setdefault(simulator, {})[scenario] = s
+    return series
+
+
+# --- per system: the drawing and the errata ----------------------------------------------
+
+
+def mechanism_geometry(system_id: str) -> dict:
+    """The mechanism at its operating equilibrium in world coordinates, in drawing order:
+    each body's shapes (segments, circles, rectangles as polygons) and, for a body with
+    mass, its centre of mass; then each joint's anchor on its parent."""
+    system = get_system(system_id)
+    values = system.parameter_values()
+    eq = operating_equilibrium(system, values)
+    model = numeric_model(system_id, values)
+    d = model.derivation
+    env = {**model.subs, **dict(zip(d.q, eq.q))}
+
+    def world(body: str, p) -> list[float]:
+        pt = sp.Matrix(p) if body == WORLD else d.point(body, p)
+        return [float(sp.sympify(c).xreplace(env)) for c in pt]
+
+    items: list[dict] = []
+    mech = system.numeric_mechanism(values)
+    for b in mech.bodies:
+        for shape in b.shapes:
+            if isinstance(shape, Segment):
+                items.append({"kind": "segment",
+                              "points": [world(b.name, shape.a), world(b.name, shape.b)]})
+            elif isinstance(shape, Circle):
+                items.append({"kind": "circle", "center": world(b.name, shape.center),
+                              "radius": float(shape.radius)})
+            elif isinstance(shape, Rectangle):
+                cx, cy = (float(v) for v in shape.center)
+                w, h = float(shape.width) / 2, float(shape.height) / 2
+                items.append({"kind": "polygon", "points": [
+                    world(b.name, (cx + sx * w, cy + sy * h))
+                    for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
+        if float(b.mass) > 0:
+            items.append({"kind": "centre_of_mass", "at": world(b.name, (0, 0))})
+    for j in mech.joints:
+        items.append({"kind": "joint", "at": world(j.parent, j.parent_anchor)})
+    return {"system": system_id, "coordinates": list(system.coordinates),
+            "operating_point": [float(v) for v in eq.q], "items": items}
+
+
+def save_system(out: Path, system_id: str) -> None:
+    """The system's drawing geometry and its errata entries (printed formulas against the
+    derivation, without the engines' witnesses)."""
+    doc = {"drawing": mechanism_geometry(system_id),
+           "errata": [e.as_dict() for e in errata(get_system(system_id))]}
+    path = out / REPORT_DATA / f"{system_id}.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _write_json(path, doc)
+
+
+def load_system(out: Path, system_id: str) -> dict:
+    """{"drawing": ..., "errata": [...]} as `save_system` saved them."""
+    return json.loads((out / REPORT_DATA / f"{system_id}.json").read_text())
+
+
+# --- the metrics -----------------------------------------------------------------------
+
+
+def load_results(out: Path) -> tuple[dict, list[Comparison]]:
+    """(provenance, comparisons) of results.json, without their series (`load_series`)."""
+    doc = json.loads((out / RESULTS).read_text())
+    comparisons = []
+    for c in doc["comparisons"]:
+        metrics = [Metric(name=m["name"], value=m["value"], tolerance=m["tolerance"],
+                          passed=m["passed"], status=m["status"], reason=m.get("reason", ""),
+                          unit=m["unit"], detail=m.get("detail", {}))
+                   for m in c["metrics"]]
+        comparisons.append(Comparison(
+            system=c["system"], simulator=c["simulator"], engine_version=c["engine_version"],
+            settings=c["settings"], parameters=c["parameters"], dt=c["dt"], metrics=metrics,
+            supported=c["supported"], reason=c["reason"], wall_time=c["wall_time_s"],
+            simulated_time=c["simulated_time_s"], variant=c["variant"]))
+    return doc["provenance"], comparisons
+
+
+# --- job costs -------------------------------------------------------------------------
+
+
+def load_job_costs(out: Path | None) -> dict[str, float]:
+    """system -> CPU seconds of its job in the last run into `out` (empty when none, or
+    when the file is unreadable: only the dispatch order depends on it)."""
+    if out is None:
+        return {}
+    try:
+        costs = json.loads((out / JOB_COSTS).read_text())
+        return {str(k): float(v) for k, v in costs.items()}
+    except (OSError, ValueError, TypeError, AttributeError):
+        return {}
+
+
+def save_job_costs(out: Path, costs: dict[str, float]) -> None:
+    """Merged into the folder's earlier costs: a run of some systems keeps the others'."""
+    out.mkdir(parents=True, exist_ok=True)
+    _write_json(out / JOB_COSTS, {**load_job_costs(out), **costs})
+
+
+# --- errata with witnesses -------------------------------------------------------------
+
+
+def engine_versions() -> dict[str, str]:
+    """id -> version of every installed engine."""
+    out = {}
+    for sim, backend in all_backends().items():
+        if backend.available()[0]:
+            out[sim] = backend.version()
+    return out
+
+
+def save_errata(entries: list[dict], out: Path) -> Path:
+    """errata.json: the entries, with the provenance and the engines' versions."""
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / ERRATA
+    _write_json(path, {"provenance": provenance(), "engines": engine_versions(),
+                       "errata": entries})
+    return path
+
+
+def load_errata(out: Path) -> dict:
+    """{"provenance", "engines", "errata"} as `save_errata` saved them."""
+    return json.loads((out / ERRATA).read_text())
+
+
+def _write_json(path: Path, doc) -> None:
+    path.write_text(json.dumps(doc, indent=1, default=float))
+
+
+def rows_of(results: Iterable) -> dict[str, list]:
+    """row -> its comparisons, in the order of `results`."""
+    rows: dict[str, list] = {}
+    for c in results:
+        rows.setdefault(row_id(c), []).append(c)
+    return rows

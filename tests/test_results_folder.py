@@ -1,0 +1,62 @@
+"""The results folder a run leaves (comparisons/results_folder.py): the report pages are
+rendered from it alone, and the pool's dispatch order comes from its measured job costs
+or, without them, from the descriptions."""
+import hashlib
+import json
+
+from typer.testing import CliRunner
+
+from mbfidelity.cli import app
+from mbfidelity.comparisons.matrix import estimated_cost, schedule
+from mbfidelity.comparisons.results_folder import (JOB_COSTS, REPORT_DATA, load_results,
+                                                   load_series)
+
+
+def _digest(path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def test_report_is_rendered_from_the_saved_results_alone(tmp_path):
+    res = CliRunner().invoke(app, ["run", "--systems", "compound_pendulum", "--sims", "mujoco",
+                                   "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    figures = sorted(tmp_path.glob("*.png"))
+    assert [p.name for p in figures] == ["compound_pendulum-drawing.png",
+                                        "compound_pendulum-large.png",
+                                        "compound_pendulum-small.png"]
+    page, summary = (tmp_path / "index.html").read_text(), (tmp_path / "summary.md").read_text()
+    made = {p.name: _digest(p) for p in figures}
+    _, (comparison,) = load_results(tmp_path)
+    series = load_series(tmp_path, "compound_pendulum")[comparison.simulator]
+    assert set(series) == {"small", "large"}
+    for s in series.values():
+        assert len(s["t"]) == len(s["q"]) == len(s["q_ref"]) and s["tolerance"] > 0
+    assert json.loads((tmp_path / JOB_COSTS).read_text())["compound_pendulum"] > 0
+    assert (tmp_path / REPORT_DATA / "compound_pendulum.json").exists()
+
+    # the same pages again, in a fresh process pool and serially, from the folder only
+    from mbfidelity.reports.html import write_report
+
+    for workers in (2, 1):
+        for p in figures:
+            p.unlink()
+        write_report(tmp_path, workers=workers)
+        assert (tmp_path / "index.html").read_text() == page
+        assert (tmp_path / "summary.md").read_text() == summary
+        assert {p.name: _digest(p) for p in sorted(tmp_path.glob("*.png"))} == made
+
+
+def test_schedule_prefers_measured_costs():
+    systems = ["compound_pendulum", "rhombus_linkage", "double_pendulum"]
+    # without measurements: the description's estimate, the four-bar loop first
+    assert schedule(systems)[0] == "rhombus_linkage"
+    assert schedule(systems)[-1] == "compound_pendulum"
+    # measured costs win over the estimates
+    assert schedule(systems, {"compound_pendulum": 3.0, "rhombus_linkage": 1.0,
+                              "double_pendulum": 2.0}) == ["compound_pendulum",
+                                                           "double_pendulum", "rhombus_linkage"]
+    # the unmeasured ones are placed by their estimates scaled to seconds
+    ratio = estimated_cost("double_pendulum") / estimated_cost("compound_pendulum")
+    measured = {"compound_pendulum": 10.0, "rhombus_linkage": 10.0 * ratio * 0.5}
+    assert schedule(systems, measured) == ["double_pendulum", "rhombus_linkage",
+                                           "compound_pendulum"]
