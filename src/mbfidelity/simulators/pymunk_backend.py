@@ -1204,7 +1204,7 @@ class PymunkBackend(Backend):
                                                  "inside a ring of contact_segments Segments) "
                                                  "with Coulomb friction, the carrier arm "
                                                  "removed: what a game-physics user would "
-                                                 "build. Measured on rolling_disc_track: "
+                                                 "build. Measured on the disc of Fig. 39: "
                                                  "trajectory error 2-10 % of the amplitude "
                                                  "(coupling 2-2.6e-3), slip up to 3e-4 m, "
                                                  "single-step losses of contact from one "
