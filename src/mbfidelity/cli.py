@@ -250,12 +250,14 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
                                            "friction contact) on the engines that build them"),
         no_cache: bool = typer.Option(False, "--no-cache", help="recompute the derivations "
                                       "instead of reading the persistent cache"),
+        resume: bool = typer.Option(False, "--resume", help="continue a killed run into "
+                                    "--out: reuse the systems it finished"),
         ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
     _use_cache(no_cache)
     from rich.progress import Progress
 
-    from .comparisons.matrix import run_matrix, write_results
+    from .comparisons.matrix import reusable_jobs, run_matrix, write_results
     from .reports.html import write_report
     from .simulators import all_backends
     from .systems import all_systems
@@ -267,6 +269,10 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
     for e in sim_ids:
         if e not in all_backends():
             _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    if resume:
+        reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants)
+        typer.echo(f"resuming: {len(reused)} of {len(sys_ids)} systems finished in {out}, "
+                   f"reused")
     start = time.perf_counter()
     with Progress(transient=False, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("comparisons", total=len(sys_ids) * len(sim_ids))
@@ -274,13 +280,17 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
         results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
-                             out=out)
+                             out=out, resume=resume)
     write_results(results, out)
     index = write_report(out)
     elapsed = time.perf_counter() - start
     failed = [f"{c.system}/{c.simulator}" for c in results if c.supported and not c.passed]
     typer.echo(f"{len(results)} comparisons in {elapsed:.1f} s; "
                f"{sum(c.passed for c in results)} passed, {len(failed)} failed")
+    for c in results:
+        for i in c.incidents:
+            typer.echo(f"  {c.system}/{c.simulator} {i['scenario']}: {i['outcome']}: "
+                       f"{i['message']}")
     typer.echo(f"results: {out.resolve()}")
     typer.echo(f"report:  {index.resolve()}")
 

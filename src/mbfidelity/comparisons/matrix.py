@@ -5,8 +5,11 @@ from __future__ import annotations
 import csv
 import json
 import os
+import pickle
+import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Callable, Iterable, Mapping
 
@@ -14,14 +17,19 @@ import numpy as np
 
 from ..systems import get_system
 from . import results_folder
-from .runner import DEFAULT_DT, Comparison, compare, provenance
+from ..analytic.derivation import cache_key
+from .runner import DEFAULT_DT, Comparison, compare, isolated_compare, provenance
+
+#: wall-clock budget of one comparison when a job is re-run engine by engine after its
+#: worker died (see `run_matrix`)
+ISOLATED_TIMEOUT = 1800.0
 
 ROW_FIELDS = ("system", "variant", "simulator", "engine_version", "metric", "value", "tolerance", "unit",
               "status", "passed", "reason", "dt", "settings", "git_describe", "date",
               "python", "platform")
 
 
-def _one_system(args) -> tuple[list[Comparison], float]:
+def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
     """Every engine on one system, in one process: the references are solved once
     (cached) and shared by all engines; with `variants`, also each variant of the system
     on the engines that build it. With `out`, what the report shows of the system is
@@ -31,11 +39,11 @@ def _one_system(args) -> tuple[list[Comparison], float]:
     comparisons and the job's CPU seconds."""
     system, sims, dt, variants, out = args
     start = time.process_time()
-    found = [compare(system, sim, dt=dt, keep_series=True) for sim in sims]
+    found = [run(system, sim, dt=dt, keep_series=True) for sim in sims]
     if variants:
         for v in get_system(system).variants:
             # engines that do not build the variant give an "unsupported" row, with why
-            found += [compare(system, sim, dt=dt, keep_series=True, variant=v.name)
+            found += [run(system, sim, dt=dt, keep_series=True, variant=v.name)
                       for sim in sims]
     if out is not None:
         for row, comps in results_folder.rows_of(found).items():
@@ -44,6 +52,55 @@ def _one_system(args) -> tuple[list[Comparison], float]:
             c.series = {}
         results_folder.save_system(out, system)
     return found, time.process_time() - start
+
+
+def _isolated_job(args) -> tuple[list[Comparison], float]:
+    """A job whose worker died, again, each comparison in a worker of its own with a
+    wall-clock budget: the one that kills its worker is recorded as crashed (or
+    timed_out) and the others complete."""
+    def run(system_id, simulator, **kwargs):
+        return isolated_compare(system_id, simulator, None, timeout=ISOLATED_TIMEOUT, **kwargs)
+    return _one_system(args, run=run)
+
+
+# --- finished jobs, kept for `run --resume` ---------------------------------------------
+
+
+def _job_request(system: str, sims: list[str], dt: float, variants: bool) -> tuple:
+    """What a finished job answers: the system (its content key: description and
+    derivation code), the engines, the step and whether variants ran."""
+    return (system, cache_key(get_system(system)), tuple(sims), dt, variants)
+
+
+def _job_path(out: Path, system: str) -> Path:
+    return out / "jobs" / f"{system}.pickle"
+
+
+def _save_job(out: Path, request: tuple, job: tuple[list[Comparison], float]) -> None:
+    """Atomically (temporary file, then rename): a run killed while writing leaves the
+    previous state, never a partial file."""
+    path = _job_path(out, request[0])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    with os.fdopen(fd, "wb") as fh:
+        pickle.dump((request, job), fh, protocol=pickle.HIGHEST_PROTOCOL)
+    os.replace(tmp, path)
+
+
+def _load_job(out: Path, request: tuple) -> tuple[list[Comparison], float] | None:
+    try:
+        saved, job = pickle.loads(_job_path(out, request[0]).read_bytes())
+    except Exception:  # missing, partial or from another version: recomputed
+        return None
+    return job if saved == request else None
+
+
+def reusable_jobs(out: Path, systems: Iterable[str], simulators: Iterable[str],
+                  dt: float = DEFAULT_DT, variants: bool = False) -> list[str]:
+    """The systems whose finished job `out` holds for this request (`run --resume`)."""
+    sims = list(simulators)
+    return [s for s in systems
+            if _load_job(out, _job_request(s, sims, dt, variants)) is not None]
 
 
 def estimated_cost(system_id: str) -> float:
@@ -74,37 +131,60 @@ def schedule(systems: Iterable[str], measured: Mapping[str, float] | None = None
 def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
                workers: int | None = None,
                progress: Callable[[Comparison], None] | None = None,
-               variants: bool = False, out: Path | None = None) -> list[Comparison]:
+               variants: bool = False, out: Path | None = None,
+               resume: bool = False) -> list[Comparison]:
     """Every system on every simulator, in `systems` order. With several workers the
     systems are dispatched longest first (`schedule`, with the job costs of the last run
     into `out`) to a process pool; each system is one job (its references and derivation
     are shared by its engines). With `out`, each job also saves what the report shows of
     its system there (see `_one_system`), and the jobs' CPU seconds are saved for the
-    next run's order."""
+    next run's order.
+
+    Each finished job is also saved there as it completes (atomically); `resume` reuses
+    the saved jobs that answer the same request (`reusable_jobs`) and runs only the
+    others. A job whose worker process dies (a segfault in an engine) loses no
+    other job: it runs again engine by engine, each comparison in a worker of its own
+    (`_isolated_job`)."""
     systems = list(systems)
     sims = list(simulators)
     workers = workers or min(2, os.cpu_count() or 1)
     workers = max(1, min(workers, len(systems)))
     batches: dict[int, list[Comparison]] = {}
     costs: dict[str, float] = {}
+    requests = {s: _job_request(s, sims, dt, variants) for s in systems}
 
-    def collect(i, job):
+    def collect(i, job, fresh=True):
         batches[i], costs[systems[i]] = job
+        if out is not None and fresh:
+            _save_job(out, requests[systems[i]], job)
         if progress:
             for res in batches[i]:
                 progress(res)
 
-    if workers <= 1:
-        for i, s in enumerate(systems):
-            collect(i, _one_system((s, sims, dt, variants, out)))
+    todo = []
+    for i, s in enumerate(systems):
+        saved = _load_job(out, requests[s]) if (resume and out is not None) else None
+        if saved is not None:
+            collect(i, saved, fresh=False)
+        else:
+            todo.append(i)
+    crashed = []
+    if workers <= 1 or len(todo) <= 1:
+        for i in todo:
+            collect(i, _one_system((systems[i], sims, dt, variants, out)))
     else:
         rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
-        order = sorted(range(len(systems)), key=lambda i: rank[systems[i]])
+        order = sorted(todo, key=lambda i: rank[systems[i]])
         with ProcessPoolExecutor(max_workers=workers) as pool:
             futures = {pool.submit(_one_system, (systems[i], sims, dt, variants, out)): i
                        for i in order}
             for fut in as_completed(futures):
-                collect(futures[fut], fut.result())
+                try:
+                    collect(futures[fut], fut.result())
+                except BrokenProcessPool:
+                    crashed.append(futures[fut])
+    for i in sorted(crashed):
+        collect(i, _isolated_job((systems[i], sims, dt, variants, out)))
     if out is not None:
         results_folder.save_job_costs(out, costs)
     # in the order of `systems`, whatever order the jobs finished in
