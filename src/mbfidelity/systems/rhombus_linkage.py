@@ -120,9 +120,8 @@ def printed(P):
         PrintedFormula("Fig. 13, eq. 35 (reduced inertia m(phi))", "kinetic_energy",
                        sp.Rational(1, 2) * inertia * phi_d**2,
                        note="m(phi) compared through m(phi) phi_dot^2/2"),
-        PrintedFormula("Fig. 13, eq. 35 (reduced conservative force)", "potential_energy",
-                       -sp.integrate(F_red, phi),
-                       note="F_red compared through its potential -integral(F_red dphi)"),
+        PrintedFormula("Fig. 13, eq. 35 (reduced conservative force)", "potential_gradient",
+                       [-F_red], note="F_red compared as -dE_p/dphi along the mechanism"),
         PrintedFormula("Fig. 13, eq. 36", "eom", [
             inertia * phi_dd - 16 * m * l**2 * c * s * phi_d**2
             - 8 * m * g * l * (-c + s) - 4 * k * l**2 * (c - r2) * s]),
