@@ -71,6 +71,16 @@ def system_key(module_file: str) -> str:
     return h.hexdigest()[:32]
 
 
+def analytic_digest() -> str:
+    """Digest of every module of `analytic/`: part of the name of entries computed by more
+    of it than the derivation (the errata comparisons)."""
+    h = hashlib.sha256()
+    for path in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(path.name.encode())
+        h.update(_file_digest(str(path)))
+    return h.hexdigest()[:16]
+
+
 def load(key: str, name: str) -> bytes | None:
     """The payload of entry `name` under `key`, or None (missing, disabled, corrupted)."""
     if not enabled():

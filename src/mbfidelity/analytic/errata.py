@@ -38,6 +38,7 @@ N^T K_p S (`printed_model_frequencies`).
 """
 from __future__ import annotations
 
+import pickle
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Mapping
@@ -48,7 +49,8 @@ from scipy.integrate import solve_ivp
 
 from ..systems import PrintedFormula, System, coordinate_symbols
 from ..systems.model import TIME, Prismatic
-from .derivation import derivation_of
+from . import cache
+from .derivation import cache_key, derivation_of
 from .linear import linearize, operating_equilibrium
 from .numeric import _lambdify, numeric_model
 
@@ -493,6 +495,22 @@ def _one_equation_each(formulas) -> list[PrintedFormula]:
 
 
 def errata(system: System, seed: int = 20101) -> list[Erratum]:
+    """Every printed formula of the system against the derivation. Deterministic, so kept
+    in the persistent cache (`analytic.cache`) under the system's content key and the
+    analytic code that computes it."""
+    key, name = cache_key(system), f"errata-{seed}-{cache.analytic_digest()}.pickle"
+    blob = cache.load(key, name)
+    if blob is not None:
+        try:
+            return pickle.loads(blob)
+        except Exception:  # an unreadable entry is recomputed, never trusted
+            pass
+    out = _errata(system, seed)
+    cache.store(key, name, pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL))
+    return out
+
+
+def _errata(system: System, seed: int) -> list[Erratum]:
     rng = np.random.default_rng(seed)
     out = []
     for pf in _one_equation_each(system.printed(system.symbols)):
