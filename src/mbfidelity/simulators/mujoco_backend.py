@@ -678,60 +678,17 @@ class _Compiled:
             J = d.efc_J.reshape(d.nefc, m.nv)
         return J[rows].T @ d.efc_force[rows]
 
-    def closure_state(self) -> tuple[list[np.ndarray], np.ndarray]:
-        """After mj_forward: per closure, its force in the contract's physical terms, and
-        its violation (PointOnPoint: distance of the two points, m; PointOnLine: signed
-        distance of the pin from the slot line, m; LinearCoupling: Phi)."""
-        m, d = self.model, self.data
-        eq_type = int(self.mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-        # the equality rows of each closure, in row order (one vectorized pass: this runs
-        # at every sample)
-        nefc = d.nefc
-        eq_rows = np.flatnonzero(d.efc_type[:nefc] == eq_type)
-        eq_ids = d.efc_id[:nefc][eq_rows]
-        efc_force, efc_pos = d.efc_force, d.efc_pos
-        forces, viol = [], np.empty(len(self.plan.closures))
-        k_slider = k_contact = 0
-        mujoco = self.mujoco
-        if len(self.slider_jnt):
-            mujoco.mj_rnePostConstraint(m, d)
-        obj_body, acc = int(mujoco.mjtObj.mjOBJ_BODY), np.zeros(6)
-        for i, (cl, eid) in enumerate(zip(self.plan.closures, self.eq_id)):
-            rr = eq_rows[eq_ids == eid]
-            f, pos = efc_force[rr], efc_pos[rr]
-            if cl.kind == "contact":
-                # generalized force of the disc's contacts on the description coordinates
-                # (A^T qfrc); the coupling's value -lam is that on the disc's coordinate
-                # over its coefficient. Violation: the accumulated slip Phi = c.q - const
-                qfrc = self._contact_qfrc(self.disc_geom[k_contact])
-                Q = self.plan.A.T @ qfrc[self.vadr]
-                j = cl.contact["j"]
-                forces.append(np.array([Q[j] / cl.coef[j]]))
-                q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
-                viol[i] = cl.coef @ q - num(cl.element.constant)
-                k_contact += 1
-            elif cl.kind == "tendon":
-                # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
-                forces.append(np.array([f[0]]))
-                viol[i] = pos[0]
-            elif cl.kind == "connect":
-                # rows p1 - p2 (world), J = J1 - J2: f acts on body_a at site1
-                forces.append(np.array(f[:2]))
-                viol[i] = math.hypot(pos[0], pos[1])
-            else:
-                # the slider's mass belongs to the pin (see _plan): the slot's force on
-                # pin + slider is the slide joint's force on the slider,
-                # m_s a_s - (weight not cancelled) + (connect force on the pin); MuJoCo's
-                # body accelerations are proper accelerations a - g
-                bid = self.slider_body[k_slider]
-                mujoco.mj_objectAcceleration(m, d, obj_body, bid, acc, 0)
-                ms = m.body_mass[bid]
-                cancelled = ms * m.opt.gravity[:2] * m.body_gravcomp[bid]
-                forces.append(np.array(f[:2]) + ms * acc[3:5] + cancelled)
-                u = d.xaxis[self.slider_jnt[k_slider]]
-                viol[i] = -u[1] * pos[0] + u[0] * pos[1]  # slot normal . (P - L)
-                k_slider += 1
-        return forces, viol
+    def contact_state(self, cl: _Closure, k_contact: int) -> tuple[float, float]:
+        """After mj_forward, for a rolling coupling built as contact (the k-th such
+        closure): the generalized force of the disc's contacts on the description
+        coordinates (A^T qfrc), as the coupling's value -lam, i.e. that on the disc's
+        coordinate over its coefficient; and the accumulated slip Phi = c.q - const."""
+        d = self.data
+        qfrc = self._contact_qfrc(self.disc_geom[k_contact])
+        Q = self.plan.A.T @ qfrc[self.vadr]
+        j = cl.contact["j"]
+        q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
+        return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self):
         plan, model = self.plan, self.model
@@ -806,6 +763,94 @@ class _Compiled:
                 u = d.xaxis[self.slider_jnt[k]]
                 rates.append(((jp - js) @ d.qvel) @ u)
             d.qvel[self.slider_vadr] = rates
+
+
+class _ClosureSamples:
+    """Each closure's force in the contract's physical terms and its violation
+    (PointOnPoint: distance of the two points, m; PointOnLine: signed distance of the pin
+    from the slot line, m; LinearCoupling: Phi) over the sampled states. `record(k)`,
+    after mj_forward at sample k, copies what the closures need (their equality rows'
+    force and position, the sliders' acceleration and axis, the contacts' state);
+    `result()` forms the physical terms over all samples at once."""
+
+    def __init__(self, comp: _Compiled, n_samples: int) -> None:
+        self.comp, self.n = comp, n_samples
+        self.closures = comp.plan.closures
+        self.contacts = [cl for cl in self.closures if cl.kind == "contact"]
+        n_sliders = len(comp.slider_jnt)
+        self.acc = np.empty((n_samples, n_sliders, 6))
+        self.axis = np.empty((n_samples, n_sliders, 3))
+        self.contact_force = np.empty((n_samples, len(self.contacts)))
+        self.contact_violation = np.empty((n_samples, len(self.contacts)))
+        self.rows: list[np.ndarray] | None = None  # each closure's equality rows
+
+    def _layout(self) -> None:
+        """The equality rows of each closure, from the first sample: MuJoCo puts the
+        equality rows first, in equality order, the same at every sample."""
+        d = self.comp.data
+        eq_type = int(self.comp.mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        nefc = d.nefc
+        eq_rows = np.flatnonzero(d.efc_type[:nefc] == eq_type)
+        if len(eq_rows) != d.ne or not np.array_equal(eq_rows, np.arange(d.ne)):
+            raise RuntimeError("mujoco: the equality rows do not come first")
+        eq_ids = d.efc_id[:nefc][eq_rows]
+        self.rows = [eq_rows[eq_ids == eid] for eid in self.comp.eq_id]
+        self.ne = d.ne
+        self.force = np.empty((self.n, self.ne))
+        self.pos = np.empty((self.n, self.ne))
+
+    def record(self, k: int) -> None:
+        comp = self.comp
+        mujoco, m, d = comp.mujoco, comp.model, comp.data
+        if self.rows is None:
+            self._layout()
+        if d.ne != self.ne:
+            raise RuntimeError("mujoco: the closures' equality rows changed between samples")
+        self.force[k] = d.efc_force[:self.ne]
+        self.pos[k] = d.efc_pos[:self.ne]
+        if len(comp.slider_jnt):
+            mujoco.mj_rnePostConstraint(m, d)
+            obj_body = int(mujoco.mjtObj.mjOBJ_BODY)
+            for j, bid in enumerate(comp.slider_body):
+                mujoco.mj_objectAcceleration(m, d, obj_body, bid, self.acc[k, j], 0)
+            self.axis[k] = d.xaxis[comp.slider_jnt]
+        for j, cl in enumerate(self.contacts):
+            self.contact_force[k, j], self.contact_violation[k, j] = comp.contact_state(cl, j)
+
+    def result(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        m = self.comp.model
+        forces: dict[str, np.ndarray] = {}
+        violation: dict[str, np.ndarray] = {}
+        k_slider = k_contact = 0
+        for cl, rr in zip(self.closures, self.rows or [()] * len(self.closures)):
+            name = cl.element.name
+            if cl.kind == "contact":
+                forces[name] = self.contact_force[:, [k_contact]]
+                violation[name] = self.contact_violation[:, k_contact]
+                k_contact += 1
+                continue
+            f, pos = self.force[:, rr], self.pos[:, rr]
+            if cl.kind == "tendon":
+                # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
+                forces[name] = f[:, :1]
+                violation[name] = pos[:, 0]
+            elif cl.kind == "connect":
+                # rows p1 - p2 (world), J = J1 - J2: f acts on body_a at site1
+                forces[name] = f[:, :2]
+                violation[name] = np.array([math.hypot(x, y) for x, y in pos[:, :2].tolist()])
+            else:
+                # the slider's mass belongs to the pin (see _plan): the slot's force on
+                # pin + slider is the slide joint's force on the slider,
+                # m_s a_s - (weight not cancelled) + (connect force on the pin); MuJoCo's
+                # body accelerations are proper accelerations a - g
+                bid = self.comp.slider_body[k_slider]
+                ms = m.body_mass[bid]
+                cancelled = ms * m.opt.gravity[:2] * m.body_gravcomp[bid]
+                forces[name] = f[:, :2] + ms * self.acc[:, k_slider, 3:5] + cancelled
+                u = self.axis[:, k_slider]
+                violation[name] = -u[:, 1] * pos[:, 0] + u[:, 0] * pos[:, 1]  # n . (P - L)
+                k_slider += 1
+        return forces, violation
 
 
 class _PassiveInstalled:
@@ -1146,25 +1191,19 @@ class MujocoBackend(Backend):
     def _closures(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
                   t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
         """Constraint forces (contract point 6) and violations at each sampled state."""
-        closures = comp.plan.closures
-        if not closures:
+        if not comp.plan.closures:
             return {}, {}
         import mujoco
 
         m, d = comp.model, comp.data
-        N = len(t)
-        forces = [np.empty((N, 1 if cl.kind in ("tendon", "contact") else 2)) for cl in closures]
-        viol = np.empty((N, len(closures)))
-        for k in range(N):
+        samples = _ClosureSamples(comp, len(t))
+        for k in range(len(t)):
             d.qpos[:] = qpos[k]
             d.qvel[:] = qvel[k]
             d.time = t[k]
             mujoco.mj_forward(m, d)
-            f, viol[k] = comp.closure_state()
-            for i, fi in enumerate(f):
-                forces[i][k] = fi
-        names = [cl.element.name for cl in closures]
-        return dict(zip(names, forces)), {nm: viol[:, i] for i, nm in enumerate(names)}
+            samples.record(k)
+        return samples.result()
 
     def _reactions(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
                    joints: Sequence[str]) -> dict[str, np.ndarray]:
