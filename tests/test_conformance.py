@@ -80,6 +80,9 @@ VARIANT_CASES = [(s.id, v.name, sim) for s in all_systems().values() for v in s.
                  for sim in v.settings]
 
 
+# a long study (the disc on a ring of 720 contact facets: 40-170 s of CPU per engine), in
+# `make test-slow` like the variants' rows of the report (`run --variants`)
+@pytest.mark.slow
 @pytest.mark.parametrize("system_id,variant,simulator", [
     pytest.param(a, b, c, id=f"{a}[{b}]-{c}", marks=pytest.mark.xdist_group(f"{a}[{b}]"))
     for a, b, c in VARIANT_CASES])

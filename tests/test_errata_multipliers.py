@@ -6,6 +6,7 @@ import json
 from functools import lru_cache
 
 import numpy as np
+import pytest
 import sympy as sp
 
 from mbfidelity.analytic.errata import (AGREEMENT, Erratum, _compare, _multiplier_errata,
@@ -234,8 +235,6 @@ def test_five_bar_eq116_engine_witness_sides_with_the_derivation():
     """Every misprint is confirmed by an engine: eq. 116 (the system row and each row cite
     the same witness) has at least one engine whose trajectory, and modes where it
     linearizes, are closer to the derived model than to the printed one."""
-    import pytest
-
     from mbfidelity.comparisons.witnesses import witness
     from mbfidelity.simulators import all_backends
 
@@ -294,12 +293,11 @@ def test_slot_actuator_equations_rows_cannot_absorb_the_actuator_force():
     assert set(right.values()) == {"agrees"}
 
 
+@pytest.mark.slow  # all four engines on the rolling disc, residuals at every sample: ~2 min
 def test_singular_printed_equations_get_a_residual_witness():
     """Fig. 39: the printed equations of motion have no phi'' in row 2 (singular: they
     cannot be integrated), so the witness puts each engine's motion into both sets of
     equations: an engine's motion must satisfy the derived ones far better."""
-    import pytest
-
     from mbfidelity.comparisons.witnesses import witness
     from mbfidelity.simulators import all_backends
 
