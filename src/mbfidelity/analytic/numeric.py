@@ -455,6 +455,45 @@ class NumericModel:
         sol = np.linalg.solve(A, b[..., None])[..., 0]
         return sol[:, :n], sol[:, n:]
 
+    def complete_along(self, qi: np.ndarray, guesses: np.ndarray) -> np.ndarray:
+        """`complete` for N samples at once, (N, n): Newton's iterations on every sample
+        together, each from its own guess (rows of `guesses`), a row frozen once its step
+        meets the tolerance of `complete`."""
+        d = self.derivation
+        q = np.array(guesses, dtype=float)
+        q[:, self.independent] = qi
+        dep, N = self.dependent, len(q)
+        active = np.ones(N, dtype=bool)
+        for _ in range(NEWTON_MAX):
+            rows = q[active]
+            phi = self._along("Phi", None, rows.T, len(rows))
+            J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
+                            rows.T, len(rows)).reshape(len(rows), self.m, self.n)[:, :, dep]
+            step = np.linalg.solve(J, phi[..., None])[..., 0]
+            rows[:, dep] -= step
+            q[active] = rows
+            done = np.max(np.abs(step), axis=1) <= NEWTON_TOL * np.maximum(
+                1.0, np.max(np.abs(rows[:, dep]), axis=1))
+            active[np.flatnonzero(active)[done]] = False
+            if not active.any():
+                break
+        else:
+            raise RuntimeError("the constraint equations did not converge (assembly lost)")
+        if np.max(np.abs(self._along("Phi", None, q.T, N))) > 1e-10:
+            raise RuntimeError("the constraint equations have no solution here")
+        return q
+
+    def velocities_along(self, q: np.ndarray, qdi: np.ndarray) -> np.ndarray:
+        """q' = S(q) q_i' for N consistent samples, (N, n)."""
+        d, N = self.derivation, len(q)
+        ind, dep = self.independent, self.dependent
+        J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
+                        q.T, N).reshape(N, self.m, self.n)
+        qd = np.zeros((N, self.n))
+        qd[:, ind] = qdi
+        qd[:, dep] = -np.linalg.solve(J[:, :, dep], (J[:, :, ind] @ qdi[..., None]))[..., 0]
+        return qd
+
     def _along(self, name: str, build, args, N: int) -> np.ndarray:
         """(N, k) values of the list-valued compiled function `name` at N samples."""
         fn = self.compiled.function(name, build)

@@ -54,35 +54,51 @@ def consistent_initial_state(system: System, scenario: Scenario, values):
     return q, model.velocity_basis(q) @ qd0[model.independent]
 
 
+#: samples between two sequential Newton solves whose results are the starting guesses of
+#: the batched solve of the samples in between (continuity along one assembly branch)
+ANCHOR_SPACING = 25
+
+
+def _sampled_positions(model, y: np.ndarray, q0: np.ndarray) -> np.ndarray:
+    """The coordinates along the independent ones sampled in `y`: in closed form where the
+    constraints solve so, otherwise by Newton's method, sequentially every ANCHOR_SPACING
+    samples (each from the last one: the motion stays on its assembly branch) and for
+    all samples in between at once, each from its anchor."""
+    k = len(model.independent)
+    if model._explicit is not None:
+        return np.array([model._explicit[0](*row[:k]) for row in y], dtype=float)
+    anchors = np.arange(0, len(y), ANCHOR_SPACING)
+    guess, solved = np.array(q0, dtype=float), []
+    for i in anchors:
+        g = guess.copy()
+        g[model.independent] = y[i, :k]
+        guess = model.complete(g)
+        solved.append(guess)
+    guesses = np.array(solved)[np.arange(len(y)) // ANCHOR_SPACING]
+    return model.complete_along(y[:, :k], guesses)
+
+
 def _full_states(model, y: np.ndarray, q0: np.ndarray):
     k = len(model.independent)
     if not model.constrained:
         return y[:, :k], y[:, k:]
-    q, qd = np.empty((len(y), model.n)), np.empty((len(y), model.n))
-    guess = q0
-    for i, row in enumerate(y):
-        q[i], qd[i] = model.state_from_independent(row[:k], row[k:], guess)
-        guess = q[i]
+    q = _sampled_positions(model, y, q0)
+    if model._explicit is not None:
+        qd = np.array([model._explicit[1](*row) for row in y], dtype=float)
+    else:
+        qd = model.velocities_along(q, y[:, k:])
+    model._warm = q[-1].copy()
     return q, qd
 
 
 def _positions(model, y: np.ndarray, q0: np.ndarray) -> np.ndarray:
-    """The coordinates of `_full_states` alone (the same Newton solves from the same
-    guesses), without the velocities: for the error estimate, which compares positions."""
+    """The coordinates of `_full_states` alone, without the velocities: for the error
+    estimate, which compares positions."""
     k = len(model.independent)
     if not model.constrained:
         return y[:, :k]
-    q = np.empty((len(y), model.n))
-    if model._explicit is not None:
-        for i, row in enumerate(y):
-            q[i] = np.array(model._explicit[0](*row[:k]), dtype=float)
-        return q
-    ind, guess = model.independent, q0
-    for i, row in enumerate(y):
-        g = np.array(guess, dtype=float)
-        g[ind] = row[:k]
-        q[i] = guess = model.complete(g)
-    model._warm = guess  # where state_from_independent would have left it
+    q = _sampled_positions(model, y, q0)
+    model._warm = q[-1].copy()
     return q
 
 
