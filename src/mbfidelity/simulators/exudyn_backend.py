@@ -647,7 +647,8 @@ class ExudynBackend(Backend):
         cfg = self.resolve_settings(settings)
         solver = self._checked_solver(mechanism, cfg)
         steps = int(round(t_end / dt))
-        exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
+        # SC owns mbs: it stays referenced until the solve returns
+        exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
         mbs.Assemble()
         return self._solve(exu, mbs, cfg, solver, bool(closures), steps * dt, steps)[1]

@@ -778,6 +778,8 @@ class _ClosureSamples:
         self.closures = comp.plan.closures
         self.contacts = [cl for cl in self.closures if cl.kind == "contact"]
         n_sliders = len(comp.slider_jnt)
+        self.sliders = list(enumerate(comp.slider_body)) if n_sliders else []
+        self.obj_body = int(comp.mujoco.mjtObj.mjOBJ_BODY)
         self.acc = np.empty((n_samples, n_sliders, 6))
         self.axis = np.empty((n_samples, n_sliders, 3))
         self.contact_force = np.empty((n_samples, len(self.contacts)))
@@ -808,11 +810,11 @@ class _ClosureSamples:
             raise RuntimeError("mujoco: the closures' equality rows changed between samples")
         self.force[k] = d.efc_force[:self.ne]
         self.pos[k] = d.efc_pos[:self.ne]
-        if len(comp.slider_jnt):
+        if self.sliders:
             mujoco.mj_rnePostConstraint(m, d)
-            obj_body = int(mujoco.mjtObj.mjOBJ_BODY)
-            for j, bid in enumerate(comp.slider_body):
-                mujoco.mj_objectAcceleration(m, d, obj_body, bid, self.acc[k, j], 0)
+            acc = self.acc[k]
+            for j, bid in self.sliders:
+                mujoco.mj_objectAcceleration(m, d, self.obj_body, bid, acc[j], 0)
             self.axis[k] = d.xaxis[comp.slider_jnt]
         for j, cl in enumerate(self.contacts):
             self.contact_force[k, j], self.contact_violation[k, j] = comp.contact_state(cl, j)
@@ -1197,12 +1199,14 @@ class MujocoBackend(Backend):
 
         m, d = comp.model, comp.data
         samples = _ClosureSamples(comp, len(t))
+        d_qpos, d_qvel = d.qpos, d.qvel  # fixed buffers of d (the efc arrays are not)
+        forward, record = mujoco.mj_forward, samples.record
         for k in range(len(t)):
-            d.qpos[:] = qpos[k]
-            d.qvel[:] = qvel[k]
+            d_qpos[:] = qpos[k]
+            d_qvel[:] = qvel[k]
             d.time = t[k]
-            mujoco.mj_forward(m, d)
-            samples.record(k)
+            forward(m, d)
+            record(k)
         return samples.result()
 
     def _reactions(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
@@ -1228,19 +1232,23 @@ class MujocoBackend(Backend):
         ext = np.empty((N, len(discs), 2))
         ten = np.empty((N, len(tids), 2))
         spos = np.empty((N, len(tids), 2, 2))
+        # fixed buffers of d, viewed once
+        d_qpos, d_qvel, cfrc_int, cfrc_ext = d.qpos, d.qvel, d.cfrc_int, d.cfrc_ext
+        ten_length, ten_velocity, site_xpos = d.ten_length, d.ten_velocity, d.site_xpos
+        forward, post = mujoco.mj_forward, mujoco.mj_rnePostConstraint
         for k in range(N):
-            d.qpos[:] = qpos[k]
-            d.qvel[:] = qvel[k]
+            d_qpos[:] = qpos[k]
+            d_qvel[:] = qvel[k]
             d.time = t[k]
-            mujoco.mj_forward(m, d)
-            mujoco.mj_rnePostConstraint(m, d)
-            cf[k] = d.cfrc_int[bid, 3:5]
+            forward(m, d)
+            post(m, d)
+            cf[k] = cfrc_int[bid, 3:5]
             if len(disc_bid):
-                ext[k] = d.cfrc_ext[disc_bid, 3:5]  # contact force on the disc (world)
+                ext[k] = cfrc_ext[disc_bid, 3:5]  # contact force on the disc (world)
             if len(tids):
-                ten[k, :, 0] = d.ten_length[tids]
-                ten[k, :, 1] = d.ten_velocity[tids]
-                spos[k] = d.site_xpos[sid][:, :, :2]
+                ten[k, :, 0] = ten_length[tids]
+                ten[k, :, 1] = ten_velocity[tids]
+                spos[k] = site_xpos[sid][:, :, :2]
         q = (qpos[:, comp.qadr] - plan.b) @ plan.Ainv.T
         qd = qvel[:, comp.vadr] @ plan.Ainv.T
         out: dict[str, np.ndarray] = {}

@@ -1039,14 +1039,16 @@ class PyBulletBackend(Backend):
         return _World(cid, body, eidx, plan, cids, contact, coupling)
 
     def _inputs(self, p, world: _World, dt: float
-                ) -> Callable[[int, list, list], tuple[np.ndarray | None, list | None]] | None:
+                ) -> tuple[Callable[[int, list, list], tuple[np.ndarray | None, list | None]],
+                           bool] | None:
         """What the engine must be given before step k, or None when nothing: the joint
         forces of the CoordinateForce laws (from the joint values and rates at the start
         of the step, `jv` and `jvd` over at least the n coordinate links) and the
         point-to-point forces (from the engine's link states), both at t = k dt, and the
-        PRISMATIC pivots moved under the pins (see `_pivot_under_pin`). The function
-        returns the joint forces and the (x, y) force on point b of each point-to-point
-        element (None where there are none)."""
+        PRISMATIC pivots moved under the pins (see `_pivot_under_pin`). Returns that
+        function, which gives back the joint forces and the (x, y) force on point b of
+        each point-to-point element (None where there are none), and whether it reads
+        `jv` and `jvd`."""
         plan, cid, body, eidx = world.plan, world.cid, world.body, world.eidx
         n = plan.n
         has_cf = bool(plan.coord_forces)
@@ -1103,8 +1105,7 @@ class PyBulletBackend(Backend):
                            physicsClientId=cid)
             return tau, forces
 
-        apply.needs_state = has_cf  # type: ignore[attr-defined]
-        return apply
+        return apply, has_cf
 
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
@@ -1114,13 +1115,14 @@ class PyBulletBackend(Backend):
         world = self._open(p, mechanism, q0, qd0, dt, self.resolve_settings(settings))
         try:
             steps = int(round(t_end / dt))
-            apply = self._inputs(p, world, dt)
+            inputs = self._inputs(p, world, dt)
             step, cid = p.stepSimulation, world.cid
+            apply, needs_state = inputs if inputs is not None else (None, False)
             if apply is None:
                 start = time.process_time()
                 for _ in range(steps):
                     step(physicsClientId=cid)
-            elif not apply.needs_state:
+            elif not needs_state:
                 start = time.process_time()
                 for k in range(steps):
                     apply(k, [], [])
@@ -1175,7 +1177,8 @@ class PyBulletBackend(Backend):
             all_links = eidx
             sensor_slots = [eidx[i] for i in joint_ids]
             n_cs = len(cids)
-            apply = self._inputs(p, world, dt)
+            inputs = self._inputs(p, world, dt)
+            apply = inputs[0] if inputs is not None else None
             if contact is not None:
                 ring_links = set(plan.fixed_links)
                 disc_link = eidx[plan.link_of[contact.inner]]
