@@ -9,7 +9,9 @@ exceeds the wall-clock budget is killed and raises `WorkerTimedOut`.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import signal
+import sys
 from typing import Any, Callable
 
 
@@ -22,6 +24,10 @@ class WorkerTimedOut(RuntimeError):
 
 
 def _child(conn, fn, args, kwargs) -> None:
+    # what engines print from their own code (Exudyn's solver banners) goes to stderr:
+    # the caller's stdout may be a JSON document
+    sys.stdout.flush()
+    os.dup2(2, 1)
     try:
         result = ("ok", fn(*args, **kwargs))
     except BaseException as exc:  # raised again in the parent
