@@ -1179,7 +1179,7 @@ class MujocoBackend(Backend):
         callback installed, as MuJoCo calls it at every stage)."""
         import mujoco
 
-        s = self._resolve(settings)
+        s = self.resolve_settings(settings)
         comp = _Compiled(self._plan(mechanism, s, dt=dt), s["integrator"], dt,
                          bool(s["autoreset"]))
         comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
