@@ -447,8 +447,7 @@ class NumericModel:
         b = np.zeros((N, n + m))
         b[:, :n] = self._along("rhs", None, args, N)
         if m:
-            J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
-                            q.T, N).reshape(N, m, n)
+            J = self._jacobians_along(q)
             A[:, :n, n:] = np.transpose(J, (0, 2, 1))
             A[:, n:, :n] = J
             b[:, n:] = self._along("gamma", None, (*q.T, *qd.T), N)
@@ -459,7 +458,6 @@ class NumericModel:
         """`complete` for N samples at once, (N, n): Newton's iterations on every sample
         together, each from its own guess (rows of `guesses`), a row frozen once its step
         meets the tolerance of `complete`."""
-        d = self.derivation
         q = np.array(guesses, dtype=float)
         q[:, self.independent] = qi
         dep, N = self.dependent, len(q)
@@ -467,8 +465,7 @@ class NumericModel:
         for _ in range(NEWTON_MAX):
             rows = q[active]
             phi = self._along("Phi", None, rows.T, len(rows))
-            J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
-                            rows.T, len(rows)).reshape(len(rows), self.m, self.n)[:, :, dep]
+            J = self._jacobians_along(rows)[:, :, dep]
             step = np.linalg.solve(J, phi[..., None])[..., 0]
             rows[:, dep] -= step
             q[active] = rows
@@ -485,14 +482,19 @@ class NumericModel:
 
     def velocities_along(self, q: np.ndarray, qdi: np.ndarray) -> np.ndarray:
         """q' = S(q) q_i' for N consistent samples, (N, n)."""
-        d, N = self.derivation, len(q)
+        N = len(q)
         ind, dep = self.independent, self.dependent
-        J = self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
-                        q.T, N).reshape(N, self.m, self.n)
+        J = self._jacobians_along(q)
         qd = np.zeros((N, self.n))
         qd[:, ind] = qdi
         qd[:, dep] = -np.linalg.solve(J[:, :, dep], (J[:, :, ind] @ qdi[..., None]))[..., 0]
         return qd
+
+    def _jacobians_along(self, q: np.ndarray) -> np.ndarray:
+        """Phi_q at N samples, (N, m, n)."""
+        d = self.derivation
+        return self._along("Phi_q_flat", lambda: (list(d.q), list(d.Phi_q), "numpy"),
+                           q.T, len(q)).reshape(len(q), self.m, self.n)
 
     def _along(self, name: str, build, args, N: int) -> np.ndarray:
         """(N, k) values of the list-valued compiled function `name` at N samples."""
