@@ -43,11 +43,17 @@ conventions 1-8) into one engine and runs it. The contract:
      in physical terms at the same samples: PointOnPoint, the force on body_a from
      body_b (world x, y); PointOnLine, the force of the slot on the pin (world x, y);
      LinearCoupling, its generalized force (k = 1), with the sign of -multiplier;
+   - ``actuator_forces``: for each `Prescribed` element, shape (N+1,): the generalized
+     force its actuator exerts on the coordinate (model convention 9: positive along the
+     coordinate), belonging to the state at the same sample (NaN where the engine cannot
+     give it); the prescribed coordinates themselves are in ``q``, ``qd`` as the engine
+     moved them, so that the error of the engine's route to impose q(t) is measured;
    - ``wall_time``: seconds spent stepping only (build excluded), and ``cpu_time``: the
      CPU seconds (``time.process_time``) of the same stepping, comparable with point 9;
    - ``integrator_order``: the order of the scheme actually used (tolerances use it).
    Applied loads that depend on time are evaluated at the time of each integrator stage
-   where the engine allows it.
+   where the engine allows it, and so are prescribed motions (`plan.Motion`): the engine
+   imposes q(t) by its most exact route, named in its settings with its order.
 7. `linearize(mechanism, q_eq, settings, dt)` returns the continuous-time eigenvalues of
    the engine's own linearization about the equilibrium q_eq (description coordinates),
    with a label of the facility used, or None when the engine has no such facility.
@@ -187,6 +193,7 @@ class RunResult:
     steps: int = 0
     constraint_forces: dict[str, np.ndarray] = field(default_factory=dict)
     cpu_time: float = 0.0
+    actuator_forces: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.q.shape != self.qd.shape or self.q.shape[0] != len(self.t):

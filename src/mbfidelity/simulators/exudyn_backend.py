@@ -81,6 +81,7 @@ from ..analytic.linear import quadratic_eigenvalues
 from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
 from .plan import (
     BODY,
+    PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -336,6 +337,7 @@ class ExudynBackend(Backend):
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
                                                   "Exudyn holds the rolling coupling exactly "
                                                   "(LinearCoupling)"),),
+        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,

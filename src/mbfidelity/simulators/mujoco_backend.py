@@ -94,6 +94,7 @@ from .base import (
 )
 from .plan import (
     BODY,
+    PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -1057,6 +1058,7 @@ class MujocoBackend(Backend):
                                                  "generalized force on the disc's coordinate "
                                                  "over its coefficient, its violation the "
                                                  "slip; linearize uses the coupling"),),
+        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,

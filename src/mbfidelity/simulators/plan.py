@@ -42,6 +42,7 @@ from ..systems.model import (
     PointOnLine,
     PointOnPoint,
     PointToPoint,
+    Prescribed,
     Prismatic,
     Revolute,
     RollingContact,
@@ -94,11 +95,13 @@ POINT_ON_POINT = "PointOnPoint"
 POINT_ON_LINE = "PointOnLine"
 LINEAR_COUPLING = "LinearCoupling"
 ROLLING_CONTACT = "RollingContact"
+PRESCRIBED = "Prescribed"
 
 #: every kind of element a description holds, in the order backends declare them
 ELEMENT_KINDS = (BODY, MASSLESS_BODY, REVOLUTE, PRISMATIC, POINT_TO_POINT_LINEAR,
                  POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR, COORDINATE_FORCE_CUSTOM,
-                 TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING, ROLLING_CONTACT)
+                 TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING, ROLLING_CONTACT,
+                 PRESCRIBED)
 
 
 @singledispatch
@@ -152,9 +155,14 @@ def _(element: RollingContact) -> str:
     return ROLLING_CONTACT
 
 
+@element_kind.register
+def _(element: Prescribed) -> str:
+    return PRESCRIBED
+
+
 def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
     """(kind, element) for every element of the description, in description order."""
-    for group in (mech.bodies, mech.joints, mech.forces, mech.constraints):
+    for group in (mech.bodies, mech.joints, mech.forces, mech.constraints, mech.prescribed):
         for element in group:
             yield element_kind(element), element
 
@@ -233,6 +241,40 @@ def _force_law(element) -> ForceLaw:
     return law
 
 
+@dataclass(frozen=True)
+class Motion:
+    """A prescribed coordinate's motion (convention 9), compiled once: `position`,
+    `rate`, `acceleration` are scalar functions of t (the rate and acceleration are the
+    symbolic derivatives of q(t), never finite differences); `index` is the coordinate's
+    place among the description coordinates."""
+
+    element: Prescribed
+    index: int
+
+    @cached_property
+    def position(self) -> Callable[[float], float]:
+        return compile_law(self.element.motion, (TIME,))
+
+    @cached_property
+    def rate(self) -> Callable[[float], float]:
+        return compile_law(self.element.rate, (TIME,))
+
+    @cached_property
+    def acceleration(self) -> Callable[[float], float]:
+        return compile_law(self.element.acceleration, (TIME,))
+
+    def along(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q, q', q'') at the sample times `t`."""
+        t = np.asarray(t, dtype=float)
+        return tuple(np.array([f(x) for x in t]) for f in (self.position, self.rate,
+                                                          self.acceleration))
+
+
+def motions(mech: Mechanism) -> list[Motion]:
+    """The prescribed motions of a numeric mechanism, in description order."""
+    return [Motion(p, mech.coordinates.index(p.coordinate)) for p in mech.prescribed]
+
+
 def coupled(mech: Mechanism) -> Mechanism:
     """The mechanism with each RollingContact replaced by the rolling coupling it stands
     for (what an engine linearizes, or balances forces against)."""
@@ -298,6 +340,11 @@ def description_reason(mech: Mechanism) -> str:
                     num(v)
                 if math.hypot(num(c.direction[0]), num(c.direction[1])) == 0.0:
                     return f"constraint {c.name}: zero slot direction"
+        for p in mech.prescribed:
+            extra = sp.sympify(p.motion).free_symbols - {TIME}
+            if extra:
+                return (f"prescribed motion {p.name}: q(t) has non-numeric parameters "
+                        f"{sorted(map(str, extra))}")
     except NotNumeric as exc:
         return f"the mechanism is not numeric (use numeric_mechanism): {exc}"
     return ""

@@ -97,6 +97,7 @@ from .base import (
 )
 from .plan import (
     BODY,
+    PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -663,6 +664,7 @@ class PyBulletBackend(Backend):
                                     "three-term constraint, and a one-joint coupling would be "
                                     "a lock", when="one, or three or more, engine joint values"),
         ),
+        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,

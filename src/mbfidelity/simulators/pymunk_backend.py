@@ -120,6 +120,7 @@ from .base import (
 )
 from .plan import (
     BODY,
+    PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -1218,6 +1219,7 @@ class PymunkBackend(Backend):
                               "couplings are refused (support)",
                        when="three body angles, two hinged on a carrier"),
         ),
+        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,

@@ -181,6 +181,13 @@ class System:
     validity: tuple[Condition, ...] = ()
     #: name of an exact solution in mbfidelity.analytic.closed_forms, if one exists
     exact_solution: str | None = None
+    #: driven systems (monograph §8, §9.6): parameter values that switch the excitation
+    #: off (its amplitudes set to zero; gravity, in a rotating frame whose weight is the
+    #: excitation): the reference motion about which the free coordinates are linearized
+    unexcited: Mapping[str, float] = field(default_factory=dict)
+    #: the excitation's angular frequencies (rad/s), expressions of the parameters: the
+    #: linear steady-state response is computed at each
+    excitation_frequencies: Callable[[SimpleNamespace], tuple[Expr, ...]] = lambda P: ()
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 

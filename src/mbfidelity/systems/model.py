@@ -28,6 +28,11 @@ Conventions (all backends and the analytic layer honour them):
    elements on one coordinate; `TIME` everywhere) and of parameter symbols. The same
    expression feeds the derivation and, compiled with `compile_law`, every engine.
 8. Positive `tension` of a point-to-point element pulls its two points together.
+9. A `Prescribed` coordinate follows its motion q(t) for the whole run (monograph §9.6);
+   its rate and acceleration are the motion's symbolic derivatives. The generalized force
+   that imposes it (the actuator, acting between the joint's parent and child, positive
+   in the direction of increasing coordinate: N along a slide, N m about a hinge) is an
+   output, reported under the element's name. The other coordinates are the free ones.
 """
 from __future__ import annotations
 
@@ -200,6 +205,24 @@ class CoordinateForce:
 ForceElement = Union[PointToPoint, CoordinateForce]
 
 
+@dataclass(frozen=True)
+class Prescribed:
+    """A coordinate imposed as a function of time (convention 9): `motion` is an
+    expression of TIME and parameters; `name` names its actuator force."""
+
+    name: str
+    coordinate: str
+    motion: Expr
+
+    @property
+    def rate(self) -> sp.Expr:
+        return sp.diff(sp.sympify(self.motion), TIME)
+
+    @property
+    def acceleration(self) -> sp.Expr:
+        return sp.diff(sp.sympify(self.motion), TIME, 2)
+
+
 # --- closure constraints (loops, slots, couplings) -------------------------------------
 # Joints form a spanning tree; constraints close it. The analytic layer treats them with
 # Lagrange multipliers (monograph §10) and by reduction to the independent coordinates the
@@ -320,6 +343,8 @@ class Mechanism:
     constraints: tuple[Constraint, ...] = ()
     #: independent coordinates when constraints remove degrees of freedom (None: all)
     independent: tuple[str, ...] | None = None
+    #: coordinates imposed as functions of time, with their actuators (convention 9)
+    prescribed: tuple[Prescribed, ...] = ()
 
     def __post_init__(self) -> None:
         names = [b.name for b in self.bodies]
@@ -356,6 +381,23 @@ class Mechanism:
                     and self.joint_of_child(c.arm).parent == c.track):
                 raise ValueError(f"contact {c.name}: the disc must be hinged on the arm, the "
                                  "arm on the track")
+        driven = [p.coordinate for p in self.prescribed]
+        for p in self.prescribed:
+            if p.coordinate not in coords:
+                raise ValueError(f"prescribed motion {p.name}: unknown coordinate "
+                                 f"{p.coordinate!r}")
+            extra = sp.sympify(p.motion).free_symbols & {COORD, COORD_RATE, LENGTH,
+                                                         LENGTH_RATE}
+            if extra:
+                raise ValueError(f"prescribed motion {p.name}: q(t) must be a function of "
+                                 f"time and parameters only, not of {sorted(map(str, extra))}")
+        if len(set(driven)) != len(driven):
+            raise ValueError(f"a coordinate is prescribed twice: {driven}")
+        if self.prescribed and (self.constraints or self.independent is not None):
+            raise ValueError("prescribed motion in a mechanism with closure constraints is "
+                             "not supported: prescribe a coordinate of an open tree")
+        if len(driven) == len(coords) and coords:
+            raise ValueError("every coordinate is prescribed: nothing is free to move")
         if self.independent is not None:
             unknown = set(self.independent) - set(coords)
             if unknown:
@@ -369,7 +411,16 @@ class Mechanism:
 
     @property
     def independent_coordinates(self) -> tuple[str, ...]:
-        return self.independent if self.independent is not None else self.coordinates
+        """The coordinates the equations of motion are integrated in: the independent
+        ones of a constrained mechanism, the free (not prescribed) ones of a driven one."""
+        if self.independent is not None:
+            return self.independent
+        driven = {p.coordinate for p in self.prescribed}
+        return tuple(c for c in self.coordinates if c not in driven)
+
+    @property
+    def driven_coordinates(self) -> tuple[str, ...]:
+        return tuple(p.coordinate for p in self.prescribed)
 
     def body(self, name: str) -> Body:
         for b in self.bodies:
@@ -449,6 +500,7 @@ class Mechanism:
             gravity=ev(self.gravity),
             constraints=tuple(ev_constraint(c) for c in self.constraints),
             independent=self.independent,
+            prescribed=tuple(replace(p, motion=ev(p.motion)) for p in self.prescribed),
         )
 
 
