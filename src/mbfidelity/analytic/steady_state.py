@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import sympy as sp
 
 from ..systems import System
 from .linear import operating_equilibrium, unexcited_values
@@ -30,8 +31,9 @@ PERIODS, SAMPLES_PER_PERIOD = 4, 64
 
 @dataclass(frozen=True)
 class Harmonic:
-    """One line of the steady state: `quantity` "position" (a free coordinate) or
-    "actuator_force" (the actuator of a prescribed coordinate)."""
+    """One line of the steady state: `quantity` "position" (a free coordinate),
+    "actuator_force" (the actuator of a prescribed coordinate) or "observable" (one of
+    the system's `observables`, named in `coordinate`)."""
 
     coordinate: str
     quantity: str
@@ -102,6 +104,7 @@ def steady_state(system: System, values) -> SteadyState:
         qd0[p] = model0.motion(0.0)[1]
     Mfull, Jqd, Jq = model0.residual_jacobians(eq.q, qd0, qdd0, 0.0)
     names = system.coordinates
+    observables = observable_functions(system, values)
     harmonics = []
     for j, w in enumerate(freqs):
         a, b = coef[1 + 2 * j], coef[2 + 2 * j]
@@ -113,7 +116,28 @@ def steady_state(system: System, values) -> SteadyState:
         for k, name in zip(p, model.actuators):
             tau = phasor_R[k] + (Jq[k, f] + 1j * w * Jqd[k, f] - w**2 * Mfull[k, f]) @ X
             harmonics.append(_line(names[k], "actuator_force", w, tau))
+        for label, (value_of, gradient) in observables.items():
+            o = value_of(*q.T)
+            o = np.broadcast_to(np.asarray(o, dtype=float), (N,))
+            oc, *_ = np.linalg.lstsq(A, o, rcond=None)
+            grad = np.asarray(gradient(*eq.q), dtype=float).reshape(-1)
+            phasor = (oc[1 + 2 * j] - 1j * oc[2 + 2 * j]) + grad[f] @ X
+            harmonics.append(_line(label, "observable", w, phasor))
     return SteadyState(tuple(harmonics), residual)
+
+
+def observable_functions(system: System, values) -> dict:
+    """name -> (value(q...), gradient(q...)) of each observable at these parameters,
+    compiled from its expression in the coordinate symbols."""
+    from ..systems import coordinate_symbols
+
+    q = [coordinate_symbols(c)[0] for c in system.coordinates]
+    out = {}
+    for name, expr in system.observables(system.symbols).items():
+        e = sp.sympify(expr).xreplace(system.subs(values))
+        out[name] = (sp.lambdify(q, e, modules="numpy"),
+                     sp.lambdify(q, [sp.diff(e, x) for x in q], modules="numpy"))
+    return out
 
 
 def _line(coordinate: str, quantity: str, w: float, phasor: complex) -> Harmonic:

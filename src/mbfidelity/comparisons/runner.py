@@ -17,7 +17,8 @@ from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria
                                operating_equilibrium, unexcited_values, wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
-from ..analytic.steady_state import excitation_frequencies, steady_state
+from ..analytic.steady_state import (excitation_frequencies, observable_functions,
+                                     steady_state)
 from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
@@ -440,16 +441,26 @@ def _compare_steady_state(system, backend, values, ref, run, n, dt, eq, name, re
     sigma = min((-s.real for s in eq.eigenvalues), default=0.0)
     order = run.integrator_order
     zeta = min((m.damping_ratio for m in eq.modes), default=0.0)
+    observables = observable_functions(system, values)
     for h in response.harmonics:
-        if h.quantity != "position":
+        if h.quantity == "actuator_force":
             continue
-        k = system.coordinates.index(h.coordinate)
+        if h.quantity == "position":
+            k = system.coordinates.index(h.coordinate)
+
+            def series(q, k=k):
+                return q[:, k] - eq.q[k]
+        else:
+            value_of = observables[h.coordinate][0]
+
+            def series(q, value_of=value_of):
+                return np.broadcast_to(np.asarray(value_of(*q.T), dtype=float), (len(q),))
         W = 2 * np.pi * h.frequency_hz
         w_top = max(W, max((abs(s) for s in eq.eigenvalues), default=0.0))
         g = tolerances.gate(tolerances.steady_state_tolerance(w_top, dt, order, zeta),
                             w_top, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
         t = ref.t[:n]
-        x_ref = ref.q[:n, k] - eq.q[k]
+        x_ref = series(ref.q[:n])
         # transient: at most the largest excursion over the run, decaying at sigma
         initial = max(float(np.max(np.abs(x_ref))), h.amplitude)
         settle = (np.log(10 * initial / (g.tolerance * h.amplitude)) / sigma
@@ -465,7 +476,7 @@ def _compare_steady_state(system, backend, values, ref, run, n, dt, eq, name, re
             continue
         window = t >= t[-1] - periods * 2 * np.pi / W
         a_ref = _harmonic_amplitude(t[window], x_ref[window], W)
-        a_run = _harmonic_amplitude(t[window], run.q[:n, k][window] - eq.q[k], W)
+        a_run = _harmonic_amplitude(t[window], series(run.q[:n])[window], W)
         value = abs(a_run - h.amplitude) / h.amplitude
         metric = _judge(system, backend.id, label, value, g)
         metric.detail = {"linear_amplitude": h.amplitude, "reference_fit": a_ref,

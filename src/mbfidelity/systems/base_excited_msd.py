@@ -95,6 +95,10 @@ def printed(P):
                        [m * z_dd + c * z_d + k * z + m * y_dd], note="row of z"),
         PrintedFormula("§8.2, relative coordinate, Galilean frame", "eom",
                        [m * (z_dd + y_dd) + c * z_d + k * z], note="row of z"),
+        # the absolute equation, written with its definition x = y + z
+        PrintedFormula("§8.2, absolute coordinate x = y + z", "eom",
+                       [m * (y_dd + z_dd) + c * (y_d + z_d) + k * (y + z) - c * y_d - k * y],
+                       note="row of z, x = y + z substituted"),
     )
 
 
@@ -121,6 +125,8 @@ SYSTEM = System(
         transmissibility_scenario(2.0),
     ),
     unexcited={"Y": 0.0},
+    # the monograph's absolute coordinate: the block's position in the fixed frame
+    observables=lambda P: {"x": sp.Symbol("y", real=True) + sp.Symbol("z", real=True)},
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Transmissibility: |X/Y| = sqrt(k^2 + (c Omega)^2) / |k - m Omega^2 + i c Omega| "
           "(absolute x = y + z) and |Z/Y| = m Omega^2 / |k - m Omega^2 + i c Omega| "
