@@ -127,6 +127,7 @@ SYSTEM = System(
     unexcited={"Y": 0.0},
     # the monograph's absolute coordinate: the block's position in the fixed frame
     observables=lambda P: {"x": sp.Symbol("y", real=True) + sp.Symbol("z", real=True)},
+    exact_solution="base_excited_relative",
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Transmissibility: |X/Y| = sqrt(k^2 + (c Omega)^2) / |k - m Omega^2 + i c Omega| "
           "(absolute x = y + z) and |Z/Y| = m Omega^2 / |k - m Omega^2 + i c Omega| "

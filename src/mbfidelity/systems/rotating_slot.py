@@ -89,5 +89,6 @@ SYSTEM = System(
     ),
     # in the disc's frame the weight is the excitation (eq. 84's right-hand side)
     unexcited={"g": 0.0},
+    exact_solution="rotating_slot_eq84",
     excitation_frequencies=lambda P: (P.omega,),
 )
