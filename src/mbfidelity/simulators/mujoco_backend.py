@@ -43,6 +43,19 @@ Translation (generic over the description, see `to_mjcf`):
   bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
   Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
   every sample; the violation is returned as ``RunResult.constraint_violation``.
+- ``Prescribed`` coordinates (setting ``prescribed_motion``): a control callback
+  (``mujoco.set_mjcb_control``, installed with the passive callback and restored after,
+  both being process-global) imposes the acceleration. MuJoCo calls it after the passive
+  and bias forces at every RK4 stage with ``d.time`` at the stage time; with f =
+  qfrc_passive - qfrc_bias and the prescribed coordinates q_p = T_p (v - b), it solves
+  (T_p M^-1 T_p^T) Q_p = q_p''(t) - T_p M^-1 f (``mj_solveM``) and applies T_p^T Q_p as
+  ``qfrc_applied``; Q_p is the actuator force in the description's coordinates (clockwise
+  hinges, absolute angles and axis lengths through T). Under Euler, implicit and
+  implicitfast it imposes the discrete acceleration ((q(t+h) - q)/h - q')/h with the
+  matrix the step solves, which puts the coordinate on q(t+h) at every step. Joint
+  equalities with a moving reference and mocap welds are soft, so they are not used.
+  The actuator force of each sample is the callback's at that state (``mj_forward`` at
+  the sample's time, outside the timed loop).
 - Prismatic ``limits`` are admissible intervals of the description, not stops; they are
   not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
   outside the interval).
@@ -809,25 +822,39 @@ class _Compiled:
                 mujoco.mj_comVel(m, d)
             return H
 
+        # fixed buffers of the data, viewed once (the callback runs at every stage)
+        data = self.data
+        passive, bias_force, applied = data.qfrc_passive, data.qfrc_bias, data.qfrc_applied
+        qpos, qvel = data.qpos, data.qvel
+        solve_m, subtract = mujoco.mj_solveM, np.subtract
+        single = k == 1
+        Tp_t = np.ascontiguousarray(Tp.T)
+        column = Tp[0]
+
         def control(m, d) -> None:
             if m is not model:  # the callback is global: act on our model only
                 return
             t = d.time
-            stack[0] = d.qfrc_passive - d.qfrc_bias
+            subtract(passive, bias_force, out=stack[0])
             if damping is None:
-                mujoco.mj_solveM(m, d, solved, stack)
+                solve_m(m, d, solved, stack)
             else:
                 solved[:] = np.linalg.solve(matrix(m, d), stack.T).T
             if discrete:
-                q_now = rows @ (d.qpos[qadr] - b)
-                qd_now = Tp @ d.qvel
-                target = np.array([((f(t + h) - x) / h - xd) / h
-                                   for f, x, xd in zip(positions, q_now, qd_now)])
+                q_now = rows @ (qpos[qadr] - b)
+                qd_now = Tp @ qvel
+                target = [((f(t + h) - x) / h - xd) / h
+                          for f, x, xd in zip(positions, q_now.tolist(), qd_now.tolist())]
             else:
-                target = np.array([f(t) for f in accelerations])
-            W = solved[1:] @ Tp.T  # T_p H^-1 T_p^T
-            actuator[:] = np.linalg.solve(W, target - Tp @ solved[0])
-            d.qfrc_applied[:] = Tp.T @ actuator
+                target = [f(t) for f in accelerations]
+            if single:
+                free, w = (solved @ column).tolist()  # T_p H^-1 f and T_p H^-1 T_p^T
+                actuator[0] = (target[0] - free) / w
+                np.multiply(column, actuator[0], out=applied)
+            else:
+                W = solved[1:] @ Tp_t  # T_p H^-1 T_p^T
+                actuator[:] = np.linalg.solve(W, np.asarray(target) - Tp @ solved[0])
+                np.dot(Tp_t, actuator, out=applied)
 
         return control
 
