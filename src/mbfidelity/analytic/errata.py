@@ -121,7 +121,12 @@ def _random_states(system: System, values, rng, count: int = 25):
         except (RuntimeError, np.linalg.LinAlgError):
             continue
         qd = model.velocity_basis(q) @ rng.uniform(-1.5, 1.5, size=len(model.independent))
-        out.append((q, qd, rng.uniform(0, 10)))
+        t = rng.uniform(0, 10)
+        if model.driven:
+            # prescribed coordinates where their motion puts them at t
+            qp, qdp, _ = model.motion(t)
+            q[model.driven], qd[model.driven] = qp, qdp
+        out.append((q, qd, t))
     return out
 
 
