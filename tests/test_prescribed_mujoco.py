@@ -93,15 +93,13 @@ def test_rk4_route_is_fourth_order():
 
 def test_euler_route_lands_on_the_motion_and_is_first_order():
     """Under Euler the discrete acceleration puts the prescribed coordinate on q(t+h) at
-    every step, up to round-off: MuJoCo's clock adds h at every step, so after N steps it
-    is off by up to N eps t_end, and y by W times that (relative to Y). The free
-    coordinate and the force are first order (observed order within 1 +- 0.1: the next
-    term is O(w h) = 0.01 relative at h = 1e-3)."""
-    t_end = 2.0
-    coarse, fine = _errors(1e-3, "Euler", t_end), _errors(5e-4, "Euler", t_end)
-    for e, dt in ((coarse, 1e-3), (fine, 5e-4)):
-        steps = round(t_end / dt)
-        assert e[1] < steps * np.finfo(float).eps * t_end * e[3]["Omega"]
+    every step: what is left is the round-off of one step (a few ulps of y, and of the
+    cancellation in (q(t+h) - q)/h multiplied back by h), which the next step removes,
+    so it does not grow with the number of steps; 1000 eps of the amplitude bounds it.
+    The free coordinate and the force are first order (observed order within 1 +- 0.1:
+    the next term is O(w h) = 0.01 relative at h = 1e-3)."""
+    coarse, fine = _errors(1e-3, "Euler"), _errors(5e-4, "Euler")
+    assert coarse[1] < 1000 * np.finfo(float).eps and fine[1] < 1000 * np.finfo(float).eps
     for i in (0, 2):
         assert abs(math.log2(coarse[i] / fine[i]) - 1) < 0.1
 
