@@ -82,8 +82,8 @@ SYSTEM = System(
     printed=printed,
     validity=(),
     scenarios=(
-        speed(5.0, 10.0, "well below the critical speed sqrt(k/m) = 10 rad/s (defaults)"),
-        speed(9.5, 10.0, "just below the critical speed: soft relative spring, large "
+        speed(5.0, 20.0, "well below the critical speed sqrt(k/m) = 10 rad/s (defaults)"),
+        speed(9.5, 20.0, "just below the critical speed: soft relative spring, large "
                          "response to the weight"),
         speed(10.5, 2.0, "above the critical speed: the block runs away exponentially"),
     ),
