@@ -127,6 +127,7 @@ def printed(P):
     )
 
 
+_L = float(SPRING_LENGTH)
 _P = SimpleNamespace(**{p.name: p.symbol for p in PARAMETERS},
                      g=sp.Symbol("g", positive=True))
 
@@ -139,9 +140,9 @@ SYSTEM = System(
     operating_point=lambda P: {"x": static_compression(P), "y": 0},
     printed=printed,
     validity=(
-        Condition(f"k_s*{SPRING_LENGTH}*(1 + ({SPRING_LENGTH}/x_s)**2) > 2*m*g",
+        Condition(f"k_s*{_L:g}*(1 + ({_L:g}/x_s)**2) > 2*m*g",
                   f"the static compression must stay well inside the drawn spring length "
-                  f"{SPRING_LENGTH} m (f at that compression above twice the weight)"),
+                  f"{_L:g} m (f at that compression above twice the weight)"),
     ),
     scenarios=(
         Scenario("free", {"x": static_compression(_P) + _P.dx0}, overrides={"Y": 0.0},
