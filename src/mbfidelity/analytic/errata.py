@@ -382,7 +382,7 @@ def _derived_with_multipliers(system_id: str) -> list[str]:
     """Our Lagrange equations with multipliers (eq. 112 with the derived Phi_q): rows
     M q'' + h - Q + Phi_q^T lam = 0, as text."""
     d = derivation_of(system_id)
-    lam = sp.Matrix([sp.Symbol(f"lam{k + 1}") for k in range(d.m)])
+    lam = sp.Matrix(d.m, 1, [sp.Symbol(f"lam{k + 1}") for k in range(d.m)])
     rows = d.residual + d.Phi_q.T * lam
     return [str(sp.collect(sp.expand(r), list(lam))) for r in rows]
 

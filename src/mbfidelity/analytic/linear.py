@@ -316,6 +316,11 @@ def _driven_equilibria(system: System, values, only_operating: bool) -> list[Equ
             q = _solve_driven(model, start)
             if q is None or not _admissible(system, values, q):
                 continue
+            # free angles into one period about the operating point (the prescribed
+            # coordinates stay where their motion puts them)
+            wrapped = wrap_angles(system, q, op)
+            wrapped[model.driven] = q[model.driven]
+            q = wrapped
             if any(np.allclose(q, other, atol=1e-7) for other in found):
                 continue
             found.append(q)
