@@ -151,7 +151,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         "modes": _modes(op),
         "printed_vs_derived": [e.as_dict() for e in errata(system)],
     }
-    if system.mechanism.prescribed:
+    if system.driven:
         from .analytic.steady_state import steady_state
 
         response = steady_state(system, values)

@@ -339,7 +339,7 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     free = list(numeric_model(system.id, values).independent) if mech.prescribed else list(
         range(len(system.coordinates)))
     w = characteristic_frequency(eq.modes, ref.q[:, free], ref.qd[:, free], eq.q[free])
-    if mech.prescribed:
+    if system.driven:
         w = max([w] + excitation_frequencies(system, values))
     order = run.integrator_order
     scale_free = metrics.amplitude(ref.q[:, free], eq.q[free])
@@ -349,7 +349,7 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
     T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
     bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta)
-    if mech.prescribed and eq.stable:
+    if system.driven and eq.stable:
         driven = _driven_trajectory_bound(system, values, eq, dt, order, T_eff, zeta)
         if driven is not None:
             bound = min(bound, driven)
@@ -358,7 +358,7 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     emax, erms = metrics.trajectory_errors(run.q[:n, free], ref.q[:n, free], scale_free)
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_max", emax, tol))
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
-    if mech.prescribed:
+    if system.driven:
         _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result)
     if len(system.coordinates) == 1:
         p_ref = metrics.mean_period(ref.t, ref.q[:, 0] - eq.q[0])

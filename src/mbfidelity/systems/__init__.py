@@ -195,6 +195,12 @@ class System:
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
+    @property
+    def driven(self) -> bool:
+        """Moved by something outside it: a prescribed coordinate or a harmonic
+        excitation (monograph §8, §9.6)."""
+        return bool(self.mechanism.prescribed) or bool(self.excitation_frequencies(self.symbols))
+
     def variant(self, name: str) -> Variant:
         for v in self.variants:
             if v.name == name:
