@@ -608,6 +608,42 @@ class ExudynBackend(Backend):
             qd0[motion.index] = motion.rate(0.0)
         return q0, qd0
 
+    def _consistent_start(self, exu, mbs, cfg: dict, mech: Mechanism,
+                          driven: list[_DrivenItem]) -> np.ndarray:
+        """Initial accelerations and multipliers that meet the prescribed accelerations
+        q''(0). Exudyn's own initial accelerations differentiate the constraints without
+        their time terms (its documentation: dg/dt 'not implemented'), i.e. as if q''(0)
+        were 0; the trapezoidal rule then carries that error as a step-to-step
+        alternation of the multiplier that never decays, generalized-alpha as one that
+        decays slowly. Here: u_p'' = q_p''(0) / scale, M_ff u_f'' = f_f - M_fp u_p'' with
+        the engine's M and f at t = 0, lam_p = f_p - (M u'')_p (Exudyn: M u'' + C^T lam =
+        f with C = e_p^T), written into the initial state that the solver starts from
+        (computeInitialAccelerations off for driven runs). Returns lam (the solver records
+        zero multipliers for the sample at t = 0)."""
+        sim = self._simulation_settings(exu, cfg, 1.0, 1)
+        helper = exu.MainSolverImplicitSecondOrder()
+        helper.InitializeSolver(mbs, sim)
+        helper.ComputeMassMatrix(mbs)
+        mass = np.asarray(helper.GetSystemMassMatrix())
+        n = len(mass)
+        helper.ComputeODE2RHS(mbs)
+        rhs = np.asarray(helper.GetSystemResidual())[:n]
+        helper.FinalizeSolver(mbs, sim)
+        accelerations = {m.index: m.acceleration(0.0) for m in motions(mech)}
+        acc = np.zeros(n)
+        held = [d.index for d in driven]
+        for d in driven:
+            acc[d.index] = accelerations[d.index] / d.scale
+        free = [i for i in range(n) if i not in held]
+        if free:
+            acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
+                                        rhs[free] - mass[np.ix_(free, held)] @ acc[held])
+        lam = rhs[held] - (mass @ acc)[held]
+        initial = exu.ConfigurationType.Initial
+        mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
+        mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
+        return lam
+
     @staticmethod
     def _tension_user_function(law: Callable[..., float]):
         def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
@@ -711,7 +747,9 @@ class ExudynBackend(Backend):
         # consistent initial accelerations (computeInitialAccelerations)
         acc0 = (self._initial_accelerations(exu, mbs, cfg, s_acc)
                 if s_acc and not (closures or driven) else {})
-        wall, cpu = self._solve(exu, mbs, cfg, solver, bool(closures or driven), t_run, steps)
+        lam0 = self._consistent_start(exu, mbs, cfg, mechanism, driven) if driven else None
+        wall, cpu = self._solve(exu, mbs, cfg, solver, bool(closures or driven), t_run, steps,
+                                initial_accelerations=not driven)
 
         U = np.asarray(mbs.GetSensorStoredData(s_u))
         Ut = np.asarray(mbs.GetSensorStoredData(s_ut))
@@ -726,10 +764,11 @@ class ExudynBackend(Backend):
             c.name: self._closure_force(c, np.asarray(mbs.GetSensorStoredData(s_closure[c.name])),
                                         geo, u)
             for c in closures}
-        actuator_forces = {
-            d.name: self._actuator_force(
-                d, np.asarray(mbs.GetSensorStoredData(s_driven[d.name]))[:, 1], solver, cfg)
-            for d in driven}
+        actuator_forces = {}
+        for k, d in enumerate(driven):
+            lam = np.asarray(mbs.GetSensorStoredData(s_driven[d.name]))[:, 1].copy()
+            lam[0] = lam0[k]  # the solver records zero multipliers at t = 0
+            actuator_forces[d.name] = self._actuator_force(d, lam)
         reactions: dict[str, np.ndarray] = {}
         if reaction_joints:
             acc = {b: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3] for b, s in s_acc.items()}
@@ -758,8 +797,10 @@ class ExudynBackend(Backend):
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
         driven = self._add_prescribed(mbs, mechanism, node, geo)
         mbs.Assemble()
+        if driven:
+            self._consistent_start(exu, mbs, cfg, mechanism, driven)
         return self._solve(exu, mbs, cfg, solver, bool(closures or driven), steps * dt,
-                           steps)[1]
+                           steps, initial_accelerations=not driven)[1]
 
     def _checked_solver(self, mechanism: Mechanism, cfg: dict) -> str:
         support = self.support(mechanism)
@@ -768,13 +809,16 @@ class ExudynBackend(Backend):
         return self._solver_for(mechanism, cfg)
 
     def _solve(self, exu, mbs, cfg: dict, solver: str, constrained: bool, t_run: float,
-               steps: int) -> tuple[float, float]:
-        """SolveDynamic over `steps` steps of the assembled system; (wall, CPU) seconds."""
+               steps: int, initial_accelerations: bool = True) -> tuple[float, float]:
+        """SolveDynamic over `steps` steps of the assembled system; (wall, CPU) seconds.
+        `initial_accelerations` False: the implicit solver starts from the accelerations
+        already in the initial state instead of computing its own."""
         import exudyn.solver as exu_solver
 
         solver_type = getattr(exu.DynamicSolverType, solver)
         sim = self._simulation_settings(exu, cfg, t_run, steps)
         sim.timeIntegration.solverType = solver_type
+        sim.timeIntegration.generalizedAlpha.computeInitialAccelerations = initial_accelerations
         if constrained:
             sim.timeIntegration.generalizedAlpha.spectralRadius = float(
                 cfg["constrained_spectral_radius"])
@@ -825,8 +869,7 @@ class ExudynBackend(Backend):
         return -data[:, 1:2].copy()
 
     @staticmethod
-    def _actuator_force(item: _DrivenItem, lam: np.ndarray, solver: str,
-                        cfg: dict) -> np.ndarray:
+    def _actuator_force(item: _DrivenItem, lam: np.ndarray) -> np.ndarray:
         """The actuator's generalized force on the description coordinate from the
         multiplier: Exudyn adds C_u^T lam = lam e_p to the engine equations, so the
         constraint pushes engine coordinate p with -lam, and q = scale u + shift maps it
