@@ -628,7 +628,10 @@ class ExudynBackend(Backend):
     def _driven_state(mech: Mechanism, q0: np.ndarray,
                       qd0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The initial state with each prescribed coordinate on its motion at t = 0
-        (convention 9: it follows q(t) for the whole run, so its start is not free)."""
+        (convention 9: it follows q(t) for the whole run, so its start is not free).
+        Undriven mechanisms get their arguments back untouched."""
+        if not mech.prescribed:
+            return q0, qd0
         q0 = np.array(q0, dtype=float)
         qd0 = np.array(qd0, dtype=float)
         for motion in motions(mech):
