@@ -41,6 +41,10 @@ FORMULAS = {
     "scotch_yoke": {"F0": lambda v: v["m"] * v["g"]},
     "rolling_disc_track": {"M0": lambda v: (v["m_p"] + v["m_d"]) * v["g"] * v["R"],
                            "I_d": lambda v: v["m_d"] * v["r"] ** 2 / 2},
+    # driven systems: the excitation's frequency as a ratio of the natural one, so that
+    # the scenarios' ratios hold for any mass and stiffness (§8.2, eq. 86)
+    "base_excited_msd": {"Omega": lambda v: v["ratio"] * (v["k"] / v["m"]) ** 0.5},
+    "unbalanced_rotor": {"omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
 }
 
 

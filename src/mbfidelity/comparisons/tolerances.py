@@ -43,6 +43,16 @@ faster forcing).
   FIT_RESOLUTION, the precision of a least-squares sinusoid fit over tens of periods of a
   sampled record, and the amplitude dependence of the frequency at the test amplitude
   (a pendulum's frequency shifts by amplitude^2/16: 6e-8 at 1e-3 rad).
+* Steady-state amplitude of a driven linear system (excitation frequency W, slowest
+  modal damping ratio zeta), fitted over whole periods once the transient has fallen below
+  a tenth of the gate. The scheme shifts the system's frequencies by a relative eps
+  ((w h)^p for p >= 2; w h for semi-implicit Euler, its offset plus its damping error) and
+  the discrete response to the sampled forcing by as much; near resonance a shift eps of
+  the natural frequency changes |K - W^2 M + i W C| by up to eps/zeta of itself. Gate:
+  1.1 eps (1 + 1/zeta), with w the fastest of W and the modes.
+* Growth rate of an unstable motion (a real eigenvalue s > 0), fitted on the run: the
+  scheme moves an eigenvalue by a relative (|s| h)^p (w h for semi-implicit Euler), with
+  w the fastest of the eigenvalues and the excitation; plus FIT_RESOLUTION.
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -138,3 +148,12 @@ def effective_duration(t, envelope) -> float:
     import numpy as np
 
     return float(np.max(np.asarray(t) * np.asarray(envelope)))
+
+
+def steady_state_tolerance(w: float, h: float, order: int, zeta: float) -> float:
+    eps = w * h if order == 1 else (w * h) ** order
+    return 1.1 * eps * (1.0 + 1.0 / max(zeta, 1e-300))
+
+
+def growth_rate_tolerance(w: float, h: float, order: int) -> float:
+    return (w * h if order == 1 else (w * h) ** order) + FIT_RESOLUTION
