@@ -418,6 +418,9 @@ def _compare_multipliers(system: System, pf: PrintedFormula, rng) -> dict:
             out["system"] = max(out["system"], float(np.max(residuals(fitted))))
             if pf.multiplier_forces:
                 forces = model.constraint_forces(q[None, :], lam[None, :])
+                # an actuator's force (§9.6) is the derivation's too: "actuator:<name>"
+                forces.update({f"actuator:{k}": v[:, None] for k, v in model.actuator_forces(
+                    q[None, :], qd[None, :], qdd[None, :], np.array([t])).items()})
                 mapped = np.array([forces[name][0, comp]
                                    for name, comp in (pf.multiplier_forces[L] for L in lams)])
             elif by_coordinate and model.constrained:

@@ -80,8 +80,9 @@ class PrintedFormula:
     #: symbols of the printed Lagrange multipliers in an "eom" (eq. 112), in printed order
     multipliers: tuple[sp.Symbol, ...] = ()
     #: where the printed multipliers are physical constraint forces: symbol -> (constraint
-    #: name, component of its force in the contract's terms); their values then come
-    #: from the derivation, so that every row is tested (none can absorb a fitted value)
+    #: name, component of its force in the contract's terms), or an actuator's force of a
+    #: prescribed coordinate: ("actuator:<name>", 0); their values then come from the
+    #: derivation, so that every row is tested (none can absorb a fitted value)
     multiplier_forces: Mapping[sp.Symbol, tuple[str, int]] | None = None
 
 

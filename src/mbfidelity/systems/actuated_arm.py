@@ -97,7 +97,7 @@ def printed(P):
         PrintedFormula("Fig. 35, §9.6 (Lagrange equations, F_act of the actuator)", "eom", [
             inertia * phi_dd + 2 * m_b * x * x_d * phi_d + m_b * h * x_dd + dEp_dphi - T_mot,
             m_b * (x_dd + h * phi_dd) - m_b * phi_d**2 * x + m_b * g * sp.sin(phi) - F_ACT],
-            multipliers=(F_ACT,),
+            multipliers=(F_ACT,), multiplier_forces={F_ACT: ("actuator:actuator", 0)},
             note="T_mot(t) = T_a sin(Omega_T t); x(t) imposed; F_act: the actuator's force"),
     )
 
