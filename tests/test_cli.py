@@ -59,6 +59,25 @@ def test_analyze_double_pendulum_bars_follow_mass_and_length():
     assert explicit["derived_parameters"] == [] and explicit["parameters"]["I"] == 0.05
 
 
+@pytest.mark.parametrize("k,m", [(50.0, 0.5), (180.0, 2.0)])
+def test_analyze_rotating_slot_critical_speed_follows_k_and_m(k, m):
+    """Issue 9 acceptance, eq. 84: the block in the turning slot is stable below
+    sqrt(k/m) and unstable above, for the k, m the user passes; below, the steady state
+    of the weight's excitation is m g / |k - 2 m w^2 + i c w| (eq. 84 with x ~ e^{i w t})."""
+    critical = np.sqrt(k / m)
+    common = ["analyze", "rotating_slot", "--param", f"k={k}", "--param", f"m={m}"]
+    below = _json(common + ["--param", f"omega={0.9 * critical}", "--json"])
+    above = _json(common + ["--param", f"omega={1.1 * critical}", "--json"])
+    assert below["stable"] and not above["stable"]
+    assert below["free_coordinates"] == ["x"] and "phi" in below["prescribed"]
+    (line,) = [h for h in below["steady_state"] if h["quantity"] == "position"]
+    w, c = 0.9 * critical, below["parameters"]["c"]
+    assert line["amplitude"] == pytest.approx(m * 9.81 / abs(k - 2 * m * w**2 + 1j * c * w),
+                                              rel=1e-10)
+    assert line["frequency_hz"] == pytest.approx(w / (2 * np.pi), rel=1e-12)
+    assert above["steady_state"] == [] and "unstable" in above["steady_state_note"]
+
+
 def test_analyze_json_damped_modes():
     doc = _json(["analyze", "mass_spring_damper", "--param", "c=4", "--json"])
     (mode,) = doc["modes"]

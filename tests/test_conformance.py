@@ -16,6 +16,9 @@ CHECKS = {
     "reaction": ("reaction_",),
     "frequency": ("frequency.", "damping."),
     "constraint": ("constraint_", "contact_"),
+    # driven mechanisms (issue 9): the engine's imposed motion, the actuator forces, and
+    # the steady-state amplitudes or growth rates measured from its own run
+    "driven": ("imposed_", "actuator_", "steady_state_", "growth_rate"),
 }
 
 
@@ -26,6 +29,8 @@ def _applicable(system):
     if system.mechanism.constraints and any("constraint_force" in sc.checks
                                             for sc in system.scenarios):
         checks.append("constraint")
+    if system.mechanism.prescribed:
+        checks.append("driven")
     return checks
 
 

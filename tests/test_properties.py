@@ -41,6 +41,14 @@ FORMULAS = {
     "scotch_yoke": {"F0": lambda v: v["m"] * v["g"]},
     "rolling_disc_track": {"M0": lambda v: (v["m_p"] + v["m_d"]) * v["g"] * v["R"],
                            "I_d": lambda v: v["m_d"] * v["r"] ** 2 / 2},
+    # driven systems: the excitation's frequency as a ratio of the natural one, so that
+    # the scenarios' ratios hold for any mass and stiffness (§8.2, eq. 86)
+    "base_excited_msd": {"Omega": lambda v: v["ratio"] * (v["k"] / v["m"]) ** 0.5},
+    "unbalanced_rotor": {"omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
+    "inertial_shaker": {"Omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
+    # the preload that makes phi0 the lever's equilibrium (Fig. 10, eq. 12)
+    "lever": {"phi_n": lambda v: v["phi0"] + v["m"] * v["g"] * v["e"] * math.cos(v["phi0"])
+              / v["k"]},
 }
 
 
@@ -214,6 +222,9 @@ GEOMETRY = {
     "rolling_disc_track": lambda v: v["r"] < v["R"],
     "belt_pulleys": lambda v: v["l"] > v["r1"] + v["r2"],
     "five_bar_bird": _five_bar_bird,
+    "lever": lambda v: v["I_O"] - v["m"] * v["e"] ** 2 > 0,
+    # the static compression (f(s) = m g) inside the drawn spring length 0.5 m, with margin
+    "suspension": lambda v: v["k_s"] * 0.5 * (1 + (0.5 / v["x_s"]) ** 2) > 2 * v["m"] * v["g"],
 }
 
 
@@ -252,6 +263,8 @@ def test_invalid_parameter_sets_are_refused_and_valid_ones_are_not(system_id, da
     ("slotted_link_spring_damper", {"l": 0.4}, "l < b"),
     ("slotted_link_spring_damper", {"k": 30.0}, "k*l0 > m*g"),
     ("slotted_bar_arctan_damper", {"l": 0.3}, "I_O > m1*l**2"),
+    ("lever", {"e": 0.4}, "I_O > m*e**2"),
+    ("suspension", {"k_s": 10.0}, "k_s*0.5*(1 + (0.5/x_s)**2) > 2*m*g"),
 ])
 def test_the_refusal_names_the_violated_condition(system_id, overrides, needle):
     with pytest.raises(ValueError, match=f"violate {re.escape(needle)} "):

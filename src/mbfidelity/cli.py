@@ -151,6 +151,20 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         "modes": _modes(op),
         "printed_vs_derived": [e.as_dict() for e in errata(system)],
     }
+    if system.driven:
+        from .analytic.steady_state import steady_state
+
+        response = steady_state(system, values)
+        doc["free_coordinates"] = list(system.mechanism.independent_coordinates)
+        doc["prescribed"] = {p.coordinate: str(p.motion) for p in system.mechanism.prescribed}
+        doc["linearization"]["about"] = ("rest state of the free coordinates with the "
+                                         "excitation off: " + ", ".join(
+                                             f"{k} = {v:g}" for k, v in system.unexcited.items()))
+        doc["steady_state"] = [h.as_dict() for h in response.harmonics]
+        if response.reason:
+            doc["steady_state_note"] = response.reason
+        else:
+            doc["steady_state_harmonic_residual"] = response.harmonic_residual
     if as_json:
         _json(doc)
         return
@@ -167,6 +181,15 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     for m in op.modes:
         typer.echo(f"  mode: f = {m.frequency_hz:.9g} Hz, zeta = {m.damping_ratio:.6g}, "
                    f"f_d = {m.damped_frequency_hz:.9g} Hz")
+    if not op.stable:
+        growth = max(s.real for s in op.eigenvalues)
+        typer.echo(f"  unstable: fastest growth rate {growth:.9g} 1/s")
+    for h in doc.get("steady_state", []):
+        typer.echo(f"  steady state {h['quantity']} {h['coordinate']}: "
+                   f"{h['amplitude']:.9g} at {h['frequency_hz']:.9g} Hz, "
+                   f"phase {h['phase']:.6g} rad")
+    if "steady_state_note" in doc:
+        typer.echo(f"  steady state: none ({doc['steady_state_note']})")
     for e in doc["printed_vs_derived"]:
         typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
 

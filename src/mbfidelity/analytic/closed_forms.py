@@ -43,13 +43,48 @@ def rigid_pendulum_elliptic(values: Mapping[str, float], q0, qd0, t: np.ndarray)
 def forced_linear_oscillator(values: Mapping[str, float], q0, qd0, t: np.ndarray):
     """m x'' + c x' + k x = F0 sin(Omega t) (eq. 79): the particular solution from the
     complex frequency response plus the homogeneous one by the exact matrix exponential."""
-    m, k, c = values["m"], values["k"], values["c"]
-    F0, W = values["F0"], values["Omega"]
+    x, v = _harmonically_forced(values["m"], values["c"], values["k"], -1j * values["F0"],
+                                values["Omega"], q0[0], qd0[0], t)
+    return x[:, None], v[:, None]
+
+
+def base_excited_relative(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """Base y = Y sin(W t) prescribed, block's relative coordinate z (§8.2):
+    m z'' + c z' + k z = -m y'' = m Y W^2 sin(W t). Coordinates (y, z)."""
+    Y, W = values["Y"], values["Omega"]
+    z, zd = _harmonically_forced(values["m"], values["c"], values["k"],
+                                 -1j * values["m"] * Y * W**2, W, q0[1], qd0[1], t)
+    return np.column_stack([Y * np.sin(W * t), z]), np.column_stack([Y * W * np.cos(W * t), zd])
+
+
+def rotating_slot_eq84(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """Disc turned at phi = w t, block along the slot (Fig. 29, eq. 84):
+    m x'' + c x' + (k - m w^2) x = m g sin(w t), stable or not. Coordinates (phi, x)."""
+    m, w = values["m"], values["omega"]
+    x, xd = _harmonically_forced(m, values["c"], values["k"] - m * w**2,
+                                 -1j * m * values["g"], w, q0[1], qd0[1], t)
+    return np.column_stack([w * t, x]), np.column_stack([np.full_like(t, w), xd])
+
+
+def unbalanced_rotor_eq86(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """Frame x, rotor turned at phi = w t (Fig. 31, eq. 86):
+    (M + m) x'' + c x' + k x = m e w^2 cos(w t). Coordinates (x, phi)."""
+    m, w = values["m"], values["omega"]
+    x, xd = _harmonically_forced(values["M"] + m, values["c"], values["k"],
+                                 m * values["e"] * w**2, w, q0[0], qd0[0], t)
+    return np.column_stack([x, w * t]), np.column_stack([xd, np.full_like(t, w)])
+
+
+def _harmonically_forced(m: float, c: float, k: float, F: complex, W: float, x0: float,
+                         v0: float, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """m x'' + c x' + k x = Re(F exp(i W t)) from (x0, v0): the particular solution from
+    the complex frequency response (k may be negative: an unstable system) plus the
+    homogeneous one by the exact matrix exponential."""
     H = 1.0 / (k - m * W**2 + 1j * c * W)
-    xp = np.imag(F0 * H * np.exp(1j * W * t))
-    vp = np.imag(1j * W * F0 * H * np.exp(1j * W * t))
+    xp = np.real(F * H * np.exp(1j * W * t))
+    vp = np.real(1j * W * F * H * np.exp(1j * W * t))
     A = np.array([[0.0, 1.0], [-k / m, -c / m]])
-    y0 = np.array([q0[0] - xp[0], qd0[0] - vp[0]])
+    y0 = np.array([x0 - xp[0], v0 - vp[0]])
     # exp(A t) y0 on every sample: eigen-decomposition when diagonalisable, else expm
     evals, V = np.linalg.eig(A)
     if abs(evals[0] - evals[1]) > 1e-9 * max(1.0, abs(evals[0])):
@@ -57,10 +92,13 @@ def forced_linear_oscillator(values: Mapping[str, float], q0, qd0, t: np.ndarray
         yh = np.real((V[None, :, :] * (coef * np.exp(np.outer(t, evals)))[:, None, :]).sum(axis=2))
     else:
         yh = np.array([scipy.linalg.expm(A * ti) @ y0 for ti in t])
-    return (xp + yh[:, 0])[:, None], (vp + yh[:, 1])[:, None]
+    return xp + yh[:, 0], vp + yh[:, 1]
 
 
 SOLUTIONS: dict[str, Callable] = {
     "rigid_pendulum_elliptic": rigid_pendulum_elliptic,
     "forced_linear_oscillator": forced_linear_oscillator,
+    "base_excited_relative": base_excited_relative,
+    "rotating_slot_eq84": rotating_slot_eq84,
+    "unbalanced_rotor_eq86": unbalanced_rotor_eq86,
 }

@@ -217,7 +217,10 @@ class Derivation:
             self.Phi_hessians = []
         names = self.mechanism.coordinates
         self.independent = [names.index(c) for c in self.mechanism.independent_coordinates]
-        self.dependent = [i for i in range(self.n) if i not in self.independent]
+        # prescribed coordinates are neither: given functions of time (numeric.py)
+        driven = {names.index(c) for c in self.mechanism.driven_coordinates}
+        self.dependent = [i for i in range(self.n)
+                          if i not in self.independent and i not in driven]
         if len(self.dependent) != self.m:
             raise ValueError(
                 f"{self.m} constraint equations but {len(self.dependent)} dependent coordinates")

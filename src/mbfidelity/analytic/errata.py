@@ -121,7 +121,12 @@ def _random_states(system: System, values, rng, count: int = 25):
         except (RuntimeError, np.linalg.LinAlgError):
             continue
         qd = model.velocity_basis(q) @ rng.uniform(-1.5, 1.5, size=len(model.independent))
-        out.append((q, qd, rng.uniform(0, 10)))
+        t = rng.uniform(0, 10)
+        if model.driven:
+            # prescribed coordinates where their motion puts them at t
+            qp, qdp, _ = model.motion(t)
+            q[model.driven], qd[model.driven] = qp, qdp
+        out.append((q, qd, t))
     return out
 
 
@@ -377,7 +382,7 @@ def _derived_with_multipliers(system_id: str) -> list[str]:
     """Our Lagrange equations with multipliers (eq. 112 with the derived Phi_q): rows
     M q'' + h - Q + Phi_q^T lam = 0, as text."""
     d = derivation_of(system_id)
-    lam = sp.Matrix([sp.Symbol(f"lam{k + 1}") for k in range(d.m)])
+    lam = sp.Matrix(d.m, 1, [sp.Symbol(f"lam{k + 1}") for k in range(d.m)])
     rows = d.residual + d.Phi_q.T * lam
     return [str(sp.collect(sp.expand(r), list(lam))) for r in rows]
 
@@ -534,7 +539,12 @@ def printed_model_trajectory(system: System, pf: PrintedFormula, values: Mapping
     model = numeric_model(system.id, values)
     syms = [coordinate_symbols(n) for n in system.coordinates]
     ind = model.independent
-    eqs = [sp.sympify(r).xreplace(system.subs(values)) for r in pf.expr]
+    given = {}
+    for p in system.mechanism.prescribed:
+        # prescribed coordinates are the given functions of time (§9.6)
+        trio = syms[system.coordinates.index(p.coordinate)]
+        given.update(zip(trio, (p.motion, p.rate, p.acceleration)))
+    eqs = [sp.sympify(r).xreplace(given).xreplace(system.subs(values)) for r in pf.expr]
     used = set().union(*(e.free_symbols for e in eqs))
     if any(s in used for i, trio in enumerate(syms) if i not in ind for s in trio):
         return None  # written in dependent coordinates too

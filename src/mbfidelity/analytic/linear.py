@@ -3,6 +3,14 @@
 eigenvalues s of M s^2 + C s + K = 0;
 frequency_hz = |s|/(2 pi), damping_ratio = -Re(s)/|s|, damped_frequency_hz = |Im s|/(2 pi).
 One mode per complex-conjugate pair (the member with Im s > 0), one per real eigenvalue.
+
+A driven system (prescribed coordinates, monograph §8, §9.6) is linearized in its free
+coordinates about the motion of the unexcited system (`System.unexcited`: the excitation's
+amplitudes set to zero; the weight, in a rotating frame where it is the excitation): the
+free coordinates at rest there while the prescribed ones follow their motion. That rest
+state and the free blocks of dR/dq'', dR/dq', dR/dq (R = M q'' + h - Q) must not depend
+on time; where they do (periodic coefficients), there is no equilibrium to linearize
+about and Floquet theory applies instead (refused here, with the reason).
 """
 from __future__ import annotations
 
@@ -225,11 +233,108 @@ def _solve_full(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
     return q
 
 
+#: times (s) at which a driven system's rest state and its linear coefficients are checked
+#: to be constant: incommensurate with any round period
+_PROBE_TIMES = (0.0, 0.1234, 0.789, 1.5557, 3.0301)
+#: relative variation of the coefficients above which they count as time-dependent
+TIME_INVARIANCE = 1e-9
+
+
+def unexcited_values(system: System, values) -> dict[str, float]:
+    """The parameter values with the excitation switched off (`System.unexcited`)."""
+    return {**dict(values), **{k: float(v) for k, v in system.unexcited.items()}}
+
+
+def _driven_blocks(model: NumericModel, q_free: np.ndarray, t: float):
+    """(M, C, K) of the free coordinates at rest at q_free, prescribed motion at t, and the
+    free rows of R there."""
+    f = model.independent
+    q, qd = model.driven_state(np.concatenate([q_free, np.zeros(len(f))]), np.array([t]))
+    qdd = np.zeros(model.n)
+    qdd[model.driven] = model.motion(float(t))[2]
+    M, J_qd, J_q = model.residual_jacobians(q[0], qd[0], qdd, t)
+    R = model.residual(q[0], qd[0], qdd, t)[f]
+    return M[np.ix_(f, f)], J_qd[np.ix_(f, f)], J_q[np.ix_(f, f)], R
+
+
+def _solve_driven(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
+    """Rest state of the free coordinates (R_f = 0 at t = 0) from a full start."""
+    f = model.independent
+
+    def residual(x):
+        return _driven_blocks(model, x, 0.0)[3]
+
+    def jacobian(x):
+        return _driven_blocks(model, x, 0.0)[2]
+
+    try:
+        sol = scipy.optimize.root(residual, np.asarray(start, float)[f], jac=jacobian,
+                                  method="hybr", tol=1e-14)
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    K = jacobian(sol.x)
+    scale = max(1.0, float(np.max(np.abs(K))) * max(1.0, float(np.max(np.abs(sol.x)))))
+    if not np.all(np.isfinite(sol.x)) or np.max(np.abs(residual(sol.x))) > 1e-9 * scale:
+        return None
+    q = np.array(start, dtype=float)
+    q[f] = sol.x
+    q[model.driven] = model.motion(0.0)[0]
+    return q
+
+
+def _linearize_driven(system: System, model: NumericModel, q: np.ndarray) -> Equilibrium:
+    f = model.independent
+    blocks = [_driven_blocks(model, q[f], t) for t in _PROBE_TIMES]
+    M, C, K, _ = blocks[0]
+    scale = max(float(np.max(np.abs(np.concatenate([M, C, K], axis=None)))), 1e-300)
+    for Mt, Ct, Kt, Rt in blocks[1:]:
+        varying = max(float(np.max(np.abs(Mt - M))), float(np.max(np.abs(Ct - C))),
+                      float(np.max(np.abs(Kt - K))))
+        if varying > TIME_INVARIANCE * scale or np.max(np.abs(Rt)) > 1e-9 * scale * max(
+                1.0, float(np.max(np.abs(q[f])))):
+            raise ValueError(
+                f"{system.id}: with the excitation off ({_unexcited_text(system)}) the free "
+                f"coordinates have no rest state with constant coefficients (they vary with "
+                f"the prescribed motion): a periodic-coefficient system, for Floquet "
+                f"analysis, not an equilibrium")
+    s = quadratic_eigenvalues(M, C, K)
+    return Equilibrium(q, is_stable(s), M, C, K, s, modes_from_eigenvalues(s))
+
+
+def _unexcited_text(system: System) -> str:
+    return ", ".join(f"{k} = {v:g}" for k, v in system.unexcited.items()) or "nothing to switch off"
+
+
+def _driven_equilibria(system: System, values, only_operating: bool) -> list[Equilibrium]:
+    model = numeric_model(system.id, unexcited_values(system, values))
+    op = system.operating_values(values)
+    starts = [op] if only_operating else [op] + _search_grid(system, values, op)
+    found: list[np.ndarray] = []
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for start in starts:
+            q = _solve_driven(model, start)
+            if q is None or not _admissible(system, values, q):
+                continue
+            # free angles into one period about the operating point (the prescribed
+            # coordinates stay where their motion puts them)
+            wrapped = wrap_angles(system, q, op)
+            wrapped[model.driven] = q[model.driven]
+            q = wrapped
+            if any(np.allclose(q, other, atol=1e-7) for other in found):
+                continue
+            found.append(q)
+    return [_linearize_driven(system, model, q) for q in found]
+
+
 def find_equilibria(system: System, values) -> list[Equilibrium]:
     """Every equilibrium within one period of each angular coordinate (centred on the
     operating point), each classified by its linearization. The operating point comes
     first when it is an equilibrium. Closed loops are also searched in all coordinates
-    and multipliers, so that equilibria on other assembly branches are found."""
+    and multipliers, so that equilibria on other assembly branches are found. A driven
+    system's are the rest states of its free coordinates with the excitation off."""
+    if system.mechanism.prescribed:
+        return _driven_equilibria(system, values, only_operating=False)
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     found: list[np.ndarray] = []
@@ -288,6 +393,13 @@ def _same_family(model: NumericModel, a: np.ndarray, b: np.ndarray) -> bool:
 
 def operating_equilibrium(system: System, values) -> Equilibrium:
     """The equilibrium the monograph studies (the system's operating point, refined)."""
+    if system.mechanism.prescribed:
+        found = _driven_equilibria(system, values, only_operating=True)
+        if not found:
+            raise ValueError(f"{system.id}: no rest state of the free coordinates near the "
+                             f"operating point with the excitation off "
+                             f"({_unexcited_text(system)})")
+        return found[0]
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     q = _solve_static(model, op)

@@ -11,6 +11,11 @@ and multipliers come from the augmented system (monograph §10)
 The linearization at an equilibrium is taken on the constraint manifold:
 M_r = S^T M S, C_r = S^T C S, K_r = S^T (K + sum_k lam_k Hess(Phi_k)) S, with lam the
 static multipliers. Without constraints S = I and these reduce to eq. 104-109.
+
+A driven mechanism (prescribed coordinates q_p = q_p(t), monograph §9.6) is integrated in
+its free coordinates q_f: with the prescribed positions, rates and accelerations given,
+M_ff q_f'' = (Q - h)_f - M_fp q_p''(t). The rows of the prescribed coordinates then give
+the actuator forces: tau_p = (M q'' + h - Q)_p.
 """
 from __future__ import annotations
 
@@ -127,6 +132,9 @@ class NumericModel:
         self.n, self.m = d.n, d.m
         self.independent, self.dependent = list(d.independent), list(d.dependent)
         self.constrained = self.m > 0
+        mech = d.mechanism
+        self.driven = [mech.coordinates.index(c) for c in mech.driven_coordinates]
+        self.actuators = [p.name for p in mech.prescribed]
         q, qd, qdd = list(d.q), list(d.qd), list(d.qdd)
         args = q + qd + [TIME]
         zero_vel = {v: 0 for v in qd + qdd}
@@ -135,8 +143,13 @@ class NumericModel:
         self._rhs = fn("rhs", lambda: (args, list(d.Q - d.h), "numpy"))
         # explicit q'' keeps the reference solver's right-hand side cheap
         self._acc_explicit = fn("acc_explicit", lambda: (
-            args, list(d.M.LUsolve(d.Q - d.h)), "math") if self.n <= 3 and not self.constrained
-            else None)
+            args, list(d.M.LUsolve(d.Q - d.h)), "math")
+            if self.n <= 3 and not self.constrained and not self.driven else None)
+        if self.driven:
+            self._motion = fn("motion", lambda: ([TIME], [
+                sp.sympify(x) for p in mech.prescribed
+                for x in (p.motion, p.rate, p.acceleration)], "numpy"))
+            self._acc_driven = fn("acc_driven", lambda: self._driven_acceleration_expr())
         self._residual = fn("residual", lambda: (q + qd + qdd + [TIME], list(d.residual), "numpy"))
         self._Q_static = fn("Q_static", lambda: (
             q, list(d.Q_autonomous.xreplace(zero_vel)), "numpy"))
@@ -192,6 +205,70 @@ class NumericModel:
 
         self._hess_V_reduced = fn("hess_V_reduced", hess_V_reduced)
 
+    def _driven_acceleration_expr(self):
+        """(q_f, q_f', t) -> q_f'' in closed form (prescribed motions substituted), for
+        up to three free coordinates; None otherwise (solved numerically)."""
+        d, mech = self.derivation, self.derivation.mechanism
+        free = self.independent
+        if len(free) > 3:
+            return None
+        given = {}
+        for k, p in zip(self.driven, mech.prescribed):
+            given.update({d.q[k]: p.motion, d.qd[k]: p.rate, d.qdd[k]: p.acceleration})
+        M = d.M.xreplace(given)
+        rhs = (d.Q - d.h).xreplace(given)
+        M_ff = M.extract(free, free)
+        qdd_p = sp.Matrix([given[d.qdd[k]] for k in self.driven])
+        b = rhs.extract(free, [0]) - M.extract(free, self.driven) * qdd_p
+        args = [d.q[i] for i in free] + [d.qd[i] for i in free] + [TIME]
+        return args, list(M_ff.LUsolve(b)), "math"
+
+    def motion(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q_p, q_p', q_p'') of the prescribed coordinates at time(s) t: each of shape
+        (len(driven),) for a scalar t, (N, len(driven)) for N times."""
+        t_arr = np.asarray(t, dtype=float)
+        vals = [np.broadcast_to(np.asarray(v, dtype=float), t_arr.shape)
+                for v in self._motion(t_arr)]
+        k = len(self.driven)
+        parts = [np.stack(vals[j::3], axis=-1) if k else np.zeros(t_arr.shape + (0,))
+                 for j in range(3)]
+        return parts[0], parts[1], parts[2]
+
+    def driven_state(self, y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Full (q, q') from free states y = (q_f, q_f') (rows of samples) at times t."""
+        y = np.atleast_2d(y)
+        k = len(self.independent)
+        qp, qdp, _ = self.motion(np.asarray(t, dtype=float).reshape(-1))
+        q = np.zeros((len(y), self.n))
+        qd = np.zeros((len(y), self.n))
+        q[:, self.independent], qd[:, self.independent] = y[:, :k], y[:, k:2 * k]
+        q[:, self.driven], qd[:, self.driven] = qp, qdp
+        return q, qd
+
+    def actuator_forces(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                        t: np.ndarray) -> dict[str, np.ndarray]:
+        """The generalized force of each prescribed coordinate's actuator along a sampled
+        motion, (N,) per actuator (model convention 9)."""
+        if not self.driven:
+            return {}
+        d, N = self.derivation, len(t)
+        r = self._along("residual", lambda: (
+            list(d.q) + list(d.qd) + list(d.qdd) + [TIME], list(d.residual), "numpy"),
+            (*np.asarray(q, float).T, *np.asarray(qd, float).T, *np.asarray(qdd, float).T,
+             np.asarray(t, float)), N)
+        return {name: r[:, k] for name, k in zip(self.actuators, self.driven)}
+
+    def residual_jacobians(self, q, qd, qdd, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(dR/dq'', dR/dq', dR/dq) of R = M q'' + h - Q at one state (n x n each): the
+        linearization of every row, the time-dependent loads included."""
+        d = self.derivation
+        args = list(d.q) + list(d.qd) + list(d.qdd) + [TIME]
+        R = d.M * d.qdd + d.h - d.Q
+        J_qd = self._bound("res_jac_qd", lambda: (args, R.jacobian(d.qd), "numpy"))
+        J_q = self._bound("res_jac_q", lambda: (args, R.jacobian(d.q), "numpy"))
+        vals = (*q, *qd, *qdd, t)
+        return self.mass_matrix(q), _matrix(J_qd, *vals), _matrix(J_q, *vals)
+
     def _bound(self, name: str, build) -> Callable | None:
         f = self.compiled.function(name, build)
         return None if f is None else partial(f, *self.parameter_values)
@@ -202,7 +279,8 @@ class NumericModel:
         d = self.derivation
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
-        return bool(d.energy_route and sp.simplify(dissipation) == 0 and not q_aut_t)
+        return bool(d.energy_route and sp.simplify(dissipation) == 0 and not q_aut_t
+                    and not self.driven)
 
     # --- constraint manifold -------------------------------------------------------------
     def constraint_values(self, q) -> np.ndarray:
@@ -272,6 +350,9 @@ class NumericModel:
         return sol[: self.n], sol[self.n:]
 
     def acceleration(self, q, qd, t: float) -> np.ndarray:
+        if self.driven:
+            return self.dynamics_along(np.atleast_2d(q), np.atleast_2d(qd),
+                                       np.atleast_1d(float(t)))[0][0]
         if self._acc_explicit is not None:
             return np.array(self._acc_explicit(*q, *qd, t), dtype=float).reshape(-1)
         return self.dynamics(q, qd, t)[0]
@@ -279,6 +360,11 @@ class NumericModel:
     def ode_rhs(self, t: float, y: np.ndarray) -> np.ndarray:
         """Right-hand side in the independent coordinates, y = (q_i, q_i')."""
         k = len(self.independent)
+        if self.driven:
+            if self._acc_driven is not None:
+                return np.concatenate([y[k:], self._acc_driven(*y, t)])
+            q, qd = self.driven_state(y, np.atleast_1d(t))
+            return np.concatenate([y[k:], self.acceleration(q[0], qd[0], t)[self.independent]])
         if not self.constrained:
             return np.concatenate([y[k:], self.acceleration(y[:k], y[k:], t)])
         if self._explicit is not None:
@@ -445,7 +531,15 @@ class NumericModel:
         A[:, :n, :n] = self._along("M_flat", lambda: (list(d.q), list(d.M), "numpy"),
                                    q.T, N).reshape(N, n, n)
         b = np.zeros((N, n + m))
-        b[:, :n] = self._along("rhs", None, args, N)
+        b[:, :n] = self._along("rhs", lambda: (list(d.q) + list(d.qd) + [TIME],
+                                               list(d.Q - d.h), "numpy"), args, N)
+        if self.driven:
+            # prescribed rows replaced by q_p'' = q_p''(t)
+            qdd_p = self.motion(t)[2]
+            for j, k in enumerate(self.driven):
+                A[:, k, :] = 0.0
+                A[:, k, k] = 1.0
+                b[:, k] = qdd_p[:, j]
         if m:
             J = self._jacobians_along(q)
             A[:, :n, n:] = np.transpose(J, (0, 2, 1))

@@ -32,6 +32,9 @@ class Reference:
     multipliers: np.ndarray | None = None
     #: physical constraint forces by constraint name (see simulators/base.py point 6)
     constraint_forces: dict | None = None
+    #: actuator force of each prescribed coordinate, (N,) by actuator name (model
+    #: convention 9; empty without prescribed motion)
+    actuator_forces: dict | None = None
 
 
 def _dop853(model, y0: np.ndarray, t: np.ndarray, tol: float) -> np.ndarray:
@@ -48,6 +51,11 @@ def consistent_initial_state(system: System, scenario: Scenario, values):
     for them are only Newton's starting guess)."""
     q0, qd0 = system.initial_state(scenario, values)
     model = numeric_model(system.id, values)
+    if model.driven:
+        # a prescribed coordinate starts where its motion does
+        qp, qdp, _ = model.motion(0.0)
+        q0[model.driven], qd0[model.driven] = qp, qdp
+        return q0, qd0
     if not model.constrained:
         return q0, qd0
     q = model.complete(q0)
@@ -78,8 +86,10 @@ def _sampled_positions(model, y: np.ndarray, q0: np.ndarray) -> np.ndarray:
     return model.complete_along(y[:, :k], guesses)
 
 
-def _full_states(model, y: np.ndarray, q0: np.ndarray):
+def _full_states(model, y: np.ndarray, q0: np.ndarray, t: np.ndarray):
     k = len(model.independent)
+    if model.driven:
+        return model.driven_state(y, t)
     if not model.constrained:
         return y[:, :k], y[:, k:]
     q = _sampled_positions(model, y, q0)
@@ -91,10 +101,12 @@ def _full_states(model, y: np.ndarray, q0: np.ndarray):
     return q, qd
 
 
-def _positions(model, y: np.ndarray, q0: np.ndarray) -> np.ndarray:
+def _positions(model, y: np.ndarray, q0: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The coordinates of `_full_states` alone, without the velocities: for the error
     estimate, which compares positions."""
     k = len(model.independent)
+    if model.driven:
+        return model.driven_state(y, t)[0]
     if not model.constrained:
         return y[:, :k]
     q = _sampled_positions(model, y, q0)
@@ -131,7 +143,7 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
     y0 = np.concatenate([q0[ind], qd0[ind]])
     model._warm = np.array(q0, dtype=float)
     tight = _dop853(model, y0, t, TIGHT)
-    q, qd = _full_states(model, tight, q0)
+    q, qd = _full_states(model, tight, q0, t)
     exact = SOLUTIONS.get(system.exact_solution or "")
     if exact is not None:
         q_exact, qd_exact = exact(values, q0, qd0, t)
@@ -141,7 +153,7 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
         method = f"closed form ({system.exact_solution}); DOP853 rtol=atol={TIGHT:g} agrees"
     else:
         model._warm = np.array(q0, dtype=float)
-        loose_q = _positions(model, _dop853(model, y0, t, LOOSE), q0)
+        loose_q = _positions(model, _dop853(model, y0, t, LOOSE), q0, t)
         error = np.max(np.abs(loose_q - q), axis=0)
         method = f"DOP853 rtol=atol={TIGHT:g}; error estimated against rtol=atol={LOOSE:g}"
     if model.constrained:
@@ -157,7 +169,8 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
                                 if c.kind == "reaction"))
     reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in joints}
     energy = model.energy(q, qd) if model.conservative else None
-    return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces)
+    return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces,
+                     model.actuator_forces(q, qd, qdd, t))
 
 
 def sensitivity(system: System, scenario: Scenario, values: Mapping[str, float],

@@ -94,3 +94,31 @@ def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess
     _, (a, sigma, wd, ph, off) = best
     w0 = float(np.hypot(abs(wd), sigma))
     return w0, float(sigma / w0)
+
+
+def fit_growth_rate(t: np.ndarray, x: np.ndarray, eigenvalues, frequencies) -> float:
+    """Growth rate sigma of x(t) = a exp(sigma t) + (the other real modes, fixed at their
+    linearization's rates) + harmonics at the excitation `frequencies` + offset, by
+    least squares with sigma the one nonlinear unknown (variable projection), searched
+    within a factor 2 of the linearization's largest real eigenvalue."""
+    s = np.asarray(eigenvalues, dtype=complex)
+    top = float(np.max(s.real))
+    others = [v for v in s if not np.isclose(v.real, top) or abs(v.imag) > 0]
+
+    def basis(sigma: float) -> np.ndarray:
+        cols = [np.exp(sigma * t), np.ones_like(t)]
+        for v in others:
+            e = np.exp(v.real * t)
+            cols += [e * np.cos(v.imag * t)] + ([e * np.sin(v.imag * t)] if v.imag else [])
+        for w in frequencies:
+            cols += [np.cos(w * t), np.sin(w * t)]
+        return np.column_stack(cols)
+
+    def misfit(sigma: float) -> float:
+        A = basis(sigma)
+        coef, *_ = np.linalg.lstsq(A, x, rcond=None)
+        return float(np.sum((A @ coef - x) ** 2))
+
+    found = scipy.optimize.minimize_scalar(misfit, bounds=(top / 2, 2 * top), method="bounded",
+                                           options={"xatol": 1e-12 * top})
+    return float(found.x)

@@ -14,9 +14,11 @@ import numpy as np
 
 from .. import __version__
 from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria,
-                               operating_equilibrium, wrap_angles)
+                               operating_equilibrium, unexcited_values, wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
+from ..analytic.steady_state import (excitation_frequencies, observable_functions,
+                                     steady_state)
 from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
@@ -290,6 +292,8 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
     `analyze`. Returns (scenario, equilibrium) pairs."""
     from ..systems.model import Scenario
 
+    if system.mechanism.prescribed:
+        return []  # a driven system is tested along its driven motion only
     op = operating_equilibrium(system, values)
     model = numeric_model(system.id, values)
     checks = ("trajectory", "constraint_force") if system.mechanism.constraints else (
@@ -330,18 +334,32 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     result.simulated_time += T
     if eq is None:
         eq = operating_equilibrium(system, values)
-    w = characteristic_frequency(eq.modes, ref.q, ref.qd, eq.q)
+    # a driven system's trajectory is that of its free coordinates (the prescribed ones
+    # are judged as the engine's imposed motion, below)
+    free = list(numeric_model(system.id, values).independent) if mech.prescribed else list(
+        range(len(system.coordinates)))
+    w = characteristic_frequency(eq.modes, ref.q[:, free], ref.qd[:, free], eq.q[free])
+    if system.driven:
+        w = max([w] + excitation_frequencies(system, values))
     order = run.integrator_order
-    scale = metrics.amplitude(ref.q, eq.q)
-    ref_err = float(np.max(ref.error_estimate / scale))
+    scale_free = metrics.amplitude(ref.q[:, free], eq.q[free])
+    scale = np.ones(len(system.coordinates))
+    scale[free] = scale_free
+    ref_err = float(np.max(ref.error_estimate[free] / scale_free))
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
     T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
-    tol = tolerances.gate(tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + ref_err,
-                          w, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
+    bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta)
+    if system.driven and eq.stable:
+        driven = _driven_trajectory_bound(system, values, eq, dt, order, T_eff, zeta)
+        if driven is not None:
+            bound = min(bound, driven)
+    tol = tolerances.gate(bound + ref_err, w, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
     n = min(len(run.t), len(ref.t))
-    emax, erms = metrics.trajectory_errors(run.q[:n], ref.q[:n], scale)
+    emax, erms = metrics.trajectory_errors(run.q[:n, free], ref.q[:n, free], scale_free)
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_max", emax, tol))
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
+    if system.driven:
+        _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result)
     if len(system.coordinates) == 1:
         p_ref = metrics.mean_period(ref.t, ref.q[:, 0] - eq.q[0])
         p_run = metrics.mean_period(run.t[:n], run.q[:n, 0] - eq.q[0])
@@ -380,6 +398,153 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
                           for j in joints if j in run.reactions},
             "tolerance": tol.tolerance, "scale": scale, "contacts": contact_series,
         }
+
+
+def _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result) -> None:
+    """The checks of a driven scenario: the engine's imposed motion against q(t), the
+    actuator forces, and (where the scenario asks) the steady-state amplitudes or the
+    growth rate of an unstable motion."""
+    model = numeric_model(system.id, values)
+    name = sc.name
+    for k, actuator in zip(model.driven, model.actuators):
+        coordinate = system.coordinates[k]
+        motion = ref.q[:n, k]
+        span = max(float(np.max(np.abs(motion - motion[0]))), 1e-300)
+        value = float(np.max(np.abs(run.q[:n, k] - motion))) / span
+        metric = _judge(system, backend.id, f"{name}.imposed_{coordinate}", value, tol)
+        metric.detail = {"span": span, "unit": "rad" if system.mechanism.angular(coordinate)
+                         else "m"}
+        result.metrics.append(metric)
+        if "actuator" not in sc.checks:
+            continue
+        f_ref = ref.actuator_forces[actuator][:n]
+        f_run = run.actuator_forces.get(actuator)
+        if f_run is None:
+            value = float("inf")
+        else:
+            f_run = np.asarray(f_run[:n], dtype=float)
+            ok = np.isfinite(f_run)
+            value = (float(np.max(np.abs(f_run[ok] - f_ref[ok]))
+                           / max(float(np.max(np.abs(f_ref))), 1e-300))
+                     if np.any(ok) else float("inf"))
+        metric = _judge(system, backend.id, f"{name}.actuator_{actuator}", value, tol)
+        metric.detail = {"reference_max": float(np.max(np.abs(f_ref)))}
+        result.metrics.append(metric)
+    if "steady_state" in sc.checks:
+        _compare_steady_state(system, backend, values, ref, run, n, dt, eq, name, result)
+    if "growth_rate" in sc.checks:
+        _compare_growth_rate(system, backend, values, ref, run, n, dt, eq, name, result)
+
+
+def _amplification(eq, w: float) -> float:
+    """2 |K| |D^-1| with D = K - w^2 M + i w C: how much a relative stiffness error moves
+    the steady response at w (tolerances.py)."""
+    D = eq.K - w**2 * eq.M + 1j * w * eq.C
+    return float(2 * np.linalg.norm(eq.K, 2) * np.linalg.norm(np.linalg.inv(D), 2))
+
+
+def _driven_trajectory_bound(system, values, eq, dt, order, t_end, zeta) -> float | None:
+    """The driven trajectory bound of tolerances.py for a stable, damped driven system
+    (None where it does not apply)."""
+    sigma = min((-s.real for s in eq.eigenvalues), default=0.0)
+    freqs = excitation_frequencies(system, values)
+    if not sigma > 0 or not freqs:
+        return None
+    w_modes = max(abs(s) for s in eq.eigenvalues)
+    amplification = max(_amplification(eq, w) for w in freqs)
+    return tolerances.driven_trajectory_tolerance(max(freqs), w_modes, dt, order, t_end, sigma,
+                                                  amplification, zeta)
+
+
+#: the steady-state fit starts once the transient is below this fraction of the response
+SETTLED = 1e-2
+
+
+def _compare_steady_state(system, backend, values, ref, run, n, dt, eq, name, result) -> None:
+    """Steady-state amplitude of each free coordinate (and observable) at each excitation
+    frequency, fitted on the engine's run over the whole periods after the transient
+    (decaying like exp(-sigma t), sigma the slowest modal decay rate) has fallen below
+    SETTLED of the response, against the reference's fitted over the same window; the
+    analytic linear amplitude (analytic/steady_state.py) is reported beside them."""
+    response = steady_state(system, values)
+    sigma = min((-s.real for s in eq.eigenvalues), default=0.0)
+    order = run.integrator_order
+    observables = observable_functions(system, values)
+    for h in response.harmonics:
+        if h.quantity == "actuator_force":
+            continue
+        if h.quantity == "position":
+            k = system.coordinates.index(h.coordinate)
+
+            def series(q, k=k):
+                return q[:, k] - eq.q[k]
+        else:
+            value_of = observables[h.coordinate][0]
+
+            def series(q, value_of=value_of):
+                return np.broadcast_to(np.asarray(value_of(*q.T), dtype=float), (len(q),))
+        W = 2 * np.pi * h.frequency_hz
+        w_top = max(W, max((abs(s) for s in eq.eigenvalues), default=0.0))
+        g = tolerances.gate(tolerances.steady_state_tolerance(w_top, dt, order,
+                                                              _amplification(eq, W)),
+                            w_top, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
+        t = ref.t[:n]
+        x_ref = series(ref.q[:n])
+        # transient: at most the largest excursion over the run, decaying at sigma
+        initial = max(float(np.max(np.abs(x_ref))), h.amplitude)
+        settle = (np.log(initial / (SETTLED * h.amplitude)) / sigma
+                  if sigma > 0 and h.amplitude > 0 else np.inf)
+        periods = np.floor((t[-1] - settle) * W / (2 * np.pi)) if np.isfinite(settle) else 0
+        label = f"{name}.steady_state_{h.coordinate}"
+        if periods < 2:
+            result.metrics.append(Metric(
+                label, float("nan"), g.tolerance, False, "unresolved",
+                f"the transient (slowest decay {sigma:.3g} 1/s) does not fall below "
+                f"{SETTLED:g} of the response within the run: two whole periods after "
+                f"{settle:.3g} s are needed",
+                expected=False))
+            continue
+        window = t >= t[-1] - periods * 2 * np.pi / W
+        a_ref = _harmonic_amplitude(t[window], x_ref[window], W)
+        a_run = _harmonic_amplitude(t[window], series(run.q[:n])[window], W)
+        value = abs(a_run - a_ref) / a_ref
+        metric = _judge(system, backend.id, label, value, g)
+        metric.detail = {"linear_amplitude": h.amplitude, "reference_fit": a_ref,
+                         "engine_fit": a_run, "frequency_hz": h.frequency_hz,
+                         "window_s": [float(t[window][0]), float(t[-1])]}
+        result.metrics.append(metric)
+
+
+def _harmonic_amplitude(t: np.ndarray, x: np.ndarray, w: float) -> float:
+    """Amplitude of the harmonic at w in x(t), least squares on (1, cos, sin)."""
+    A = np.column_stack([np.ones_like(t), np.cos(w * t), np.sin(w * t)])
+    coef, *_ = np.linalg.lstsq(A, x, rcond=None)
+    return float(np.hypot(coef[1], coef[2]))
+
+
+def _compare_growth_rate(system, backend, values, ref, run, n, dt, eq, name, result) -> None:
+    """Exponential growth rate of an unstable driven motion (e.g. the rotating slot above
+    its critical speed), fitted on the engine's run, against the largest real part of the
+    linearization's eigenvalues."""
+    sigma = max(s.real for s in eq.eigenvalues)
+    if not sigma > 0:
+        return
+    order = run.integrator_order
+    w_top = max(abs(s) for s in eq.eigenvalues)
+    freqs = excitation_frequencies(system, values)
+    g = tolerances.gate(tolerances.growth_rate_tolerance(max([w_top] + freqs), dt, order),
+                        max([w_top] + freqs), dt, order, tolerances.MAX_FREQUENCY_TOLERANCE,
+                        "relative")
+    model = numeric_model(system.id, values)
+    t = ref.t[:n]
+    k = model.independent[0]
+    fit_ref = metrics.fit_growth_rate(t, ref.q[:n, k] - eq.q[k], eq.eigenvalues, freqs)
+    fit_run = metrics.fit_growth_rate(t, run.q[:n, k] - eq.q[k], eq.eigenvalues, freqs)
+    value = abs(fit_run - sigma) / sigma
+    metric = _judge(system, backend.id, f"{name}.growth_rate", value, g)
+    metric.detail = {"analytic_per_s": sigma, "reference_fit_per_s": fit_ref,
+                     "engine_fit_per_s": fit_run}
+    result.metrics.append(metric)
 
 
 def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
@@ -460,6 +625,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
                          variant=None):
     """Modes of the operating equilibrium: the engine's own linearization, and a
     free-vibration fit of each modal coordinate after a small modal release."""
+    if system.mechanism.prescribed:
+        values = unexcited_values(system, values)
     eq = operating_equilibrium(system, values)
     if not eq.stable:
         return
@@ -512,6 +679,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
         guess[ind] += tolerances.FIT_AMPLITUDE * np.real(v[:k_dof])
         q0 = model.complete(guess)
         qd0 = model.velocity_basis(q0) @ (tolerances.FIT_AMPLITUDE * np.real(v[k_dof:]))
+        if model.driven:
+            q0[model.driven], qd0[model.driven] = model.motion(0.0)[:2]
         T = max(min(t_end or 10.0, 40 / m.frequency_hz), 10 / m.frequency_hz)
         run = _guarded_run(backend, result, f"fit_mode{i + 1}", T,
                            mech, q0, qd0, T, dt, settings, ())

@@ -43,6 +43,25 @@ faster forcing).
   FIT_RESOLUTION, the precision of a least-squares sinusoid fit over tens of periods of a
   sampled record, and the amplitude dependence of the frequency at the test amplitude
   (a pendulum's frequency shifts by amplitude^2/16: 6e-8 at 1e-3 rad).
+* Steady-state amplitude of a driven system at the excitation frequency W. The scheme
+  shifts the system's frequencies by a relative eps ((w h)^p for p >= 2; w h for
+  semi-implicit Euler, its offset plus its damping error), and its discrete response to
+  the sampled forcing by as much; a relative shift eps of the stiffness changes
+  D = K - W^2 M + i W C by 2 eps K, so the response by up to 2 eps |K| |D^-1| (the
+  amplification: 1/(zeta r) near resonance, 2/|1 - r^2| away from it for one degree of
+  freedom at frequency ratio r). Gate: eps (1 + amplification), with w the fastest of W
+  and the modes. The engine's amplitude is fitted over the whole periods that follow the
+  transient's decay below a hundredth of the response, and compared with the reference's
+  fitted over the same window (the residual transient is the same physics in both).
+* Trajectory of a stable, damped driven system (slowest modal decay rate sigma > 0): its
+  error is that of the steady response (the bound above, which does not grow with time:
+  the forcing fixes the phase) plus that of the transient, whose phase error accumulates
+  only while it lasts, about 1/sigma: (w_n h)^p (1 + w_n min(T, 1/sigma)) with w_n the
+  fastest mode (semi-implicit Euler: its order-1 trajectory bound over the same time). The
+  smaller of this and the general bound is the gate.
+* Growth rate of an unstable motion (a real eigenvalue s > 0), fitted on the run: the
+  scheme moves an eigenvalue by a relative (|s| h)^p (w h for semi-implicit Euler), with
+  w the fastest of the eigenvalues and the excitation; plus FIT_RESOLUTION.
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -138,3 +157,20 @@ def effective_duration(t, envelope) -> float:
     import numpy as np
 
     return float(np.max(np.asarray(t) * np.asarray(envelope)))
+
+
+def steady_state_tolerance(w: float, h: float, order: int, amplification: float) -> float:
+    eps = w * h if order == 1 else (w * h) ** order
+    return eps * (1.0 + amplification)
+
+
+def driven_trajectory_tolerance(w_excitation: float, w_modes: float, h: float, order: int,
+                                t_end: float, sigma: float, amplification: float,
+                                zeta: float) -> float:
+    memory = min(t_end, 1.0 / sigma)
+    steady = steady_state_tolerance(max(w_excitation, w_modes), h, order, amplification)
+    return steady + trajectory_tolerance(w_modes, h, order, memory, zeta)
+
+
+def growth_rate_tolerance(w: float, h: float, order: int) -> float:
+    return (w * h if order == 1 else (w * h) ** order) + FIT_RESOLUTION

@@ -43,6 +43,19 @@ Translation (generic over the description, see `to_mjcf`):
   bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
   Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
   every sample; the violation is returned as ``RunResult.constraint_violation``.
+- ``Prescribed`` coordinates (setting ``prescribed_motion``): a control callback
+  (``mujoco.set_mjcb_control``, installed with the passive callback and restored after,
+  both being process-global) imposes the acceleration. MuJoCo calls it after the passive
+  and bias forces at every RK4 stage with ``d.time`` at the stage time; with f =
+  qfrc_passive - qfrc_bias and the prescribed coordinates q_p = T_p (v - b), it solves
+  (T_p M^-1 T_p^T) Q_p = q_p''(t) - T_p M^-1 f (``mj_solveM``) and applies T_p^T Q_p as
+  ``qfrc_applied``; Q_p is the actuator force in the description's coordinates (clockwise
+  hinges, absolute angles and axis lengths through T). Under Euler, implicit and
+  implicitfast it imposes the discrete acceleration ((q(t+h) - q)/h - q')/h with the
+  matrix the step solves, which puts the coordinate on q(t+h) at every step. Joint
+  equalities with a moving reference and mocap welds are soft, so they are not used.
+  The actuator force of each sample is the callback's at that state (``mj_forward`` at
+  the sample's time, outside the timed loop).
 - Prismatic ``limits`` are admissible intervals of the description, not stops; they are
   not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
   outside the interval).
@@ -110,6 +123,7 @@ from .plan import (
     ForceLaw,
     coordinate_map,
     coupled,
+    motions,
     num,
     rot,
 )
@@ -661,6 +675,9 @@ class _Compiled:
             ring = np.flatnonzero(m.geom_conaffinity == 2)
             m.geom_solref[ring] = (cs, float(plan.opts.get("contact_dampratio", 1.0)))
         self.callback = self._make_callback()
+        #: the actuator forces (description coordinates) the control callback applied last
+        self.actuator = np.zeros(len(plan.mech.prescribed))
+        self.control = self._make_control(integrator, dt)
 
     def _contact_qfrc(self, geom: int) -> np.ndarray:
         """Joint-space force of the contacts of one geom (after mj_forward)."""
@@ -735,6 +752,115 @@ class _Compiled:
                 qfrc[cols] -= tension * d.ten_J[a0:a1]  # -T dL/dq
 
         return passive
+
+    def _make_control(self, integrator: str, dt: float):
+        """The control callback that imposes the prescribed motions, or None.
+
+        The prescribed coordinates are rows of q = T (v - b), so their accelerations are
+        T_p v'' and their actuator forces Q_p enter as the engine forces T_p^T Q_p
+        (virtual work). With v'' = H^-1 (f + T_p^T Q_p), f = qfrc_passive - qfrc_bias
+        (the passive callback's forces are already in qfrc_passive), the k x k system
+        (T_p H^-1 T_p^T) Q_p = target - T_p H^-1 f gives Q_p, written to qfrc_applied.
+        RK4 calls the callback at every stage with the stage time: target = q''(t) and
+        H = M. The first-order integrators move the velocity by h H^-1 (force) with H the
+        matrix they solve (Euler: M + h diag(dof_damping), its implicit damping;
+        implicitfast and implicit: also the tendon dampers' J^T b J; implicit adds the
+        velocity derivative of the bias forces, by central differences, exact for a
+        quadratic), and the target is the discrete acceleration ((q(t+h) - q)/h - q')/h
+        that lands the coordinate on q(t+h) after the step."""
+        plan, model = self.plan, self.model
+        moves = motions(plan.mech)
+        if not moves:
+            return None
+        mujoco = self.mujoco
+        nv, k = model.nv, len(moves)
+        rows = plan.Ainv[[mv.index for mv in moves]]  # q_p = rows (v - b)
+        Tp = np.zeros((k, nv))
+        Tp[:, self.vadr] = rows
+        qadr, vadr, b = self.qadr, self.vadr, plan.b
+        stack = np.zeros((1 + k, nv))  # the free force and the actuators' columns
+        stack[1:] = Tp
+        solved = np.zeros_like(stack)
+        positions = [mv.position for mv in moves]
+        accelerations = [mv.acceleration for mv in moves]
+        actuator = self.actuator
+        discrete = integrator != "RK4"
+        h = float(dt)
+        damping = np.diag(model.dof_damping) if integrator != "RK4" else None
+        euler_damp = integrator == "Euler" and not (
+            model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP))
+        if integrator == "Euler" and not euler_damp:
+            damping = None
+        tendons = ([int(i) for i in np.flatnonzero(model.tendon_damping)]
+                   if integrator in ("implicit", "implicitfast") else [])
+        coriolis = integrator == "implicit"
+        if damping is not None and not damping.any() and not tendons and not coriolis:
+            damping = None
+        full = np.zeros((nv, nv))
+        bias = np.zeros(nv)
+        bias_minus = np.zeros(nv)
+
+        def matrix(m, d) -> np.ndarray:
+            """H: the matrix the integrator solves with (damping is not None)."""
+            mujoco.mj_fullM(m, d, full)
+            H = full + h * damping
+            for tid in tendons:
+                adr, nnz = int(d.ten_J_rowadr[tid]), int(d.ten_J_rownnz[tid])
+                J = np.zeros(nv)
+                J[d.ten_J_colind[adr:adr + nnz]] = d.ten_J[adr:adr + nnz]
+                H += h * m.tendon_damping[tid] * np.outer(J, J)
+            if coriolis:
+                v0 = d.qvel.copy()
+                for i in range(nv):
+                    for sign, out in ((1.0, bias), (-1.0, bias_minus)):
+                        d.qvel[:] = v0
+                        d.qvel[i] += sign * 1e-3
+                        mujoco.mj_comVel(m, d)
+                        mujoco.mj_rne(m, d, 0, out)
+                    H[:, i] += h * (bias - bias_minus) / 2e-3  # - h d(-bias)/dv
+                d.qvel[:] = v0
+                mujoco.mj_comVel(m, d)
+            return H
+
+        # fixed buffers of the data, viewed once (the callback runs at every stage)
+        data = self.data
+        passive, bias_force, applied = data.qfrc_passive, data.qfrc_bias, data.qfrc_applied
+        qpos, qvel = data.qpos, data.qvel
+        solve_m, subtract = mujoco.mj_solveM, np.subtract
+        single = k == 1
+        half = h / 2
+        Tp_t = np.ascontiguousarray(Tp.T)
+        column = Tp[0]
+
+        def control(m, d) -> None:
+            if m is not model:  # the callback is global: act on our model only
+                return
+            # MuJoCo's clock adds h at every step and drifts by ~N eps t after N steps,
+            # a phase error of the motion that does not shrink with h; the stage times
+            # of a fixed-step run from t = 0 are multiples of h/2
+            t = round(d.time / half) * half
+            subtract(passive, bias_force, out=stack[0])
+            if damping is None:
+                solve_m(m, d, solved, stack)
+            else:
+                solved[:] = np.linalg.solve(matrix(m, d), stack.T).T
+            if discrete:
+                q_now = rows @ (qpos[qadr] - b)
+                qd_now = Tp @ qvel
+                target = [((f(t + h) - x) / h - xd) / h
+                          for f, x, xd in zip(positions, q_now.tolist(), qd_now.tolist())]
+            else:
+                target = [f(t) for f in accelerations]
+            if single:
+                free, w = (solved @ column).tolist()  # T_p H^-1 f and T_p H^-1 T_p^T
+                actuator[0] = (target[0] - free) / w
+                np.multiply(column, actuator[0], out=applied)
+            else:
+                W = solved[1:] @ Tp_t  # T_p H^-1 T_p^T
+                actuator[:] = np.linalg.solve(W, np.asarray(target) - Tp @ solved[0])
+                np.dot(Tp_t, actuator, out=applied)
+
+        return control
 
     def set_state(self, q: np.ndarray, qd: np.ndarray, t: float = 0.0) -> None:
         """Description state -> MuJoCo state; the slider bodies of point-on-line
@@ -856,22 +982,29 @@ class _ClosureSamples:
         return forces, violation
 
 
-class _PassiveInstalled:
-    """Installs a passive callback for a block and restores the previous one after."""
+class _CallbacksInstalled:
+    """Installs the passive callback (and the control callback of prescribed motions,
+    when given) for a block and restores the previous ones after: MuJoCo's callbacks
+    are process-global."""
 
-    def __init__(self, callback) -> None:
+    def __init__(self, passive, control=None) -> None:
         import mujoco
 
-        self.mujoco, self.callback, self.previous = mujoco, callback, None
+        self.mujoco = mujoco
+        self.callbacks = [(mujoco.get_mjcb_passive, mujoco.set_mjcb_passive, passive),
+                          (mujoco.get_mjcb_control, mujoco.set_mjcb_control, control)]
+        self.previous: list = []
 
     def __enter__(self) -> None:
-        if self.callback is not None:
-            self.previous = self.mujoco.get_mjcb_passive()
-            self.mujoco.set_mjcb_passive(self.callback)
+        self.previous = []
+        for get, put, callback in self.callbacks:
+            if callback is not None:
+                self.previous.append((put, get()))
+                put(callback)
 
     def __exit__(self, *exc) -> None:
-        if self.callback is not None:
-            self.mujoco.set_mjcb_passive(self.previous)
+        for put, previous in reversed(self.previous):
+            put(previous)
 
 
 class MujocoBackend(Backend):
@@ -987,6 +1120,17 @@ class MujocoBackend(Backend):
         "ring_segments": Setting(
             720, int,
             "RollingContact: number of boxes forming the ring."),
+        "prescribed_motion": Setting(
+            "acceleration", ("acceleration",),
+            "Prescribed coordinates: a control callback (set_mjcb_control) imposes the "
+            "acceleration through qfrc_applied, solved with mj_solveM at every RK4 stage "
+            "at the stage time (q''(t): fourth order with RK4); under Euler, implicit and "
+            "implicitfast it imposes the discrete acceleration ((q(t+h) - q)/h - q')/h "
+            "with the matrix the step solves (first order in the free coordinates, the "
+            "prescribed one on q(t) at every step). The applied force is the actuator "
+            "force. MuJoCo has no exact imposed motion: joint equalities with a moving "
+            "reference and mocap welds are soft (1e-2 rad errors), position actuators "
+            "lag."),
     }
 
     def available(self) -> tuple[bool, str]:
@@ -1058,7 +1202,10 @@ class MujocoBackend(Backend):
                                                  "generalized force on the disc's coordinate "
                                                  "over its coefficient, its violation the "
                                                  "slip; linearize uses the coupling"),),
-        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
+        PRESCRIBED: (Expression(EXACT, "the acceleration imposed by a control callback "
+                                       "(qfrc_applied from mj_solveM, every RK4 stage at "
+                                       "the stage time; setting prescribed_motion); the "
+                                       "applied force is the actuator force"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,
@@ -1152,7 +1299,7 @@ class MujocoBackend(Backend):
         states = np.empty((steps + 1, mujoco.mj_stateSize(m, spec)))
         step, get_state = mujoco.mj_step, mujoco.mj_getState
         get_state(m, d, states[0], spec)
-        with _PassiveInstalled(comp.callback):
+        with _CallbacksInstalled(comp.callback, comp.control):
             start, cpu_start = time.perf_counter(), time.process_time()
             for row in states[1:]:
                 step(m, d)
@@ -1163,13 +1310,15 @@ class MujocoBackend(Backend):
             t = dt * np.arange(steps + 1)
             reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
             forces, violation = self._closures(comp, qpos, qvel, t)
+            actuators = self._actuators(comp, qpos, qvel, t)
         V = qpos[:, comp.qadr]
         VD = qvel[:, comp.vadr]
         q = (V - plan.b) @ plan.Ainv.T
         qd = VD @ plan.Ainv.T
         run = RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                         integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
-                        steps=steps, constraint_forces=forces, cpu_time=cpu)
+                        steps=steps, constraint_forces=forces, cpu_time=cpu,
+                        actuator_forces=actuators)
         # the substitute's own error: each closure's violation at every sample (not part
         # of the contract; read by the reports when present)
         run.constraint_violation = violation
@@ -1186,11 +1335,31 @@ class MujocoBackend(Backend):
                          bool(s["autoreset"]))
         comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
         steps = int(round(t_end / dt))
-        with _PassiveInstalled(comp.callback):
+        with _CallbacksInstalled(comp.callback, comp.control):
             start = time.process_time()
             if steps:
                 mujoco.mj_step(comp.model, comp.data, nstep=steps)
             return time.process_time() - start
+
+    def _actuators(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
+                   t: np.ndarray) -> dict[str, np.ndarray]:
+        """Each prescribed coordinate's actuator force at each sampled state: what the
+        control callback applies there (mj_forward calls it with the sample's time)."""
+        prescribed = comp.plan.mech.prescribed
+        if not prescribed:
+            return {}
+        import mujoco
+
+        m, d = comp.model, comp.data
+        out = np.empty((len(t), len(prescribed)))
+        d_qpos, d_qvel, forward = d.qpos, d.qvel, mujoco.mj_forward
+        for k in range(len(t)):
+            d_qpos[:] = qpos[k]
+            d_qvel[:] = qvel[k]
+            d.time = t[k]
+            forward(m, d)
+            out[k] = comp.actuator
+        return {p.name: out[:, i] for i, p in enumerate(prescribed)}
 
     def _closures(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
                   t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
@@ -1366,6 +1535,10 @@ class MujocoBackend(Backend):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         import mujoco
 
+        if mechanism.prescribed:
+            # the engine's linearization would differentiate the imposed motion's force
+            # as a state feedback; the free coordinates' linearization is not built
+            return None
         s = self.resolve_settings(settings)
         mechanism = coupled(mechanism)  # a contact has no linearization: the exact coupling
         plan = self._plan(mechanism, s, autonomous=True, dt=dt)
@@ -1376,7 +1549,7 @@ class MujocoBackend(Backend):
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
         if s["linearization"] == "inverseFD" and plan.closures:
             comp = _Compiled(plan, integrator, dt)
-            with _PassiveInstalled(comp.callback):
+            with _CallbacksInstalled(comp.callback, comp.control):
                 eig, extra = self._constrained_modes(comp, q_eq, eps)
             method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "
                       f"central differences, eps={eps:g}) plus the geometric stiffness of "
@@ -1388,7 +1561,7 @@ class MujocoBackend(Backend):
             comp = _Compiled(plan, integrator, dt)
             m, d = comp.model, comp.data
             mats = []
-            with _PassiveInstalled(comp.callback):
+            with _CallbacksInstalled(comp.callback, comp.control):
                 for h in (eps, -eps):  # forward and backward differences -> central
                     comp.set_state(q_eq, np.zeros(n))
                     d.qacc[:] = 0
@@ -1410,7 +1583,7 @@ class MujocoBackend(Backend):
         else:
             comp = _Compiled(plan, integrator, dt)
             m, d = comp.model, comp.data
-            with _PassiveInstalled(comp.callback):
+            with _CallbacksInstalled(comp.callback, comp.control):
                 comp.set_state(q_eq, np.zeros(n))
                 mujoco.mj_forward(m, d)
                 Ad = np.zeros((2 * m.nv + m.na, 2 * m.nv + m.na))

@@ -188,8 +188,18 @@ class System:
     #: the excitation's angular frequencies (rad/s), expressions of the parameters: the
     #: linear steady-state response is computed at each
     excitation_frequencies: Callable[[SimpleNamespace], tuple[Expr, ...]] = lambda P: ()
+    #: named quantities of the motion, expressions of the coordinate symbols and the
+    #: parameters (e.g. the absolute position x = y + z of a base-excited block, §8.2):
+    #: their steady-state response is computed and checked like a coordinate's
+    observables: Callable[[SimpleNamespace], Mapping[str, Expr]] = lambda P: {}
     notes: str = ""
     module_doc: str = field(default="", compare=False)
+
+    @property
+    def driven(self) -> bool:
+        """Moved by something outside it: a prescribed coordinate or a harmonic
+        excitation (monograph §8, §9.6)."""
+        return bool(self.mechanism.prescribed) or bool(self.excitation_frequencies(self.symbols))
 
     def variant(self, name: str) -> Variant:
         for v in self.variants:

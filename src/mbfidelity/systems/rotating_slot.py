@@ -58,9 +58,6 @@ def printed(P):
         PrintedFormula("Fig. 29, eq. 84", "eom",
                        [m * x_dd + c * x_d + (k - m * w**2) * x - m * g * sp.sin(w * TIME)],
                        note="row of x, phi = omega t"),
-        PrintedFormula("§8.5, kinetic energy in the disc's frame", "kinetic_energy",
-                       m * x_d**2 / 2, note="relative to the turning disc"),
-        PrintedFormula("§8.5, potential energy", "potential_energy", k * x**2 / 2),
         PrintedFormula("§8.5, critical speed", "frequency", sp.sqrt(k / m - w**2),
                        note="undamped frequency of the relative motion; zero at omega = "
                             "sqrt(k/m), beyond which the block is unstable"),
@@ -85,12 +82,13 @@ SYSTEM = System(
     printed=printed,
     validity=(),
     scenarios=(
-        speed(5.0, 10.0, "well below the critical speed sqrt(k/m) = 10 rad/s (defaults)"),
-        speed(9.5, 10.0, "just below the critical speed: soft relative spring, large "
+        speed(5.0, 20.0, "well below the critical speed sqrt(k/m) = 10 rad/s (defaults)"),
+        speed(9.5, 20.0, "just below the critical speed: soft relative spring, large "
                          "response to the weight"),
         speed(10.5, 2.0, "above the critical speed: the block runs away exponentially"),
     ),
     # in the disc's frame the weight is the excitation (eq. 84's right-hand side)
     unexcited={"g": 0.0},
+    exact_solution="rotating_slot_eq84",
     excitation_frequencies=lambda P: (P.omega,),
 )

@@ -82,5 +82,6 @@ SYSTEM = System(
     printed=printed,
     scenarios=tuple(rotor_speed(r) for r in SPEED_RATIOS),
     unexcited={"e": 0.0},
+    exact_solution="unbalanced_rotor_eq86",
     excitation_frequencies=lambda P: (P.omega,),
 )
