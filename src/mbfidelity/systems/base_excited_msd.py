@@ -22,8 +22,10 @@ massless); the description gives it a mass, so they are not compared.
 """
 import sympy as sp
 
+from ._reasons import coarse_first_order
 from . import PrintedFormula, System, coordinate_symbols
-from .model import (LENGTH, LENGTH_RATE, TIME, Body, CoordinateForce, Mechanism, Parameter, PointToPoint,
+from .model import (LENGTH, LENGTH_RATE, TIME, Body, CoordinateForce, Mechanism, Parameter,
+                    PointToPoint,
                     Prescribed, Prismatic, Rectangle, Scenario, coordinate_spring_damper)
 
 #: length of the block and the base drawings; the absolute formulation's spring runs
@@ -132,4 +134,5 @@ SYSTEM = System(
     notes="Transmissibility: |X/Y| = sqrt(k^2 + (c Omega)^2) / |k - m Omega^2 + i c Omega| "
           "(absolute x = y + z) and |Z/Y| = m Omega^2 / |k - m Omega^2 + i c Omega| "
           "(relative z).",
+    expectations=coarse_first_order("omega_1wn.*", engines=("pymunk",)),
 )

@@ -42,6 +42,7 @@ from types import SimpleNamespace
 import sympy as sp
 
 from ._reasons import coarse_second_order
+from ._reasons import coarse_first_order
 from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import (LENGTH, TIME, Body, Mechanism, Parameter, PointToPoint, Prescribed,
                     Prismatic, Rectangle, Scenario)
@@ -157,5 +158,5 @@ SYSTEM = System(
     ),
     unexcited={"Y": 0.0},
     excitation_frequencies=lambda P: (2 * sp.pi * P.v / P.lam,),
-    expectations=coarse_second_order("free.trajectory_*", "free.imposed_*"),
+    expectations=coarse_first_order("free.trajectory_*", "free.imposed_*", engines=("pymunk",)) + coarse_second_order("free.trajectory_*", "free.imposed_*"),
 )
