@@ -98,6 +98,7 @@ from .base import (
 from .plan import (
     BODY,
     PRESCRIBED,
+    motions,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -591,6 +592,21 @@ class PyBulletBackend(Backend):
             "Boxes in the ring of the contact variant (16 per fixed link: "
             "createCollisionShapeArray keeps at most 16 children; a multibody keeps at "
             "most 127 links). Radial facet bump (R - r)(1/cos(pi/N) - 1)."),
+        "prescribed_motion": Setting(
+            "velocity_motor", ("velocity_motor",),
+            "A prescribed coordinate (convention 9) is driven by the joint's VELOCITY_CONTROL "
+            "motor with targetVelocity = (q(t+h) - q)/h and force prescribed_motor_force, set "
+            "before every step: the velocity-level solve then lands the coordinate on q(t+h) "
+            "(semi-implicit Euler moves positions with the new velocities), so the imposed "
+            "motion is exact to the solver's tolerance and the free coordinates keep the "
+            "scheme's first order; the actuator force is the motor's applied force "
+            "(getJointState()[3]) of the step that starts at the sample. Replaces "
+            "resetJointState each step (the free bodies would never feel the acceleration: "
+            "0.40 rad on a driven pendulum) and the default motor gains (1.2e-2)."),
+        "prescribed_motor_force": Setting(
+            1.0e9, float,
+            "Maximum force/torque of a prescribed coordinate's velocity motor: large enough "
+            "never to saturate, so the motor is a velocity constraint."),
         "contact_breaking_threshold": Setting(
             0.02, float,
             "contactBreakingThreshold (engine default 0.02 m: speculative contacts). "
@@ -664,11 +680,23 @@ class PyBulletBackend(Backend):
                                     "three-term constraint, and a one-joint coupling would be "
                                     "a lock", when="one, or three or more, engine joint values"),
         ),
-        PRESCRIBED: (Expression(UNSUPPORTED, "imposed motion not translated yet"),),
+        PRESCRIBED: (
+            Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h "
+                              "with a force that never saturates (prescribed_motion): the "
+                              "coordinate lands on q(t+h) at every step; actuator force from "
+                              "getJointState", when="the coordinate is one engine joint value"),
+            Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an "
+                                    "absolute angle on a turning parent): one joint motor "
+                                    "cannot impose it", when="otherwise"),
+        ),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
+        if kind == PRESCRIBED:
+            A = coordinate_map(mechanism).A
+            i = mechanism.coordinates.index(element.coordinate)
+            return cases[0] if np.count_nonzero(A[i]) == 1 else cases[1]
         if kind == MASSLESS_BODY:
             if any(j.parent == element.name for j in mechanism.joints):
                 return cases[0]
@@ -1109,16 +1137,59 @@ class PyBulletBackend(Backend):
 
         return apply, has_cf
 
+    @staticmethod
+    def _drivers(p, world: _World, mechanism: Mechanism, dt: float, cfg: dict):
+        """The velocity motors of the prescribed coordinates (setting prescribed_motion):
+        a function of the step k and the engine joint values that sets every driven
+        joint's target velocity to (v(t_k+1) - v)/h, or None without prescribed motion;
+        and the engine link and A[i, i] of each (the actuator force is A[i, i] tau)."""
+        driven = motions(mechanism)
+        if not driven:
+            return None, []
+        plan, body, cid = world.plan, world.body, world.cid
+        A, b = plan.map.A, plan.map.b
+        links = [world.eidx[m.index] for m in driven]
+        scale = [float(A[m.index, m.index]) for m in driven]
+        shift = [float(b[m.index]) for m in driven]
+        position = [m.position for m in driven]
+        slot = [m.index for m in driven]
+        force = [float(cfg["prescribed_motor_force"])] * len(driven)
+        set_motors, velocity_mode = p.setJointMotorControlArray, p.VELOCITY_CONTROL
+
+        def drive(k: int, jv: list) -> None:
+            t_next = (k + 1) * dt
+            target = [(a * q(t_next) + c - jv[i]) / dt
+                      for a, q, c, i in zip(scale, position, shift, slot)]
+            set_motors(body, links, velocity_mode, targetVelocities=target, forces=force,
+                       physicsClientId=cid)
+
+        return drive, list(zip(links, scale, (m.element.name for m in driven)))
+
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
-        """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
+        """The world of `simulate` stepped with only the per-step inputs (`_inputs`) and
+        the drive of the prescribed coordinates (`_drivers`)."""
         import pybullet as p
 
-        world = self._open(p, mechanism, q0, qd0, dt, self.resolve_settings(settings))
+        cfg = self.resolve_settings(settings)
+        world = self._open(p, mechanism, q0, qd0, dt, cfg)
         try:
             steps = int(round(t_end / dt))
             inputs = self._inputs(p, world, dt)
             step, cid = p.stepSimulation, world.cid
+            drive, _ = self._drivers(p, world, mechanism, dt, cfg)
+            if drive is not None:
+                get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
+                apply = inputs[0] if inputs is not None else None
+                start = time.process_time()
+                for k in range(steps):
+                    js = get_states(body, links, physicsClientId=cid)
+                    jv = [s[0] for s in js]
+                    if apply is not None:
+                        apply(k, jv, [s[1] for s in js])
+                    drive(k, jv)
+                    step(physicsClientId=cid)
+                return time.process_time() - start
             apply, needs_state = inputs if inputs is not None else (None, False)
             if apply is None:
                 start = time.process_time()
@@ -1160,7 +1231,8 @@ class PyBulletBackend(Backend):
         closures = plan.closures
         # one extra step gives the reaction/acceleration (and the constraint forces) of
         # the last sample
-        total = steps + 1 if (reaction_joints or closures or contact) else steps
+        total = steps + 1 if (reaction_joints or closures or contact
+                              or mechanism.prescribed) else steps
         try:
             JV = np.empty((total + 1, n_all))
             JVD = np.empty((total + 1, n_all))
@@ -1181,6 +1253,9 @@ class PyBulletBackend(Backend):
             n_cs = len(cids)
             inputs = self._inputs(p, world, dt)
             apply = inputs[0] if inputs is not None else None
+            drive, driven = self._drivers(p, world, mechanism, dt, cfg)
+            driven_slots = [all_links.index(link) for link, _, _ in driven]
+            motor = np.full((total + 1, len(driven)), np.nan)
             if contact is not None:
                 ring_links = set(plan.fixed_links)
                 disc_link = eidx[plan.link_of[contact.inner]]
@@ -1198,8 +1273,13 @@ class PyBulletBackend(Backend):
                         tau_applied[k] = tau
                     if forces is not None:
                         f_point[k] = forces
+                if drive is not None:
+                    drive(k, jv)
                 step(physicsClientId=cid)
                 js = get_states(body, all_links, physicsClientId=cid)
+                # the motor's force read after a step belongs to the state before it
+                for r, slot in enumerate(driven_slots):
+                    motor[k, r] = js[slot][3]
                 # constraint and contact forces read after a step belong to the state
                 # before it
                 for r in range(n_cs):
@@ -1260,9 +1340,10 @@ class PyBulletBackend(Backend):
                                                   JV[: steps + 1], FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
+        actuators = {name: a * motor[: steps + 1, r] for r, (_, a, name) in enumerate(driven)}
         run = RunResult(t=np.arange(steps + 1) * dt, q=q, qd=qd, reactions=reactions,
                         wall_time=wall, integrator_order=1, settings=cfg, steps=steps,
-                        constraint_forces=forces, cpu_time=cpu)
+                        constraint_forces=forces, cpu_time=cpu, actuator_forces=actuators)
         # the substitutes' own error: each closure's violation at every sample (not part
         # of the contract; read by the reports when present)
         run.constraint_violation = violation
@@ -1468,6 +1549,8 @@ class PyBulletBackend(Backend):
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
+        if mechanism.prescribed:
+            return None  # inverse dynamics about a rest state: a driven joint does not rest
         import pybullet as p
 
         cfg = self.resolve_settings(settings)

@@ -134,5 +134,5 @@ SYSTEM = System(
     notes="Transmissibility: |X/Y| = sqrt(k^2 + (c Omega)^2) / |k - m Omega^2 + i c Omega| "
           "(absolute x = y + z) and |Z/Y| = m Omega^2 / |k - m Omega^2 + i c Omega| "
           "(relative z).",
-    expectations=coarse_first_order("omega_1wn.*", engines=("pymunk",)),
+    expectations=coarse_first_order("omega_1wn.*"),
 )

@@ -98,6 +98,5 @@ SYSTEM = System(
     unexcited={"Y": 0.0},
     excitation_frequencies=lambda P: (P.Omega,),
     expectations=coarse_first_order("ratio_*.trajectory_*", "ratio_*.imposed_*",
-                                    "ratio_*.actuator_*", "ratio_1.steady_state_*",
-                                    engines=("pymunk",)),
+                                    "ratio_*.actuator_*", "ratio_1.steady_state_*"),
 )

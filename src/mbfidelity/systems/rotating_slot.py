@@ -93,5 +93,5 @@ SYSTEM = System(
     exact_solution="rotating_slot_eq84",
     excitation_frequencies=lambda P: (P.omega,),
     expectations=coarse_first_order("omega_10_5.trajectory_*", "omega_10_5.imposed_*",
-                                    "omega_10_5.actuator_*", engines=("pymunk",)),
+                                    "omega_10_5.actuator_*"),
 )

@@ -158,5 +158,6 @@ SYSTEM = System(
     ),
     unexcited={"Y": 0.0},
     excitation_frequencies=lambda P: (2 * sp.pi * P.v / P.lam,),
-    expectations=coarse_first_order("free.trajectory_*", "free.imposed_*", engines=("pymunk",)) + coarse_second_order("free.trajectory_*", "free.imposed_*"),
+    expectations=(coarse_first_order("free.trajectory_*", "free.imposed_*")
+                  + coarse_second_order("free.trajectory_*", "free.imposed_*")),
 )

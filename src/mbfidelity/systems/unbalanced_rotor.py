@@ -92,7 +92,9 @@ SYSTEM = System(
     unexcited={"e": 0.0},
     exact_solution="unbalanced_rotor_eq86",
     excitation_frequencies=lambda P: (P.omega,),
-    expectations=coarse_first_order("ratio_*", "frequency.fit_*", "damping.fit_*", engines=("pymunk",)) + coarse_second_order("ratio_*.trajectory_*", "ratio_*.imposed_*",
-                                     "ratio_*.actuator_*") + (
-        Expectation("exudyn", "ratio_*.steady_state_*", "unresolved", RESONANT_STEADY_STATE),),
+    expectations=(coarse_first_order("ratio_*", "frequency.fit_*", "damping.fit_*")
+                  + coarse_second_order("ratio_*.trajectory_*", "ratio_*.imposed_*",
+                                        "ratio_*.actuator_*")
+                  + (Expectation("exudyn", "ratio_*.steady_state_*", "unresolved",
+                                 RESONANT_STEADY_STATE),)),
 )
