@@ -396,7 +396,13 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
             "reactions": {j: (ref.reactions[j][:n], run.reactions[j][:n])
                           for j in joints if j in run.reactions},
-            "tolerance": tol.tolerance, "scale": scale, "contacts": contact_series,
+            "tolerance": tol.tolerance, "scale": scale,
+            # actuator forces are drawn with the contact forces (same panel, N or N m)
+            "contacts": {**contact_series, **{
+                f"actuator {a}": (ref.actuator_forces[a][:n],
+                                  np.asarray(run.actuator_forces.get(a, np.full(n, np.nan)),
+                                             dtype=float)[:n])
+                for a in (ref.actuator_forces or {})}},
         }
 
 

@@ -128,7 +128,10 @@ def _envelope(t: np.ndarray, y: np.ndarray, bins: int = ENVELOPE_BINS):
 def _figures(system_id: str, comps, out: Path) -> list[str]:
     names = []
     scenarios = {name for c in comps for name in c.series}
-    coords = get_system(base_id(system_id)).coordinates
+    system = get_system(base_id(system_id))
+    # a driven system's prescribed coordinates run away (phi = w t): its free ones are drawn
+    drawn = [(i, c) for i, c in enumerate(system.coordinates)
+             if c not in system.mechanism.driven_coordinates]
     for scenario in sorted(scenarios):
         with_contacts = any(c.series.get(scenario, {}).get("contacts") for c in comps)
         fig, axes = plt.subplots(3 if with_contacts else 2, 1,
@@ -140,11 +143,11 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
                 continue
             t = s["t"]
             if not drawn_ref:
-                for i, name in enumerate(coords):
+                for i, name in drawn:
                     axes[0].plot(*_envelope(t, s["q_ref"][:, i]), "k-", lw=2.5, alpha=0.35,
                                  label=f"reference {name}")
                 drawn_ref = True
-            for i, name in enumerate(coords):
+            for i, name in drawn:
                 axes[0].plot(*_envelope(t, s["q"][:, i]), lw=0.8,
                              label=f"{c.simulator} {name}")
             if with_contacts:
@@ -164,7 +167,7 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
         axes[1].legend(fontsize=7)
         if with_contacts:
             axes[2].axhline(0.0, color="k", lw=0.5, ls=":")
-            axes[2].set_ylabel("contact forces [N]")
+            axes[2].set_ylabel("contact / actuator forces")
             axes[2].legend(fontsize=7, ncol=4)
         fig.suptitle(f"{system_id}, scenario {scenario} (dashed: tolerances)")
         fig.tight_layout()
