@@ -119,3 +119,28 @@ def test_reference_settles_on_the_steady_state():
     want = np.real(X * np.exp(1j * w * r.t[late]))
     decay = np.exp(-c / (2 * (M + m)) * 4.0)
     np.testing.assert_allclose(r.q[late, 0], want, atol=2 * decay * abs(X) + 1e-12)
+
+
+def test_errata_can_fail_on_a_driven_system():
+    """eq. 84 with the centrifugal term's sign flipped (k + m w^2) and eq. 86 without the
+    rotor's mass on the frame are judged misprints: the printed rows are evaluated with
+    the prescribed coordinates on their motion (the check is not vacuous)."""
+    from mbfidelity.analytic.errata import _compare
+    from mbfidelity.systems import PrintedFormula
+    from mbfidelity.systems.model import TIME
+
+    s = get_system("rotating_slot")
+    P = s.symbols
+    x, x_d, x_dd = coordinate_symbols("x")
+    good = PrintedFormula("eq. 84", "eom", [P.m * x_dd + P.c * x_d + (P.k - P.m * P.omega**2) * x
+                                            - P.m * P.g * sp.sin(P.omega * TIME)])
+    wrong = PrintedFormula("eq. 84 flipped", "eom", [
+        P.m * x_dd + P.c * x_d + (P.k + P.m * P.omega**2) * x
+        - P.m * P.g * sp.sin(P.omega * TIME)])
+    assert _compare(s, good, np.random.default_rng(1))[0] < 1e-12
+    assert _compare(s, wrong, np.random.default_rng(1))[0] > 1e-2
+    s = get_system("unbalanced_rotor")
+    P = s.symbols
+    wrong = PrintedFormula("eq. 86 without m", "eom", [
+        P.M * x_dd + P.c * x_d + P.k * x - P.m * P.omega**2 * P.e * sp.cos(P.omega * TIME)])
+    assert _compare(s, wrong, np.random.default_rng(1))[0] > 1e-2

@@ -409,7 +409,13 @@ def _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, re
     for k, actuator in zip(model.driven, model.actuators):
         coordinate = system.coordinates[k]
         motion = ref.q[:n, k]
-        span = max(float(np.max(np.abs(motion - motion[0]))), 1e-300)
+        span = float(np.max(np.abs(motion - motion[0])))
+        # a motion that stays put (its amplitude set to zero) is judged on the
+        # coordinate's own scale: 1 rad, or its distance from the origin (at least 0.1 m)
+        scale = (1.0 if system.mechanism.angular(coordinate)
+                 else max(abs(float(motion[0])), 0.1))
+        if not span > 1e-12 * scale:
+            span = scale
         value = float(np.max(np.abs(run.q[:n, k] - motion))) / span
         metric = _judge(system, backend.id, f"{name}.imposed_{coordinate}", value, tol)
         metric.detail = {"span": span, "unit": "rad" if system.mechanism.angular(coordinate)
