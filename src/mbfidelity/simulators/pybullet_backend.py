@@ -62,6 +62,21 @@ forces f (1, ratio). Because the projection is velocity level, a constraint's cu
 term (centripetal J'v) enters the force one step late, through the position error: a run
 that starts fast on a curved constraint reports at the first sample a force lacking J'v
 (and half of it too much at the second); afterwards the forces are first-order accurate.
+
+Prescribed motion (convention 9; setting ``prescribed_motion``): before every step the
+driven joint's VELOCITY_CONTROL motor gets targetVelocity = (v(t+h) - v)/h, v = A q + b
+its engine joint value, with a force that never saturates; the free joints keep their
+velocity motors disabled. The motor is a velocity constraint of the same solve as the
+joints, so the free bodies feel the imposed acceleration within the step, and semi-implicit
+Euler then moves the coordinate onto v(t+h) (its error is the solver's residual). The
+free coordinates keep the scheme's first order. Overwriting the joint state each step
+(resetJointState) would move the driven body without accelerating the others; the
+default motor gains only follow the target loosely. The actuator force is the motor's
+applied force ``getJointState()[3]`` (impulse / dt of the step, so it belongs to the
+state before it) times A[i, i]: the motor acts on its own joint only, and generalized
+forces map as Q = A^T tau. A coordinate that is a sum of engine joint values (an
+absolute angle on a turning parent) would need the parent's angle at t+h before the
+step: refused.
 """
 from __future__ import annotations
 
