@@ -90,6 +90,8 @@ def save_series(out: Path, row: str, comps: Iterable[Comparison]) -> None:
             arrays[_key(scenario, c.simulator, "tolerance")] = np.asarray(s["tolerance"])
             for contact, (_, f_run) in s["contacts"].items():
                 arrays[_key(scenario, c.simulator, _contact("engine", contact))] = f_run
+            for label, a in s.get("checks", {}).items():
+                arrays[_key(scenario, c.simulator, _check(label))] = np.asarray(a)
     path = series_path(out, row)
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, **arrays)
@@ -106,13 +108,18 @@ def _contact(side: str, name: str) -> str:
     return f"{side}_contact{KEY_SEPARATOR}{name}"
 
 
+def _check(label: str) -> str:
+    return f"check{KEY_SEPARATOR}{label}"
+
+
 def _key(scenario: str, owner: str, name: str) -> str:
     return KEY_SEPARATOR.join((scenario, owner, name))
 
 
 def load_series(out: Path, row: str) -> dict[str, dict]:
     """simulator -> scenario -> {"t", "q_ref", "q", "scale", "tolerance", "contacts":
-    name -> (reference, engine)}, as `save_series` saved them (empty when none were)."""
+    name -> (reference, engine), "checks": label -> array (what the scenario's checks
+    kept for the figures)}, as `save_series` saved them (empty when none were)."""
     path = series_path(out, row)
     if not path.exists():
         return {}
@@ -129,7 +136,10 @@ def load_series(out: Path, row: str) -> dict[str, dict]:
             ref = {name: a[:n] for name, a in shared[scenario].items()}
             ref.update({name: a for name, a in own.items() if name in ref})
             s = {"t": ref["t"], "q_ref": ref["q_ref"], "q": own["q"], "scale": own["scale"],
-                 "tolerance": float(own["tolerance"]), "contacts": {}}
+                 "tolerance": float(own["tolerance"]), "contacts": {}, "checks": {}}
+            for name, a in own.items():
+                if name.startswith(_check("")):
+                    s["checks"][name[len(_check("")):]] = a
             prefix = _contact("engine", "")
             for name, f_run in own.items():
                 if name.startswith(prefix):

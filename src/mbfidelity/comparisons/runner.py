@@ -22,7 +22,7 @@ from ..analytic.steady_state import (excitation_frequencies, observable_function
 from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
-from . import metrics, tolerances
+from . import checks, metrics, tolerances
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
 
 DEFAULT_DT = 1e-3
@@ -360,6 +360,22 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
     if system.driven:
         _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result)
+    scenario_series: dict = {}
+    for check in sc.checks:
+        measure = checks.registry().get(check)
+        if measure is None:
+            continue
+        measure(checks.ScenarioRun(
+            system, backend, sc, values, mech, ref, run, n, tol, w, dt, eq, settings,
+            judge=lambda label, value, gate, unit="relative": _record(
+                result, _judge(system, backend.id, f"{name}.{label}", value, gate, unit)),
+            unresolved=lambda label, tolerance, reason, unit="relative": _record(
+                result, Metric(f"{name}.{label}", float("nan"), tolerance, False, "unresolved",
+                               reason, unit, expected=_is_declared(system, backend.id,
+                                                                f"{name}.{label}"))),
+            simulate=lambda m, a, b, t: _guarded_run(backend, result, f"{name}.{check}", t,
+                                                     m, a, b, t, dt, settings, ()),
+            series=scenario_series))
     if len(system.coordinates) == 1:
         p_ref = metrics.mean_period(ref.t, ref.q[:, 0] - eq.q[0])
         p_run = metrics.mean_period(run.t[:n], run.q[:n, 0] - eq.q[0])
@@ -396,7 +412,7 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
             "t": ref.t[:n], "q_ref": ref.q[:n], "q": run.q[:n],
             "reactions": {j: (ref.reactions[j][:n], run.reactions[j][:n])
                           for j in joints if j in run.reactions},
-            "tolerance": tol.tolerance, "scale": scale,
+            "tolerance": tol.tolerance, "scale": scale, "checks": scenario_series,
             # actuator forces are drawn with the contact forces (same panel, N or N m)
             "contacts": {**contact_series, **{
                 f"actuator {a}": (ref.actuator_forces[a][:n],
@@ -404,6 +420,16 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
                                              dtype=float)[:n])
                 for a in (ref.actuator_forces or {})}},
         }
+
+
+def _record(result: "Comparison", metric: Metric) -> Metric:
+    result.metrics.append(metric)
+    return metric
+
+
+def _is_declared(system: System, simulator: str, name: str) -> bool:
+    exp = expectation_for(system, simulator, name)
+    return exp is not None and exp.kind in ("xfail", "unresolved")
 
 
 def _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result) -> None:

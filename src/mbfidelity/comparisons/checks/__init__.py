@@ -1,0 +1,72 @@
+"""Scenario checks beyond the trajectory (the catalog's X checks), one module per check,
+discovered automatically (the pattern of `systems`): a module defines ``CHECK``, the name
+a `Scenario` lists in its ``checks``, and ``measure(run: ScenarioRun) -> None``, which
+appends its metrics through ``run.judge`` / ``run.unresolved``. The runner calls every
+check a scenario lists after its trajectory metrics, with the engine's run and the
+reference of the same scenario."""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+
+@dataclass
+class ScenarioRun:
+    """What a check sees: the system, the engine (`backend`, its resolved `settings`),
+    the scenario and its parameter `values`, the numeric `mechanism` the engine built,
+    the `reference` and the engine's `run` (first `n` samples comparable), the trajectory
+    `gate` (tolerances.Gate) with the motion's fastest angular frequency `w`, the step
+    `dt`, the operating `equilibrium`, and how to record metrics."""
+
+    system: Any
+    backend: Any
+    scenario: Any
+    values: Mapping[str, float]
+    mechanism: Any
+    reference: Any
+    run: Any
+    n: int
+    gate: Any
+    w: float
+    dt: float
+    equilibrium: Any
+    settings: Mapping[str, Any]
+    #: (name, value, gate, unit) -> Metric, appended to the comparison
+    judge: Callable[..., Any]
+    #: (name, tolerance, reason) -> Metric with status unresolved, appended
+    unresolved: Callable[..., Any]
+    #: (mechanism, q0, qd0, t_end) -> RunResult or None (an incident is recorded)
+    simulate: Callable[..., Any]
+    #: arrays for the report's figures, by name (saved with the scenario's series)
+    series: dict = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return self.scenario.name
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.reference.t[: self.n]
+
+
+_REGISTRY: dict[str, Callable[[ScenarioRun], None]] | None = None
+
+
+def registry() -> dict[str, Callable[[ScenarioRun], None]]:
+    """check name -> measure function, from the modules of this package."""
+    global _REGISTRY
+    if _REGISTRY is None:
+        found = {}
+        for info in pkgutil.iter_modules(__path__):
+            module = importlib.import_module(f"{__name__}.{info.name}")
+            name = getattr(module, "CHECK", None)
+            if name is not None:
+                if name in found:
+                    raise ValueError(f"check {name!r} is defined twice")
+                found[name] = module.measure
+        _REGISTRY = found
+    return _REGISTRY
