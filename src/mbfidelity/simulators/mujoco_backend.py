@@ -674,7 +674,7 @@ class _Compiled:
                 cs, float(plan.opts.get("contact_dampratio", 1.0)))
             ring = np.flatnonzero(m.geom_conaffinity == 2)
             m.geom_solref[ring] = (cs, float(plan.opts.get("contact_dampratio", 1.0)))
-        self.callback = self._make_callback()
+        self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
         self.actuator = np.zeros(len(plan.mech.prescribed))
         self.control = self._make_control(integrator, dt)
@@ -708,8 +708,9 @@ class _Compiled:
         q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
-    def _make_callback(self):
+    def _make_callback(self, dt: float):
         plan, model = self.plan, self.model
+        half = dt / 2
         coord_terms = []
         for e in plan.coord:
             if e.native is not None:
@@ -735,7 +736,9 @@ class _Compiled:
         def passive(m, d) -> None:
             if m is not model:  # the callback is global: act on our model only
                 return
-            t = d.time
+            # the stage times of a fixed-step run from t = 0 are multiples of h/2; MuJoCo's
+            # own clock drifts from them by ~N eps t (see the control callback)
+            t = round(d.time / half) * half
             qfrc = d.qfrc_passive
             if coord_terms:
                 qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
