@@ -174,6 +174,8 @@ class NumericModel:
                               for k, H in enumerate(d.Phi_hessians)]
         self._reactions: dict[str, Callable] = {}
         self._warm: np.ndarray | None = None
+        #: (q, S(q)) of the last state completed from `_warm`: the Newton predictor
+        self._tangent: tuple[np.ndarray, np.ndarray] | None = None
         # closed-form reduction (constraints solved symbolically): a cheap explicit ODE
         self._explicit = None
         small_reduced = self.constrained and len(self.independent) <= 3
@@ -322,13 +324,21 @@ class NumericModel:
         if self._explicit is not None:
             return (np.array(self._explicit[0](*qi), dtype=float),
                     np.array(self._explicit[1](*qi, *qdi), dtype=float))
+        predictor = None
         if guess is None:
             guess = self._warm if self._warm is not None else np.zeros(self.n)
+            if self._tangent is not None and self._tangent[0] is guess:
+                predictor = self._tangent[1]
         q = np.array(guess, dtype=float)
+        if predictor is not None:
+            # first-order predictor along the constraint manifold: Newton then starts
+            # a step's square away from the solution
+            q += predictor @ (np.asarray(qi, dtype=float) - q[self.independent])
         q[self.independent] = qi
         q = self.complete(q)
-        self._warm = q
-        return q, self.velocity_basis(q) @ np.asarray(qdi, dtype=float)
+        S = self.velocity_basis(q)
+        self._warm, self._tangent = q, (q, S)
+        return q, S @ np.asarray(qdi, dtype=float)
 
     # --- dynamics ------------------------------------------------------------------------
     def mass_matrix(self, q) -> np.ndarray:
