@@ -41,8 +41,7 @@ from types import SimpleNamespace
 
 import sympy as sp
 
-from ._reasons import coarse_second_order
-from ._reasons import coarse_first_order
+from ._reasons import coarse_first_order, coarse_second_order
 from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import (LENGTH, TIME, Body, Mechanism, Parameter, PointToPoint, Prescribed,
                     Prismatic, Rectangle, Scenario)

@@ -14,8 +14,7 @@ the catalog) sets the actuator torque only; gravity acts across the guide.
 """
 import sympy as sp
 
-from ._reasons import coarse_second_order
-from ._reasons import coarse_first_order
+from ._reasons import coarse_first_order, coarse_second_order
 from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, Prescribed,
                     Prismatic, Rectangle, Revolute, Scenario, coordinate_spring_damper)
