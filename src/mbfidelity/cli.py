@@ -208,17 +208,16 @@ def _relative_note(system, coords: list, op) -> dict:
     return {
         "acceleration": acceleration,
         "rigid_directions": rigid,
-        "note": (f"no static equilibrium in absolute coordinates: {system.id} has no "
-                 f"ground, and its loads have a resultant that only the inertia of the "
-                 f"whole balances ({moving}); reported instead: the relative "
-                 if moving else
-                 f"{system.id} has no ground: its loads have no resultant here, so the "
-                 f"relative equilibrium (Italian notes §5.3.1) is at rest; "
-                 f"reported: "
-                 f"equilibrium (Italian notes §5.3.1), the configuration that moves rigidly "
-                 f"with that uniform acceleration, linearized about that motion; its "
-                 f"rigid-body mode has zero frequency, and 'stable' judges the relative "
-                 f"motion"),
+        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
+                  f"ground, and its loads have a resultant that only the inertia of the "
+                  f"whole balances ({moving}); reported instead: the relative equilibrium "
+                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
+                  f"uniform acceleration, linearized about that motion"
+                  if moving else
+                  f"{system.id} has no ground, and its loads have no resultant here: its "
+                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
+                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
+                   "relative motion"),
     }
 
 
