@@ -151,6 +151,9 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         "modes": _modes(op),
         "printed_vs_derived": [e.as_dict() for e in errata(system)],
     }
+    if op.acceleration is not None:
+        doc["static_equilibrium"] = None
+        doc["relative_equilibrium"] = _relative_note(system, coords, op)
     if system.driven:
         from .analytic.steady_state import steady_state
 
@@ -173,8 +176,11 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     formulas = {p.name: p.default for p in system.all_parameters}
     if derived:
         typer.echo("derived: " + ", ".join(f"{k} = {formulas[k]}" for k in derived))
+    if "relative_equilibrium" in doc:
+        typer.echo(doc["relative_equilibrium"]["note"])
     for e in equilibria:
-        typer.echo(f"equilibrium {e['q']}: {'stable' if e['stable'] else 'unstable'}")
+        kind = "relative equilibrium" if "relative_equilibrium" in doc else "equilibrium"
+        typer.echo(f"{kind} {e['q']}: {'stable' if e['stable'] else 'unstable'}")
     typer.echo(f"at {doc['operating_point']}:")
     for key in ("M", "C", "K"):
         typer.echo(f"  {key} = {np.array2string(getattr(op, key), precision=6)}")
@@ -192,6 +198,27 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(f"  steady state: none ({doc['steady_state_note']})")
     for e in doc["printed_vs_derived"]:
         typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
+
+
+def _relative_note(system, coords: list, op) -> dict:
+    """What `analyze` says of a floating mechanism (Italian notes §5.3.1)."""
+    acceleration = dict(zip(coords, op.acceleration.tolist()))
+    rigid = [dict(zip(coords, col.tolist())) for col in op.rigid.T]
+    moving = ", ".join(f"{c}'' = {a:.9g}" for c, a in acceleration.items() if a)
+    return {
+        "acceleration": acceleration,
+        "rigid_directions": rigid,
+        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
+                  f"ground, and its loads have a resultant that only the inertia of the "
+                  f"whole balances ({moving}); reported instead: the relative equilibrium "
+                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
+                  f"uniform acceleration, linearized about that motion"
+                  if moving else
+                  f"{system.id} has no ground, and its loads have no resultant here: its "
+                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
+                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
+                   "relative motion"),
+    }
 
 
 def _settings(items: Optional[List[str]]) -> dict:

@@ -102,3 +102,30 @@ SOLUTIONS: dict[str, Callable] = {
     "rotating_slot_eq84": rotating_slot_eq84,
     "unbalanced_rotor_eq86": unbalanced_rotor_eq86,
 }
+
+
+# --- free_free_two_mass (Italian notes §5.3.1) -------------------------------------------
+
+
+def free_pair_under_constant_force(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """Two masses m joined by a spring k, a constant force F on mass 1, no ground;
+    coordinates (x1, dx), x1 of mass 1, dx the spring's stretch. Newton on each mass:
+    m x1'' = F + k dx, m x2'' = -k dx. Their sum moves the centre of mass
+    x_CG = x1 + (l0 + dx)/2 at F/(2m); their difference gives
+    dx'' + (2k/m) dx = -F/m, a harmonic motion at w = sqrt(2k/m) about -F/(2k). Then
+    x1 = x_CG - (l0 + dx)/2."""
+    m, k, F = values["m"], values["k"], values["F"]
+    w = np.sqrt(2 * k / m)
+    s_eq = -F / (2 * k)
+    x10, s0 = float(q0[0]), float(q0[1])
+    v10, sd0 = float(qd0[0]), float(qd0[1])
+    s = s_eq + (s0 - s_eq) * np.cos(w * t) + sd0 / w * np.sin(w * t)
+    sd = -(s0 - s_eq) * w * np.sin(w * t) + sd0 * np.cos(w * t)
+    a = F / (2 * m)
+    v_cg0 = v10 + sd0 / 2
+    x1 = x10 + (s0 - s) / 2 + v_cg0 * t + a * t**2 / 2
+    v1 = v_cg0 + a * t - sd / 2
+    return np.column_stack([x1, s]), np.column_stack([v1, sd])
+
+
+SOLUTIONS["free_pair_under_constant_force"] = free_pair_under_constant_force

@@ -52,6 +52,7 @@ from ..systems.model import TIME, Prismatic
 from . import cache
 from .derivation import cache_key, derivation_of
 from .linear import linearize, operating_equilibrium
+from .relative_equilibrium import relative_residual
 from .numeric import _lambdify, numeric_model
 
 AGREEMENT = 1e-9  # relative; round-off of the numeric comparison is ~1e-14
@@ -303,8 +304,15 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str, dict]
                 q[system.coordinates.index(name)] = system.evaluate(value, values)
             q = model.complete(q)
             scale = max(1.0, float(np.max(np.abs(eq.K))))
-            worst = max(worst, float(np.max(np.abs(model.static_residual(q)))) / scale)
+            # a floating mechanism's equilibrium is relative: its residual with the rigid
+            # accelerations that fit it (Italian notes §5.3.1)
+            residual = (model.static_residual(q) if eq.rigid is None
+                        else relative_residual(model, q, eq.rigid))
+            worst = max(worst, float(np.max(np.abs(residual))) / scale)
             derived_text = f"q_eq = {np.array2string(eq.q, precision=9)}"
+            if eq.acceleration is not None:
+                derived_text += (f", moving rigidly with q'' = "
+                                 f"{np.array2string(eq.acceleration, precision=9)}")
         elif pf.kind in ("frequency", "damping_ratio"):
             value = float(pf.expr.xreplace(system.subs(values)))
             if pf.kind == "frequency":

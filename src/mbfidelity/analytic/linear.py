@@ -4,6 +4,10 @@ eigenvalues s of M s^2 + C s + K = 0;
 frequency_hz = |s|/(2 pi), damping_ratio = -Re(s)/|s|, damped_frequency_hz = |Im s|/(2 pi).
 One mode per complex-conjugate pair (the member with Im s > 0), one per real eigenvalue.
 
+A floating system (no ground, `System.rigid_directions`) has no static equilibrium under
+a load with a non-zero resultant: its equilibria are relative ones (Italian notes
+§5.3.1), found and linearized in analytic/relative_equilibrium.py.
+
 A driven system (prescribed coordinates, monograph §8, §9.6) is linearized in its free
 coordinates about the motion of the unexcited system (`System.unexcited`: the excitation's
 amplitudes set to zero; the weight, in a rotating frame where it is the excitation): the
@@ -56,6 +60,11 @@ class Equilibrium:
     K: np.ndarray
     eigenvalues: np.ndarray
     modes: list[Mode] = field(default_factory=list)
+    #: a relative equilibrium (floating mechanism, analytic/relative_equilibrium.py): the
+    #: reference's uniform acceleration q'' (None: a static equilibrium) and the rigid
+    #: directions (columns)
+    acceleration: np.ndarray | None = None
+    rigid: np.ndarray | None = None
 
 
 def companion_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
@@ -335,6 +344,11 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     system's are the rest states of its free coordinates with the excitation off."""
     if system.mechanism.prescribed:
         return _driven_equilibria(system, values, only_operating=False)
+    if system.rigid_directions(system.symbols):
+        from .relative_equilibrium import relative_equilibria
+
+        op = system.operating_values(values)
+        return relative_equilibria(system, values, [op] + _search_grid(system, values, op))
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     found: list[np.ndarray] = []
@@ -399,6 +413,13 @@ def operating_equilibrium(system: System, values) -> Equilibrium:
             raise ValueError(f"{system.id}: no rest state of the free coordinates near the "
                              f"operating point with the excitation off "
                              f"({_unexcited_text(system)})")
+        return found[0]
+    if system.rigid_directions(system.symbols):
+        from .relative_equilibrium import relative_equilibria
+
+        found = relative_equilibria(system, values)
+        if not found:
+            raise ValueError(f"{system.id}: no relative equilibrium near the operating point")
         return found[0]
     model = numeric_model(system.id, values)
     op = system.operating_values(values)

@@ -735,7 +735,7 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
                                                        abs(m.eigenvalue), m.damping_ratio)
             value = abs(w_fit - abs(m.eigenvalue)) / abs(m.eigenvalue)
             dz = abs(z_fit - m.damping_ratio)
-        except RuntimeError:
+        except (RuntimeError, ValueError):  # no convergence, or a diverged (NaN) run
             w_fit, value, dz = float("nan"), float("inf"), float("inf")
         metric = _judge(system, backend.id, f"frequency.fit_mode{i + 1}", value, tol)
         metric.detail = {"reference_hz": m.frequency_hz, "method": "free-vibration fit",

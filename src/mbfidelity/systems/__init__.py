@@ -193,6 +193,13 @@ class System:
     #: parameters (e.g. the absolute position x = y + z of a base-excited block, §8.2):
     #: their steady-state response is computed and checked like a coordinate's
     observables: Callable[[SimpleNamespace], Mapping[str, Expr]] = lambda P: {}
+    #: a floating mechanism (no ground, Italian notes §5.3.1): directions in the
+    #: coordinates (coordinate -> component) along which it moves as a rigid whole, with
+    #: no stiffness or damping and a mass matrix that does not change; its equilibrium is
+    #: a relative one, the configuration that translates rigidly with the acceleration
+    #: the loads give it (analytic/relative_equilibrium.py)
+    rigid_directions: Callable[[SimpleNamespace], tuple[Mapping[str, Expr], ...]] = (
+        lambda P: ())
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
