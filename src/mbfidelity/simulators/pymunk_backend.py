@@ -644,6 +644,11 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
               and id(j) not in folded and id(j) not in linked and id(j) not in in_component
               and id(j) not in held]
     layout = _Layout(dynamic, folds, pivots, grooves, links, components, drives=drives)
+    # a body that every joint from the world slides (no hinge) cannot turn: an infinite
+    # moment takes it out of every rotational equation, where a GearJoint holding its
+    # angle would be solved only iteratively (two such bodies in a chain drift apart
+    # under a velocity-level groove without error correction)
+    layout.infinite |= {b for b in dynamic if _rotation_fixed(mech, b)}
     for d in drives:
         if d.kinematic and isinstance(d.joint, Revolute) and _vec(d.joint.child_anchor).any():
             # a kinematic body turns about its centre of gravity: put it on the hinge

@@ -34,7 +34,6 @@ sqrt(2k/m) about -F/(2k) (`analytic/closed_forms.py`, `free_pair_under_constant_
 import sympy as sp
 
 from . import PrintedFormula, System, coordinate_symbols
-from . import Expectation
 from .model import (Body, CoordinateForce, Mechanism, Parameter, Prismatic, Rectangle,
                     Scenario, coordinate_spring_damper)
 
@@ -111,14 +110,6 @@ SYSTEM = System(
                  checks=("trajectory", "floating"),
                  description="moving backwards at 1 m/s, the stretch 20 mm off the "
                              "relative equilibrium: F stops the pair and drives it back"),
-    ),
-    expectations=(
-        Expectation("pymunk", "*", "xfail",
-                    "measured: Pymunk's run diverges (the stretch dx reaches 178 m by "
-                    "t = 0.25 s, non-finite at t = 1.5-1.7 s, at h = 1e-3 and with "
-                    "groove_half_length 10 or 1000): mass 2's GrooveJoint + GearJoint on the "
-                    "moving mass 1 with the spring on that slide does not hold; the three "
-                    "other engines pass"),
     ),
     exact_solution="free_pair_under_constant_force",
 )
