@@ -6,10 +6,12 @@ documents), the initial state and sample times, and returns (q, qd) arrays of sh
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable, Mapping
 
 import numpy as np
 import scipy.linalg
+import scipy.optimize
 import scipy.special
 
 
@@ -95,12 +97,146 @@ def _harmonically_forced(m: float, c: float, k: float, F: complex, W: float, x0:
     return xp + yh[:, 0], vp + yh[:, 1]
 
 
+# --- piecewise-linear oscillator with elastic end stops (monograph §2.1) -----------------
+
+
+def _linear_piece(m: float, C: float, K: float, y0: float, v0: float,
+                  t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """m y'' + C y' + K y = 0 from (y0, v0), any damping: with s = C/(2m) and
+    D = K/m - s^2, y = exp(-s t) (y0 Co(t) + (v0 + s y0) Si(t)) and
+    y' = exp(-s t) (v0 Co(t) - (s v0 + (K/m) y0) Si(t)), where Co = cos(sqrt(D) t),
+    Si = sin(sqrt(D) t)/sqrt(D) (cosh, sinh over damped; 1, t critically damped)."""
+    s = C / (2.0 * m)
+    D = K / m - s * s
+    if D > 0:
+        w = np.sqrt(D)
+        co, si = np.cos(w * t), t * np.sinc(w * t / np.pi)
+    elif D < 0:
+        w = np.sqrt(-D)
+        co, si = np.cosh(w * t), np.sinh(w * t) / w
+    else:
+        co, si = np.ones_like(t), t
+    decay = np.exp(-s * t)
+    return (decay * (y0 * co + (v0 + s * y0) * si),
+            decay * (v0 * co - (s * v0 + K / m * y0) * si))
+
+
+@dataclass(frozen=True)
+class StopEvent:
+    """A switching instant of the end-stop oscillator: `kind` "hit" (|x| reaches l going
+    out, the stop engages) or "release" (back to l going in); `side` +1 right, -1 left;
+    `velocity` x' at that instant."""
+
+    t: float
+    kind: str
+    side: int
+    velocity: float
+
+
+@dataclass(frozen=True)
+class _Piece:
+    start: float
+    side: int  # 0 between the stops, +1 / -1 against the right / left stop
+    x0: float
+    v0: float
+
+
+def _stop_pieces(values: Mapping[str, float], x0: float, v0: float, t_end: float):
+    """The chain of linear pieces from (x0, v0) up to t_end, and the events between them.
+
+    On a piece with stiffness K and neutral point x_n (0 between the stops, +-k2 l / K
+    against them) the motion is `_linear_piece` in y = x - x_n. A piece ends at the first
+    root of x(t) = +-l: the piece's closed form is sampled at 1/64 of its period to bracket
+    the zeros of x' (simple, a half period apart), x is monotonic between them, so each
+    crossing is bracketed there and found by brentq to round-off."""
+    m, k1, c, k2, l = (values[n] for n in ("m", "k1", "c", "k2", "l"))
+    C = 2.0 * c
+    pieces, events = [], []
+    t0, x, v = 0.0, float(x0), float(v0)
+    side = 0 if abs(x) < l or (abs(x) == l and x * v <= 0) else int(np.sign(x))
+    while True:
+        pieces.append(_Piece(t0, side, x, v))
+        K = 2.0 * k1 + (k2 if side else 0.0)
+        x_n = side * k2 * l / K
+        horizon = t_end - t0
+        if horizon <= 0:
+            break
+
+        def state(tau, x=x, v=v, K=K, x_n=x_n):
+            y, yd = _linear_piece(m, C, K, x - x_n, v, np.atleast_1d(np.asarray(tau, float)))
+            return y + x_n, yd
+
+        resolution = 2 * np.pi / np.sqrt(K / m) / 64
+        grid = np.linspace(0.0, horizon, int(np.ceil(horizon / resolution)) + 2)
+        _, vg = state(grid)
+        turns = [scipy.optimize.brentq(lambda s: state(s)[1][0], a, b, xtol=1e-15,
+                                       rtol=4 * np.finfo(float).eps)
+                 for a, b, va, vb in zip(grid[:-1], grid[1:], vg[:-1], vg[1:])
+                 if va * vb < 0]
+        nodes = [0.0] + [s for s in turns if s > 0] + [horizon]
+        targets = (l, -l) if side == 0 else (side * l,)
+        found = None
+        for a, b in zip(nodes[:-1], nodes[1:]):
+            xa, xb = state(a)[0][0], state(b)[0][0]
+            for target in targets:
+                ga, gb = xa - target, xb - target
+                if a == 0.0 and ga == 0.0:
+                    continue  # the piece starts on this boundary
+                if ga * gb <= 0 and gb != ga:
+                    found = (scipy.optimize.brentq(lambda s: state(s)[0][0] - target, a, b,
+                                                   xtol=1e-15, rtol=4 * np.finfo(float).eps),
+                             target)
+                    break
+            if found:
+                break
+        if found is None:
+            break
+        tau, target = found
+        v = float(state(tau)[1][0])
+        t0, x = t0 + tau, target
+        if side == 0:
+            side = int(np.sign(target))
+            events.append(StopEvent(t0, "hit", side, v))
+        else:
+            events.append(StopEvent(t0, "release", side, v))
+            side = 0
+    return pieces, events
+
+
+def oscillator_with_elastic_stops(values: Mapping[str, float], q0, qd0, t: np.ndarray):
+    """m x'' + 2 c x' + 2 k1 x + s(x) = 0 with the stops s = k2 (x - l) for x > l,
+    k2 (x + l) for x < -l, zero between (§2.1, Fig. 1): piecewise exact, each linear piece
+    in closed form, the switching instants found on the closed forms (`elastic_stop_events`)."""
+    pieces, _ = _stop_pieces(values, float(q0[0]), float(qd0[0]), float(np.max(t)))
+    m, k1, c, k2, l = (values[n] for n in ("m", "k1", "c", "k2", "l"))
+    starts = np.array([p.start for p in pieces])
+    which = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(pieces) - 1)
+    x, v = np.empty(len(t)), np.empty(len(t))
+    for i, p in enumerate(pieces):
+        sel = which == i
+        if not np.any(sel):
+            continue
+        K = 2.0 * k1 + (k2 if p.side else 0.0)
+        x_n = p.side * k2 * l / K
+        y, yd = _linear_piece(m, 2.0 * c, K, p.x0 - x_n, p.v0, t[sel] - p.start)
+        x[sel], v[sel] = y + x_n, yd
+    return x[:, None], v[:, None]
+
+
+def elastic_stop_events(values: Mapping[str, float], x0: float, v0: float,
+                        t_end: float) -> list[StopEvent]:
+    """The instants the stops of `oscillator_with_elastic_stops` are hit and released up to
+    t_end, each a root of its piece's closed form to round-off."""
+    return _stop_pieces(values, x0, v0, t_end)[1]
+
+
 SOLUTIONS: dict[str, Callable] = {
     "rigid_pendulum_elliptic": rigid_pendulum_elliptic,
     "forced_linear_oscillator": forced_linear_oscillator,
     "base_excited_relative": base_excited_relative,
     "rotating_slot_eq84": rotating_slot_eq84,
     "unbalanced_rotor_eq86": unbalanced_rotor_eq86,
+    "oscillator_with_elastic_stops": oscillator_with_elastic_stops,
 }
 
 

@@ -348,7 +348,9 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     ref_err = float(np.max(ref.error_estimate[free] / scale_free))
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
     T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
-    bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta)
+    bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + sum(
+        allowance(system, sc, values, ref, eq, dt, order)
+        for allowance in checks.trajectory_allowances(sc.checks))
     if system.driven and eq.stable:
         driven = _driven_trajectory_bound(system, values, eq, dt, order, T_eff, zeta)
         if driven is not None:

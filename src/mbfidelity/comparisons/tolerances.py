@@ -62,6 +62,27 @@ faster forcing).
 * Growth rate of an unstable motion (a real eigenvalue s > 0), fitted on the run: the
   scheme moves an eigenvalue by a relative (|s| h)^p (w h for semi-implicit Euler), with
   w the fastest of the eigenvalues and the excitation; plus FIT_RESOLUTION.
+* Switching instants of a piecewise law (the end stops of §2.1: a spring k2 that engages
+  at |x| = l; the force is continuous there, its slope jumps by k2). An engine that does
+  not locate the corner integrates across it as if the law were smooth. Over the step
+  that contains the corner the velocity increment is a quadrature of the acceleration,
+  whose part (k2/m)|v| (t - t_c)_+ is a ramp starting inside the step (at a fraction
+  theta of it): a rule exact for smooth laws misses E(theta) h^2 (k2/m)|v| of it, with
+  max |E| = 1/2 for a one-point rule at the step's start (semi-implicit Euler), 1/8 for
+  the trapezoidal and midpoint rules (second-order schemes), 1/24 for RK4's Simpson
+  weights. So each switch leaves a velocity error c_p (k2/m)|v_j| h^2: O(h^2) whatever
+  the order, where a smooth step leaves (w h)^(p+1) (RK4 loses two orders at a switch,
+  first-order schemes none). A velocity error dv becomes a position error dv/w0 (w0 the
+  damped frequency of the slowest piece), carried forward with the growth factor G of a
+  perturbation of the motion (analytic/reference.py `sensitivity`: the motion is not
+  chaotic, G stays of order one). The position error at switch i is therefore at most
+  A g + G sum_{j<i} c_p (k2/m)|v_j| h^2 / w0, with A the amplitude and g the trajectory
+  gate; a position error e shifts a crossing of |x| = l by e/|v_i| (v_i the crossing
+  speed), and locating it by linear interpolation between samples adds at most
+  h^2 |a_i| / (8 |v_i|) (a_i the acceleration there). That sum is the gate of each
+  instant. It holds where the trajectory gate holds and while the shift stays below half
+  the shortest interval between two switches (beyond, crossings can no longer be paired:
+  the instant is unresolved).
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -174,3 +195,22 @@ def driven_trajectory_tolerance(w_excitation: float, w_modes: float, h: float, o
 
 def growth_rate_tolerance(w: float, h: float, order: int) -> float:
     return (w * h if order == 1 else (w * h) ** order) + FIT_RESOLUTION
+
+
+#: largest quadrature error, in units of h^2 times the ramp's slope, of a step whose
+#: acceleration has a corner inside it, by integrator order (see the module docstring)
+CORNER_QUADRATURE = {1: 1 / 2, 2: 1 / 8, 3: 1 / 8, 4: 1 / 24}
+
+
+def switching_time_tolerance(position_error: float, speed: float, acceleration: float,
+                             h: float) -> float:
+    """Shift of a crossing instant: the position error over the crossing speed plus the
+    linear interpolation between samples (see the module docstring)."""
+    return (position_error + h * h * abs(acceleration) / 8.0) / abs(speed)
+
+
+def corner_velocity_error(order: int, slope_jump: float, speed: float, h: float) -> float:
+    """Velocity error left by a step across a corner of the law (slope jump k2/m of the
+    acceleration per unit displacement, crossing speed `speed`)."""
+    coefficient = CORNER_QUADRATURE.get(order, CORNER_QUADRATURE[4])
+    return coefficient * slope_jump * abs(speed) * h * h

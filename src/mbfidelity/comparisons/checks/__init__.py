@@ -3,7 +3,10 @@ discovered automatically (the pattern of `systems`): a module defines ``CHECK``,
 a `Scenario` lists in its ``checks``, and ``measure(run: ScenarioRun) -> None``, which
 appends its metrics through ``run.judge`` / ``run.unresolved``. The runner calls every
 check a scenario lists after its trajectory metrics, with the engine's run and the
-reference of the same scenario."""
+reference of the same scenario. A check whose physics widens the trajectory's error bound
+(a force law with corners that the engines step across) may also define
+``trajectory_allowance(system, scenario, values, reference, equilibrium, dt, order)``:
+the error it adds, relative to the amplitude, with its derivation."""
 from __future__ import annotations
 
 import importlib
@@ -54,6 +57,13 @@ class ScenarioRun:
 
 
 _REGISTRY: dict[str, Callable[[ScenarioRun], None]] | None = None
+_ALLOWANCES: dict[str, Callable[..., float]] = {}
+
+
+def trajectory_allowances(check_names) -> list[Callable[..., float]]:
+    """The `trajectory_allowance` functions of the checks named."""
+    registry()
+    return [_ALLOWANCES[c] for c in check_names if c in _ALLOWANCES]
 
 
 def registry() -> dict[str, Callable[[ScenarioRun], None]]:
@@ -68,5 +78,7 @@ def registry() -> dict[str, Callable[[ScenarioRun], None]]:
                 if name in found:
                     raise ValueError(f"check {name!r} is defined twice")
                 found[name] = module.measure
+                if hasattr(module, "trajectory_allowance"):
+                    _ALLOWANCES[name] = module.trajectory_allowance
         _REGISTRY = found
     return _REGISTRY
