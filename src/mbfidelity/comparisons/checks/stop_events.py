@@ -2,7 +2,7 @@
 the engine's run against the exact switching instants.
 
 Applies to a system whose parameters name the stop law: gap `l`, stop stiffness `k2`,
-mass `m`, springs `k1` and dampers `c` of the pairs (systems/end_stops.py). The exact
+mass `m`, springs `k1` and dampers `c` of the pairs (the end-stop mechanism of §2.1). The exact
 instants are roots of the piecewise closed form (`analytic.closed_forms.
 elastic_stop_events`). On the engine's samples a crossing of |x| = l is located by linear
 interpolation between the two samples around it: outward a hit, inward a release. The
