@@ -240,7 +240,7 @@ SOLUTIONS: dict[str, Callable] = {
 }
 
 
-# --- two free masses and a spring (Italian notes §5.3.1) -------------------------------------------
+# --- two free masses and a spring (Italian notes §5.3.1) ------------------------------
 
 
 def free_pair_under_constant_force(values: Mapping[str, float], q0, qd0, t: np.ndarray):
