@@ -154,6 +154,10 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     if op.acceleration is not None:
         doc["static_equilibrium"] = None
         doc["relative_equilibrium"] = _relative_note(system, coords, op)
+    if system.stability_parameter:
+        from .analytic.stability import stability_threshold
+
+        doc["stability_threshold"] = stability_threshold(system, values).as_dict()
     if system.driven:
         from .analytic.steady_state import steady_state
 
@@ -190,6 +194,15 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     if not op.stable:
         growth = max(s.real for s in op.eigenvalues)
         typer.echo(f"  unstable: fastest growth rate {growth:.9g} 1/s")
+    if "stability_threshold" in doc:
+        th = doc["stability_threshold"]
+        if th["value"] is None:
+            typer.echo(f"  stability: no change of stability for {th['parameter']} in "
+                       f"[{th['scanned'][0]:g}, {th['scanned'][1]:g}]")
+        else:
+            side = "above" if th["stable_above"] else "below"
+            typer.echo(f"  stability threshold: {th['parameter']} = {th['value']:.12g} "
+                       f"(stable {side})")
     for h in doc.get("steady_state", []):
         typer.echo(f"  steady state {h['quantity']} {h['coordinate']}: "
                    f"{h['amplitude']:.9g} at {h['frequency_hz']:.9g} Hz, "

@@ -1,5 +1,7 @@
 """Reference trajectories: exact where a closed form exists, otherwise DOP853 at tight
-tolerance whose own error is estimated by a second solve at a 100x looser tolerance."""
+tolerance whose own error is estimated by a second solve at a 10x looser tolerance. A
+force law that jumps with the rate (dry friction at zero slip) is followed through its
+stick phases by analytic/sliding.py, with the same two tolerances."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -12,6 +14,7 @@ from ..systems import System
 from ..systems.model import Scenario
 from .closed_forms import SOLUTIONS
 from .numeric import numeric_model
+from .sliding import Switch, integrate_with_sliding, model_acceleration, rate_surfaces
 
 TIGHT = 1e-12
 LOOSE = 1e-11
@@ -32,6 +35,8 @@ class Reference:
     multipliers: np.ndarray | None = None
     #: physical constraint forces by constraint name (see simulators/base.py point 6)
     constraint_forces: dict | None = None
+    #: instants the motion sticks to / slips off a rate surface (analytic/sliding.py)
+    switches: list[Switch] | None = None
     #: actuator force of each prescribed coordinate, (N,) by actuator name (model
     #: convention 9; empty without prescribed motion)
     actuator_forces: dict | None = None
@@ -142,6 +147,10 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
     ind = model.independent
     y0 = np.concatenate([q0[ind], qd0[ind]])
     model._warm = np.array(q0, dtype=float)
+    surfaces = rate_surfaces(system, values)
+    switches = None
+    if surfaces:
+        return _sliding_reference(system, model, surfaces, t, q0, qd0)
     tight = _dop853(model, y0, t, TIGHT)
     q, qd = _full_states(model, tight, q0, t)
     exact = SOLUTIONS.get(system.exact_solution or "")
@@ -170,7 +179,26 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
     reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in joints}
     energy = model.energy(q, qd) if model.conservative else None
     return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces,
-                     model.actuator_forces(q, qd, qdd, t))
+                     switches, model.actuator_forces(q, qd, qdd, t))
+
+
+def _sliding_reference(system, model, surfaces, t, q0, qd0) -> Reference:
+    """One coordinate with a force that jumps across x' = s: analytic/sliding.py at TIGHT,
+    its error estimated against LOOSE."""
+    if len(surfaces) > 1 or model.driven or model.constrained:
+        raise ValueError(f"{system.id}: the sliding reference handles one rate surface on "
+                         f"one unconstrained, undriven coordinate")
+    acc = model_acceleration(model, surfaces[0].coordinate)
+    x, v, a, switches = integrate_with_sliding(acc, q0[0], qd0[0], t, surfaces[0].rate, TIGHT)
+    loose = integrate_with_sliding(acc, q0[0], qd0[0], t, surfaces[0].rate, LOOSE)[0]
+    error = np.array([float(np.max(np.abs(loose - x)))])
+    method = (f"DOP853 rtol=atol={TIGHT:g} on the slip phases, stick phases exact "
+              f"(Filippov, analytic/sliding.py); error estimated against rtol=atol={LOOSE:g}")
+    reactions = {j: model.reaction(j, x[:, None], v[:, None], a[:, None], t, np.zeros((len(t), 0)))
+                 for j in system.reaction_joints}
+    return Reference(t, x[:, None], v[:, None], a[:, None], reactions, None, error, method,
+                     np.zeros((len(t), 0)), {}, switches, model.actuator_forces(
+                         x[:, None], v[:, None], a[:, None], t))
 
 
 def sensitivity(system: System, scenario: Scenario, values: Mapping[str, float],

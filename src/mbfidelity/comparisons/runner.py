@@ -384,7 +384,9 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
         if p_ref is not None:
             value = abs(p_run - p_ref) / p_ref if p_run is not None else float("inf")
             result.metrics.append(_judge(system, backend.id, f"{name}.period", value, tolerances.gate(
-                tolerances.period_tolerance(w, dt, order, p_ref, zeta), w, dt, order,
+                tolerances.period_tolerance(w, dt, order, p_ref, zeta) + sum(
+                    allowance(system, sc, values, ref, eq, dt, order)
+                    for allowance in checks.period_allowances(sc.checks)), w, dt, order,
                 tolerances.MAX_FREQUENCY_TOLERANCE, "relative")))
     if ref.energy is not None:
         model_energy = _energy_of(system, values, run.q[:n], run.qd[:n])

@@ -83,6 +83,38 @@ faster forcing).
   instant. It holds where the trajectory gate holds and while the shift stays below half
   the shortest interval between two switches (beyond, crossings can no longer be paired:
   the instant is unresolved).
+* Stick-slip (a force that jumps by J at a rate surface x' = s, dry friction at zero
+  slip, §7.2; acceleration jump a_J = J/m). No engine locates the surface: the step that
+  reaches it integrates the wrong side's force over part of the step, a velocity error of
+  at most a_J h whatever the scheme (a quadrature with positive weights misses at most the
+  whole jump over one step), and while the exact motion sticks (x' = s) the engine's
+  velocity chatters about s within that band, its position drifting by at most a_J h per
+  unit time. The exact motion arrives at the surface with deceleration a+ (the one-sided
+  acceleration there): a velocity error dv moves the arrival by dv/|a+| and the position
+  there by dv^2/(2 |a+|). It leaves the surface where the holding force reaches its bound,
+  at a fixed position x_r, which the engine's chattering motion meets within a_J h^2.
+  Since every stick phase ends at x_r, a cycle's position errors do not carry over: each
+  becomes a timing error dx/|s| of that cycle (`stick_slip_time_shift`), and those add up
+  over the cycles, a phase drift the trajectory gate gains as max|x'| sum(dt_i) relative
+  to the amplitude (`trajectory_allowance` of comparisons/checks/limit_cycle.py) and the
+  mean period as sum(dt_i)/T. The cycle's amplitude, on the other hand, is set anew each
+  cycle from x_r: its error is one period's smooth bound (w h)^p (1 + w P) plus the
+  velocity band a_J h relative to the velocity amplitude, plus the sampling of the
+  extremes (w h)^2/8. The bounds hold while a+ stays away from zero (a tangential arrival
+  makes dv^2/|a+| grow without limit, and the gate says so by growing).
+* Stability threshold (the parameter value p* where a mode's growth rate sigma(p)
+  crosses zero, found by an engine by bisection on the sign of its own fitted growth
+  rate). The engine's threshold moves by its error in sigma at the neutral mode over the
+  slope |d sigma / dp|. An order-p scheme's amplification factor on an undamped mode is
+  1 + O((w h)^(p+1)) per step, a growth-rate error of at most w (w h)^p (RK4: w (w h)^5 /
+  144 from |R(i w h)|^2 = 1 - (w h)^6/72 + ...). Semi-implicit Euler is the exception that
+  helps: its map on a linear oscillator with damping c (force at the step's velocity,
+  either end) has determinant 1 - h c/m or 1/(1 + h c/m), so its growth rate vanishes
+  exactly where c does; the first error term is second order, and w (w h)^2 bounds it.
+  Plus FIT_RESOLUTION w, the resolution of the fitted growth rate. Gate on
+  |p - p*| / p*: that over |d sigma / dp| p*, plus the bracket's final half-width. It
+  holds while the perturbation stays in the linear range (the test's amplitude is a
+  thirtieth of the belt speed, far from sticking).
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -214,3 +246,25 @@ def corner_velocity_error(order: int, slope_jump: float, speed: float, h: float)
     acceleration per unit displacement, crossing speed `speed`)."""
     coefficient = CORNER_QUADRATURE.get(order, CORNER_QUADRATURE[4])
     return coefficient * slope_jump * abs(speed) * h * h
+
+
+def limit_cycle_tolerance(w: float, h: float, order: int, period: float,
+                          acceleration_jump: float, velocity_amplitude: float) -> float:
+    """Relative error of a stick-slip cycle's amplitude (module docstring, "Stick-slip")."""
+    smooth = trajectory_tolerance(w, h, order, period)
+    return smooth + acceleration_jump * h / velocity_amplitude + (w * h) ** 2 / 8
+
+
+def stick_slip_time_shift(acceleration_jump: float, h: float, onset_deceleration: float,
+                          stick_duration: float, surface_speed: float) -> float:
+    """Timing error one stick-slip cycle adds (module docstring, "Stick-slip")."""
+    dv = acceleration_jump * h
+    dx = (dv * dv / (2.0 * abs(onset_deceleration)) + dv * stick_duration
+          + acceleration_jump * h * h)
+    return dx / abs(surface_speed)
+
+
+def threshold_tolerance(w: float, h: float, order: int, slope: float) -> float:
+    """Shift of a stability threshold in the parameter's units (module docstring,
+    "Stability threshold"): growth-rate error at the neutral mode over |d sigma / dp|."""
+    return (w * (w * h) ** max(order, 2) + FIT_RESOLUTION * w) / slope

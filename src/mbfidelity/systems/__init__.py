@@ -200,6 +200,9 @@ class System:
     #: the loads give it (analytic/relative_equilibrium.py)
     rigid_directions: Callable[[SimpleNamespace], tuple[Mapping[str, Expr], ...]] = (
         lambda P: ())
+    #: a parameter on which the operating equilibrium's stability turns (the belt speed
+    #: of a self-excited system, §7.2): `analyze` reports where it changes stability
+    stability_parameter: str | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 

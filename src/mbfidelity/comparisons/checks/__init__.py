@@ -6,7 +6,9 @@ check a scenario lists after its trajectory metrics, with the engine's run and t
 reference of the same scenario. A check whose physics widens the trajectory's error bound
 (a force law with corners that the engines step across) may also define
 ``trajectory_allowance(system, scenario, values, reference, equilibrium, dt, order)``:
-the error it adds, relative to the amplitude, with its derivation."""
+the error it adds, relative to the amplitude, with its derivation; and
+``period_allowance`` with the same arguments: what it adds to the mean period's relative
+error."""
 from __future__ import annotations
 
 import importlib
@@ -58,12 +60,19 @@ class ScenarioRun:
 
 _REGISTRY: dict[str, Callable[[ScenarioRun], None]] | None = None
 _ALLOWANCES: dict[str, Callable[..., float]] = {}
+_PERIOD_ALLOWANCES: dict[str, Callable[..., float]] = {}
 
 
 def trajectory_allowances(check_names) -> list[Callable[..., float]]:
     """The `trajectory_allowance` functions of the checks named."""
     registry()
     return [_ALLOWANCES[c] for c in check_names if c in _ALLOWANCES]
+
+
+def period_allowances(check_names) -> list[Callable[..., float]]:
+    """The `period_allowance` functions of the checks named."""
+    registry()
+    return [_PERIOD_ALLOWANCES[c] for c in check_names if c in _PERIOD_ALLOWANCES]
 
 
 def registry() -> dict[str, Callable[[ScenarioRun], None]]:
@@ -80,5 +89,7 @@ def registry() -> dict[str, Callable[[ScenarioRun], None]]:
                 found[name] = module.measure
                 if hasattr(module, "trajectory_allowance"):
                     _ALLOWANCES[name] = module.trajectory_allowance
+                if hasattr(module, "period_allowance"):
+                    _PERIOD_ALLOWANCES[name] = module.period_allowance
         _REGISTRY = found
     return _REGISTRY
