@@ -85,3 +85,25 @@ def test_classify_double_multiplier_on_the_circle_is_marginal():
     assert classify(np.array([1.0 + 1e-7, 1.0 - 1e-7]), 1e-6)[0] == "marginal"
     assert classify(np.array([-1.0, -1.0]), 1e-9)[0] == "marginal"
     assert classify(np.array([1.2, 1 / 1.2]), 1e-9) == ("unstable", pytest.approx(0.2))
+
+
+def test_driven_system_with_constant_coefficients_gives_exp_of_its_matrix():
+    # the base-excited block (§8.2): m z'' + c z' + k z = -m y''(t); its variational
+    # equations have constant coefficients, so the monodromy is exp(A T), A the companion
+    # matrix of (m, c, k) written here from the printed equation
+    import scipy.linalg
+
+    from mbfidelity.analytic.floquet import driven_floquet
+    from mbfidelity.systems import get_system
+
+    system = get_system("base_excited_msd")
+    values = system.parameter_values({"ratio": 1.7})
+    m, c, k = values["m"], values["c"], values["k"]
+    period = 2 * np.pi / (1.7 * np.sqrt(k / m))
+    expected = np.linalg.eigvals(scipy.linalg.expm(
+        np.array([[0.0, 1.0], [-k / m, -c / m]]) * period))
+    ((q, result),) = driven_floquet(system, values)
+    assert result.period == pytest.approx(period, rel=1e-12)
+    assert np.allclose(np.sort_complex(result.multipliers), np.sort_complex(expected),
+                       atol=1e-9)
+    assert result.verdict == "stable"

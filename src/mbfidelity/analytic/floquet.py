@@ -127,3 +127,36 @@ def second_order_system(M: Callable[[float], np.ndarray], C: Callable[[float], n
         return np.block([[np.zeros((n, n)), np.eye(n)],
                          [-np.linalg.solve(Mt, Kt), -np.linalg.solve(Mt, Ct)]])
     return A
+
+
+def excitation_period(system, values) -> float:
+    """The period of a system excited at one angular frequency (System.excitation_frequencies)."""
+    frequencies = sorted({round(system.evaluate(w, values), 12)
+                          for w in system.excitation_frequencies(system.symbols)} - {0.0})
+    if len(frequencies) != 1:
+        raise ValueError(f"{system.id}: Floquet analysis needs one excitation frequency "
+                         f"(has {len(frequencies)})")
+    return 2.0 * np.pi / abs(frequencies[0])
+
+
+def driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
+    """Floquet analysis of a periodically driven system about each rest state of its free
+    coordinates with the excitation off (`System.unexcited`): the variational equations
+    M(t) dq'' + C(t) dq' + K(t) dq = 0 of the free coordinates there, with the prescribed
+    motion on, from the compiled model. Where the excitation also forces the free
+    coordinates (R_f(t) != 0 at rest), that forcing is the inhomogeneous term and leaves
+    the multipliers of the variational equations unchanged."""
+    from .linear import companion_matrix, driven_coefficients, driven_rest_states
+    from .numeric import numeric_model
+
+    model = numeric_model(system.id, dict(values))
+    period = excitation_period(system, values)
+    free = model.independent
+    results = []
+    for q in driven_rest_states(system, values, only_operating=False):
+        q_free = q[free]
+        def A(t: float, q_free=q_free) -> np.ndarray:
+            return companion_matrix(*driven_coefficients(model, q_free, t))
+
+        results.append((q, floquet(A, period, 2 * len(free))))
+    return results
