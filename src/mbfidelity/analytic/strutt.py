@@ -92,3 +92,14 @@ def strutt_chart(n_lambda: int, n_gamma: int, lambda_range=LAMBDA_RANGE,
     shape = (n_gamma, n_lambda)
     return StruttChart(lambdas, gammas, mu.reshape(*shape, 2), error.reshape(shape),
                        verdict.reshape(shape))
+
+
+def mathieu_point(point: tuple[float, float]) -> dict:
+    """The one-point Floquet analysis of eq. 83 at (lambda, gamma), as a JSON-able dict
+    (a sweep's unit of work)."""
+    from .floquet import floquet
+
+    lam, gamma = float(point[0]), float(point[1])
+    result = floquet(lambda t: np.array([[0.0, 1.0], [-(lam + gamma * np.cos(t)), 0.0]]),
+                     PERIOD, 2)
+    return {"lambda": lam, "gamma": gamma, **result.as_dict()}
