@@ -57,3 +57,23 @@ def test_hundred_by_hundred_under_a_minute():
     chart = strutt_chart(100, 100)
     assert time.process_time() - start < 60.0
     assert chart.verdict.shape == (100, 100)
+
+
+def test_strutt_command_json_and_figure(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from mbfidelity.cli import app
+
+    result = CliRunner().invoke(app, ["strutt", "--grid", "6", "--lambda", "-0.5,2",
+                                      "--gamma", "0.2,1.5", "--json", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    doc = json.loads(result.output)
+    assert len(doc["points"]) == 36
+    chart = strutt_chart(6, 6, (-0.5, 2.0), (0.2, 1.5))
+    assert [p["verdict"] for p in doc["points"]] == list(chart.verdict.ravel())
+    assert {"lambda", "gamma", "floquet_max_abs_multiplier", "stable"} <= set(doc["points"][0])
+    assert (tmp_path / "strutt.png").stat().st_size > 0
+    bad = CliRunner().invoke(app, ["strutt", "--lambda", "2,1"])
+    assert bad.exit_code == 2
