@@ -396,6 +396,50 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                 typer.echo(f"    {sim}: {w['verdict']}")
 
 
+@app.command("strutt")
+def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
+               lambda_range: str = typer.Option("-1,3", "--lambda", help="A,B"),
+               gamma_range: str = typer.Option("0,3", "--gamma", help="A,B"),
+               as_json: bool = typer.Option(False, "--json"),
+               out: Optional[Path] = typer.Option(
+                   None, "--out", help="also write strutt.json and strutt.png there"),
+               ) -> None:
+    """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory."""
+    from .analytic.strutt import strutt_chart
+
+    def bounds(text: str, option: str) -> tuple[float, float]:
+        try:
+            a, b = (float(x) for x in text.split(","))
+        except ValueError:
+            _fail(f"{option} expects A,B (two numbers), got {text!r}")
+        if not (np.isfinite(a) and np.isfinite(b) and a <= b):
+            _fail(f"{option} expects finite A <= B, got {text!r}")
+        return a, b
+
+    if grid < 1:
+        _fail(f"--grid must be a positive integer, got {grid}")
+    chart = strutt_chart(grid, grid, bounds(lambda_range, "--lambda"),
+                         bounds(gamma_range, "--gamma"))
+    points = chart.points()
+    counts = {v: sum(p["verdict"] == v for p in points) for v in ("stable", "unstable",
+                                                                   "marginal")}
+    doc = {"equation": "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)",
+           "period": 2 * np.pi, "grid": grid, "counts": counts, "points": points}
+    if out is not None:
+        from .reports.strutt_figure import write_strutt_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "strutt.json").write_text(json.dumps(doc, indent=1))
+        figure = write_strutt_figure(points, out / "strutt.png")
+        if not as_json:
+            typer.echo(f"Strutt chart: {figure.resolve()}")
+    if as_json:
+        _json(doc)
+        return
+    typer.echo(f"Strutt chart of eq. 83, {grid} x {grid} points: " +
+               ", ".join(f"{k} {v}" for k, v in counts.items()))
+
+
 def main() -> None:
     app()
 

@@ -314,7 +314,15 @@ def _unexcited_text(system: System) -> str:
     return ", ".join(f"{k} = {v:g}" for k, v in system.unexcited.items()) or "nothing to switch off"
 
 
-def _driven_equilibria(system: System, values, only_operating: bool) -> list[Equilibrium]:
+def driven_coefficients(model: NumericModel, q_free: np.ndarray, t: float):
+    """(M, C, K) of the free coordinates at rest at q_free with the prescribed motion at
+    time t: the coefficients of the variational equations there."""
+    return _driven_blocks(model, q_free, t)[:3]
+
+
+def driven_rest_states(system: System, values, only_operating: bool) -> list[np.ndarray]:
+    """Rest states of the free coordinates with the excitation off (full q; the
+    prescribed coordinates where their motion puts them at t = 0)."""
     model = numeric_model(system.id, unexcited_values(system, values))
     op = system.operating_values(values)
     starts = [op] if only_operating else [op] + _search_grid(system, values, op)
@@ -333,7 +341,13 @@ def _driven_equilibria(system: System, values, only_operating: bool) -> list[Equ
             if any(np.allclose(q, other, atol=1e-7) for other in found):
                 continue
             found.append(q)
-    return [_linearize_driven(system, model, q) for q in found]
+    return found
+
+
+def _driven_equilibria(system: System, values, only_operating: bool) -> list[Equilibrium]:
+    model = numeric_model(system.id, unexcited_values(system, values))
+    return [_linearize_driven(system, model, q)
+            for q in driven_rest_states(system, values, only_operating)]
 
 
 def find_equilibria(system: System, values) -> list[Equilibrium]:
