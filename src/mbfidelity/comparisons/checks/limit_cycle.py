@@ -82,9 +82,8 @@ def measure(run: ScenarioRun) -> None:
     ref, eng = run.reference, run.run
     t, n = run.t, run.n
     x_eng, v_eng = eng.q[:n, 0], eng.qd[:n, 0]
-    run.series["phase_x"] = x_eng
+    # the phase portrait's velocities (its positions are the scenario's q and q_ref)
     run.series["phase_xd"] = v_eng
-    run.series["phase_x_reference"] = ref.q[:n, 0]
     run.series["phase_xd_reference"] = ref.qd[:n, 0]
     releases = [s for s in (ref.switches or []) if s.kind == "slip"]
     surfaces = rate_surfaces(run.system, run.values)
