@@ -60,3 +60,16 @@ def test_schedule_prefers_measured_costs():
     measured = {"compound_pendulum": 10.0, "rhombus_linkage": 10.0 * ratio * 0.5}
     assert schedule(systems, measured) == ["double_pendulum", "rhombus_linkage",
                                            "compound_pendulum"]
+
+
+def test_check_series_are_saved_and_drawn(tmp_path):
+    """Issue 11: what a scenario's checks measure (here the end-stop instants of Fig. 2)
+    reaches the report as its own figure, drawn from the saved series."""
+    res = CliRunner().invoke(app, ["run", "--systems", "end_stops", "--sims", "mujoco",
+                                   "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    checks = load_series(tmp_path, "end_stops")["mujoco"]["fig2"]["checks"]
+    errors, gates = checks["stop_events_error"], checks["stop_events_tolerance"]
+    assert len(errors) == len(gates) == len(checks["stop_events_reference"]) > 0
+    assert (tmp_path / "end_stops-fig2-checks.png").stat().st_size > 0
+    assert "end_stops-fig2-checks.png" in (tmp_path / "index.html").read_text()

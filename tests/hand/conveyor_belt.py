@@ -8,6 +8,8 @@ unstable."""
 import numpy as np
 
 EQUILIBRIA = (1, 0)
+#: at v0 = 0.29 m/s the reduced damping c + Ft'(v0) = 2 + (2*10*0.29 - 8) = -0.2 N s/m < 0
+OPERATING_POINT_STABLE = False
 MISPRINTS = set()
 
 

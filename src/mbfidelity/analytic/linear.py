@@ -108,6 +108,17 @@ def is_stable(eigenvalues: np.ndarray) -> bool:
     return int(np.sum(np.abs(s) <= ZERO_REAL_PART * scale)) <= 1
 
 
+def oscillatory_instability(eigenvalues: np.ndarray) -> bool:
+    """Unstable only through oscillatory modes (complex pairs with a positive real part, as
+    in self-excitation, monograph §7): a small release oscillates with a growing amplitude,
+    so its frequency and (negative) damping ratio can be measured. A real positive
+    eigenvalue (a static divergence) departs without oscillating."""
+    s = np.asarray(eigenvalues, dtype=complex)
+    scale = max(np.max(np.abs(s)), 1.0)
+    growing = s[s.real > ZERO_REAL_PART * scale]
+    return len(growing) > 0 and bool(np.all(np.abs(growing.imag) > ZERO_REAL_PART * scale))
+
+
 def linearize(model: NumericModel, q_eq: np.ndarray) -> Equilibrium:
     M, C, K = model.linearization(q_eq)
     s = quadratic_eigenvalues(M, C, K)

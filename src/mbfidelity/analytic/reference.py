@@ -182,12 +182,16 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
                      switches, model.actuator_forces(q, qd, qdd, t))
 
 
-def _sliding_reference(system, model, surfaces, t, q0, qd0) -> Reference:
-    """One coordinate with a force that jumps across x' = s: analytic/sliding.py at TIGHT,
-    its error estimated against LOOSE."""
+def _check_sliding(system, model, surfaces) -> None:
     if len(surfaces) > 1 or model.driven or model.constrained:
         raise ValueError(f"{system.id}: the sliding reference handles one rate surface on "
                          f"one unconstrained, undriven coordinate")
+
+
+def _sliding_reference(system, model, surfaces, t, q0, qd0) -> Reference:
+    """One coordinate with a force that jumps across x' = s: analytic/sliding.py at TIGHT,
+    its error estimated against LOOSE."""
+    _check_sliding(system, model, surfaces)
     acc = model_acceleration(model, surfaces[0].coordinate)
     x, v, a, switches = integrate_with_sliding(acc, q0[0], qd0[0], t, surfaces[0].rate, TIGHT)
     loose = integrate_with_sliding(acc, q0[0], qd0[0], t, surfaces[0].rate, LOOSE)[0]
@@ -211,6 +215,15 @@ def sensitivity(system: System, scenario: Scenario, values: Mapping[str, float],
     ind = model.independent
     y0 = np.concatenate([q0[ind], qd0[ind]])
     t = np.linspace(0.0, scenario.t_end, 501)
+    surfaces = rate_surfaces(system, values)
+    if surfaces:  # a force that jumps across a rate surface: the Filippov integration
+        _check_sliding(system, model, surfaces)
+        acc = model_acceleration(model, surfaces[0].coordinate)
+
+        def positions(x0: float) -> np.ndarray:
+            return integrate_with_sliding(acc, x0, qd0[0], t, surfaces[0].rate, 1e-11)[0]
+        return float(np.max(np.abs(positions(q0[0]) - positions(q0[0] + perturbation)))
+                     / perturbation)
     model._warm = np.array(q0, dtype=float)
     a = _dop853(model, y0, t, 1e-11)
     y1 = y0.copy()

@@ -14,7 +14,8 @@ import numpy as np
 
 from .. import __version__
 from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria,
-                               operating_equilibrium, unexcited_values, wrap_angles)
+                               operating_equilibrium, oscillatory_instability,
+                               unexcited_values, wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference
 from ..analytic.steady_state import (excitation_frequencies, observable_functions,
@@ -670,8 +671,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     if system.mechanism.prescribed:
         values = unexcited_values(system, values)
     eq = operating_equilibrium(system, values)
-    if not eq.stable:
-        return
+    if not (eq.stable or oscillatory_instability(eq.eigenvalues)):
+        return  # a divergent equilibrium: a release departs without oscillating
     # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
     mech = system.numeric_mechanism(values, variant).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
@@ -697,7 +698,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
             metric.detail = {"reference_hz": m.frequency_hz, "method": lin.method,
                              "engine_hz": got[i].frequency_hz if i < len(got) else None}
             result.metrics.append(metric)
-            if m.damping_ratio > ZERO_REAL_PART:  # not round-off of an undamped mode
+            # not round-off of an undamped mode (a negative ratio: a self-excited mode)
+            if abs(m.damping_ratio) > ZERO_REAL_PART:
                 result.metrics.append(_judge(system, backend.id,
                                              f"damping.linearization_mode{i + 1}", dz, tol,
                                              unit="absolute"))

@@ -24,6 +24,7 @@ from ..comparisons.results_folder import (base_id, load_errata, load_results,  #
                                           load_series, load_system, row_id, rows_of,
                                           series_path)
 from ..systems import get_system  # noqa: E402
+from .check_figures import check_figure  # noqa: E402
 
 #: why an engine deviates, in words a student can follow (SIMULATORS.md)
 EXPLANATIONS = {
@@ -175,6 +176,9 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
         fig.savefig(out / name, dpi=80)
         plt.close(fig)
         names.append(name)
+        checks = check_figure(system_id, scenario, comps, system.coordinates, out)
+        if checks:
+            names.append(checks)
     return names
 
 
