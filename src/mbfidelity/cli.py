@@ -127,6 +127,12 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     system = _system(system_id)
     values, derived = _values(system, _parse_params(param))
     coords = list(system.coordinates)
+    if system.driven:
+        from .analytic.floquet import has_periodic_coefficients
+
+        if has_periodic_coefficients(system, values):
+            _analyze_parametric(system, values, derived, coords, as_json)
+            return
     try:
         eqs = find_equilibria(system, values)
         op = operating_equilibrium(system, values)
@@ -209,6 +215,66 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                    f"phase {h['phase']:.6g} rad")
     if "steady_state_note" in doc:
         typer.echo(f"  steady state: none ({doc['steady_state_note']})")
+    for e in doc["printed_vs_derived"]:
+        typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
+
+
+def _analyze_parametric(system, values, derived, coords: list, as_json: bool) -> None:
+    """`analyze` of a parametrically excited system (monograph §8.4): the excitation makes
+    the variational equations about the rest states time-periodic, so each rest state of
+    the unexcited system is judged by its Floquet multipliers over one excitation period,
+    not by a linearization with constant coefficients."""
+    from .analytic.errata import errata
+    from .analytic.floquet import driven_floquet
+
+    try:
+        results = driven_floquet(system, values)
+    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+        _fail(f"{system.id}: Floquet analysis failed ({exc})")
+    if not results:
+        _fail(f"{system.id}: no rest state of the free coordinates with the excitation off "
+              f"({', '.join(f'{k} = {v:g}' for k, v in system.unexcited.items())})")
+    equilibria = []
+    for q, result in results:
+        floquet = result.as_dict()
+        equilibria.append({"q": dict(zip(coords, q.tolist())), "stable": result.stable,
+                           "floquet_multipliers": floquet["floquet_multipliers"],
+                           "floquet": floquet})
+    op_q, op_result = results[0]
+    doc = {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
+        "free_coordinates": list(system.mechanism.independent_coordinates),
+        "prescribed": {p.coordinate: str(p.motion) for p in system.mechanism.prescribed},
+        "parametric_excitation": (
+            "the excitation makes the coefficients of the variational equations about the "
+            "rest states periodic in time (monograph §8.4): stability by Floquet theory "
+            "over one excitation period, about the rest states with the excitation off: "
+            + ", ".join(f"{k} = {v:g}" for k, v in system.unexcited.items())),
+        "equilibria": equilibria,
+        "operating_point": dict(zip(coords, op_q.tolist())),
+        "stable": op_result.stable,
+        "floquet_multipliers": op_result.as_dict()["floquet_multipliers"],
+        "floquet": op_result.as_dict(),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
+    if as_json:
+        _json(doc)
+        return
+    typer.echo(f"{system.id}: {system.title} ({system.source})")
+    typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in values.items()))
+    formulas = {p.name: p.default for p in system.all_parameters}
+    if derived:
+        typer.echo("derived: " + ", ".join(f"{k} = {formulas[k]}" for k in derived))
+    typer.echo("parametric excitation: stability of each rest state by its Floquet "
+               "multipliers (monograph §8.4)")
+    for e in equilibria:
+        f = e["floquet"]
+        typer.echo(f"rest state {e['q']}: Floquet {f['verdict']} (|mu|max = "
+                   f"{f['floquet_max_abs_multiplier']:.9g} +- {f['floquet_error']:.1e}, "
+                   f"period {f['period']:.6g} s, margin {f['margin']:.3g})")
+    typer.echo(f"operating point {doc['operating_point']}: "
+               f"{op_result.verdict}")
     for e in doc["printed_vs_derived"]:
         typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
 

@@ -160,3 +160,25 @@ def driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
 
         results.append((q, floquet(A, period, 2 * len(free))))
     return results
+
+
+def has_periodic_coefficients(system, values) -> bool:
+    """Whether the excitation makes the variational equations of the free coordinates
+    time-dependent about a rest state of the unexcited system (a parametric excitation,
+    §8.4): then the linearization with the excitation off does not judge stability, and
+    Floquet theory (`driven_floquet`) does."""
+    from .linear import _PROBE_TIMES, TIME_INVARIANCE, driven_coefficients, driven_rest_states
+    from .numeric import numeric_model
+
+    if not system.mechanism.prescribed:
+        return False
+    model = numeric_model(system.id, dict(values))
+    free = model.independent
+    for q in driven_rest_states(system, values, only_operating=False):
+        blocks = [np.concatenate([b.ravel() for b in driven_coefficients(model, q[free], t)])
+                  for t in _PROBE_TIMES]
+        scale = max(float(np.max(np.abs(blocks[0]))), 1e-300)
+        if any(float(np.max(np.abs(b - blocks[0]))) > TIME_INVARIANCE * scale
+               for b in blocks[1:]):
+            return True
+    return False
