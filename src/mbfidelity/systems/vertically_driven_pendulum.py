@@ -24,9 +24,23 @@ fast, large enough shaking (Kapitza: Y^2 Omega^2 > 2 g L_e to leading order in Y
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (TIME, Body, Mechanism, Parameter, Prescribed, Prismatic, Rectangle,
                     Revolute, Scenario, Segment)
+
+FAST_SHAKING = (
+    "The pivot is shaken at Omega = 2 pi 50 rad/s: at the default step (1e-3 s) Omega h = "
+    "0.31, and the trajectory error bound of every engine's scheme over the scenario (about "
+    "6 times the amplitude, measured) is far above the 0.1 a gate can discriminate; the "
+    "motion is measured and shown, and the inverted position's keeping is judged by the "
+    "Floquet check instead.")
+
+PYBULLET_VERTICAL_MOTOR = (
+    "PyBullet's velocity motor on the vertical guide reports an actuator force 0.144 of the "
+    "peak reference force away from it, the same at dt = 1e-3 and 5e-4 s (measured: no "
+    "convergence with the step, so not the scheme's error), while the imposed motion and "
+    "the pendulum's motion pass their gates: the motor's applied force misses part of the "
+    "load on the carriage.")
 
 PARAMETERS = (
     Parameter("m", 1.0, "kg", "mass of the pendulum", "MECHANISMS.md D; Fig. 27"),
@@ -72,10 +86,10 @@ def printed(P):
                        [(I_G + m * l**2) * phi_dd + m * l * (g + y_dd) * sp.sin(phi)],
                        note="row of phi"),
         PrintedFormula("§8.3, phi_eq = n pi (n = 0)", "equilibrium", {"phi": 0}),
-        # eq. 82, the linearization about the inverted position (the operating point),
-        # compared through its coefficients with the pivot at rest (y'' = 0)
-        PrintedFormula("§8.3, eq. 82 (inertia)", "M", sp.Matrix([[I_G + m * l**2]])),
-        PrintedFormula("§8.3, eq. 82 (stiffness, y'' = 0)", "K", sp.Matrix([[-m * l * g]])),
+        # eq. 81, the linearization about hanging (the operating point), compared through
+        # its coefficients with the pivot at rest (y'' = 0)
+        PrintedFormula("§8.3, eq. 81 (inertia)", "M", sp.Matrix([[I_G + m * l**2]])),
+        PrintedFormula("§8.3, eq. 81 (stiffness, y'' = 0)", "K", sp.Matrix([[m * l * g]])),
     )
 
 
@@ -85,7 +99,7 @@ SYSTEM = System(
     source="monograph §8.3-8.4, Fig. 27-28, eq. 80-83",
     parameters=PARAMETERS,
     build=build,
-    operating_point=lambda P: {"phi": sp.pi},
+    operating_point=lambda P: {"phi": 0},
     printed=printed,
     scenarios=(
         Scenario("inverted_stabilised", {"phi": "pi + phi0"}, t_end=2.0,
@@ -99,6 +113,10 @@ SYSTEM = System(
                              "resonance"),
     ),
     unexcited={"Y": 0.0},
+    expectations=tuple(Expectation(engine, "inverted_stabilised.*", "unresolved",
+                                   FAST_SHAKING) for engine in
+                       ("mujoco", "pybullet", "exudyn", "pymunk"))
+    + (Expectation("pybullet", "hanging.actuator_actuator", "xfail", PYBULLET_VERTICAL_MOTOR),),
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Inverted position Floquet-stable for Y^2 Omega^2 > 2 g L_e to leading order "
           "(L_e = (I_G + m l^2)/(m l)); parametric resonance about hanging near "
