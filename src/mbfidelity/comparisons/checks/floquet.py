@@ -6,8 +6,9 @@ Floquet's verdict there, with the excitation on, says whether the engine must ke
 motion near it or leave:
 
 - ``floquet_kept`` (verdict stable): the largest excursion of the free coordinates from
-  the rest state over the run, over the neighbourhood radius NEIGHBOURHOOD times the
-  initial excursion; at most 1 (the engine kept the rest state).
+  the rest state over the run, over the neighbourhood radius: NEIGHBOURHOOD times the
+  largest excursion over the first excitation period (a start from rest or with a
+  velocity alike); at most 1 (the engine kept the rest state).
 - ``floquet_left`` (verdict unstable): the neighbourhood radius over the largest
   excursion; at most 1 (the engine left).
 - ``growth_rate`` (verdict unstable): the engine's exponential rate against ln|mu|max / T.
@@ -82,7 +83,8 @@ def measure(run: ScenarioRun) -> None:
         (wrap_angles(system, start, r[0]) - r[0])[free]))))
     t = run.t
     engine = _excursion(system, run.run.q[: run.n], rest, free)
-    radius = NEIGHBOURHOOD * max(float(engine[0]), 1e-12)
+    first = t < t[0] + result.period
+    radius = NEIGHBOURHOOD * max(float(np.max(engine[first])), 1e-12)
     largest = float(np.max(engine)) if np.all(np.isfinite(engine)) else float("inf")
     run.series["floquet_excursion"] = engine
     if result.verdict == "stable":
