@@ -197,3 +197,20 @@ def test_analyze_parametric_excitation_text_names_the_floquet_verdicts():
     res = runner.invoke(app, ["analyze", "vertically_driven_pendulum"])
     assert res.exit_code == 0, res.output
     assert res.output.count("Floquet stable") == 2
+
+
+# Fig. 11, eq. 14: l phi'' + 2 l' phi' + g phi = 0 about phi = 0 with l = l0 - h_a sin(Omega t).
+# Parametric resonance (Landau & Lifshitz, Mechanics §27): the first instability tongue is
+# centred on Omega = 2 w0, w0 = sqrt(g/l0), its width proportional to h_a/l0; above it
+# (Omega = 3 w0 lies beyond the first tongue, and the others are at 2 w0 / n) the motion
+# stays bounded: over one period the monodromy's determinant is (l(0)/l(T))^2 = 1, so the
+# multipliers sit on the unit circle.
+@pytest.mark.parametrize("ratio, stable", [(2.0, False), (3.0, True)])
+def test_analyze_variable_length_pendulum_tongue(ratio, stable):
+    w0 = np.sqrt(9.81 / 1.0)
+    doc = _json(["analyze", "variable_length_pendulum", "--param", f"Omega={ratio * w0}",
+                 "--json"])
+    hanging = [e for e in doc["equilibria"] if abs(e["q"]["phi"]) < 1e-9]
+    assert len(hanging) == 1 and hanging[0]["stable"] is stable
+    mu = np.array([complex(*m) for m in hanging[0]["floquet_multipliers"]])
+    assert abs(np.prod(mu) - 1.0) < 1e-8
