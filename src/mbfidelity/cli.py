@@ -469,8 +469,18 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                as_json: bool = typer.Option(False, "--json"),
                out: Optional[Path] = typer.Option(
                    None, "--out", help="also write strutt.json and strutt.png there"),
+               sim: Optional[List[str]] = typer.Option(
+                   None, "--sim", help="also classify every point by simulation on this "
+                   "engine (repeatable): the vertically driven pendulum mapped to "
+                   "(lambda, gamma), comparisons/strutt_engine.py"),
+               scheduler: Optional[str] = typer.Option(
+                   None, "--scheduler", help="Dask scheduler address for the engine runs"),
+               workers: Optional[int] = typer.Option(
+                   None, "--workers", help="local processes for the engine runs (default: "
+                   "one per core)"),
                ) -> None:
-    """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory."""
+    """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory, and with
+    --sim as each engine draws it."""
     from .analytic.strutt import strutt_chart
 
     def bounds(text: str, option: str) -> tuple[float, float]:
@@ -491,12 +501,27 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                                                                    "marginal")}
     doc = {"equation": "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)",
            "period": 2 * np.pi, "grid": grid, "counts": counts, "points": points}
+    if workers is not None and workers < 1:
+        _fail(f"--workers must be a positive integer, got {workers}")
+    if sim:
+        from .comparisons.strutt_engine import engine_chart
+        from .simulators import SIMULATOR_IDS
+
+        for name in sim:
+            if name not in SIMULATOR_IDS:
+                _fail(f"unknown engine {name!r}; engines: {', '.join(SIMULATOR_IDS)}")
+        doc["engines"] = {name: engine_chart(name, chart, scheduler, workers) for name in sim}
     if out is not None:
         from .reports.strutt_figure import write_strutt_figure
 
         out.mkdir(parents=True, exist_ok=True)
         (out / "strutt.json").write_text(json.dumps(doc, indent=1))
         figure = write_strutt_figure(points, out / "strutt.png")
+        for name, engine in doc.get("engines", {}).items():
+            write_strutt_figure(points, out / f"strutt_{name}.png",
+                                disagreements=[(p["lambda"], p["gamma"]) for p in
+                                               engine["points"] if p.get("agrees") is False],
+                                engine=name)
         if not as_json:
             typer.echo(f"Strutt chart: {figure.resolve()}")
     if as_json:
@@ -504,6 +529,14 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
         return
     typer.echo(f"Strutt chart of eq. 83, {grid} x {grid} points: " +
                ", ".join(f"{k} {v}" for k, v in counts.items()))
+    for name, engine in doc.get("engines", {}).items():
+        wrong = [p for p in engine["points"] if p.get("agrees") is False]
+        agreement = engine["agreement"]
+        typer.echo(f"  {name}: agrees with Floquet at {agreement:.1%} of {engine['classified']} "
+                   f"classified points ({len(wrong)} disagree"
+                   + (f", {sum(p.get('slow_growth', False) for p in wrong)} of them growing "
+                      f"too slowly to show in {engine['periods']} periods)" if wrong else ")")
+                   if agreement is not None else f"  {name}: no point classified")
 
 
 def main() -> None:
