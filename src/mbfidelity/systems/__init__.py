@@ -205,6 +205,11 @@ class System:
     #: a parameter on which the operating equilibrium's stability turns (the belt speed
     #: of a self-excited system, §7.2): `analyze` reports where it changes stability
     stability_parameter: str | None = None
+    #: (lambda, gamma, values) -> parameter values at which the linearization about the
+    #: operating point is Mathieu's equation as printed (monograph eq. 83), with time
+    #: scaled by the excitation's frequency: the mechanism that draws the Strutt chart by
+    #: simulation (comparisons/strutt_engine.py)
+    mathieu_map: Callable[[float, float, Mapping[str, float]], dict] | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
