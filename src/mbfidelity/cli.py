@@ -128,9 +128,9 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     values, derived = _values(system, _parse_params(param))
     coords = list(system.coordinates)
     if system.driven:
-        from .analytic.floquet import has_periodic_coefficients
+        from .analytic.floquet import parametrically_excited
 
-        if has_periodic_coefficients(system, values):
+        if parametrically_excited(system, values):
             _analyze_parametric(system, values, derived, coords, as_json)
             return
     try:
