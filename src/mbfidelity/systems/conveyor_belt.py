@@ -28,6 +28,8 @@ stability statement (the reduced damping c + Ft'(v0) changes sign at the thresho
 printed numbers (x_eq = 11.5 mm at v0 = 0.29 m/s, the threshold 0.3 m/s, a velocity
 amplitude of about 0.3 m/s on the limit cycle) are hand facts (tests/hand/conveyor_belt.py).
 """
+import math
+
 import sympy as sp
 
 from . import Expectation, PrintedFormula, System, coordinate_symbols
@@ -39,7 +41,7 @@ PARAMETERS = (
     Parameter("k", 500.0, "N/m", "spring constant", "MECHANISMS.md C; §7.2"),
     Parameter("c", 2.0, "N s/m", "viscous damping", "MECHANISMS.md C; §7.2",
               domain="nonnegative"),
-    Parameter("alpha", "25*pi/180", "rad", "inclination of the belt (25 degrees)",
+    Parameter("alpha", math.radians(25.0), "rad", "inclination of the belt (25 degrees)",
               "MECHANISMS.md C; §7.2"),
     Parameter("v0", 0.29, "m/s", "speed of the belt (Fig. 23; the scenarios span "
               "0.29-0.31)", "MECHANISMS.md C; §7.2, Fig. 22-23"),
