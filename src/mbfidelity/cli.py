@@ -121,7 +121,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
     from .analytic.errata import errata
-    from .analytic.linear import find_equilibria, operating_equilibrium
+    from .analytic.linear import find_equilibria, operating_equilibrium, oscillatory_instability
 
     _use_cache(no_cache)
     system = _system(system_id)
@@ -136,9 +136,10 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     equilibria = []
     for e in eqs:
         item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
-        if e.stable:
+        if e.stable or oscillatory_instability(e.eigenvalues):
+            # a self-excited mode has a frequency and a negative damping ratio
             item["modes"] = _modes(e)
-        else:
+        if not e.stable:
             item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
         equilibria.append(item)
     doc = {
