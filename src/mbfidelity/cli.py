@@ -1,4 +1,6 @@
-"""Command line (DESIGN.md): list, analyze, compare, run, errata."""
+"""Command line (DESIGN.md): list, analyze, compare, run, errata, strutt; and the users'
+gates: check (the gates against the installed engines, optionally against a baseline) and
+diff (what changed between two runs)."""
 from __future__ import annotations
 
 import json
@@ -12,6 +14,43 @@ import typer
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Cross-validate multibody simulators against exact models.")
+
+
+def _use_system_paths(paths: Optional[List[Path]]) -> None:
+    """A user's mechanism modules join the catalog (systems/__init__.py): through the
+    environment, so that worker processes load them too."""
+    if not paths:
+        return
+    import os
+
+    from . import systems
+
+    previous = os.environ.get(systems.SYSTEM_PATH_VARIABLE)
+    known = previous.split(os.pathsep) if previous else []
+    added = [str(Path(p).resolve()) for p in paths]
+    os.environ[systems.SYSTEM_PATH_VARIABLE] = os.pathsep.join(
+        dict.fromkeys(known + added))
+    systems._REGISTRY = None
+    try:
+        systems.all_systems()
+    except ValueError as exc:
+        if previous is None:
+            os.environ.pop(systems.SYSTEM_PATH_VARIABLE)
+        else:
+            os.environ[systems.SYSTEM_PATH_VARIABLE] = previous
+        systems._REGISTRY = None
+        _fail(str(exc))
+
+
+SYSTEM_PATH_HELP = ("a mechanism module of your own (written like those in "
+                    "mbfidelity/systems/), added to the catalog; repeatable")
+
+
+@app.callback()
+def _options(system_path: Optional[List[Path]] = typer.Option(
+        None, "--system-path", help=SYSTEM_PATH_HELP)) -> None:
+    """Cross-validate multibody simulators against exact models."""
+    _use_system_paths(system_path)
 
 
 def _fail(message: str) -> None:
@@ -316,9 +355,12 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
                                       "instead of reading the persistent cache"),
         resume: bool = typer.Option(False, "--resume", help="continue a killed run into "
                                     "--out: reuse the systems it finished"),
+        setting: Optional[List[str]] = typer.Option(
+            None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
         ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
     _use_cache(no_cache)
+    settings = _engine_settings(setting)
     from rich.progress import Progress
 
     from .comparisons.matrix import reusable_jobs, run_matrix, write_results
@@ -334,7 +376,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         if e not in all_backends():
             _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     if resume:
-        reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants)
+        reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants, settings)
         typer.echo(f"resuming: {len(reused)} of {len(sys_ids)} systems finished in {out}, "
                    f"reused")
     start = time.perf_counter()
@@ -344,7 +386,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
         results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
-                             out=out, resume=resume)
+                             out=out, resume=resume, settings=settings)
     write_results(results, out)
     index = write_report(out)
     elapsed = time.perf_counter() - start
@@ -361,6 +403,29 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
 
 def _split(items):
     return [x for item in items or [] for x in item.split(",") if x]
+
+
+def _engine_settings(items: Optional[List[str]]) -> dict[str, dict]:
+    """ENGINE.KEY=VALUE items -> {engine: {key: value}}, each engine's settings validated
+    by its backend (one line and exit 2 for a bad one)."""
+    from .simulators import all_backends
+
+    out: dict[str, dict] = {}
+    for item in items or []:
+        head = item.split("=", 1)[0]
+        if "=" not in item or "." not in head:
+            _fail(f"--setting expects ENGINE.KEY=VALUE, got {item!r}")
+        engine, rest = item.split(".", 1)
+        if engine not in all_backends():
+            _fail(f"--setting {item!r}: unknown simulator {engine!r}; valid: "
+                  f"{', '.join(all_backends())}")
+        out.setdefault(engine, {}).update(_settings([rest]))
+    for engine, chosen in out.items():
+        try:
+            all_backends()[engine].resolve_settings(chosen)
+        except (KeyError, ValueError) as exc:
+            _fail(f"--setting for {engine}: {exc.args[0] if exc.args else exc}")
+    return out
 
 
 @app.command("errata")
@@ -439,6 +504,146 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
         return
     typer.echo(f"Strutt chart of eq. 83, {grid} x {grid} points: " +
                ", ".join(f"{k} {v}" for k, v in counts.items()))
+
+
+@app.command("check")
+def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
+              sims: Optional[List[str]] = typer.Option(
+                  None, "--sims", help="simulator ids (default: every installed engine)"),
+              baseline: Optional[Path] = typer.Option(
+                  None, "--baseline", help="a results folder (or results.json) to compare "
+                                           "with: a gate that got worse fails the check"),
+              out: Path = typer.Option(Path("mbfidelity-check"), "--out",
+                                       help="where the results are written"),
+              dt: float = typer.Option(1e-3, "--dt"),
+              setting: Optional[List[str]] = typer.Option(
+                  None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
+              report: bool = typer.Option(False, "--report/--no-report",
+                                          help="also write the HTML report into --out"),
+              as_json: bool = typer.Option(False, "--json"),
+              system_path: Optional[List[Path]] = typer.Option(
+                  None, "--system-path", help=SYSTEM_PATH_HELP),
+              no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
+                                            "derivations instead of reading the cache"),
+              ) -> None:
+    """The gates of the installed package against the installed engines: a verdict per
+    system x engine, the results in --out; exit 0 only if every gate passes or is declared
+    (and, with --baseline, none got worse than there). One line in a user's CI."""
+    _use_system_paths(system_path)
+    _use_cache(no_cache)
+    from .comparisons.diff import diff_runs, holds
+    from .comparisons.matrix import run_matrix, write_results
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    settings = _engine_settings(setting)
+    sys_ids = _split(systems) or list(all_systems())
+    for s in sys_ids:
+        _system(s)
+    if sims:
+        sim_ids = _split(sims)
+        for e in sim_ids:
+            if e not in all_backends():
+                _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+            ok, why = all_backends()[e].available()
+            if not ok:
+                _fail(f"{e} is not installed: {why}")
+    else:
+        sim_ids = [e for e, b in all_backends().items() if b.available()[0]]
+    if not dt > 0:
+        _fail("--dt must be positive")
+    if baseline is not None and not (baseline / "results.json" if baseline.is_dir()
+                                     else baseline).exists():
+        _fail(f"--baseline {baseline}: no results.json there")
+    results = run_matrix(sys_ids, sim_ids, dt=dt, out=out, settings=settings)
+    write_results(results, out)
+    if report:
+        from .reports.html import write_report
+
+        write_report(out)
+    verdicts = []
+    for c in results:
+        failing = [m.name for m in c.metrics if not holds(m)]
+        verdict = ("unsupported" if not c.supported else "pass" if c.passed else "fail")
+        verdicts.append({"system": c.system, "simulator": c.simulator,
+                         "engine_version": c.engine_version, "verdict": verdict,
+                         "failing": failing, "reason": c.reason,
+                         "incidents": [i["outcome"] for i in c.incidents]})
+    changes = None
+    if baseline is not None:
+        try:
+            changes = diff_runs(baseline, out)
+        except ValueError as exc:
+            _fail(str(exc))
+    passed = all(v["verdict"] != "fail" for v in verdicts) and not (changes and changes.worse)
+    if as_json:
+        _json({"passed": passed, "results": str(out.resolve()), "verdicts": verdicts,
+               "diff": changes.as_dict() if changes else None})
+    else:
+        for v in verdicts:
+            why = (f"  {', '.join(v['failing'])}" if v["verdict"] == "fail" else
+                   f"  {v['reason']}" if v["verdict"] == "unsupported" else "")
+            typer.echo(f"{v['system']:28s} {v['simulator']:9s} {v['verdict'].upper():11s}{why}")
+        if changes is not None:
+            _print_diff(changes)
+        typer.echo(f"results: {out.resolve()}")
+        typer.echo("CHECK PASSED" if passed else "CHECK FAILED")
+    raise typer.Exit(0 if passed else 1)
+
+
+def _print_diff(changes) -> None:
+    changed = [p for p in changes.pairs if p.kind != "same"]
+    typer.echo(f"diff {changes.old} -> {changes.new}: {len(changed)} of {len(changes.pairs)} "
+               f"system x engine pairs changed" + (", a gate got worse" if changes.worse
+                                                   else ""))
+    for p in changed:
+        head = f"  {p.row}/{p.simulator}: {p.kind}"
+        if p.versions and p.versions[0] != p.versions[1]:
+            head += f"; engine {p.versions[0]} -> {p.versions[1]}"
+        if p.passed and p.passed[0] != p.passed[1]:
+            head += f"; {'passed' if p.passed[0] else 'failed'} -> " \
+                    f"{'passed' if p.passed[1] else 'failed'}"
+        typer.echo(head + ("  [WORSE]" if p.worse else ""))
+        for key, (a, b) in p.settings.items():
+            typer.echo(f"    setting {key}: {a!r} -> {b!r}")
+        for key, (a, b) in p.inputs.items():
+            typer.echo(f"    input {key}: {a!r} -> {b!r}")
+        for m in p.metrics:
+            a = f"{m.old['value']:.6g} ({m.old['status']})" if m.old else "-"
+            b = f"{m.new['value']:.6g} ({m.new['status']})" if m.new else "-"
+            typer.echo(f"    {m.kind:8s} {m.name:34s} {a} -> {b}"
+                       + ("  [WORSE]" if m.worse else ""))
+
+
+@app.command("diff")
+def diff_cmd(old: Path = typer.Argument(..., metavar="OLD", help="results folder or "
+                                        "results.json (e.g. a recorded baseline)"),
+             new: Path = typer.Argument(..., metavar="NEW", help="results folder or "
+                                        "results.json"),
+             as_json: bool = typer.Option(False, "--json"),
+             html_page: Optional[Path] = typer.Option(None, "--html",
+                                                      help="also write the diff as a page"),
+             ) -> None:
+    """What changed between two runs, per system x engine x metric: engine versions and
+    settings, metrics that moved, gates that flipped, new and vanished metrics. Exit 1
+    when a gate got worse."""
+    from .comparisons.diff import diff_runs
+
+    try:
+        changes = diff_runs(old, new)
+    except ValueError as exc:
+        _fail(str(exc))
+    if html_page is not None:
+        from .reports.diff_page import write_diff_page
+
+        write_diff_page(changes.as_dict(), html_page)
+    if as_json:
+        _json(changes.as_dict())
+    else:
+        _print_diff(changes)
+        if html_page is not None:
+            typer.echo(f"page: {html_page.resolve()}")
+    raise typer.Exit(1 if changes.worse else 0)
 
 
 def main() -> None:

@@ -1,0 +1,124 @@
+"""The gates in a user's hands (issue 14): `check` against the installed engines and a
+baseline, `diff` between two runs, a user's own mechanism module through the commands."""
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from mbfidelity import systems
+from mbfidelity.cli import app
+
+runner = CliRunner()
+EXAMPLE = Path(__file__).parents[1] / "examples" / "cart_pendulum.py"
+
+
+@pytest.fixture(autouse=True)
+def _catalog_restored():
+    """`--system-path` adds to the process's catalog (through the environment, for the
+    workers): the next tests see the catalog alone again."""
+    before = os.environ.get(systems.SYSTEM_PATH_VARIABLE)
+    yield
+    if before is None:
+        os.environ.pop(systems.SYSTEM_PATH_VARIABLE, None)
+    else:
+        os.environ[systems.SYSTEM_PATH_VARIABLE] = before
+    systems._REGISTRY = None
+
+
+def _check(*args):
+    return runner.invoke(app, ["check", "--systems", "compound_pendulum", "--sims", "mujoco",
+                               "--json", *args])
+
+
+def test_a_changed_setting_is_named_by_check_against_its_baseline(tmp_path):
+    first = _check("--out", str(tmp_path / "base"))
+    assert first.exit_code == 0, first.output
+    (verdict,) = json.loads(first.output)["verdicts"]
+    assert (verdict["system"], verdict["verdict"], verdict["failing"]) == (
+        "compound_pendulum", "pass", [])
+    # MuJoCo's semi-implicit Euler instead of RK4: still within its own (first-order)
+    # gates, so the check passes, but every trajectory metric moves
+    second = _check("--out", str(tmp_path / "euler"), "--setting", 'mujoco.integrator="Euler"',
+                    "--baseline", str(tmp_path / "base"))
+    assert second.exit_code == 0, second.output
+    diff = json.loads(second.output)["diff"]
+    (pair,) = diff["pairs"]
+    assert pair["settings"] == {"integrator": ["RK4", "Euler"]}
+    moved = {m["name"] for m in pair["metrics"] if m["kind"] == "moved"}
+    assert {"small.trajectory_max", "large.trajectory_max"} <= moved
+    assert not diff["worse"]
+
+    # the same run again: deterministic, so nothing moved at all
+    again = runner.invoke(app, ["diff", str(tmp_path / "euler"), str(tmp_path / "euler"),
+                                "--json"])
+    assert again.exit_code == 0
+    assert json.loads(again.output)["pairs"] == []
+
+
+def test_diff_exits_1_when_a_gate_got_worse_and_writes_its_page(tmp_path):
+    base = tmp_path / "base"
+    assert _check("--out", str(base)).exit_code == 0
+    # a recorded baseline (a results.json under another name) in which one gate failed
+    # earlier, and a new run where another fails: one flip is better, one worse
+    doc = json.loads((base / "results.json").read_text())
+    metrics = doc["comparisons"][0]["metrics"]
+    metrics[0].update(status="fail", passed=False)
+    recorded = tmp_path / "recorded_baseline.json"
+    recorded.write_text(json.dumps(doc))
+    worse = json.loads((base / "results.json").read_text())
+    worse["comparisons"][0]["metrics"][1].update(status="fail", passed=False)
+    (tmp_path / "new").mkdir()
+    (tmp_path / "new" / "results.json").write_text(json.dumps(worse))
+
+    res = runner.invoke(app, ["diff", str(recorded), str(tmp_path / "new"), "--html",
+                              str(tmp_path / "diff.html")])
+    assert res.exit_code == 1, res.output
+    assert f"flipped  {metrics[1]['name']}" in res.output and "[WORSE]" in res.output
+    page = (tmp_path / "diff.html").read_text()
+    assert metrics[0]["name"] in page and metrics[1]["name"] in page
+    assert json.loads((tmp_path / "diff.json").read_text())["worse"] is True
+
+
+def test_diff_of_something_that_is_not_a_run_is_one_line(tmp_path):
+    res = runner.invoke(app, ["diff", str(tmp_path), str(tmp_path)])
+    assert res.exit_code == 2
+    assert "no readable results.json" in res.output
+    assert len(res.output.strip().splitlines()) == 1
+
+
+def test_a_users_mechanism_goes_through_analyze_and_check(tmp_path):
+    """The README's example, a pendulum on a cart held by a spring (not in the catalog):
+    its linearization about the hanging rest state is, by hand, M = [[M + m, m L/2],
+    [m L/2, m L^2/3]], K = diag(k, m g L/2)."""
+    res = runner.invoke(app, ["--system-path", str(EXAMPLE), "analyze", "cart_pendulum",
+                              "--json"])
+    assert res.exit_code == 0, res.output
+    lin = json.loads(res.output)["linearization"]
+    M, m, L, k, g = 2.0, 0.5, 0.6, 80.0, 9.81
+    np.testing.assert_allclose(lin["M"], [[M + m, m * L / 2], [m * L / 2, m * L**2 / 3]],
+                               rtol=1e-12)
+    np.testing.assert_allclose(lin["K"], [[k, 0], [0, m * g * L / 2]], rtol=1e-12,
+                               atol=1e-12)
+    res = runner.invoke(app, ["check", "--system-path", str(EXAMPLE), "--systems",
+                              "cart_pendulum", "--sims", "mujoco", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert "cart_pendulum" in res.output and "PASS" in res.output
+
+
+def test_a_bad_mechanism_module_is_one_clear_line(tmp_path):
+    cases = {
+        "broken.py": ("def build(:\n", "SyntaxError"),
+        "empty.py": ('"""nothing here"""\n', "defines no SYSTEM"),
+        "twice.py": ("from mbfidelity.systems.compound_pendulum import SYSTEM\n",
+                     "already in the catalog"),
+    }
+    for name, (text, needle) in cases.items():
+        path = tmp_path / name
+        path.write_text(text)
+        res = runner.invoke(app, ["--system-path", str(path), "list"])
+        assert res.exit_code == 2, (name, res.output)
+        assert needle in res.output and str(path) in res.output, (name, res.output)
+        assert len(res.output.strip().splitlines()) == 1, (name, res.output)
