@@ -646,6 +646,40 @@ def diff_cmd(old: Path = typer.Argument(..., metavar="OLD", help="results folder
     raise typer.Exit(1 if changes.worse else 0)
 
 
+@app.command("export")
+def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
+               sim: str = typer.Option("mujoco", "--sim", help="the engine (MJCF: mujoco)"),
+               out: Path = typer.Option(..., "--out", help="file to write"),
+               param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
+               setting: Optional[List[str]] = typer.Option(
+                   None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
+               dt: float = typer.Option(1e-3, "--dt", help="time step written in the model"),
+               ) -> None:
+    """The mechanism as the harness builds it, saved: MuJoCo's MJCF with a keyframe per
+    scenario and the map from the description's coordinates (custom numerics)."""
+    from .comparisons.export import export_model
+    from .simulators import get_backend
+
+    system = _system(system_id)
+    params = _parse_params(param)
+    _values(system, params, system.scenarios)
+    try:
+        get_backend(sim)
+    except KeyError as exc:
+        _fail(exc.args[0])
+    if not dt > 0:
+        _fail("--dt must be positive")
+    try:
+        text, outside = export_model(system.id, sim, params, _settings(setting), dt)
+    except ValueError as exc:
+        _fail(str(exc))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    typer.echo(f"{system.id} for {sim}: {out.resolve()}")
+    for note in outside:
+        typer.echo(f"  not in the file: {note}")
+
+
 def main() -> None:
     app()
 

@@ -1276,6 +1276,47 @@ class MujocoBackend(Backend):
             xml = f"{head}<flag {attrs} {' '.join(flags)}/>{rest}"
         return xml
 
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(MJCF, what the file alone does not reproduce). The file is `to_mjcf`'s, with a
+        keyframe per initial state (named after it, in MuJoCo's coordinates) and the map
+        from the description's coordinates as custom numerics: ``qpos[mbfidelity_qadr] =
+        A q + b`` (``mbfidelity_A`` row-major, ``mbfidelity_b``), the coordinates' names in
+        the custom text ``mbfidelity_coordinates``. Force laws the harness applies in the
+        passive callback, and prescribed motions it imposes in the control callback, are
+        not in the file: they are listed in the second element (empty: the file alone
+        moves as the harness's build)."""
+        s = self.resolve_settings(settings)
+        plan = self._plan(mechanism, s, dt=dt)
+        comp = _Compiled(plan, s["integrator"], dt, bool(s["autoreset"]))
+        keys = []
+        for name, (q, qd) in initial_states.items():
+            comp.set_state(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
+            keys.append(f'    <key name="{name}" qpos="{_fmt(*comp.data.qpos)}" '
+                        f'qvel="{_fmt(*comp.data.qvel)}"/>')
+        custom = (f'  <custom>\n'
+                  f'    <numeric name="mbfidelity_qadr" data="{_fmt(*comp.qadr)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{_fmt(*plan.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{_fmt(*plan.b)}"/>\n'
+                  f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
+                  f'  </custom>\n')
+        keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
+        xml = self.to_mjcf(mechanism, settings, dt)
+        head, tail = xml.rsplit("</mujoco>", 1)
+        xml = f"{head}{custom}{keyframes}</mujoco>{tail}"
+        outside = []
+        laws = [e.element.name for e in plan.coord + plan.p2p if e.native is None]
+        if laws:
+            outside.append("force laws applied by the harness's passive callback "
+                           f"(mjcb_passive): {', '.join(laws)}")
+        if comp.control is not None:
+            outside.append("prescribed motions imposed by the harness's control callback "
+                           f"(mjcb_control): {', '.join(p.name for p in mechanism.prescribed)}")
+        if plan.opts.get("ring_segments") and any(c.kind == "contact" for c in plan.closures):
+            outside.append("the contact ring's solref, set on the compiled model")
+        return xml, outside
+
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         integrator = str(self.resolve_settings(settings)["integrator"])
         if integrator == "RK4":
