@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 from mbfidelity import systems
 from mbfidelity.cli import app
 
+pytest_plugins = ["pytester"]
 runner = CliRunner()
 EXAMPLE = Path(__file__).parents[1] / "examples" / "cart_pendulum.py"
 
@@ -158,3 +159,17 @@ def test_an_exported_mjcf_moves_in_plain_mujoco_as_the_harness_build(tmp_path, s
                                          steps * dt, dt)
     assert np.max(np.abs(run.q[steps] - q0)) > 1e-2  # it moved
     assert np.max(np.abs(run.q[steps] - q_plain)) <= 1e-12
+
+
+def test_the_pytest_plugin_runs_the_gates_in_an_empty_folder(pytester):
+    """`pytest --mbfidelity` (entry point pytest11) in a folder with no tests: one test per
+    system x engine, with readable ids; a bad choice is a usage error."""
+    res = pytester.runpytest_subprocess("--mbfidelity", "--mbfidelity-systems=compound_pendulum",
+                                        "--mbfidelity-sims=mujoco", "-v")
+    res.assert_outcomes(passed=1)
+    res.stdout.fnmatch_lines(["*mbfidelity/compound_pendulum-mujoco PASSED*"])
+    bad = pytester.runpytest_subprocess("--mbfidelity", "--mbfidelity-systems=no_such_system")
+    assert bad.ret == pytest.ExitCode.USAGE_ERROR
+    bad.stderr.fnmatch_lines(["*unknown no_such_system*"])
+    # without the option the plugin adds nothing
+    assert pytester.runpytest_subprocess().ret == pytest.ExitCode.NO_TESTS_COLLECTED
