@@ -173,3 +173,21 @@ def test_the_pytest_plugin_runs_the_gates_in_an_empty_folder(pytester):
     bad.stderr.fnmatch_lines(["*unknown no_such_system*"])
     # without the option the plugin adds nothing
     assert pytester.runpytest_subprocess().ret == pytest.ExitCode.NO_TESTS_COLLECTED
+
+
+def test_the_python_api_returns_what_the_cli_prints():
+    """`mbfidelity.compare` is what `mbfidelity compare --json` prints (deterministic: the
+    same metrics, bitwise); bad input is a ValueError of one line."""
+    import mbfidelity
+
+    result = mbfidelity.compare("compound_pendulum", "mujoco")
+    printed = json.loads(runner.invoke(app, ["compare", "compound_pendulum", "--sim", "mujoco",
+                                             "--json"]).output)
+    assert result.as_dict()["metrics"] == printed["metrics"]
+    assert result.passed is printed["passed"] is True
+    for bad in (lambda: mbfidelity.compare("no_such_system", "mujoco"),
+                lambda: mbfidelity.compare("compound_pendulum", "gazebo"),
+                lambda: mbfidelity.compare("compound_pendulum", "mujoco", {"m": -1.0})):
+        with pytest.raises(ValueError) as err:
+            bad()
+        assert "\n" not in str(err.value)

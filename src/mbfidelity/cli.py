@@ -531,64 +531,26 @@ def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
     (and, with --baseline, none got worse than there). One line in a user's CI."""
     _use_system_paths(system_path)
     _use_cache(no_cache)
-    from .comparisons.diff import diff_runs, holds
-    from .comparisons.matrix import run_matrix, write_results
-    from .simulators import all_backends
-    from .systems import all_systems
+    from . import api
 
-    settings = _engine_settings(setting)
-    sys_ids = _split(systems) or list(all_systems())
-    for s in sys_ids:
-        _system(s)
-    if sims:
-        sim_ids = _split(sims)
-        for e in sim_ids:
-            if e not in all_backends():
-                _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
-            ok, why = all_backends()[e].available()
-            if not ok:
-                _fail(f"{e} is not installed: {why}")
-    else:
-        sim_ids = [e for e, b in all_backends().items() if b.available()[0]]
-    if not dt > 0:
-        _fail("--dt must be positive")
-    if baseline is not None and not (baseline / "results.json" if baseline.is_dir()
-                                     else baseline).exists():
-        _fail(f"--baseline {baseline}: no results.json there")
-    results = run_matrix(sys_ids, sim_ids, dt=dt, out=out, settings=settings)
-    write_results(results, out)
-    if report:
-        from .reports.html import write_report
-
-        write_report(out)
-    verdicts = []
-    for c in results:
-        failing = [m.name for m in c.metrics if not holds(m)]
-        verdict = ("unsupported" if not c.supported else "pass" if c.passed else "fail")
-        verdicts.append({"system": c.system, "simulator": c.simulator,
-                         "engine_version": c.engine_version, "verdict": verdict,
-                         "failing": failing, "reason": c.reason,
-                         "incidents": [i["outcome"] for i in c.incidents]})
-    changes = None
-    if baseline is not None:
-        try:
-            changes = diff_runs(baseline, out)
-        except ValueError as exc:
-            _fail(str(exc))
-    passed = all(v["verdict"] != "fail" for v in verdicts) and not (changes and changes.worse)
+    try:
+        outcome = api.check(_split(systems) or None, _split(sims) or None, out,
+                            baseline=baseline, dt=dt, settings=_engine_settings(setting),
+                            report=report)
+    except ValueError as exc:
+        _fail(str(exc))
     if as_json:
-        _json({"passed": passed, "results": str(out.resolve()), "verdicts": verdicts,
-               "diff": changes.as_dict() if changes else None})
+        _json(outcome.as_dict())
     else:
-        for v in verdicts:
-            why = (f"  {', '.join(v['failing'])}" if v["verdict"] == "fail" else
-                   f"  {v['reason']}" if v["verdict"] == "unsupported" else "")
-            typer.echo(f"{v['system']:28s} {v['simulator']:9s} {v['verdict'].upper():11s}{why}")
-        if changes is not None:
-            _print_diff(changes)
-        typer.echo(f"results: {out.resolve()}")
-        typer.echo("CHECK PASSED" if passed else "CHECK FAILED")
-    raise typer.Exit(0 if passed else 1)
+        for v in outcome.verdicts:
+            why = (f"  {', '.join(v.failing)}" if v.verdict == "fail" else
+                   f"  {v.reason}" if v.verdict == "unsupported" else "")
+            typer.echo(f"{v.system:28s} {v.simulator:9s} {v.verdict.upper():11s}{why}")
+        if outcome.diff is not None:
+            _print_diff(outcome.diff)
+        typer.echo(f"results: {outcome.results}")
+        typer.echo("CHECK PASSED" if outcome.passed else "CHECK FAILED")
+    raise typer.Exit(0 if outcome.passed else 1)
 
 
 def _print_diff(changes) -> None:
@@ -657,20 +619,13 @@ def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                ) -> None:
     """The mechanism as the harness builds it, saved: MuJoCo's MJCF with a keyframe per
     scenario and the map from the description's coordinates (custom numerics)."""
-    from .comparisons.export import export_model
-    from .simulators import get_backend
+    from . import api
 
     system = _system(system_id)
     params = _parse_params(param)
     _values(system, params, system.scenarios)
     try:
-        get_backend(sim)
-    except KeyError as exc:
-        _fail(exc.args[0])
-    if not dt > 0:
-        _fail("--dt must be positive")
-    try:
-        text, outside = export_model(system.id, sim, params, _settings(setting), dt)
+        text, outside = api.export(system.id, sim, params, settings=_settings(setting), dt=dt)
     except ValueError as exc:
         _fail(str(exc))
     out.parent.mkdir(parents=True, exist_ok=True)
