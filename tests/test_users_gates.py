@@ -185,6 +185,11 @@ def test_the_python_api_returns_what_the_cli_prints():
                                              "--json"]).output)
     assert result.as_dict()["metrics"] == printed["metrics"]
     assert result.passed is printed["passed"] is True
+    doc = mbfidelity.analyze("compound_pendulum", {"m": 2.0})
+    shown = json.loads(runner.invoke(app, ["analyze", "compound_pendulum", "--param", "m=2",
+                                           "--json"]).output)
+    np.testing.assert_array_equal(doc["linearization"]["K"], shown["linearization"]["K"])
+    assert doc["modes"] == shown["modes"] and doc["equilibria"] == shown["equilibria"]
     for bad in (lambda: mbfidelity.compare("no_such_system", "mujoco"),
                 lambda: mbfidelity.compare("compound_pendulum", "gazebo"),
                 lambda: mbfidelity.compare("compound_pendulum", "mujoco", {"m": -1.0})):

@@ -3,7 +3,7 @@ mechanisms of a monograph on mechanical vibrations."""
 __version__ = "0.1.0"
 
 #: the Python API (mbfidelity/api.py), imported on first use: `import mbfidelity` stays light
-_API = ("compare", "run", "check", "diff", "export")
+_API = ("analyze", "compare", "run", "check", "diff", "export")
 
 
 def __getattr__(name: str):

@@ -2,6 +2,7 @@
 the CLI prints as JSON (each has ``as_dict()``). The CLI is a thin layer over it.
 
     import mbfidelity
+    doc = mbfidelity.analyze(system_id, {"m": 2.0})        # equilibria, M, C, K, modes
     result = mbfidelity.compare(system_id, "mujoco")   # a Comparison (ids: mbfidelity list)
     result.passed, [m.name for m in result.metrics if m.status == "fail"]
     outcome = mbfidelity.check(systems=[system_id], sims=["mujoco"], out="gates")
@@ -20,7 +21,7 @@ from typing import Iterable, Mapping
 from .comparisons.diff import ResultsDiff, diff_runs, holds
 from .comparisons.runner import DEFAULT_DT, Comparison
 
-__all__ = ["compare", "run", "check", "diff", "export", "Verdict", "CheckResult",
+__all__ = ["analyze", "compare", "run", "check", "diff", "export", "Verdict", "CheckResult",
            "DEFAULT_DT"]
 
 
@@ -49,6 +50,100 @@ def _checked_parameters(system, params: Mapping[str, float] | None) -> None:
             system.parameter_values(params, scenario=sc)
     except KeyError as exc:
         raise ValueError(exc.args[0]) from None
+
+
+def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
+    """What `mbfidelity analyze --json` prints: the equilibria with their stability (and
+    modes), the operating point's linearization M, C, K (arrays) and modes, the printed
+    formulas against the derivation; a floating mechanism's relative equilibrium, a
+    self-excited one's stability threshold, a driven one's steady state."""
+    import numpy as np
+
+    from .analytic.errata import errata
+    from .analytic.linear import (find_equilibria, operating_equilibrium,
+                                  oscillatory_instability)
+
+    system = _system(system_id)
+    try:
+        values, derived = system.resolve_parameters(params)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+    coords = list(system.coordinates)
+    try:
+        eqs = find_equilibria(system, values)
+        op = operating_equilibrium(system, values)
+    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
+        raise ValueError(f"{system.id} with these parameters has no assembled equilibrium "
+                         f"near its operating point ({exc})") from None
+
+    def modes(eq) -> list[dict]:
+        return [m.as_dict() for m in eq.modes]
+
+    equilibria = []
+    for e in eqs:
+        item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
+        if e.stable or oscillatory_instability(e.eigenvalues):
+            # a self-excited mode has a frequency and a negative damping ratio
+            item["modes"] = modes(e)
+        if not e.stable:
+            item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
+        equilibria.append(item)
+    doc = {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
+        "equilibria": equilibria,
+        "operating_point": dict(zip(coords, op.q.tolist())),
+        "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C,
+                          "K": op.K},
+        "stable": op.stable,
+        "modes": modes(op),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
+    if not op.stable:
+        doc["growth_rate"] = float(max(s.real for s in op.eigenvalues))
+    if op.acceleration is not None:
+        doc["static_equilibrium"] = None
+        doc["relative_equilibrium"] = _relative_equilibrium(system, coords, op)
+    if system.stability_parameter:
+        from .analytic.stability import stability_threshold
+
+        doc["stability_threshold"] = stability_threshold(system, values).as_dict()
+    if system.driven:
+        from .analytic.steady_state import steady_state
+
+        response = steady_state(system, values)
+        doc["free_coordinates"] = list(system.mechanism.independent_coordinates)
+        doc["prescribed"] = {p.coordinate: str(p.motion) for p in system.mechanism.prescribed}
+        doc["linearization"]["about"] = ("rest state of the free coordinates with the "
+                                         "excitation off: " + ", ".join(
+                                             f"{k} = {v:g}" for k, v in system.unexcited.items()))
+        doc["steady_state"] = [h.as_dict() for h in response.harmonics]
+        if response.reason:
+            doc["steady_state_note"] = response.reason
+        else:
+            doc["steady_state_harmonic_residual"] = response.harmonic_residual
+    return doc
+
+
+def _relative_equilibrium(system, coords: list, op) -> dict:
+    """What `analyze` says of a floating mechanism (Italian notes §5.3.1)."""
+    acceleration = dict(zip(coords, op.acceleration.tolist()))
+    rigid = [dict(zip(coords, col.tolist())) for col in op.rigid.T]
+    moving = ", ".join(f"{c}'' = {a:.9g}" for c, a in acceleration.items() if a)
+    return {
+        "acceleration": acceleration,
+        "rigid_directions": rigid,
+        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
+                  f"ground, and its loads have a resultant that only the inertia of the "
+                  f"whole balances ({moving}); reported instead: the relative equilibrium "
+                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
+                  f"uniform acceleration, linearized about that motion"
+                  if moving else
+                  f"{system.id} has no ground, and its loads have no resultant here: its "
+                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
+                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
+                   "relative motion"),
+    }
 
 
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None, *,

@@ -7,6 +7,7 @@ import json
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 from typing import List, Optional
 
 import numpy as np
@@ -147,10 +148,6 @@ def _use_cache(off: bool) -> None:
         cache.disable()
 
 
-def _modes(eq):
-    return [m.as_dict() for m in eq.modes]
-
-
 @app.command()
 def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
@@ -159,59 +156,18 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                                           "instead of reading the persistent cache"),
             ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
-    from .analytic.errata import errata
-    from .analytic.linear import find_equilibria, operating_equilibrium, oscillatory_instability
+    from . import api
 
     _use_cache(no_cache)
     system = _system(system_id)
-    values, derived = _values(system, _parse_params(param))
-    coords = list(system.coordinates)
+    params = _parse_params(param)
+    values, derived = _values(system, params)
     try:
-        eqs = find_equilibria(system, values)
-        op = operating_equilibrium(system, values)
-    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
-        _fail(f"{system.id} with these parameters has no assembled equilibrium near its "
-              f"operating point ({exc})")
-    equilibria = []
-    for e in eqs:
-        item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
-        if e.stable or oscillatory_instability(e.eigenvalues):
-            # a self-excited mode has a frequency and a negative damping ratio
-            item["modes"] = _modes(e)
-        if not e.stable:
-            item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
-        equilibria.append(item)
-    doc = {
-        "system": system.id, "title": system.title, "source": system.source,
-        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
-        "equilibria": equilibria,
-        "operating_point": dict(zip(coords, op.q.tolist())),
-        "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C, "K": op.K},
-        "stable": op.stable,
-        "modes": _modes(op),
-        "printed_vs_derived": [e.as_dict() for e in errata(system)],
-    }
-    if op.acceleration is not None:
-        doc["static_equilibrium"] = None
-        doc["relative_equilibrium"] = _relative_note(system, coords, op)
-    if system.stability_parameter:
-        from .analytic.stability import stability_threshold
-
-        doc["stability_threshold"] = stability_threshold(system, values).as_dict()
-    if system.driven:
-        from .analytic.steady_state import steady_state
-
-        response = steady_state(system, values)
-        doc["free_coordinates"] = list(system.mechanism.independent_coordinates)
-        doc["prescribed"] = {p.coordinate: str(p.motion) for p in system.mechanism.prescribed}
-        doc["linearization"]["about"] = ("rest state of the free coordinates with the "
-                                         "excitation off: " + ", ".join(
-                                             f"{k} = {v:g}" for k, v in system.unexcited.items()))
-        doc["steady_state"] = [h.as_dict() for h in response.harmonics]
-        if response.reason:
-            doc["steady_state_note"] = response.reason
-        else:
-            doc["steady_state_harmonic_residual"] = response.harmonic_residual
+        doc = api.analyze(system.id, params)
+    except ValueError as exc:
+        _fail(str(exc))
+    op = SimpleNamespace(**{k: np.asarray(doc["linearization"][k]) for k in "MCK"})
+    equilibria = doc["equilibria"]
     if as_json:
         _json(doc)
         return
@@ -228,12 +184,11 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     typer.echo(f"at {doc['operating_point']}:")
     for key in ("M", "C", "K"):
         typer.echo(f"  {key} = {np.array2string(getattr(op, key), precision=6)}")
-    for m in op.modes:
-        typer.echo(f"  mode: f = {m.frequency_hz:.9g} Hz, zeta = {m.damping_ratio:.6g}, "
-                   f"f_d = {m.damped_frequency_hz:.9g} Hz")
-    if not op.stable:
-        growth = max(s.real for s in op.eigenvalues)
-        typer.echo(f"  unstable: fastest growth rate {growth:.9g} 1/s")
+    for m in doc["modes"]:
+        typer.echo(f"  mode: f = {m['frequency_hz']:.9g} Hz, zeta = {m['damping_ratio']:.6g}, "
+                   f"f_d = {m['damped_frequency_hz']:.9g} Hz")
+    if not doc["stable"]:
+        typer.echo(f"  unstable: fastest growth rate {doc['growth_rate']:.9g} 1/s")
     if "stability_threshold" in doc:
         th = doc["stability_threshold"]
         if th["value"] is None:
@@ -251,27 +206,6 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(f"  steady state: none ({doc['steady_state_note']})")
     for e in doc["printed_vs_derived"]:
         typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
-
-
-def _relative_note(system, coords: list, op) -> dict:
-    """What `analyze` says of a floating mechanism (Italian notes §5.3.1)."""
-    acceleration = dict(zip(coords, op.acceleration.tolist()))
-    rigid = [dict(zip(coords, col.tolist())) for col in op.rigid.T]
-    moving = ", ".join(f"{c}'' = {a:.9g}" for c, a in acceleration.items() if a)
-    return {
-        "acceleration": acceleration,
-        "rigid_directions": rigid,
-        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
-                  f"ground, and its loads have a resultant that only the inertia of the "
-                  f"whole balances ({moving}); reported instead: the relative equilibrium "
-                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
-                  f"uniform acceleration, linearized about that motion"
-                  if moving else
-                  f"{system.id} has no ground, and its loads have no resultant here: its "
-                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
-                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
-                   "relative motion"),
-    }
 
 
 def _settings(items: Optional[List[str]]) -> dict:
