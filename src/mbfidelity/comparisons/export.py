@@ -1,7 +1,8 @@
 """A mechanism as the harness builds it in an engine, saved for use outside the harness:
 for MuJoCo the MJCF (loadable by ``mujoco.MjModel.from_xml_path``) with a keyframe per
-scenario's initial state and the coordinate map (simulators/mujoco_backend.py, `export`).
-The other backends build through their Python APIs and have no file form here."""
+scenario's initial state and the coordinate map (simulators/mujoco_backend.py, `export`);
+for an engine built through its Python API, a standalone script of the recorded build
+calls (simulators/script_export.py; PyBullet). A backend without `export` has none."""
 from __future__ import annotations
 
 from typing import Mapping
@@ -21,8 +22,8 @@ def export_model(system_id: str, simulator: str, params: Mapping[str, float] | N
     system = get_system(system_id)
     backend = get_backend(simulator)
     if not hasattr(backend, "export"):
-        raise ValueError(f"export writes MuJoCo's MJCF only: {simulator} builds through its "
-                         f"Python API and has no model file here")
+        raise ValueError(f"no export for {simulator}: its build is not recorded as a file or "
+                         f"a script (export exists for MuJoCo's MJCF and PyBullet's script)")
     values = system.parameter_values(params)
     mech = system.numeric_mechanism(values)
     support = backend.support(mech)
@@ -35,6 +36,6 @@ def export_model(system_id: str, simulator: str, params: Mapping[str, float] | N
     text, outside = backend.export(mech, system.coordinates, states, settings, dt)
     skipped = [sc.name for sc in system.scenarios if sc.name not in states]
     if skipped:
-        outside.append(f"no keyframe for the scenarios that change parameters: "
+        outside.append(f"no initial state for the scenarios that change parameters: "
                        f"{', '.join(skipped)}")
     return text, outside

@@ -1229,6 +1229,48 @@ class PyBulletBackend(Backend):
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone Python script, what it does not reproduce): the build `simulate`
+        makes, recorded call by call (simulators/script_export.py), from the first
+        initial state, then stepping and the description's coordinates at the end."""
+        import pybullet
+
+        from .script_export import Recorder, script
+
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        recorder = Recorder(pybullet)
+        world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
+        try:
+            outside = []
+            if self._inputs(pybullet, world, dt) is not None:
+                laws = [e.name for e in mechanism.forces]
+                outside.append("the force laws' joint and point forces (TORQUE_CONTROL and "
+                               f"applyExternalForce before every step): {', '.join(laws)}")
+            if mechanism.prescribed:
+                outside.append("the prescribed motions' velocity motors, set before every "
+                               "step: " + ", ".join(p.name for p in mechanism.prescribed))
+            n = world.plan.n
+            text = script(
+                title=(f"The mechanism as mbfidelity builds it in PyBullet "
+                       f"{self.version()}, from the initial state of scenario {name!r}.\n"
+                       f"Backend settings:\n" + "\n".join(f"  {k} = {v!r}"
+                                                           for k, v in cfg.items())),
+                module="pybullet", connect="pybullet.connect(pybullet.DIRECT)",
+                client_id=world.cid, calls=recorder.calls,
+                step="pybullet.stepSimulation(physicsClientId=cid)",
+                read=(f"[s[0] for s in pybullet.getJointStates({world.body}, "
+                      f"{list(world.eidx[:n])}, physicsClientId=cid)]"),
+                coordinates=coordinates, T=world.plan.map.T, c=world.plan.map.c, dt=dt,
+                not_in_script=outside)
+        finally:
+            pybullet.disconnect(physicsClientId=world.cid)
+        return text, outside
+
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
