@@ -198,10 +198,17 @@ def test_the_python_api_returns_what_the_cli_prints():
         assert "\n" not in str(err.value)
 
 
+#: what each script shows of the defaults its backend neutralises
+NEUTRALISED = {"pybullet": ("linearDamping=0.0", "angularDamping=0.0"),
+               "exudyn": ("'automaticStepSize': False", "'adaptiveStep': False")}
+
+
+@pytest.mark.parametrize("engine", sorted(NEUTRALISED))
 @pytest.mark.parametrize("system_id", ["double_pendulum", "five_bar_bird"])
-def test_an_exported_pybullet_script_moves_as_the_harness_build(tmp_path, system_id):
-    """Issue 14: the standalone script (only pybullet imported) run for 1 s gives the
-    harness's coordinates to 1e-12; the defaults the backend neutralises are visible."""
+def test_an_exported_script_moves_as_the_harness_build(tmp_path, system_id, engine):
+    """Issue 14: the standalone script (only the engine imported) run for 1 s gives the
+    harness's coordinates to 1e-12, on a chain and on a closed loop; the defaults the
+    backend neutralises are visible in it."""
     import subprocess
     import sys
 
@@ -209,21 +216,21 @@ def test_an_exported_pybullet_script_moves_as_the_harness_build(tmp_path, system
     from mbfidelity.simulators import get_backend
 
     path = tmp_path / f"{system_id}.py"
-    res = runner.invoke(app, ["export", system_id, "--sim", "pybullet", "--out", str(path)])
+    res = runner.invoke(app, ["export", system_id, "--sim", engine, "--out", str(path)])
     assert res.exit_code == 0, res.output
     assert "not in the file" not in res.output
     text = path.read_text()
     assert "import mbfidelity" not in text and "from mbfidelity" not in text
-    assert "linearDamping=0.0" in text and "angularDamping=0.0" in text
+    assert all(shown in text for shown in NEUTRALISED[engine])
     out = subprocess.run([sys.executable, str(path), "1.0"], capture_output=True, text=True,
-                         check=True, timeout=120).stdout
+                         check=True, timeout=120, cwd=tmp_path).stdout
     printed = json.loads(out.strip().splitlines()[0])
 
     system = systems.get_system(system_id)
     values = system.parameter_values()
     scenario = system.scenarios[0]
     q0, qd0 = consistent_initial_state(system, scenario, values)
-    run = get_backend("pybullet").simulate(system.numeric_mechanism(values), q0, qd0, 1.0, 1e-3)
+    run = get_backend(engine).simulate(system.numeric_mechanism(values), q0, qd0, 1.0, 1e-3)
     assert np.max(np.abs(run.q[-1] - q0)) > 1e-3  # it moved
     np.testing.assert_allclose([printed[c] for c in system.coordinates], run.q[-1],
                                rtol=0, atol=1e-12)

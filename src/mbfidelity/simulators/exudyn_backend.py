@@ -725,6 +725,54 @@ class ExudynBackend(Backend):
         s.linearSolver.ignoreSingularJacobian = False
         return s
 
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone Python script, what it does not reproduce): every node, object,
+        marker and load of the system `simulate` builds, as the dictionaries Exudyn
+        reports for them (mbs.GetObject(i), ...), added back in the same order, the
+        simulation settings as their dictionary, then `SolveDynamic` and the
+        description's coordinates at the end (simulators/script_export.py). Python user
+        functions (force laws, prescribed motion) cannot be written out: they are left
+        out of the items and listed."""
+        from .script_export import exudyn_script
+
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        solver = self._checked_solver(mechanism, cfg)
+        q0, qd0 = self._driven_state(mechanism, q0, qd0)
+        exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
+        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
+        driven = self._add_prescribed(mbs, mechanism, node, geo)
+        data = mbs.systemData
+        items = [(kind, get(i)) for kind, count, get in (
+            ("Node", data.NumberOfNodes(), mbs.GetNode),
+            ("Object", data.NumberOfObjects(), mbs.GetObject),
+            ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
+            ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
+        sim = self._simulation_settings(exu, cfg, 1.0, int(round(1.0 / dt)))
+        sim.timeIntegration.generalizedAlpha.computeInitialAccelerations = not driven
+        if closures or driven:
+            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
+                cfg["constrained_spectral_radius"])
+        outside = []
+        if mechanism.forces:
+            outside.append("the force laws computed in Python user functions: "
+                           + ", ".join(f.name for f in mechanism.forces))
+        if driven:
+            outside.append("the prescribed motions' offset user functions and the "
+                           "consistent start the harness computes: "
+                           + ", ".join(p.name for p in mechanism.prescribed))
+        text = exudyn_script(
+            title=(f"The mechanism as mbfidelity builds it in Exudyn {self.version()}, from "
+                   f"the initial state of scenario {name!r}, solver {solver}.\nBackend "
+                   f"settings:\n" + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
+            items=items, simulation=sim.GetDictionary(), solver=solver, node=int(node),
+            coordinates=coordinates, T=geo.T, c=geo.c, dt=dt, not_in_script=outside)
+        return text, outside
+
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         solver = self._solver_for(mechanism, self.resolve_settings(settings))
         # implicit solvers are unconditionally stable; of the explicit ones only the

@@ -1,11 +1,13 @@
-"""A build through an engine's Python API, written out as a standalone script: the
-backend builds the mechanism against a `Recorder` that stands in for the engine's module,
-forwards every call and keeps those that change the world; `script` writes them as
-literal calls (every default the backend neutralises is one of them, visible), then steps
-and prints the description's coordinates through the coordinate map.
+"""A build through an engine's Python API, written out as a standalone script that needs
+only the engine: it builds, steps and prints the description's coordinates through the
+coordinate map. Two routes. PyBullet: the backend builds against a `Recorder` that stands
+in for the engine's module, forwards every call and keeps those that change the world;
+`script` writes them as literal calls (every default the backend neutralises is one of
+them, visible). Exudyn: the system's items as the dictionaries Exudyn reports for them and
+the simulation settings as theirs, added back in order (`exudyn_script`).
 
-Calls that only read the world (``get*``, ``compute*``) are left out, so are ``connect``
-and ``disconnect`` (the script opens its own client). Identifiers the engine returns
+Recorded calls that only read the world (``get*``, ``compute*``) are left out, so are
+``connect`` and ``disconnect`` (the script opens its own client). Identifiers the engine returns
 (bodies, constraints, shapes) are deterministic in a fresh client, so they are written as
 the numbers the recording saw.
 """
@@ -92,6 +94,77 @@ def script(*, title: str, module: str, connect: str, client_id: int,
     lines += ["", "steps = int(round(float(sys.argv[1] if len(sys.argv) > 1 else 1.0) / DT))",
               "for _ in range(steps):", f"    {step}", f"values = {read}",
               "q = [sum(T[i][j] * values[j] for j in range(len(values))) + C[i]",
+              "     for i in range(len(COORDINATES))]",
+              "print(json.dumps(dict(zip(COORDINATES, q))))", ""]
+    return "\n".join(lines)
+
+
+# --- Exudyn: the system's items as the dictionaries Exudyn reports -----------------------
+
+#: item keys that are derived from others, or only draw the item
+EXUDYN_DERIVED_KEYS = ("jointHTs", "localHT")
+
+
+def exudyn_literal(x: Any) -> str:
+    """Python source of a value of an Exudyn item dictionary: its enums by name, its
+    3-D lists by their constructors, item indices as numbers."""
+    kind = type(x).__name__
+    if kind in ("Matrix3DList", "Vector3DList", "Matrix6DList"):
+        # these lists index but do not iterate safely
+        return f"exudyn.{kind}({exudyn_literal([np.asarray(x[i]).tolist() for i in range(len(x))])})"
+    if kind.endswith("Index"):
+        return repr(int(x))
+    if type(x).__module__.startswith("exudyn") and hasattr(x, "name"):
+        return f"exudyn.{kind}.{x.name}"
+    if isinstance(x, dict):
+        return "{" + ", ".join(f"{k!r}: {exudyn_literal(v)}" for k, v in x.items()) + "}"
+    if isinstance(x, (list, tuple)):
+        return "[" + ", ".join(exudyn_literal(v) for v in x) + "]"
+    return literal(x)
+
+
+def _exudyn_item(kind: str, item: dict) -> tuple[str, bool]:
+    """(source adding the item, whether a Python user function was left out)."""
+    kept, dropped = {}, False
+    for key, value in item.items():
+        if key.startswith("V") or key in EXUDYN_DERIVED_KEYS:
+            continue
+        if "UserFunction" in key:
+            dropped |= not (isinstance(value, int) and value == 0)
+            continue
+        kept[key] = value
+    return f"mbs.Add{kind}({exudyn_literal(kept)})", dropped
+
+
+def exudyn_script(*, title: str, items: Sequence[tuple[str, dict]], simulation: dict,
+                  solver: str, node: int, coordinates: Sequence[str], T: np.ndarray,
+                  c: np.ndarray, dt: float, not_in_script: Sequence[str]) -> str:
+    """A script that adds the `items` back in order, sets the `simulation` settings'
+    dictionary, solves with `solver` for the requested time and prints q = T u + c of
+    the tree's coordinates u (node `node`) as JSON."""
+    added = [_exudyn_item(kind, item) for kind, item in items]
+    lines = [f'"""{title}', "",
+             "Standalone: needs only the engine. Usage: python THIS_FILE [SECONDS] (default 1);",
+             "prints the description's coordinates at that time as JSON."]
+    if not_in_script:
+        lines += ["", "Not in this script (the harness adds them, so the motion differs",
+                  "from the harness's where they act):"]
+        lines += [f"- {note}" for note in not_in_script]
+    lines += ['"""', "import json", "import sys", "", "import exudyn", "",
+              f"DT = {dt!r}", f"COORDINATES = {list(coordinates)!r}",
+              "# description coordinates from the tree's coordinates u: q = T u + c",
+              f"T = {literal(np.asarray(T))}", f"C = {literal(np.asarray(c))}", "",
+              "SC = exudyn.SystemContainer()", "mbs = SC.AddSystem()"]
+    lines += [source for source, _ in added]
+    lines += ["mbs.Assemble()", "", "simulation = exudyn.SimulationSettings()",
+              f"simulation.SetDictionary({exudyn_literal(simulation)})",
+              "steps = int(round(float(sys.argv[1] if len(sys.argv) > 1 else 1.0) / DT))",
+              "simulation.timeIntegration.numberOfSteps = steps",
+              "simulation.timeIntegration.endTime = steps * DT",
+              "simulation.solution.sensors.writePeriod = 0.5 * DT",
+              f"mbs.SolveDynamic(simulation, solverType=exudyn.DynamicSolverType.{solver})",
+              f"u = mbs.GetNodeOutput({node}, exudyn.OutputVariableType.Coordinates)",
+              "q = [sum(T[i][j] * u[j] for j in range(len(u))) + C[i]",
               "     for i in range(len(COORDINATES))]",
               "print(json.dumps(dict(zip(COORDINATES, q))))", ""]
     return "\n".join(lines)
