@@ -234,3 +234,27 @@ def test_an_exported_script_moves_as_the_harness_build(tmp_path, system_id, engi
     assert np.max(np.abs(run.q[-1] - q0)) > 1e-3  # it moved
     np.testing.assert_allclose([printed[c] for c in system.coordinates], run.q[-1],
                                rtol=0, atol=1e-12)
+
+
+def test_an_installed_package_registers_its_mechanism_by_entry_point(tmp_path, monkeypatch):
+    """A package that declares `[project.entry-points."mbfidelity.systems"]` adds its
+    mechanism to the catalog: here a distribution on sys.path (its .dist-info with the
+    entry point, as pip would install it) whose module is the README's example."""
+    import importlib
+    import shutil
+
+    shutil.copy(EXAMPLE, tmp_path / "users_cart.py")
+    (tmp_path / "users_cart.py").write_text(
+        (tmp_path / "users_cart.py").read_text().replace('id="cart_pendulum"',
+                                                         'id="users_cart"'))
+    info = tmp_path / "users_cart-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: users-cart\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(
+        f"[{systems.ENTRY_POINT_GROUP}]\nusers_cart = users_cart\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    importlib.invalidate_caches()
+    systems._REGISTRY = None
+    res = runner.invoke(app, ["list", "--json"])
+    assert res.exit_code == 0, res.output
+    assert "users_cart" in {s["system"] for s in json.loads(res.output)["systems"]}
