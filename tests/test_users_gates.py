@@ -200,15 +200,17 @@ def test_the_python_api_returns_what_the_cli_prints():
 
 #: what each script shows of the defaults its backend neutralises
 NEUTRALISED = {"pybullet": ("linearDamping=0.0", "angularDamping=0.0"),
-               "exudyn": ("'automaticStepSize': False", "'adaptiveStep': False")}
+               "exudyn": ("'automaticStepSize': False", "'adaptiveStep': False"),
+               "pymunk": ("space.damping = 1.0", "space.sleep_time_threshold = math.inf")}
 
 
 @pytest.mark.parametrize("engine", sorted(NEUTRALISED))
 @pytest.mark.parametrize("system_id", ["double_pendulum", "five_bar_bird"])
 def test_an_exported_script_moves_as_the_harness_build(tmp_path, system_id, engine):
     """Issue 14: the standalone script (only the engine imported) run for 1 s gives the
-    harness's coordinates to 1e-12, on a chain and on a closed loop; the defaults the
-    backend neutralises are visible in it."""
+    harness's coordinates to 1e-12, on a chain and on a closed loop (Pymunk's prints its
+    bodies' states: their angles against the harness's, through the coordinate map); the
+    defaults the backend neutralises are visible in it."""
     import subprocess
     import sys
 
@@ -232,6 +234,15 @@ def test_an_exported_script_moves_as_the_harness_build(tmp_path, system_id, engi
     q0, qd0 = consistent_initial_state(system, scenario, values)
     run = get_backend(engine).simulate(system.numeric_mechanism(values), q0, qd0, 1.0, 1e-3)
     assert np.max(np.abs(run.q[-1] - q0)) > 1e-3  # it moved
+    if engine == "pymunk":
+        from mbfidelity.simulators.plan import coordinate_map
+
+        angles = coordinate_map(system.numeric_mechanism(values))
+        assert printed  # every engine body, by name
+        np.testing.assert_allclose([state[2] for state in printed.values()],
+                                   [float(angles.angle(body, run.q[-1])) for body in printed],
+                                   rtol=0, atol=1e-12)
+        return
     np.testing.assert_allclose([printed[c] for c in system.coordinates], run.q[-1],
                                rtol=0, atol=1e-12)
 

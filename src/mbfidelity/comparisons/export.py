@@ -2,8 +2,8 @@
 for MuJoCo the MJCF (loadable by ``mujoco.MjModel.from_xml_path``) with a keyframe per
 scenario's initial state and the coordinate map (simulators/mujoco_backend.py, `export`);
 for an engine built through its Python API, a standalone script of the recorded build
-calls (PyBullet) or of the system's item dictionaries (Exudyn), see
-simulators/script_export.py. A backend without `export` has none."""
+calls (PyBullet), of the system's item dictionaries (Exudyn) or of the space read back
+(Pymunk), see simulators/script_export.py. A backend without `export` has none."""
 from __future__ import annotations
 
 from typing import Mapping
@@ -24,7 +24,7 @@ def export_model(system_id: str, simulator: str, params: Mapping[str, float] | N
     backend = get_backend(simulator)
     if not hasattr(backend, "export"):
         raise ValueError(f"no export for {simulator}: its build is not recorded as a file or "
-                         f"a script (export exists for MuJoCo's MJCF and PyBullet's and Exudyn's scripts)")
+                         f"a script (export exists for MuJoCo's MJCF and the other engines' scripts)")
     values = system.parameter_values(params)
     mech = system.numeric_mechanism(values)
     support = backend.support(mech)

@@ -4,7 +4,9 @@ coordinate map. Two routes. PyBullet: the backend builds against a `Recorder` th
 in for the engine's module, forwards every call and keeps those that change the world;
 `script` writes them as literal calls (every default the backend neutralises is one of
 them, visible). Exudyn: the system's items as the dictionaries Exudyn reports for them and
-the simulation settings as theirs, added back in order (`exudyn_script`).
+the simulation settings as theirs, added back in order (`exudyn_script`). Pymunk: the
+space, its bodies and its constraints read back from the built space, each constructed
+with its parameters and every attribute the backend sets (`pymunk_script`).
 
 Recorded calls that only read the world (``get*``, ``compute*``) are left out, so are
 ``connect`` and ``disconnect`` (the script opens its own client). Identifiers the engine returns
@@ -13,6 +15,7 @@ the numbers the recording saw.
 """
 from __future__ import annotations
 
+import math
 from typing import Any, Sequence
 
 import numpy as np
@@ -168,3 +171,102 @@ def exudyn_script(*, title: str, items: Sequence[tuple[str, dict]], simulation: 
               "     for i in range(len(COORDINATES))]",
               "print(json.dumps(dict(zip(COORDINATES, q))))", ""]
     return "\n".join(lines)
+
+
+# --- Pymunk: the built space read back ---------------------------------------------------
+
+#: constructor arguments of the constraints the backends build, after the two bodies
+PYMUNK_CONSTRUCTORS = {
+    "PivotJoint": ("anchor_a", "anchor_b"),
+    "PinJoint": ("anchor_a", "anchor_b"),
+    "GrooveJoint": ("groove_a", "groove_b", "anchor_b"),
+    "GearJoint": ("phase", "ratio"),
+}
+#: attributes set after construction (a PinJoint's distance is measured at construction,
+#: from wherever the bodies were then: it is set again)
+PYMUNK_ATTRIBUTES = {"PinJoint": ("distance",)}
+PYMUNK_COMMON = ("error_bias", "max_bias", "max_force", "collide_bodies")
+
+
+def pymunk_script(*, title: str, space, first_iterations: int, iterations: int,
+                  names: dict, dt: float, not_in_script: Sequence[str]) -> str:
+    """A script that rebuilds `space` (bodies in their order, named by `names`: body ->
+    name), steps it (`first_iterations` solver iterations in the first step, then
+    `iterations`) and prints every body's frame position, angle, velocity and angular
+    velocity as JSON."""
+    import pymunk
+
+    bodies = list(space.bodies)
+    if space.shapes:
+        raise ValueError("a space with shapes (contacts) is not written out")
+    index = {b: i for i, b in enumerate(bodies)}
+
+    def body(b) -> str:
+        return "space.static_body" if b is space.static_body else f"bodies[{index[b]}]"
+
+    lines = [f'"""{title}', "",
+             "Standalone: needs only the engine. Usage: python THIS_FILE [SECONDS] (default 1);",
+             "prints each body's frame position, angle, velocity and angular velocity as",
+             "JSON."]
+    if not_in_script:
+        lines += ["", "Not in this script (the harness applies them at every step, so the",
+                  "motion differs from the harness's where they act):"]
+        lines += [f"- {note}" for note in not_in_script]
+    lines += ['"""', "import json", "import math", "import sys", "", "import pymunk", "",
+              f"DT = {dt!r}", f"NAMES = {[names[b] for b in bodies]!r}", "",
+              "space = pymunk.Space()",
+              f"space.gravity = {literal(tuple(space.gravity))}",
+              f"space.damping = {literal(space.damping)}",
+              f"space.sleep_time_threshold = {_pymunk_number(space.sleep_time_threshold)}",
+              "bodies = []"]
+    for b in bodies:
+        kind = {pymunk.Body.DYNAMIC: "DYNAMIC", pymunk.Body.KINEMATIC: "KINEMATIC",
+                pymunk.Body.STATIC: "STATIC"}[b.body_type]
+        if kind == "DYNAMIC":
+            lines.append(f"b = pymunk.Body({_pymunk_number(b.mass)}, "
+                         f"{_pymunk_number(b.moment)})")
+        else:
+            lines.append(f"b = pymunk.Body(body_type=pymunk.Body.{kind})")
+        lines += [f"b.center_of_gravity = {literal(tuple(b.center_of_gravity))}",
+                  f"b.angle = {literal(b.angle)}",
+                  f"b.position = {literal(tuple(b.position))}",
+                  f"b.velocity = {literal(tuple(b.velocity))}",
+                  f"b.angular_velocity = {literal(b.angular_velocity)}",
+                  "space.add(b)", "bodies.append(b)"]
+    lines.append("constraints = []")
+    for c in space.constraints:
+        kind = type(c).__name__
+        if kind not in PYMUNK_CONSTRUCTORS:
+            raise ValueError(f"a {kind} is not written out")
+        args = [body(c.a), body(c.b)] + [literal(_plain(getattr(c, a)))
+                                         for a in PYMUNK_CONSTRUCTORS[kind]]
+        lines.append(f"c = pymunk.{kind}({', '.join(args)})")
+        for attribute in PYMUNK_ATTRIBUTES.get(kind, ()) + PYMUNK_COMMON:
+            value = getattr(c, attribute)
+            lines.append(f"c.{attribute} = " + (repr(bool(value)) if attribute == "collide_bodies"
+                                                 else _pymunk_number(value)))
+        lines.append("constraints.append(c)")
+    lines += ["space.add(*constraints)", "",
+              "steps = int(round(float(sys.argv[1] if len(sys.argv) > 1 else 1.0) / DT))",
+              "# the first step has no cached impulses to start from: more iterations",
+              f"space.iterations = {int(first_iterations)}",
+              "for k in range(steps):",
+              "    space.step(DT)",
+              "    if k == 0:",
+              f"        space.iterations = {int(iterations)}",
+              "print(json.dumps({name: [*b.position, b.angle, *b.velocity, b.angular_velocity]",
+              "                  for name, b in zip(NAMES, bodies)}))", ""]
+    return "\n".join(lines)
+
+
+def _plain(value):
+    """A pymunk Vec2d as a tuple; numbers as they are."""
+    return tuple(value) if hasattr(value, "x") and hasattr(value, "y") else value
+
+
+def _pymunk_number(x) -> str:
+    """A number, with infinity written as math.inf."""
+    if isinstance(x, bool):
+        return repr(x)
+    x = float(x)
+    return ("math.inf" if x > 0 else "-math.inf") if math.isinf(x) else repr(x)
