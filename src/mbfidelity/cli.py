@@ -440,6 +440,72 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                ", ".join(f"{k} {v}" for k, v in counts.items()))
 
 
+@app.command("convergence")
+def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems",
+                                                                help="system ids"),
+                    sims: Optional[List[str]] = typer.Option(
+                        None, "--sims", help="simulator ids (default: every installed one)"),
+                    steps: str = typer.Option("4e-3,2e-3,1e-3,5e-4", "--steps",
+                                              help="the steps, s (multiples of the finest)"),
+                    t_end: float = typer.Option(2.0, "--t-end", help="simulated time, s"),
+                    out: Optional[Path] = typer.Option(
+                        None, "--out", help="also write convergence.json, convergence.html "
+                                            "and the figures there"),
+                    scheduler: Optional[str] = typer.Option(
+                        None, "--scheduler", help="a Dask scheduler's address (default: a "
+                                                  "local process pool)"),
+                    as_json: bool = typer.Option(False, "--json"),
+                    ) -> None:
+    """Error against the step and work-precision, per system x engine: the fitted order
+    next to the engine's declared order (gate: within 0.5, where the curve still falls).
+    Exit 1 when an order gate fails."""
+    from .comparisons import convergence as conv
+    from .comparisons.runner import provenance
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = _split(systems) or list(all_systems())
+    for s in sys_ids:
+        _system(s)
+    sim_ids = _split(sims) or [e for e, b in all_backends().items() if b.available()[0]]
+    for e in sim_ids:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    try:
+        dts = sorted({float(x) for x in steps.split(",") if x}, reverse=True)
+    except ValueError:
+        _fail(f"--steps expects numbers A,B,...; got {steps!r}")
+    if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
+        _fail(f"--steps needs at least {conv.MIN_FIT_POINTS} positive steps; got {steps!r}")
+    if not t_end > 0:
+        _fail("--t-end must be positive")
+    try:
+        studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
+    except ValueError as exc:
+        _fail(str(exc))
+    doc = {"provenance": provenance(), "steps": dts, "t_end": t_end,
+           "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
+           "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
+    failed = [s for s in studies if s["metric"]["status"] in ("fail", "xpass")
+              or (s["metric"]["status"] == "unresolved" and not s["metric"].get("expected"))]
+    if out is not None:
+        from .reports.convergence_page import CONVERGENCE, write_convergence_page
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=_jsonable))
+        page = write_convergence_page(out)
+    if as_json:
+        _json(doc)
+    else:
+        for s in studies:
+            order = (f"{s['observed_order']:.2f}" if s["observed_order"] is not None else "-")
+            typer.echo(f"{s['system']:28s} {s['simulator']:9s} order {order:>5s} / "
+                       f"{s['integrator_order']}  {s['metric']['status']}")
+        if out is not None:
+            typer.echo(f"page: {page.resolve()}")
+    raise typer.Exit(1 if failed else 0)
+
+
 @app.command("check")
 def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
               sims: Optional[List[str]] = typer.Option(

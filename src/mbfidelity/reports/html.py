@@ -84,6 +84,10 @@ bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} mi
 {% if expected[sys] %}<p>Declared expected failures:</p><ul>{% for e in expected[sys] %}<li><b>{{ e.simulator }}</b>, {{ e.metric }}: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
+{% if convergence %}<h2>Convergence and work-precision</h2>
+<p>Each engine's error against the step, its fitted order next to the declared one, and its
+error against CPU seconds: <a href="convergence.html">convergence.html</a> (written by
+<code>mbfidelity convergence --out DIR</code>; <code>make report</code> writes it).</p>{% endif %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
 <p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
 (written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
@@ -207,7 +211,8 @@ def write_report(out: Path, workers: int | None = None) -> Path:
                            titles={s: _title(s) for s in systems}, versions=versions,
                            explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
                            expected={s: _expected(s) for s in systems},
-                           liftoff=liftoff)
+                           liftoff=liftoff,
+                           convergence=(out / "convergence.json").exists())
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))

@@ -66,6 +66,13 @@ FIRST_ORDER_NEUTRAL = (
     "first-order trajectory bound (w h) + (w h)^2 (1 + w T) (comparisons/tolerances.py) "
     "exceeds a tenth of the amplitude at dt = 1e-3 s; at dt = 2.5e-4 s it resolves.")
 
+FIRST_ORDER_MIXED = (
+    "Semi-implicit Euler on this weakly (negatively) damped oscillation: its O(h) "
+    "distortion of the orbit and its O(h^2 w T) phase drift are of one size at the studied "
+    "steps and partly cancel in the error's maximum, so the error falls irregularly with "
+    "the step (by 1.4 to 2.5 per halving) and no single order fits (mbfidelity "
+    "convergence).")
+
 #: the belt speeds of Fig. 22: unstable, critical and stable rest state
 BELT_SPEEDS = (0.29, 0.30, 0.31)
 
@@ -163,6 +170,8 @@ SYSTEM = System(
     stability_parameter="v0",
     expectations=(
         Expectation("*", "v0_0_29.trajectory_*", "unresolved", STICK_SLIP_DRIFT),
+        *(Expectation(engine, "convergence.order", "unresolved", FIRST_ORDER_MIXED)
+          for engine in ("pybullet", "pymunk")),
         *(Expectation(engine, metric, "unresolved", FIRST_ORDER_NEUTRAL)
           for engine in ("pybullet", "pymunk")
           for metric in ("v0_0_30.trajectory_*", "v0_0_30.final_amplitude")),
