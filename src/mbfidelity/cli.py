@@ -403,9 +403,29 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                as_json: bool = typer.Option(False, "--json"),
                out: Optional[Path] = typer.Option(
                    None, "--out", help="also write strutt.json and strutt.png there"),
+               sim: Optional[List[str]] = typer.Option(
+                   None, "--sim", help="also classify every point by this engine's runs "
+                                       "(repeatable)"),
+               scheduler: Optional[str] = typer.Option(
+                   None, "--scheduler", help="a Dask scheduler's address for the engines' "
+                                             "runs (default: a local process pool)"),
+               steps_per_period: int = typer.Option(
+                   200, "--steps-per-period", help="engine steps per excitation period"),
+               periods: int = typer.Option(10, "--periods",
+                                           help="excitation periods of each engine run"),
                ) -> None:
-    """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory."""
+    """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory, and with
+    --sim from each engine's simulation of the pendulum that maps to every point."""
     from .analytic.strutt import strutt_chart
+    from .simulators import all_backends
+
+    engines = _split(sim)
+    for e in engines:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+        ok, why = all_backends()[e].available()
+        if not ok:
+            _fail(f"{e} is not installed: {why}")
 
     def bounds(text: str, option: str) -> tuple[float, float]:
         try:
@@ -425,6 +445,13 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                                                                    "marginal")}
     doc = {"equation": "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)",
            "period": 2 * np.pi, "grid": grid, "counts": counts, "points": points}
+    if engines:
+        from .comparisons.strutt_engines import engine_chart
+
+        if steps_per_period < 4 or periods < 1:
+            _fail("--steps-per-period must be at least 4 and --periods at least 1")
+        doc["simulation"] = engine_chart(points, engines, scheduler=scheduler,
+                                         periods=periods, steps_per_period=steps_per_period)
     if out is not None:
         from .reports.strutt_figure import write_strutt_figure
 
@@ -438,6 +465,10 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
         return
     typer.echo(f"Strutt chart of eq. 83, {grid} x {grid} points: " +
                ", ".join(f"{k} {v}" for k, v in counts.items()))
+    for e, summary in doc.get("simulation", {}).get("engines", {}).items():
+        typer.echo(f"  {e}: agrees with eq. 83 at {summary['agreement_with_eq83']:.1%} of "
+                   f"{summary['decided_points']} decided points "
+                   f"({len(summary['disagreements'])} differ)")
 
 
 @app.command("convergence")
