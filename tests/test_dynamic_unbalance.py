@@ -1,0 +1,61 @@
+"""The dynamically unbalanced rotor (monograph §8.8, Fig. 32, eq. 87-88), a spatial
+mechanism. Expected values are the closed forms worked by hand in tests/hand/
+dynamic_unbalance.py (steady response of eq. 88, motor torque about e3)."""
+import numpy as np
+import pytest
+
+from mbfidelity.analytic.linear import operating_equilibrium
+from mbfidelity.analytic.reference import reference
+from mbfidelity.systems import get_system
+
+from hand import dynamic_unbalance as hand
+
+SYSTEM = get_system("dynamic_unbalance")
+
+
+def _scenario(name):
+    return next(sc for sc in SYSTEM.scenarios if sc.name == name)
+
+
+def test_the_description_is_spatial_and_pymunk_says_why_it_cannot_build_it():
+    from mbfidelity.simulators import all_backends
+
+    assert SYSTEM.mechanism.spatial
+    mech = SYSTEM.numeric_mechanism(SYSTEM.parameter_values())
+    support = all_backends()["pymunk"].support(mech)
+    assert not support.ok and "planar (2-D) engine" in support.reason
+
+
+def test_steady_scenario_follows_the_steady_response_of_eq88():
+    sc = _scenario("steady")
+    v = SYSTEM.parameter_values(scenario=sc)
+    ref = reference(SYSTEM, sc, v, 1e-2)
+    A = hand.steady_amplitude(v)
+    w = v["omega"]
+    np.testing.assert_allclose(ref.q[:, 0], A * np.sin(w * ref.t), rtol=0, atol=1e-9 * abs(A))
+    np.testing.assert_allclose(ref.q[:, 1], w * ref.t, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["steady", "parametric"])
+def test_motor_torque_is_the_e3_component_of_the_momentum_derivative(name):
+    sc = _scenario(name)
+    v = SYSTEM.parameter_values(scenario=sc)
+    ref = reference(SYSTEM, sc, v, 1e-2)
+    want = hand.motor_torque(v, ref.t, ref.qd[:, 0], ref.qdd[:, 0])
+    got = ref.actuator_forces["motor"]
+    assert np.max(np.abs(want)) > 1e-5  # the check is not vacuous
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.max(np.abs(want)))
+
+
+def test_unequal_moments_make_a_parametric_system_without_an_equilibrium():
+    """I1 != I2 (eq. 87): the inertia about the vertical varies with omega t, so the
+    driven linearization, which needs constant coefficients, refuses it."""
+    v = SYSTEM.parameter_values({"I1": 0.012, "I2": 0.008})
+    with pytest.raises(ValueError, match="periodic-coefficient"):
+        operating_equilibrium(SYSTEM, v)
+
+
+def test_natural_frequency_of_eq88():
+    v = SYSTEM.parameter_values()
+    (mode,) = operating_equilibrium(SYSTEM, v).modes
+    assert abs(mode.eigenvalue) == pytest.approx(hand.frequencies(v)[0], rel=1e-12)
