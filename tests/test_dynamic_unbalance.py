@@ -68,3 +68,23 @@ def test_natural_frequency_of_eq88():
     v = SYSTEM.parameter_values()
     (mode,) = operating_equilibrium(SYSTEM, v).modes
     assert abs(mode.eigenvalue) == pytest.approx(hand.frequencies(v)[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet", "exudyn"])
+def test_each_engine_stores_the_full_tensor(engine):
+    """The rotor's tensor as the engine stored it (principal moments and axes, read back)
+    is the description's; its principal moments, worked by hand: I1, and the eigenvalues
+    (I2 + I3)/2 -+ sqrt(((I3 - I2)/2)^2 + I23^2) of the e2-e3 block."""
+    from mbfidelity.comparisons.runner import compare
+    from mbfidelity.simulators import all_backends
+
+    ok, why = all_backends()[engine].available()
+    if not ok:
+        pytest.skip(why)
+    result = compare("dynamic_unbalance", engine, scenarios=["steady"])
+    rotor = {m.name: m for m in result.metrics}["inertia.rotor"]
+    assert rotor.status == "pass", (rotor.value, rotor.tolerance)
+    v = SYSTEM.parameter_values()
+    mean, half = (v["I2"] + v["I3"]) / 2, np.hypot((v["I3"] - v["I2"]) / 2, v["I23"])
+    np.testing.assert_allclose(sorted(rotor.detail["engine_principal_moments"]),
+                               sorted([v["I1"], mean - half, mean + half]), rtol=1e-12)

@@ -250,6 +250,13 @@ class Backend(ABC):
         raise NotImplementedError(f"{self.id} declares several cases of {kind} but does "
                                   "not choose among them")
 
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """A spatial mechanism's central inertia as the engine stored it, read back from
+        the built model: per body, (principal moments, principal axes as the columns of a
+        rotation in the body's frame). Empty where the backend does not read it back."""
+        return {}
+
     def translation_reason(self, mechanism: Mechanism) -> str:
         """Why the engine's structure cannot hold the mechanism although no single element
         is unsupported (empty string: it can)."""

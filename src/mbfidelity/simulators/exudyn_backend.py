@@ -462,6 +462,20 @@ class ExudynBackend(Backend):
 
     SPATIAL_REASON = ""
 
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The tree's linkInertiasCOM as stored (a full 3 x 3 tensor, not diagonalised),
+        in principal form."""
+        cfg = self.resolve_settings(settings)
+        zeros = np.zeros(len(mechanism.joints))
+        _, mbs, _, _, tree, _, _ = self._build(mechanism, zeros, zeros, cfg)
+        tensors = np.array(mbs.GetObjectParameter(tree, "linkInertiasCOM"), dtype=float)
+        out = {}
+        for j, tensor in zip(mechanism.joints, tensors.reshape(-1, 3, 3)):
+            values, axes = np.linalg.eigh(tensor)
+            out[j.child] = (values, axes)
+        return out
+
     def translation_reason(self, mechanism: Mechanism) -> str:
         return _spatial_reason(mechanism) if mechanism.spatial else ""
 

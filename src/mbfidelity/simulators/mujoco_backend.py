@@ -1339,6 +1339,21 @@ class MujocoBackend(Backend):
             xml = f"{head}<flag {attrs} {' '.join(flags)}/>{rest}"
         return xml
 
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """body_inertia and body_iquat of the compiled model (the compiler diagonalises
+        fullinertia; the body frame is the description's)."""
+        import mujoco
+
+        model = mujoco.MjModel.from_xml_string(self.to_mjcf(mechanism, settings))
+        out = {}
+        for b in mechanism.bodies:
+            bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b.name)
+            R = np.empty(9)
+            mujoco.mju_quat2Mat(R, model.body_iquat[bid])
+            out[b.name] = (np.array(model.body_inertia[bid], dtype=float), R.reshape(3, 3))
+        return out
+
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         integrator = str(self.resolve_settings(settings)["integrator"])
         if integrator == "RK4":

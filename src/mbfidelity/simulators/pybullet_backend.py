@@ -315,12 +315,9 @@ def principal_inertia(tensor: np.ndarray) -> tuple[list[float], list[float]]:
     values, vectors = np.linalg.eigh(tensor)
     if np.linalg.det(vectors) < 0:
         vectors[:, 2] = -vectors[:, 2]
-    R = vectors
-    w = math.sqrt(max(0.0, 1.0 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
-    x = math.copysign(math.sqrt(max(0.0, 1.0 + R[0, 0] - R[1, 1] - R[2, 2])) / 2, R[2, 1] - R[1, 2])
-    y = math.copysign(math.sqrt(max(0.0, 1.0 - R[0, 0] + R[1, 1] - R[2, 2])) / 2, R[0, 2] - R[2, 0])
-    z = math.copysign(math.sqrt(max(0.0, 1.0 - R[0, 0] - R[1, 1] + R[2, 2])) / 2, R[1, 0] - R[0, 1])
-    return [float(v) for v in values], [x, y, z, w]
+    from scipy.spatial.transform import Rotation
+
+    return [float(v) for v in values], [float(v) for v in Rotation.from_matrix(vectors).as_quat()]
 
 
 def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
@@ -1636,6 +1633,26 @@ class PyBulletBackend(Backend):
                     R += F
             reactions[name] = R
         return reactions
+
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """getDynamicsInfo of each link: its local inertia diagonal and inertial frame
+        orientation (a spatial link's frame is aligned with its body's)."""
+        import pybullet as p
+
+        cfg = self.resolve_settings(settings)
+        plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
+        cid = self._connect(p, cfg, 1e-3, plan.gravity_vector)
+        try:
+            body, eidx, _ = self._build(p, cid, plan, cfg)
+            out = {}
+            for i, lk in enumerate(plan.links[:plan.n]):
+                info = p.getDynamicsInfo(body, eidx[i], physicsClientId=cid)
+                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=cid))
+                out[lk.body] = (np.array(info[2], dtype=float), R.reshape(3, 3))
+            return out
+        finally:
+            p.disconnect(physicsClientId=cid)
 
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
