@@ -88,3 +88,28 @@ def test_each_engine_stores_the_full_tensor(engine):
     mean, half = (v["I2"] + v["I3"]) / 2, np.hypot((v["I3"] - v["I2"]) / 2, v["I23"])
     np.testing.assert_allclose(sorted(rotor.detail["engine_principal_moments"]),
                                sorted([v["I1"], mean - half, mean + half]), rtol=1e-12)
+
+
+@pytest.mark.parametrize("ratio, verdict", [(1.0, "unstable"), (0.8, "stable")])
+def test_analyze_gives_the_floquet_stability_of_the_parametric_case(ratio, verdict):
+    """I1 != I2: d/dt(J(t) psi') + k_t psi = 0 with J = J0 + dJ cos(2 omega t),
+    J0 = I_Gb + (I1 + I2)/2, dJ = (I2 - I1)/2 (eq. 87 at I23 = 0), a Hill equation: the
+    first parametric-resonance tongue sits at 2 omega = 2 sqrt(k_t/J0); at |dJ|/J0 = 0.22
+    its centre is unstable and 0.8 of it lies outside."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from mbfidelity.cli import app
+
+    I1, I2, I_Gb, k_t = 0.03, 0.001, 0.05, 10.0
+    omega = ratio * np.sqrt(k_t / (I_Gb + (I1 + I2) / 2))
+    out = CliRunner().invoke(app, ["analyze", "dynamic_unbalance", "--json",
+                                   "--param", f"I1={I1}", "--param", f"I2={I2}",
+                                   "--param", f"omega={omega}"])
+    assert out.exit_code == 0, out.output
+    doc = json.loads(out.output)
+    assert doc["linearization"] is None and "periodic-coefficient" in doc["periodic_coefficients"]
+    (result,) = doc["floquet"]
+    assert result["verdict"] == verdict, result
+    assert result["period"] == pytest.approx(2 * np.pi / omega, rel=1e-12)
