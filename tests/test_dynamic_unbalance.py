@@ -113,3 +113,38 @@ def test_analyze_gives_the_floquet_stability_of_the_parametric_case(ratio, verdi
     (result,) = doc["floquet"]
     assert result["verdict"] == verdict, result
     assert result["period"] == pytest.approx(2 * np.pi / omega, rel=1e-12)
+
+
+def test_printed_angular_momentum_and_its_derivative_agree_with_the_derivation():
+    """§8.8 prints Omega, L_Gr = I_Gr Omega and the three components of dL_Gr/dt in the
+    rotor basis {e1, e2, e3}. From the derivation's rotation matrices: Omega in body axes
+    (x, y, z) = (e3, e1, e2), and dL/dt = (dL/dt)_body + Omega x L with psi'' free and
+    phi = omega t; every printed component (coded here as printed) must match."""
+    import sympy as sp
+
+    from mbfidelity.analytic.derivation import derivation_of
+    from mbfidelity.systems import coordinate_symbols
+
+    d = derivation_of("dynamic_unbalance")
+    P = SYSTEM.symbols
+    psi, psi_d, psi_dd = coordinate_symbols("psi")
+    phi, phi_d, phi_dd = coordinate_symbols("phi")
+    I1, I2, I3, I23, w = P.I1, P.I2, P.I3, P.I23, P.omega
+    s, c = sp.sin(phi), sp.cos(phi)
+    body = d.angular_velocity("rotor")  # (x, y, z) = (e3, e1, e2)
+    omega_e = sp.Matrix([body[1], body[2], body[0]])
+    assert (omega_e - sp.Matrix([psi_d * s, psi_d * c, phi_d])).applyfunc(sp.simplify) == \
+        sp.zeros(3, 1)
+    I_e = sp.Matrix([[I1, 0, 0], [0, I2, I23], [0, I23, I3]])
+    L = I_e * omega_e
+    rates = {psi: psi_d, psi_d: psi_dd, phi: phi_d, phi_d: phi_dd}
+    L_dot = sp.Matrix([sum(sp.diff(e, x) * v for x, v in rates.items()) for e in L])
+    L_dot = (L_dot + omega_e.cross(L)).subs({phi_d: w, phi_dd: 0})
+    printed = sp.Matrix([
+        I1 * psi_dd * s + I1 * psi_d * w * c + I23 * psi_d**2 * c**2 + I3 * psi_d * w * c
+        - I2 * psi_d * w * c - I23 * w**2,
+        I2 * psi_dd * c - I2 * psi_d * w * s - I23 * psi_d**2 * s * c - I3 * psi_d * w * s
+        + I1 * psi_d * w * s,
+        I23 * psi_dd * c - I23 * psi_d * w * s + I2 * psi_d**2 * s * c + I23 * psi_d * w * s
+        - I1 * psi_d**2 * s * c])
+    assert (L_dot - printed).applyfunc(sp.simplify) == sp.zeros(3, 1)

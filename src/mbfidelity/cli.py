@@ -97,6 +97,9 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
         marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
                          for b in backends)
         typer.echo(f"{r['system']:26s} {marks} {r['source']}")
+        for b in backends:
+            if not r["simulators"][b]["supported"] and r["simulators"][b]["reason"]:
+                typer.echo(f"  {b} unsupported: {r['simulators'][b]['reason']}")
         for name, v in r["variants"].items():
             typer.echo(f"  variant {name}: {', '.join(v['simulators'])}")
 
