@@ -70,11 +70,6 @@ def build(P) -> Mechanism:
     )
 
 
-def steady_amplitude(P):
-    """Amplitude of the steady response of eq. 88, psi = A sin(omega t) (signed)."""
-    return P.I23 * P.omega**2 / (P.k_t - (P.I1 + P.I_Gb) * P.omega**2)
-
-
 def printed(P):
     psi, psi_d, psi_dd = coordinate_symbols("psi")
     phi, phi_d, phi_dd = coordinate_symbols("phi")
