@@ -13,6 +13,10 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   axis scales the slide), generalized forces map with ``T^T``;
 - massless link bodies are kept as zero-mass links (the tree accepts them while the
   mass matrix stays regular, i.e. while a massive descendant carries the coordinates);
+- a spatial mechanism (model convention 10; open trees of massive bodies on relative
+  counter-clockwise hinges about a link axis, without offset) gets RevoluteX/Y/Z links
+  whose frames sit at the joints, aligned with their parents, with the full 3 x 3
+  central tensor in ``linkInertiasCOM`` (stored as given: `stored_inertia`);
 - gravity is the tree's own gravity vector; a `CoordinateForce` whose law is affine in
   COORD/COORD_RATE and free of TIME uses the tree's PD terms (C++), any other law is a
   Python ``forceUserFunction`` of the tree (called at every integrator stage with the

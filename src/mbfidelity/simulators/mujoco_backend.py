@@ -11,6 +11,11 @@ Translation (generic over the description, see `to_mjcf`):
   each with its anchor and axis expressed in the body frame at the reference
   configuration. This is exact (no substitute mass).
 - ``Revolute`` -> hinge about z (relative angle); ``Prismatic`` -> slide in the x-y plane.
+  A spatial mechanism (model convention 10; open trees of massive bodies, relative
+  counter-clockwise joints without offset) is written body by body instead: frames at
+  parent_anchor - child_anchor, joints about the description's axes at child_anchor, the
+  full central tensor as ``fullinertia`` (compiled into body_inertia and body_iquat, read
+  back by `stored_inertia`) and gravity along -up.
   Engine joint values v relate to the description coordinates q by a constant affine map
   ``v = A q + b`` (A lower triangular, diagonal +-1 or the axis length): absolute angles
   become ``q - theta_parent``, clockwise coordinates change sign. The reference

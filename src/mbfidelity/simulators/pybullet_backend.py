@@ -12,6 +12,11 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   angles (``absolute=True``), clockwise coordinates and non-unit prismatic axes make the
   engine's joint values an affine map of the description coordinates, ``jv = A q + b``;
   states map back with ``A^-1`` and generalized forces map as ``tau = A^-T Q``.
+- A spatial mechanism (model convention 10; open trees of massive bodies on relative
+  counter-clockwise hinges without offset): link frames at the 3-D anchors aligned with
+  the parent, hinge axes from the description, the full central tensor as its principal
+  moments (``localInertiaDiagonal``) and principal axes (the inertial frame's
+  orientation), read back by `stored_inertia`; gravity along -up.
 - ``Prismatic``: axis in the x-y plane of the joint frame (the parent axis rotated by
   ``-angle_offset``), normalised (its length goes into ``A``).
 - Massless bodies are links of mass 0 and inertia 0: Featherstone's articulated-body
