@@ -115,47 +115,23 @@ def _modes(eq):
     return [m.as_dict() for m in eq.modes]
 
 
-def _periodic_coefficients(system, values) -> bool:
-    """Whether the driven system's variational equations about its unexcited rest states
-    have coefficients that vary with the prescribed motion (then Floquet's question)."""
-    from .analytic.linear import _PROBE_TIMES, driven_coefficients, driven_rest_states
-    from .analytic.numeric import numeric_model
-
-    try:
-        model = numeric_model(system.id, values)
-        rests = driven_rest_states(system, values, only_operating=True)
-    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError):
-        return False
-    for q in rests:
-        first = driven_coefficients(model, q[model.independent], _PROBE_TIMES[0])
-        for t in _PROBE_TIMES[1:]:
-            later = driven_coefficients(model, q[model.independent], t)
-            if any(not np.allclose(a, b, rtol=1e-9, atol=0) for a, b in zip(first, later)):
-                return True
-    return False
-
-
 def _floquet_analysis(system, values, derived, reason: str, as_json: bool) -> None:
     """`analyze` of a periodic-coefficient driven system: the Floquet multipliers of the
     variational equations about each unexcited rest state over one excitation period."""
     from .analytic.errata import errata
-    from .analytic.floquet import driven_floquet
+    from .analytic.floquet import driven_floquet_summary
 
-    coords = list(system.coordinates)
-    results = driven_floquet(system, values)
+    floquet = driven_floquet_summary(system, values)
     doc = {
         "system": system.id, "title": system.title, "source": system.source,
-        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
+        "coordinates": list(system.coordinates), "parameters": values,
+        "derived_parameters": list(derived),
         "free_coordinates": list(system.mechanism.independent_coordinates),
         "prescribed": {p.coordinate: str(p.motion) for p in system.mechanism.prescribed},
         "linearization": None,
         "periodic_coefficients": reason,
-        "floquet": [{"q": dict(zip(coords, q.tolist())), "period": r.period,
-                     "multipliers": [[complex(m).real, complex(m).imag] for m in r.multipliers],
-                     "moduli": [float(abs(m)) for m in r.multipliers],
-                     "verdict": r.verdict, "margin": r.margin, "error": r.error}
-                    for q, r in results],
-        "stable": bool(results) and all(r.verdict == "stable" for _, r in results),
+        "floquet": floquet,
+        "stable": bool(floquet) and all(r["verdict"] == "stable" for r in floquet),
         "printed_vs_derived": [e.as_dict() for e in errata(system)],
     }
     if as_json:
@@ -179,6 +155,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
     from .analytic.errata import errata
+    from .analytic.floquet import periodic_coefficients
     from .analytic.linear import find_equilibria, operating_equilibrium
 
     _use_cache(no_cache)
@@ -189,7 +166,7 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         eqs = find_equilibria(system, values)
         op = operating_equilibrium(system, values)
     except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
-        if system.driven and _periodic_coefficients(system, values):
+        if system.driven and periodic_coefficients(system, values):
             _floquet_analysis(system, values, derived, str(exc), as_json)
             return
         _fail(f"{system.id} with these parameters has no assembled equilibrium near its "
