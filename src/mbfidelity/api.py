@@ -73,6 +73,11 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
         eqs = find_equilibria(system, values)
         op = operating_equilibrium(system, values)
     except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
+        from .analytic.floquet import driven_floquet_summary, periodic_coefficients
+
+        if system.driven and periodic_coefficients(system, values):
+            return _floquet_document(system, values, derived, str(exc),
+                                     driven_floquet_summary(system, values))
         raise ValueError(f"{system.id} with these parameters has no assembled equilibrium "
                          f"near its operating point ({exc})") from None
 
@@ -123,6 +128,26 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
         else:
             doc["steady_state_harmonic_residual"] = response.harmonic_residual
     return doc
+
+
+def _floquet_document(system, values: dict, derived, reason: str, floquet: list) -> dict:
+    """`analyze` of a driven system whose variational equations have periodic coefficients
+    (no constant linearization): the Floquet multipliers about each unexcited rest state
+    over one excitation period."""
+    from .analytic.errata import errata
+
+    return {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": list(system.coordinates), "parameters": values,
+        "derived_parameters": list(derived),
+        "free_coordinates": list(system.mechanism.independent_coordinates),
+        "prescribed": {p.coordinate: str(p.motion) for p in system.mechanism.prescribed},
+        "linearization": None,
+        "periodic_coefficients": reason,
+        "floquet": floquet,
+        "stable": bool(floquet) and all(r["verdict"] == "stable" for r in floquet),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
 
 
 def _relative_equilibrium(system, coords: list, op) -> dict:

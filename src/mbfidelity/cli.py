@@ -137,6 +137,9 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
         marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
                          for b in backends)
         typer.echo(f"{r['system']:26s} {marks} {r['source']}")
+        for b in backends:
+            if not r["simulators"][b]["supported"] and r["simulators"][b]["reason"]:
+                typer.echo(f"  {b} unsupported: {r['simulators'][b]['reason']}")
         for name, v in r["variants"].items():
             typer.echo(f"  variant {name}: {', '.join(v['simulators'])}")
 
@@ -146,6 +149,17 @@ def _use_cache(off: bool) -> None:
         from .analytic import cache
 
         cache.disable()
+
+
+def _print_floquet(doc: dict) -> None:
+    """`analyze`'s text for a periodic-coefficient driven system."""
+    typer.echo(f"{doc['system']}: {doc['title']} ({doc['source']})")
+    typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in doc["parameters"].items()))
+    typer.echo(f"periodic coefficients: {doc['periodic_coefficients']}")
+    for item in doc["floquet"]:
+        typer.echo(f"Floquet about {item['q']} over T = {item['period']:.9g} s: "
+                   f"{item['verdict']} (|multipliers| = "
+                   + ", ".join(f"{m:.9g}" for m in item["moduli"]) + ")")
 
 
 @app.command()
@@ -166,6 +180,12 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         doc = api.analyze(system.id, params)
     except ValueError as exc:
         _fail(str(exc))
+    if doc.get("floquet") is not None:
+        if as_json:
+            _json(doc)
+        else:
+            _print_floquet(doc)
+        return
     op = SimpleNamespace(**{k: np.asarray(doc["linearization"][k]) for k in "MCK"})
     equilibria = doc["equilibria"]
     if as_json:

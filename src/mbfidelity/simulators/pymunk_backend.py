@@ -1416,6 +1416,9 @@ class PymunkBackend(Backend):
             return cases[1] if substituted else cases[0]
         return cases[1] if any(p.name == element.name for p in layout.pitches) else cases[0]
 
+    SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
+                      "tensor, hinges about horizontal axes) has no expression in it")
+
     def translation_reason(self, mechanism: Mechanism) -> str:
         layout = _plan(mechanism, self.default_settings())
         return layout if isinstance(layout, str) else ""
