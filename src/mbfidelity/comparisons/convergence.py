@@ -73,8 +73,10 @@ class ConvergenceStudy:
     #: the reference's own error relative to the amplitude (0: a closed form), a floor
     #: for the errors
     reference_error: float = 0.0
-    #: a run that failed (unsupported, diverged, an engine error): the message
+    #: a run that failed (diverged, an engine error): the message
     failure: str = ""
+    #: why the engine cannot build the mechanism, when it cannot
+    unsupported: str = ""
 
     @property
     def order_matches(self) -> bool | None:
@@ -139,8 +141,9 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     points, order = [], backend.scheme(mech, settings).order
     study = ConvergenceStudy(system.id, sc.name, simulator, backend.version(), order, points,
                              None, reference_error=reference_error)
-    if not backend.support(mech).ok:
-        study.failure = f"{simulator} cannot express {system.id}: {backend.support(mech).reason}"
+    support = backend.support(mech)
+    if not support.ok:
+        study.unsupported = f"{simulator} cannot express {system.id}: {support.reason}"
         return study
     for dt, k in zip(dts, multiples):
         q_ref = ref.q[::k, free]
@@ -173,6 +176,9 @@ def judge_order(study: ConvergenceStudy) -> Metric:
     ORDER_TOLERANCE; unresolved where the curve flattened; failed for a failed study. A
     declared expected failure that passes is an unexpected pass (strict)."""
     system = get_system(study.system)
+    if study.unsupported:
+        return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "unsupported",
+                      study.unsupported, "order")
     if study.failure:
         return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "fail",
                       study.failure, "order")

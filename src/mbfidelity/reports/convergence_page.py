@@ -19,7 +19,7 @@ TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">
 <title>mbfidelity convergence</title><style>
 body{font-family:sans-serif;margin:2em;max-width:1300px}
 table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
-th{background:#f0f0f0}.pass{background:#dff5df}.fail,.xpass{background:#f8d0d0}.xfail,.unresolved{background:#fbeec8}
+th{background:#f0f0f0}.pass{background:#dff5df}.fail,.xpass{background:#f8d0d0}.xfail,.unresolved{background:#fbeec8}.unsupported{background:#e6e6e6}
 img{max-width:100%}
 </style></head><body>
 <h1>Convergence and work-precision</h1>
@@ -30,7 +30,7 @@ at least) and stays {{ doc.reference_margin }} times above the reference's own e
 order the engine declares within {{ doc.order_tolerance }}.</p>
 <table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}: fitted / declared order</th>{% endfor %}</tr>
 {% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
-{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s %}<td class="{{ s.metric.status }}" title="{{ s.metric.reason or s.flattened or s.failure }}">
+{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s %}<td class="{{ s.metric.status }}" title="{{ s.metric.reason or s.flattened or s.failure or s.unsupported }}">
 {{ "%.2f"|format(s.observed_order) if s.observed_order is not none else "-" }} / {{ s.integrator_order }} {{ s.metric.status }}</td>{% else %}<td>-</td>{% endif %}{% endfor %}</tr>{% endfor %}
 </table>
 {% for sys in systems %}<h2 id="{{ sys }}">{{ sys }}</h2>

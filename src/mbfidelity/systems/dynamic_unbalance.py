@@ -29,7 +29,7 @@ printed in §8.8 (the prescribed spin's actuator force, convention 9).
 """
 import sympy as sp
 
-from . import PrintedFormula, System, coordinate_symbols
+from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, Prescribed,
                     Rectangle, Revolute, Scenario, coordinate_spring_damper)
 
@@ -93,6 +93,17 @@ def printed(P):
     )
 
 
+VERLET_START = (
+    "Semi-implicit Euler's positions are the Stormer-Verlet sequence (second order) but for "
+    "the first step, whose error h^2 a(0)/2 acts as an O(h) error of the initial velocity "
+    "and makes the scheme first order; this scenario starts on the steady response at "
+    "psi = 0, where the acceleration is zero, so the error falls as dt^2 (measured order "
+    "2.00 over 4-0.5 ms and over 20-2.5 ms, mbfidelity convergence).")
+REFERENCE_FLOOR = (
+    "At 4-0.5 ms RK4's error meets the reference's own (2e-10 of the amplitude) after two "
+    "halvings, too few points above it for a fit; at 20, 10, 5 and 2.5 ms the order is "
+    "3.99 (measured).")
+
 SYSTEM = System(
     id="dynamic_unbalance",
     title="Frame on a torsional spring with a dynamically unbalanced rotor (3-D)",
@@ -109,4 +120,6 @@ SYSTEM = System(
     ),
     unexcited={"I23": 0.0},
     excitation_frequencies=lambda P: (P.omega,),
+    expectations=(Expectation("pybullet", "convergence.order", "xfail", VERLET_START),
+                  Expectation("mujoco", "convergence.order", "unresolved", REFERENCE_FLOOR)),
 )
