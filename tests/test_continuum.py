@@ -62,7 +62,7 @@ def _ritz_sine_series(m: float, a: float, terms: int) -> np.ndarray:
 def test_beam_with_mass_agrees_with_a_sine_series_ritz_model(c, mass_ratio):
     m, a = mass_ratio * RHO * L, c * L
     exact = np.array(beam_with_point_mass_frequencies(EI, RHO, L, m, a))
-    ritz = _ritz_sine_series(m, a, terms=1000)
+    ritz = _ritz_sine_series(m, a, terms=600)
     assert np.all(ritz >= exact * (1 - 1e-10))  # Ritz is an upper bound
     np.testing.assert_allclose(exact, ritz, rtol=1e-8)
 
@@ -99,3 +99,61 @@ def test_spring_roots_satisfy_the_frequency_equation():
     for w in spring_with_end_mass_frequencies(K, SPRING_MASS, m):
         beta = w / math.sqrt(K / SPRING_MASS)
         assert beta * math.tan(beta) == pytest.approx(SPRING_MASS / m, rel=1e-9)
+
+
+# Rayleigh's estimates of §6.1 (eq. 67-68 with the shape of eq. 66, then with the
+# uniform-load shape) and §6.2 (eq. 69-70), written here from the monograph's formulas,
+# compared with the exact continuum: Rayleigh's quotient is an upper bound.
+
+def _rayleigh_point_load_shape(m, c):
+    stiffness = 3 * EI / ((1 - c) ** 2 * c**2 * L**3)
+    mass = m + (2 + 4 * c - c**2 - 6 * c**3 + 3 * c**4) / (105 * (1 - c) ** 2 * c**2) * RHO * L
+    return math.sqrt(stiffness / mass)
+
+
+def _rayleigh_uniform_load_shape(m, c):
+    shape_at_mass = c - 2 * c**3 + c**4
+    stiffness = 24 * EI / (5 * shape_at_mass**2 * L**3)
+    mass = m + 31 / (630 * shape_at_mass**2) * RHO * L
+    return math.sqrt(stiffness / mass)
+
+
+def test_printed_values_at_mid_span_without_block():
+    """§6.1 prints f = 1.5822, 1.5719 (the two shapes) and 1.5708 (exact) times
+    sqrt(EI/(rho l^4)) for c = 0.5, m = 0."""
+    unit = math.sqrt(EI / (RHO * L**4))
+    exact = beam_with_point_mass_frequencies(EI, RHO, L, 0.0, L / 2, count=1)[0] / (2 * math.pi)
+    assert exact / unit == pytest.approx(1.5708, abs=5e-5)
+    assert _rayleigh_point_load_shape(0.0, 0.5) / (2 * math.pi) / unit == pytest.approx(1.5822, abs=5e-5)
+    assert _rayleigh_uniform_load_shape(0.0, 0.5) / (2 * math.pi) / unit == pytest.approx(1.5719, abs=5e-5)
+
+
+@pytest.mark.parametrize("c", [0.5, 0.3, 0.15])
+def test_rayleigh_estimates_bound_the_exact_beam_frequency_from_above(c):
+    """Both estimates lie above the exact first frequency. The point-load static shape
+    becomes the first mode as the block dominates, so its excess shrinks as m grows; the
+    uniform-load shape is the static shape of the bare beam, best without the block."""
+    point_excess, uniform_excess = [], []
+    for mass_ratio in (0.0, 0.2, 1.0, 5.0):
+        m = mass_ratio * RHO * L
+        exact = beam_with_point_mass_frequencies(EI, RHO, L, m, c * L, count=1)[0]
+        point, uniform = _rayleigh_point_load_shape(m, c), _rayleigh_uniform_load_shape(m, c)
+        assert point >= exact * (1 - 1e-12) and uniform >= exact * (1 - 1e-12)
+        point_excess.append(point / exact - 1)
+        uniform_excess.append(uniform / exact - 1)
+    assert point_excess == sorted(point_excess, reverse=True)
+    assert uniform_excess[0] == min(uniform_excess)
+
+
+def test_rayleigh_estimate_of_the_massive_spring_bounds_the_exact_frequency():
+    """§6.2 eq. 70: w = sqrt(k / (m + rho l / 3)) with the linear shape of eq. 69, the
+    static shape under an end load: above the exact value, the more so the heavier the
+    spring relative to the block."""
+    excess = []
+    for mass_ratio in (0.05, 0.5, 2.0):
+        m = SPRING_MASS / mass_ratio
+        exact = spring_with_end_mass_frequencies(K, SPRING_MASS, m, count=1)[0]
+        estimate = math.sqrt(K / (m + SPRING_MASS / 3))
+        assert estimate >= exact * (1 - 1e-12)
+        excess.append(estimate / exact - 1)
+    assert excess == sorted(excess)
