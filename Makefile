@@ -15,6 +15,8 @@ $(BIN)/.installed: pyproject.toml
 install: $(BIN)/.installed
 
 report: install
+	$(BIN)/mbfidelity convergence --out $(OUT) > /dev/null
+	$(BIN)/mbfidelity strutt --grid 100 --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity run --out $(OUT)
 	$(BIN)/mbfidelity errata --out $(OUT) > /dev/null
 	@echo "errata:  $(OUT)/errata.html"

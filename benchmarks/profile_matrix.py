@@ -69,7 +69,7 @@ def serial(systems, prof_path):
         t0 = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:
             pr.enable()
-            _one_system((s, sims, 1e-3, False, Path(tmp)))
+            _one_system((s, sims, 1e-3, False, Path(tmp), {}))
             pr.disable()
         stats = pstats.Stats(pr)
         rows[s] = {"wall": time.perf_counter() - t0, **_phase_times(stats)}

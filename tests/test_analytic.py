@@ -24,8 +24,9 @@ def test_every_system_has_hand_facts():
 
 
 def _random_values(system_id, seed):
-    """Parameter values away from the defaults (any user value must work); draws that
-    leave the mechanism without an assembly or an equilibrium are redrawn."""
+    """Parameter values away from the defaults (any user value must work), tied by the
+    hand module's `relations` when it has them; draws that leave the mechanism without an
+    assembly or an equilibrium are redrawn."""
     s = get_system(system_id)
     rng = np.random.default_rng(seed)
     valid = getattr(HAND[system_id], "valid", lambda v: True)
@@ -33,6 +34,7 @@ def _random_values(system_id, seed):
     while True:
         # every parameter drawn, those with formula defaults too (given explicitly)
         values = {name: v * rng.uniform(0.5, 2.0) if v else v for name, v in base.items()}
+        values = getattr(HAND[system_id], "relations", lambda v: v)(values)
         if s.is_valid(values) and valid(values):
             return values
 

@@ -87,7 +87,7 @@ def test_analyze_json_damped_modes():
 
 
 @pytest.mark.parametrize("args,needle", [
-    (["analyze", "no_such_system"], "compound_pendulum, double_pendulum"),
+    (["analyze", "no_such_system"], "valid: actuated_arm, base_excited_msd,"),
     (["analyze", "compound_pendulum", "--param", "mass=2"], "valid: m, L"),
     (["analyze", "compound_pendulum", "--param", "L=-1"], "must be > 0"),
     (["analyze", "compound_pendulum", "--param", "L"], "NAME=VALUE"),
@@ -179,7 +179,7 @@ def _kapitza_rate(Y, m=1.0, l=0.2, I_G=0.001, W=2 * np.pi * 50, g=9.81):
 @pytest.mark.parametrize("Y, inverted_stable", [(0.01, True), (0.005, False)])
 def test_analyze_parametric_excitation_reports_floquet_per_rest_state(Y, inverted_stable):
     doc = _json(["analyze", "vertically_driven_pendulum", "--param", f"Y={Y}", "--json"])
-    assert "parametric_excitation" in doc and "linearization" not in doc
+    assert "parametric_excitation" in doc
     by_angle = {round(e["q"]["phi"] / np.pi) % 2: e for e in doc["equilibria"]}
     assert set(by_angle) == {0, 1}  # hanging and inverted (§8.3: phi_eq = n pi)
     inverted, hanging = by_angle[1], by_angle[0]

@@ -1,5 +1,5 @@
 """The package's layers, read from its source: each layer imports only the layers below it
-(systems <- analytic <- simulators <- comparisons <- reports <- cli), the report computes
+(systems <- analytic <- simulators <- comparisons <- reports <- api <- cli), the report computes
 nothing of its own, and no system id is written anywhere outside `systems/`."""
 import ast
 import re
@@ -11,7 +11,7 @@ import mbfidelity
 from mbfidelity.systems import all_systems
 
 PACKAGE = Path(mbfidelity.__file__).parent
-LAYERS = ("systems", "analytic", "simulators", "comparisons", "reports", "cli")
+LAYERS = ("systems", "analytic", "simulators", "comparisons", "reports", "api", "cli")
 #: what the report pages draw is computed upstream and saved: the report reads the saved
 #: results (through comparisons' results folder) and the descriptions only
 REPORTS_MAY_NOT_IMPORT = ("analytic", "simulators")

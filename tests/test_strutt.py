@@ -78,37 +78,3 @@ def test_strutt_command_json_and_figure(tmp_path):
     bad = CliRunner().invoke(app, ["strutt", "--lambda", "2,1"])
     assert bad.exit_code == 2
 
-
-# The engines' chart (comparisons/strutt_engine.py) at points far from the tongues'
-# boundaries: first tongue of eq. 83 between lambda = 1/4 -+ gamma/2 (Nayfeh & Mook,
-# Nonlinear Oscillations §5.2; at gamma = 0.3 within 0.012), so lambda = 0.25 grows and
-# lambda = 0.6 stays bounded (below the second tongue, from lambda = 1 - gamma^2/12).
-@pytest.mark.parametrize("lam, verdict", [(0.25, "growth"), (0.6, "bounded")])
-def test_engine_point_verdict_far_from_the_boundaries(lam, verdict):
-    from mbfidelity.comparisons.strutt_engine import EnginePoint, engine_verdict
-    from mbfidelity.simulators import all_backends
-
-    backend = all_backends().get("pybullet")
-    if backend is None or not backend.available()[0]:
-        pytest.skip("pybullet not installed")
-    assert engine_verdict(EnginePoint("pybullet", lam, 0.3))["verdict"] == verdict
-
-
-def test_strutt_cli_engine_chart_json():
-    import json
-
-    from typer.testing import CliRunner
-
-    from mbfidelity.cli import app
-    from mbfidelity.simulators import all_backends
-
-    backend = all_backends().get("pybullet")
-    if backend is None or not backend.available()[0]:
-        pytest.skip("pybullet not installed")
-    res = CliRunner().invoke(app, ["strutt", "--grid", "2", "--lambda", "0.25,0.6",
-                                   "--gamma", "0.3,0.3", "--sim", "pybullet", "--workers", "1",
-                                   "--json"])
-    assert res.exit_code == 0, res.output
-    engine = json.loads(res.stdout)["engines"]["pybullet"]
-    assert engine["classified"] == 4 and engine["agreement"] == 1.0
-    assert {p["verdict"] for p in engine["points"]} == {"growth", "bounded"}

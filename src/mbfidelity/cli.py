@@ -1,10 +1,13 @@
-"""Command line (DESIGN.md): list, analyze, compare, run, errata."""
+"""Command line (DESIGN.md): list, analyze, compare, run, errata, strutt; and the users'
+gates: check (the gates against the installed engines, optionally against a baseline) and
+diff (what changed between two runs)."""
 from __future__ import annotations
 
 import json
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 from typing import List, Optional
 
 import numpy as np
@@ -12,6 +15,43 @@ import typer
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Cross-validate multibody simulators against exact models.")
+
+
+def _use_system_paths(paths: Optional[List[Path]]) -> None:
+    """A user's mechanism modules join the catalog (systems/__init__.py): through the
+    environment, so that worker processes load them too."""
+    if not paths:
+        return
+    import os
+
+    from . import systems
+
+    previous = os.environ.get(systems.SYSTEM_PATH_VARIABLE)
+    known = previous.split(os.pathsep) if previous else []
+    added = [str(Path(p).resolve()) for p in paths]
+    os.environ[systems.SYSTEM_PATH_VARIABLE] = os.pathsep.join(
+        dict.fromkeys(known + added))
+    systems._REGISTRY = None
+    try:
+        systems.all_systems()
+    except ValueError as exc:
+        if previous is None:
+            os.environ.pop(systems.SYSTEM_PATH_VARIABLE)
+        else:
+            os.environ[systems.SYSTEM_PATH_VARIABLE] = previous
+        systems._REGISTRY = None
+        _fail(str(exc))
+
+
+SYSTEM_PATH_HELP = ("a mechanism module of your own (written like those in "
+                    "mbfidelity/systems/), added to the catalog; repeatable")
+
+
+@app.callback()
+def _options(system_path: Optional[List[Path]] = typer.Option(
+        None, "--system-path", help=SYSTEM_PATH_HELP)) -> None:
+    """Cross-validate multibody simulators against exact models."""
+    _use_system_paths(system_path)
 
 
 def _fail(message: str) -> None:
@@ -97,6 +137,9 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
         marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
                          for b in backends)
         typer.echo(f"{r['system']:26s} {marks} {r['source']}")
+        for b in backends:
+            if not r["simulators"][b]["supported"] and r["simulators"][b]["reason"]:
+                typer.echo(f"  {b} unsupported: {r['simulators'][b]['reason']}")
         for name, v in r["variants"].items():
             typer.echo(f"  variant {name}: {', '.join(v['simulators'])}")
 
@@ -108,8 +151,15 @@ def _use_cache(off: bool) -> None:
         cache.disable()
 
 
-def _modes(eq):
-    return [m.as_dict() for m in eq.modes]
+def _print_floquet(doc: dict) -> None:
+    """`analyze`'s text for a periodic-coefficient driven system."""
+    typer.echo(f"{doc['system']}: {doc['title']} ({doc['source']})")
+    typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in doc["parameters"].items()))
+    typer.echo(f"periodic coefficients: {doc['periodic_coefficients']}")
+    for item in doc["floquet"]:
+        typer.echo(f"Floquet about {item['q']} over T = {item['period']:.9g} s: "
+                   f"{item['verdict']} (|multipliers| = "
+                   + ", ".join(f"{m:.9g}" for m in item["moduli"]) + ")")
 
 
 @app.command()
@@ -120,64 +170,24 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                                           "instead of reading the persistent cache"),
             ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
-    from .analytic.errata import errata
-    from .analytic.linear import find_equilibria, operating_equilibrium
+    from . import api
 
     _use_cache(no_cache)
     system = _system(system_id)
-    values, derived = _values(system, _parse_params(param))
-    coords = list(system.coordinates)
-    if system.driven:
-        from .analytic.floquet import parametrically_excited
-
-        if parametrically_excited(system, values):
-            _analyze_parametric(system, values, derived, coords, as_json)
-            return
+    params = _parse_params(param)
+    values, derived = _values(system, params)
     try:
-        eqs = find_equilibria(system, values)
-        op = operating_equilibrium(system, values)
-    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
-        _fail(f"{system.id} with these parameters has no assembled equilibrium near its "
-              f"operating point ({exc})")
-    equilibria = []
-    for e in eqs:
-        item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
-        if e.stable:
-            item["modes"] = _modes(e)
+        doc = api.analyze(system.id, params)
+    except ValueError as exc:
+        _fail(str(exc))
+    if doc.get("floquet") is not None:
+        if as_json:
+            _json(doc)
         else:
-            item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
-        equilibria.append(item)
-    doc = {
-        "system": system.id, "title": system.title, "source": system.source,
-        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
-        "equilibria": equilibria,
-        "operating_point": dict(zip(coords, op.q.tolist())),
-        "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C, "K": op.K},
-        "stable": op.stable,
-        "modes": _modes(op),
-        "printed_vs_derived": [e.as_dict() for e in errata(system)],
-    }
-    if op.acceleration is not None:
-        doc["static_equilibrium"] = None
-        doc["relative_equilibrium"] = _relative_note(system, coords, op)
-    if system.stability_parameter:
-        from .analytic.stability import stability_threshold
-
-        doc["stability_threshold"] = stability_threshold(system, values).as_dict()
-    if system.driven:
-        from .analytic.steady_state import steady_state
-
-        response = steady_state(system, values)
-        doc["free_coordinates"] = list(system.mechanism.independent_coordinates)
-        doc["prescribed"] = {p.coordinate: str(p.motion) for p in system.mechanism.prescribed}
-        doc["linearization"]["about"] = ("rest state of the free coordinates with the "
-                                         "excitation off: " + ", ".join(
-                                             f"{k} = {v:g}" for k, v in system.unexcited.items()))
-        doc["steady_state"] = [h.as_dict() for h in response.harmonics]
-        if response.reason:
-            doc["steady_state_note"] = response.reason
-        else:
-            doc["steady_state_harmonic_residual"] = response.harmonic_residual
+            _print_floquet(doc)
+        return
+    op = SimpleNamespace(**{k: np.asarray(doc["linearization"][k]) for k in "MCK"})
+    equilibria = doc["equilibria"]
     if as_json:
         _json(doc)
         return
@@ -190,16 +200,23 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(doc["relative_equilibrium"]["note"])
     for e in equilibria:
         kind = "relative equilibrium" if "relative_equilibrium" in doc else "equilibrium"
+        if "floquet" in e:  # a parametric excitation: Floquet's verdict (api.analyze)
+            f = e["floquet"]
+            typer.echo(f"{kind} {e['q']}: Floquet {f['verdict']} (|mu|max = "
+                       f"{f['floquet_max_abs_multiplier']:.9g} +- {f['floquet_error']:.1e} "
+                       f"over the period {f['period']:.6g} s)")
+            continue
         typer.echo(f"{kind} {e['q']}: {'stable' if e['stable'] else 'unstable'}")
+    if "parametric_excitation" in doc:
+        typer.echo(f"parametric excitation: {doc['parametric_excitation']}")
     typer.echo(f"at {doc['operating_point']}:")
     for key in ("M", "C", "K"):
         typer.echo(f"  {key} = {np.array2string(getattr(op, key), precision=6)}")
-    for m in op.modes:
-        typer.echo(f"  mode: f = {m.frequency_hz:.9g} Hz, zeta = {m.damping_ratio:.6g}, "
-                   f"f_d = {m.damped_frequency_hz:.9g} Hz")
-    if not op.stable:
-        growth = max(s.real for s in op.eigenvalues)
-        typer.echo(f"  unstable: fastest growth rate {growth:.9g} 1/s")
+    for m in doc["modes"]:
+        typer.echo(f"  mode: f = {m['frequency_hz']:.9g} Hz, zeta = {m['damping_ratio']:.6g}, "
+                   f"f_d = {m['damped_frequency_hz']:.9g} Hz")
+    if not doc["stable"]:
+        typer.echo(f"  unstable: fastest growth rate {doc['growth_rate']:.9g} 1/s")
     if "stability_threshold" in doc:
         th = doc["stability_threshold"]
         if th["value"] is None:
@@ -217,87 +234,6 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(f"  steady state: none ({doc['steady_state_note']})")
     for e in doc["printed_vs_derived"]:
         typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
-
-
-def _analyze_parametric(system, values, derived, coords: list, as_json: bool) -> None:
-    """`analyze` of a parametrically excited system (monograph §8.4): the excitation makes
-    the variational equations about the rest states time-periodic, so each rest state of
-    the unexcited system is judged by its Floquet multipliers over one excitation period,
-    not by a linearization with constant coefficients."""
-    from .analytic.errata import errata
-    from .analytic.floquet import driven_floquet
-
-    try:
-        results = driven_floquet(system, values)
-    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
-        _fail(f"{system.id}: Floquet analysis failed ({exc})")
-    if not results:
-        _fail(f"{system.id}: no rest state of the free coordinates with the excitation off "
-              f"({', '.join(f'{k} = {v:g}' for k, v in system.unexcited.items())})")
-    equilibria = []
-    for q, result in results:
-        floquet = result.as_dict()
-        equilibria.append({"q": dict(zip(coords, q.tolist())), "stable": result.stable,
-                           "floquet_multipliers": floquet["floquet_multipliers"],
-                           "floquet": floquet})
-    op_q, op_result = results[0]
-    doc = {
-        "system": system.id, "title": system.title, "source": system.source,
-        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
-        "free_coordinates": list(system.mechanism.independent_coordinates),
-        "prescribed": {p.coordinate: str(p.motion) for p in system.mechanism.prescribed},
-        "parametric_excitation": (
-            "the excitation makes the coefficients of the variational equations about the "
-            "rest states periodic in time (monograph §8.4): stability by Floquet theory "
-            "over one excitation period, about the rest states with the excitation off: "
-            + ", ".join(f"{k} = {v:g}" for k, v in system.unexcited.items())),
-        "equilibria": equilibria,
-        "operating_point": dict(zip(coords, op_q.tolist())),
-        "stable": op_result.stable,
-        "floquet_multipliers": op_result.as_dict()["floquet_multipliers"],
-        "floquet": op_result.as_dict(),
-        "printed_vs_derived": [e.as_dict() for e in errata(system)],
-    }
-    if as_json:
-        _json(doc)
-        return
-    typer.echo(f"{system.id}: {system.title} ({system.source})")
-    typer.echo("parameters: " + ", ".join(f"{k}={v:g}" for k, v in values.items()))
-    formulas = {p.name: p.default for p in system.all_parameters}
-    if derived:
-        typer.echo("derived: " + ", ".join(f"{k} = {formulas[k]}" for k in derived))
-    typer.echo("parametric excitation: stability of each rest state by its Floquet "
-               "multipliers (monograph §8.4)")
-    for e in equilibria:
-        f = e["floquet"]
-        typer.echo(f"rest state {e['q']}: Floquet {f['verdict']} (|mu|max = "
-                   f"{f['floquet_max_abs_multiplier']:.9g} +- {f['floquet_error']:.1e}, "
-                   f"period {f['period']:.6g} s, margin {f['margin']:.3g})")
-    typer.echo(f"operating point {doc['operating_point']}: "
-               f"{op_result.verdict}")
-    for e in doc["printed_vs_derived"]:
-        typer.echo(f"  {e['label']}: {e['verdict']} ({e['max_relative_difference']:.1e})")
-
-
-def _relative_note(system, coords: list, op) -> dict:
-    """What `analyze` says of a floating mechanism (Italian notes §5.3.1)."""
-    acceleration = dict(zip(coords, op.acceleration.tolist()))
-    rigid = [dict(zip(coords, col.tolist())) for col in op.rigid.T]
-    moving = ", ".join(f"{c}'' = {a:.9g}" for c, a in acceleration.items() if a)
-    return {
-        "acceleration": acceleration,
-        "rigid_directions": rigid,
-        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
-                  f"ground, and its loads have a resultant that only the inertia of the "
-                  f"whole balances ({moving}); reported instead: the relative equilibrium "
-                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
-                  f"uniform acceleration, linearized about that motion"
-                  if moving else
-                  f"{system.id} has no ground, and its loads have no resultant here: its "
-                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
-                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
-                   "relative motion"),
-    }
 
 
 def _settings(items: Optional[List[str]]) -> dict:
@@ -381,9 +317,12 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
                                       "instead of reading the persistent cache"),
         resume: bool = typer.Option(False, "--resume", help="continue a killed run into "
                                     "--out: reuse the systems it finished"),
+        setting: Optional[List[str]] = typer.Option(
+            None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
         ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
     _use_cache(no_cache)
+    settings = _engine_settings(setting)
     from rich.progress import Progress
 
     from .comparisons.matrix import reusable_jobs, run_matrix, write_results
@@ -399,7 +338,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         if e not in all_backends():
             _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     if resume:
-        reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants)
+        reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants, settings)
         typer.echo(f"resuming: {len(reused)} of {len(sys_ids)} systems finished in {out}, "
                    f"reused")
     start = time.perf_counter()
@@ -409,7 +348,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
         results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
-                             out=out, resume=resume)
+                             out=out, resume=resume, settings=settings)
     write_results(results, out)
     index = write_report(out)
     elapsed = time.perf_counter() - start
@@ -426,6 +365,29 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
 
 def _split(items):
     return [x for item in items or [] for x in item.split(",") if x]
+
+
+def _engine_settings(items: Optional[List[str]]) -> dict[str, dict]:
+    """ENGINE.KEY=VALUE items -> {engine: {key: value}}, each engine's settings validated
+    by its backend (one line and exit 2 for a bad one)."""
+    from .simulators import all_backends
+
+    out: dict[str, dict] = {}
+    for item in items or []:
+        head = item.split("=", 1)[0]
+        if "=" not in item or "." not in head:
+            _fail(f"--setting expects ENGINE.KEY=VALUE, got {item!r}")
+        engine, rest = item.split(".", 1)
+        if engine not in all_backends():
+            _fail(f"--setting {item!r}: unknown simulator {engine!r}; valid: "
+                  f"{', '.join(all_backends())}")
+        out.setdefault(engine, {}).update(_settings([rest]))
+    for engine, chosen in out.items():
+        try:
+            all_backends()[engine].resolve_settings(chosen)
+        except (KeyError, ValueError) as exc:
+            _fail(f"--setting for {engine}: {exc.args[0] if exc.args else exc}")
+    return out
 
 
 @app.command("errata")
@@ -470,18 +432,28 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                out: Optional[Path] = typer.Option(
                    None, "--out", help="also write strutt.json and strutt.png there"),
                sim: Optional[List[str]] = typer.Option(
-                   None, "--sim", help="also classify every point by simulation on this "
-                   "engine (repeatable): the vertically driven pendulum mapped to "
-                   "(lambda, gamma), comparisons/strutt_engine.py"),
+                   None, "--sim", help="also classify every point by this engine's runs "
+                                       "(repeatable)"),
                scheduler: Optional[str] = typer.Option(
-                   None, "--scheduler", help="Dask scheduler address for the engine runs"),
-               workers: Optional[int] = typer.Option(
-                   None, "--workers", help="local processes for the engine runs (default: "
-                   "one per core)"),
+                   None, "--scheduler", help="a Dask scheduler's address for the engines' "
+                                             "runs (default: a local process pool)"),
+               steps_per_period: int = typer.Option(
+                   200, "--steps-per-period", help="engine steps per excitation period"),
+               periods: int = typer.Option(10, "--periods",
+                                           help="excitation periods of each engine run"),
                ) -> None:
     """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory, and with
-    --sim as each engine draws it."""
+    --sim from each engine's simulation of the pendulum that maps to every point."""
     from .analytic.strutt import strutt_chart
+    from .simulators import all_backends
+
+    engines = _split(sim)
+    for e in engines:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+        ok, why = all_backends()[e].available()
+        if not ok:
+            _fail(f"{e} is not installed: {why}")
 
     def bounds(text: str, option: str) -> tuple[float, float]:
         try:
@@ -501,27 +473,19 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                                                                    "marginal")}
     doc = {"equation": "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)",
            "period": 2 * np.pi, "grid": grid, "counts": counts, "points": points}
-    if workers is not None and workers < 1:
-        _fail(f"--workers must be a positive integer, got {workers}")
-    if sim:
-        from .comparisons.strutt_engine import engine_chart
-        from .simulators import SIMULATOR_IDS
+    if engines:
+        from .comparisons.strutt_engines import engine_chart
 
-        for name in sim:
-            if name not in SIMULATOR_IDS:
-                _fail(f"unknown engine {name!r}; engines: {', '.join(SIMULATOR_IDS)}")
-        doc["engines"] = {name: engine_chart(name, chart, scheduler, workers) for name in sim}
+        if steps_per_period < 4 or periods < 1:
+            _fail("--steps-per-period must be at least 4 and --periods at least 1")
+        doc["simulation"] = engine_chart(points, engines, scheduler=scheduler,
+                                         periods=periods, steps_per_period=steps_per_period)
     if out is not None:
         from .reports.strutt_figure import write_strutt_figure
 
         out.mkdir(parents=True, exist_ok=True)
         (out / "strutt.json").write_text(json.dumps(doc, indent=1))
         figure = write_strutt_figure(points, out / "strutt.png")
-        for name, engine in doc.get("engines", {}).items():
-            write_strutt_figure(points, out / f"strutt_{name}.png",
-                                disagreements=[(p["lambda"], p["gamma"]) for p in
-                                               engine["points"] if p.get("agrees") is False],
-                                engine=name)
         if not as_json:
             typer.echo(f"Strutt chart: {figure.resolve()}")
     if as_json:
@@ -529,14 +493,205 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
         return
     typer.echo(f"Strutt chart of eq. 83, {grid} x {grid} points: " +
                ", ".join(f"{k} {v}" for k, v in counts.items()))
-    for name, engine in doc.get("engines", {}).items():
-        wrong = [p for p in engine["points"] if p.get("agrees") is False]
-        agreement = engine["agreement"]
-        typer.echo(f"  {name}: agrees with Floquet at {agreement:.1%} of {engine['classified']} "
-                   f"classified points ({len(wrong)} disagree"
-                   + (f", {sum(p.get('slow_growth', False) for p in wrong)} of them growing "
-                      f"too slowly to show in {engine['periods']} periods)" if wrong else ")")
-                   if agreement is not None else f"  {name}: no point classified")
+    for e, summary in doc.get("simulation", {}).get("engines", {}).items():
+        typer.echo(f"  {e}: agrees with eq. 83 at {summary['agreement_with_eq83']:.1%} of "
+                   f"{summary['decided_points']} decided points "
+                   f"({len(summary['disagreements'])} differ)")
+
+
+@app.command("convergence")
+def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems",
+                                                                help="system ids"),
+                    sims: Optional[List[str]] = typer.Option(
+                        None, "--sims", help="simulator ids (default: every installed one)"),
+                    steps: str = typer.Option("4e-3,2e-3,1e-3,5e-4", "--steps",
+                                              help="the steps, s (multiples of the finest)"),
+                    t_end: float = typer.Option(2.0, "--t-end", help="simulated time, s"),
+                    out: Optional[Path] = typer.Option(
+                        None, "--out", help="also write convergence.json, convergence.html "
+                                            "and the figures there"),
+                    scheduler: Optional[str] = typer.Option(
+                        None, "--scheduler", help="a Dask scheduler's address (default: a "
+                                                  "local process pool)"),
+                    as_json: bool = typer.Option(False, "--json"),
+                    ) -> None:
+    """Error against the step and work-precision, per system x engine: the fitted order
+    next to the engine's declared order (gate: within 0.5, where the curve still falls).
+    Exit 1 when an order gate fails."""
+    from .comparisons import convergence as conv
+    from .comparisons.runner import provenance
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = _split(systems) or list(all_systems())
+    for s in sys_ids:
+        _system(s)
+    sim_ids = _split(sims) or [e for e, b in all_backends().items() if b.available()[0]]
+    for e in sim_ids:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    try:
+        dts = sorted({float(x) for x in steps.split(",") if x}, reverse=True)
+    except ValueError:
+        _fail(f"--steps expects numbers A,B,...; got {steps!r}")
+    if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
+        _fail(f"--steps needs at least {conv.MIN_FIT_POINTS} positive steps; got {steps!r}")
+    if not t_end > 0:
+        _fail("--t-end must be positive")
+    try:
+        studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
+    except ValueError as exc:
+        _fail(str(exc))
+    doc = {"provenance": provenance(), "steps": dts, "t_end": t_end,
+           "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
+           "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
+    failed = [s for s in studies if s["metric"]["status"] in ("fail", "xpass")
+              or (s["metric"]["status"] == "unresolved" and not s["metric"].get("expected"))]
+    if out is not None:
+        from .reports.convergence_page import CONVERGENCE, write_convergence_page
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=_jsonable))
+        page = write_convergence_page(out)
+    if as_json:
+        _json(doc)
+    else:
+        for s in studies:
+            order = (f"{s['observed_order']:.2f}" if s["observed_order"] is not None else "-")
+            typer.echo(f"{s['system']:28s} {s['simulator']:9s} order {order:>5s} / "
+                       f"{s['integrator_order']}  {s['metric']['status']}")
+        if out is not None:
+            typer.echo(f"page: {page.resolve()}")
+    raise typer.Exit(1 if failed else 0)
+
+
+@app.command("check")
+def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
+              sims: Optional[List[str]] = typer.Option(
+                  None, "--sims", help="simulator ids (default: every installed engine)"),
+              baseline: Optional[Path] = typer.Option(
+                  None, "--baseline", help="a results folder (or results.json) to compare "
+                                           "with: a gate that got worse fails the check"),
+              out: Path = typer.Option(Path("mbfidelity-check"), "--out",
+                                       help="where the results are written"),
+              dt: float = typer.Option(1e-3, "--dt"),
+              setting: Optional[List[str]] = typer.Option(
+                  None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
+              report: bool = typer.Option(False, "--report/--no-report",
+                                          help="also write the HTML report into --out"),
+              as_json: bool = typer.Option(False, "--json"),
+              system_path: Optional[List[Path]] = typer.Option(
+                  None, "--system-path", help=SYSTEM_PATH_HELP),
+              no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
+                                            "derivations instead of reading the cache"),
+              ) -> None:
+    """The gates of the installed package against the installed engines: a verdict per
+    system x engine, the results in --out; exit 0 only if every gate passes or is declared
+    (and, with --baseline, none got worse than there). One line in a user's CI."""
+    _use_system_paths(system_path)
+    _use_cache(no_cache)
+    from . import api
+
+    try:
+        outcome = api.check(_split(systems) or None, _split(sims) or None, out,
+                            baseline=baseline, dt=dt, settings=_engine_settings(setting),
+                            report=report)
+    except ValueError as exc:
+        _fail(str(exc))
+    if as_json:
+        _json(outcome.as_dict())
+    else:
+        for v in outcome.verdicts:
+            why = (f"  {', '.join(v.failing)}" if v.verdict == "fail" else
+                   f"  {v.reason}" if v.verdict == "unsupported" else "")
+            typer.echo(f"{v.system:28s} {v.simulator:9s} {v.verdict.upper():11s}{why}")
+        if outcome.diff is not None:
+            _print_diff(outcome.diff)
+        typer.echo(f"results: {outcome.results}")
+        typer.echo("CHECK PASSED" if outcome.passed else "CHECK FAILED")
+    raise typer.Exit(0 if outcome.passed else 1)
+
+
+def _print_diff(changes) -> None:
+    changed = [p for p in changes.pairs if p.kind != "same"]
+    typer.echo(f"diff {changes.old} -> {changes.new}: {len(changed)} of {len(changes.pairs)} "
+               f"system x engine pairs changed" + (", a gate got worse" if changes.worse
+                                                   else ""))
+    for p in changed:
+        head = f"  {p.row}/{p.simulator}: {p.kind}"
+        if p.versions and p.versions[0] != p.versions[1]:
+            head += f"; engine {p.versions[0]} -> {p.versions[1]}"
+        if p.passed and p.passed[0] != p.passed[1]:
+            head += f"; {'passed' if p.passed[0] else 'failed'} -> " \
+                    f"{'passed' if p.passed[1] else 'failed'}"
+        typer.echo(head + ("  [WORSE]" if p.worse else ""))
+        for key, (a, b) in p.settings.items():
+            typer.echo(f"    setting {key}: {a!r} -> {b!r}")
+        for key, (a, b) in p.inputs.items():
+            typer.echo(f"    input {key}: {a!r} -> {b!r}")
+        for m in p.metrics:
+            a = f"{m.old['value']:.6g} ({m.old['status']})" if m.old else "-"
+            b = f"{m.new['value']:.6g} ({m.new['status']})" if m.new else "-"
+            typer.echo(f"    {m.kind:8s} {m.name:34s} {a} -> {b}"
+                       + ("  [WORSE]" if m.worse else ""))
+
+
+@app.command("diff")
+def diff_cmd(old: Path = typer.Argument(..., metavar="OLD", help="results folder or "
+                                        "results.json (e.g. a recorded baseline)"),
+             new: Path = typer.Argument(..., metavar="NEW", help="results folder or "
+                                        "results.json"),
+             as_json: bool = typer.Option(False, "--json"),
+             html_page: Optional[Path] = typer.Option(None, "--html",
+                                                      help="also write the diff as a page"),
+             ) -> None:
+    """What changed between two runs, per system x engine x metric: engine versions and
+    settings, metrics that moved, gates that flipped, new and vanished metrics. Exit 1
+    when a gate got worse."""
+    from .comparisons.diff import diff_runs
+
+    try:
+        changes = diff_runs(old, new)
+    except ValueError as exc:
+        _fail(str(exc))
+    if html_page is not None:
+        from .reports.diff_page import write_diff_page
+
+        write_diff_page(changes.as_dict(), html_page)
+    if as_json:
+        _json(changes.as_dict())
+    else:
+        _print_diff(changes)
+        if html_page is not None:
+            typer.echo(f"page: {html_page.resolve()}")
+    raise typer.Exit(1 if changes.worse else 0)
+
+
+@app.command("export")
+def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
+               sim: str = typer.Option("mujoco", "--sim", help="the engine (MJCF: mujoco)"),
+               out: Path = typer.Option(..., "--out", help="file to write"),
+               param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
+               setting: Optional[List[str]] = typer.Option(
+                   None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
+               dt: float = typer.Option(1e-3, "--dt", help="time step written in the model"),
+               ) -> None:
+    """The mechanism as the harness builds it, saved: MuJoCo's MJCF with a keyframe per
+    scenario and the map from the description's coordinates (custom numerics)."""
+    from . import api
+
+    system = _system(system_id)
+    params = _parse_params(param)
+    _values(system, params, system.scenarios)
+    try:
+        text, outside = api.export(system.id, sim, params, settings=_settings(setting), dt=dt)
+    except ValueError as exc:
+        _fail(str(exc))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text)
+    typer.echo(f"{system.id} for {sim}: {out.resolve()}")
+    for note in outside:
+        typer.echo(f"  not in the file: {note}")
 
 
 def main() -> None:

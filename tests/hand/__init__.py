@@ -7,6 +7,8 @@ independently of the code under test. Each module defines:
   hand at the default parameters;
 - ``MISPRINTS``: labels of printed formulas that the hand derivation shows to be wrong,
   each with the reason in a comment;
+- optionally ``relations(v) -> dict``: the values tied by the relations under which the
+  mechanism has an equilibrium to linearize (e.g. I2 = I1 of eq. 88);
 - optionally ``valid(v) -> bool``: whether random parameter values keep the mechanism
   assembled with an equilibrium near the operating point.
 """

@@ -7,6 +7,12 @@ force element by virtual power (eq. 95):
 
     M(q) q'' + h(q, q') = Q(q, q', t),   h = d/dt(dT/dq') - dT/dq - M q''.
 
+A spatial mechanism (model convention 10) takes the same route in three dimensions: each
+body's rotation matrix R(q) is composed along the tree, its angular velocity (body axes) is
+read from the skew matrix R^T R' (never assumed), and T = sum(m v.v/2 + w.I w/2) with the
+full central tensor I; gravity acts along -up. Planar mechanisms keep the planar
+computation unchanged.
+
 Route 2 (energy functions, used to cross-check the linearization, monograph eq. 107-109
 and Italian notes §5.3.3-5.3.4): T, V and Rayleigh's D, whose Hessians at an equilibrium
 are M, K and C.
@@ -38,7 +44,10 @@ from ..systems.model import (
     Prismatic,
     Revolute,
     as_column,
+    as_column3,
+    inertia_matrix,
     rotation,
+    rotation3,
 )
 
 
@@ -46,6 +55,12 @@ from ..systems.model import (
 class Pose:
     position: sp.Matrix  # 2x1, centre of mass in world axes
     angle: sp.Expr
+
+
+@dataclass
+class SpatialPose:
+    position: sp.Matrix  # 3x1, centre of mass in world axes
+    rotation: sp.Matrix  # 3x3, body axes to world axes
 
 
 class Derivation:
@@ -59,9 +74,15 @@ class Derivation:
         self.qd = sp.Matrix([s[1] for s in syms])
         self.qdd = sp.Matrix([s[2] for s in syms])
         self.n = len(names)
-        self.poses = self._poses()
-        self.joint_values = self._joint_values()
-        self._energies()
+        self.spatial = mechanism.spatial
+        if self.spatial:
+            self.poses = self._spatial_poses()
+            self.joint_values = self._spatial_joint_values()
+            self._spatial_energies()
+        else:
+            self.poses = self._poses()
+            self.joint_values = self._joint_values()
+            self._energies()
         self._forces()
         self._constraints()
         self.residual = (self.M * self.qdd + self.h - self.Q).applyfunc(sp.expand)
@@ -97,9 +118,55 @@ class Derivation:
                 vals.append(qj)
         return sp.Matrix(vals)
 
+    def _spatial_poses(self) -> dict[str, SpatialPose]:
+        """Positions and rotation matrices composed along the tree (convention 10)."""
+        poses = {WORLD: SpatialPose(sp.zeros(3, 1), sp.eye(3))}
+        for j, qj in zip(self.mechanism.joints, self.q):
+            parent = poses[j.parent]
+            if isinstance(j, Revolute):
+                turn = rotation3(j.axis if j.axis is not None else (0, 0, 1),
+                                 (-qj if j.clockwise else qj) + j.angle_offset)
+                R = turn if j.absolute else parent.rotation * turn
+                anchor = parent.position + parent.rotation * as_column3(j.parent_anchor)
+            elif isinstance(j, Prismatic):
+                R = parent.rotation * rotation3((0, 0, 1), j.angle_offset)
+                anchor = parent.position + parent.rotation * (
+                    as_column3(j.parent_anchor) + qj * as_column3(j.axis))
+            else:  # pragma: no cover - the Joint union is closed
+                raise TypeError(j)
+            R = R.applyfunc(sp.simplify)
+            position = anchor - R * as_column3(j.child_anchor)
+            poses[j.child] = SpatialPose(position.applyfunc(sp.simplify), R)
+        return poses
+
+    def _spatial_joint_values(self) -> sp.Matrix:
+        """The engines' joint values: the hinge angle about its axis (q, or -q when
+        clockwise), the slide's coordinate."""
+        return sp.Matrix([-qj if isinstance(j, Revolute) and j.clockwise else qj
+                          for j, qj in zip(self.mechanism.joints, self.q)])
+
+    def angular_velocity(self, body: str) -> sp.Matrix:
+        """Angular velocity in the body's axes, from the skew matrix R^T R'."""
+        R = self.poses[body].rotation
+        Rdot = sp.zeros(3, 3)
+        for qi, vi in zip(self.q, self.qd):
+            Rdot += R.diff(qi) * vi
+        W = (R.T * Rdot).applyfunc(sp.simplify)
+        skew = (W + W.T).applyfunc(sp.simplify)
+        if any(e != 0 for e in skew):
+            raise ValueError(f"R^T R' of {body} is not skew-symmetric: {skew}")
+        return sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
+
     def point(self, body: str, local) -> sp.Matrix:
         pose = self.poses[body]
+        if self.spatial:
+            return pose.position + pose.rotation * as_column3(local)
         return pose.position + rotation(pose.angle) * as_column(local)
+
+    def up(self) -> sp.Matrix:
+        """The unit up direction of a spatial mechanism."""
+        u = as_column3(self.mechanism.up)
+        return u / sp.sqrt(sum(c**2 for c in u))
 
     def velocity(self, expr: sp.Matrix) -> sp.Matrix:
         return expr.jacobian(self.q) * self.qd
@@ -120,6 +187,27 @@ class Derivation:
             M += b.mass * (Jv.T * Jv) + b.inertia * (Jw.T * Jw)
             V += b.mass * mech.gravity * pose.position[1]
         self.M = M.applyfunc(sp.simplify)
+        self._bias_forces()
+        self.V_gravity = V
+
+    def _spatial_energies(self) -> None:
+        """M from T = sum(m v.v/2 + w.I w/2), w from R^T R' in body axes."""
+        mech = self.mechanism
+        M = sp.zeros(self.n, self.n)
+        V = sp.Integer(0)
+        up = self.up()
+        for b in mech.bodies:
+            pose = self.poses[b.name]
+            Jv = pose.position.jacobian(self.q)
+            Jw = self.angular_velocity(b.name).jacobian(self.qd)
+            M += b.mass * (Jv.T * Jv) + Jw.T * inertia_matrix(b) * Jw
+            V += b.mass * mech.gravity * (up.T * pose.position)[0]
+        self.M = M.applyfunc(sp.simplify)
+        self._bias_forces()
+        self.V_gravity = V
+
+    def _bias_forces(self) -> None:
+        """T = q'.M q'/2 and h = (dM/dt) q' - dT/dq."""
         self.T = sp.expand((self.qd.T * self.M * self.qd)[0] / 2)
         # h = (dM/dt) q' - dT/dq
         Mdot = sp.zeros(self.n, self.n)
@@ -127,7 +215,6 @@ class Derivation:
             Mdot += self.M.diff(self.q[k]) * self.qd[k]
         dT_dq = sp.Matrix([sp.diff(self.T, qi) for qi in self.q])
         self.h = (Mdot * self.qd - dT_dq).applyfunc(sp.simplify)
-        self.V_gravity = V
 
     # --- forces --------------------------------------------------------------------------
     def element_length(self, f: PointToPoint) -> tuple[sp.Expr, sp.Matrix]:
@@ -135,9 +222,15 @@ class Derivation:
         length = sp.sqrt(sp.simplify((d.T * d)[0]))
         return length, d
 
+    def gravity_vector(self) -> sp.Matrix:
+        """Gravitational acceleration in world axes: (0, -g) planar, -g up spatial."""
+        if self.spatial:
+            return -self.mechanism.gravity * self.up()
+        return sp.Matrix([0, -self.mechanism.gravity])
+
     def _forces(self) -> None:
         mech = self.mechanism
-        g_vec = sp.Matrix([0, -mech.gravity])
+        g_vec = self.gravity_vector()
         Q = sp.zeros(self.n, 1)
         for b in mech.bodies:
             Jv = self.poses[b.name].position.jacobian(self.q)
@@ -316,8 +409,8 @@ class Derivation:
         mech = self.mechanism
         joint = mech.joint(joint_name)
         subtree = set(mech.subtree(joint.child))
-        g_vec = sp.Matrix([0, -mech.gravity])
-        total = sp.zeros(2, 1)
+        g_vec = self.gravity_vector()
+        total = sp.zeros(3 if self.spatial else 2, 1)
         for name in subtree:
             b = mech.body(name)
             if b.mass != 0:
@@ -358,7 +451,7 @@ class Derivation:
         if isinstance(f, PointToPoint):
             in_a, in_b = f.body_a in subtree, f.body_b in subtree
             if in_a == in_b:
-                return sp.zeros(2, 1)
+                return sp.zeros(3 if self.spatial else 2, 1)
             length, d = self.element_length(f)
             rate = (sp.Matrix([length]).jacobian(self.q) * self.qd)[0]
             tension = sp.sympify(f.tension).xreplace({LENGTH: length, LENGTH_RATE: rate})
@@ -366,14 +459,17 @@ class Derivation:
             return tension * unit if in_a else -tension * unit
         if isinstance(f, CoordinateForce):
             owner = self.mechanism.joints[self.mechanism.coordinates.index(f.coordinate)]
-            if owner is not joint:
-                return sp.zeros(2, 1)  # internal to the subtree or a torque only
-            if isinstance(owner, Revolute):
-                return sp.zeros(2, 1)
+            if owner is not joint or isinstance(owner, Revolute):
+                # internal to the subtree or a torque only
+                return sp.zeros(3 if self.spatial else 2, 1)
             i = self.mechanism.coordinates.index(f.coordinate)
             force = sp.sympify(f.force).xreplace({COORD: self.q[i], COORD_RATE: self.qd[i]})
-            axis = as_column(owner.axis)
-            axis_world = rotation(self.poses[owner.parent].angle) * axis
+            if self.spatial:
+                axis = as_column3(owner.axis)
+                axis_world = self.poses[owner.parent].rotation * axis
+            else:
+                axis = as_column(owner.axis)
+                axis_world = rotation(self.poses[owner.parent].angle) * axis
             # virtual power: F . (axis q') = Q q'  =>  F = Q axis / |axis|^2
             return force * axis_world / (axis.T * axis)[0]
         raise TypeError(f)

@@ -422,6 +422,8 @@ def _compare_multipliers(system: System, pf: PrintedFormula, rng) -> dict:
         model = numeric_model(system.id, values)
         for q, qd, t in _random_states(system, values, rng):
             qdd, lam = model.dynamics(q, qd, t)
+            if model.driven:  # prescribed coordinates follow their motion (convention 9)
+                qdd = model.acceleration(q, qd, t)
             env = _env(system, values, q, qd, qdd, t)
             A = np.array([[_num(a, env) for a in row] for row in A_sym]).reshape(len(rows), -1)
             r0 = np.array([_num(r, env) for r in r0_sym])

@@ -162,6 +162,38 @@ def driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
     return results
 
 
+def periodic_coefficients(system, values) -> bool:
+    """Whether a driven system's variational equations about its unexcited rest states
+    have coefficients that vary with the prescribed motion (then stability is Floquet's
+    question, not an equilibrium's)."""
+    from .linear import _PROBE_TIMES, driven_coefficients, driven_rest_states
+    from .numeric import numeric_model
+
+    try:
+        model = numeric_model(system.id, dict(values))
+        rests = driven_rest_states(system, values, only_operating=True)
+    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError):
+        return False
+    for q in rests:
+        first = driven_coefficients(model, q[model.independent], _PROBE_TIMES[0])
+        for t in _PROBE_TIMES[1:]:
+            later = driven_coefficients(model, q[model.independent], t)
+            if any(not np.allclose(a, b, rtol=1e-9, atol=0) for a, b in zip(first, later)):
+                return True
+    return False
+
+
+def driven_floquet_summary(system, values) -> list[dict]:
+    """`driven_floquet` as data: per unexcited rest state, its coordinates, the period,
+    the multipliers (re, im) and their moduli, the verdict, its margin and the error."""
+    coords = list(system.coordinates)
+    return [{"q": dict(zip(coords, q.tolist())), "period": r.period,
+             "multipliers": [[complex(m).real, complex(m).imag] for m in r.multipliers],
+             "moduli": [float(abs(m)) for m in r.multipliers],
+             "verdict": r.verdict, "margin": r.margin, "error": r.error}
+            for q, r in driven_floquet(system, values)]
+
+
 def parametrically_excited(system, values) -> bool:
     """Whether the system is excited parametrically only (§8.4): every rest state of the
     unexcited system stays a solution with the excitation on (the excitation does not

@@ -1,17 +1,50 @@
-"""Convergence and work-precision studies: error against time step for one engine on one
-scenario, the observed order fitted on a log-log scale, and the cost of each run."""
+"""Convergence and work-precision: for one engine on one scenario, the error against the
+time step (max |q - q_ref| over the run, relative to the motion's amplitude) over a
+sequence of halved steps, the observed order fitted on a log-log scale next to the order
+the engine's scheme declares, and the CPU seconds of each run (work-precision).
+
+The reference is solved once, at the finest step, and sampled at each coarser one (the
+steps are integer multiples of the finest). An error within REFERENCE_MARGIN times the
+reference's own error (its tight solve's, estimated as the tight-loose difference scaled
+by the ratio of their tolerances) measures the reference as much as the engine: those
+points are left out of the fit (a closed-form reference has none). Where the error stops falling with the step, something
+other than the step sets it (round-off, a constraint's compliance): the fit uses the steps
+from the coarsest down to the last one that still lowered the error by `MIN_DECREASE`, and
+needs `MIN_FIT_POINTS` of them; otherwise the order is not judged (`flattened`, metric
+unresolved). The judged metric ``convergence.order`` is |fitted - declared| against
+ORDER_TOLERANCE, with the expectations of comparisons (a system's or a backend's
+declaration of the metric). Every mechanism x engine is one item of the sweep facility
+(comparisons/sweep.py)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Mapping, Sequence
 
 import numpy as np
 
 from ..analytic.linear import operating_equilibrium
-from ..analytic.reference import reference
+from ..analytic.reference import LOOSE, TIGHT, reference
 from ..simulators import get_backend
 from ..systems import get_system
-from . import metrics
+from . import metrics, tolerances
+from .runner import Metric, _judge
+
+#: the steps of a study (s): halvings, each an integer multiple of the finest
+DEFAULT_STEPS = (4e-3, 2e-3, 1e-3, 5e-4)
+#: a halving that lowers the error by less than this factor has reached a floor (an order
+#: of 0.6 and above still lowers it by 1.5 per halving)
+MIN_DECREASE = 1.5
+MIN_FIT_POINTS = 3
+#: the fitted order must match the declared one within this (issue 10)
+ORDER_TOLERANCE = 0.5
+#: a point is fitted when its error is at least this many times the reference's: the
+#: reference then adds at most a third to it
+REFERENCE_MARGIN = 3.0
+#: simulated time of a study (s): several periods of every catalog mechanism, short
+#: enough for the whole catalog in a report
+DEFAULT_T_END = 2.0
+#: the name of the judged metric
+ORDER_METRIC = "convergence.order"
 
 
 @dataclass
@@ -19,6 +52,7 @@ class ConvergencePoint:
     dt: float
     error: float          # max |q - q_ref| / amplitude
     wall_time: float      # s of stepping
+    cpu_time: float       # CPU s of stepping
     steps: int
 
 
@@ -30,13 +64,32 @@ class ConvergenceStudy:
     engine_version: str
     integrator_order: int
     points: list[ConvergencePoint]
-    observed_order: float
+    #: slope of log(error) against log(dt) over the falling part (None: flattened)
+    observed_order: float | None
+    #: the steps the fit used (the falling part)
+    fitted_steps: list[float] = field(default_factory=list)
+    #: why the order is not judged, when it is not
+    flattened: str = ""
+    #: the reference's own error relative to the amplitude (0: a closed form), a floor
+    #: for the errors
+    reference_error: float = 0.0
+    #: a run that failed (diverged, an engine error): the message
+    failure: str = ""
+    #: why the engine cannot build the mechanism, when it cannot
+    unsupported: str = ""
+
+    @property
+    def order_matches(self) -> bool | None:
+        """Whether the fitted order is the declared one within ORDER_TOLERANCE (None:
+        not judged)."""
+        if self.observed_order is None:
+            return None
+        return abs(self.observed_order - self.integrator_order) <= ORDER_TOLERANCE
 
     def as_dict(self) -> dict:
-        return {"system": self.system, "scenario": self.scenario, "simulator": self.simulator,
-                "engine_version": self.engine_version, "integrator_order": self.integrator_order,
-                "observed_order": self.observed_order,
-                "points": [p.__dict__ for p in self.points]}
+        d = asdict(self)
+        d["order_matches"] = self.order_matches
+        return d
 
 
 def observed_order(dts: Sequence[float], errors: Sequence[float]) -> float:
@@ -45,22 +98,115 @@ def observed_order(dts: Sequence[float], errors: Sequence[float]) -> float:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def convergence(system_id: str, simulator: str, scenario: str, dts: Sequence[float],
-                t_end: float | None = None, settings: Mapping | None = None) -> ConvergenceStudy:
+def falling_part(points: Sequence[ConvergencePoint],
+                 floor: float = 0.0) -> list[ConvergencePoint]:
+    """The points from the coarsest step down to the last halving that still lowered the
+    error by MIN_DECREASE, without those whose error is below `floor`."""
+    ordered = sorted(points, key=lambda p: -p.dt)
+    kept = ordered[:1]
+    for p in ordered[1:]:
+        if not (np.isfinite(p.error) and p.error > floor
+                and kept[-1].error / p.error >= MIN_DECREASE):
+            break
+        kept.append(p)
+    return kept
+
+
+def convergence(system_id: str, simulator: str, scenario: str | None = None,
+                dts: Sequence[float] = DEFAULT_STEPS, t_end: float | None = DEFAULT_T_END,
+                settings: Mapping | None = None) -> ConvergenceStudy:
+    """The study of one engine on one scenario (default: the system's first), over
+    `t_end` seconds (None: the scenario's)."""
     system = get_system(system_id)
-    sc = system.scenario(scenario)
+    sc = system.scenario(scenario) if scenario else system.scenarios[0]
     values = system.parameter_values(scenario=sc)
     backend = get_backend(simulator)
     mech = system.numeric_mechanism(values)
     eq = operating_equilibrium(system, values)
-    T = sc.t_end if t_end is None else t_end
-    points, order = [], 0
-    for dt in dts:
-        ref = reference(system, sc, values, dt, T)
-        run = backend.simulate(mech, ref.q[0], ref.qd[0], T, dt, settings)
-        n = min(len(run.t), len(ref.t))
-        err, _ = metrics.trajectory_errors(run.q[:n], ref.q[:n], metrics.amplitude(ref.q, eq.q))
-        points.append(ConvergencePoint(dt, err, run.wall_time, n - 1))
+    T = sc.t_end if t_end is None else min(t_end, sc.t_end)
+    finest = min(dts)
+    multiples = [int(round(dt / finest)) for dt in dts]
+    if any(abs(k * finest - dt) > 1e-9 * dt for k, dt in zip(multiples, dts)):
+        raise ValueError(f"the steps {list(dts)} must be integer multiples of the finest")
+    ref = reference(system, sc, values, finest, T)
+    free = [i for i, c in enumerate(system.coordinates)
+            if c not in system.mechanism.driven_coordinates]
+    scale = metrics.amplitude(ref.q[:, free], eq.q[free])
+    # a closed form is exact to round-off (its error_estimate is DOP853's distance to it);
+    # a DOP853 reference's own error is its tight solve's, about the tight-loose
+    # difference times TIGHT / LOOSE
+    exact = ref.method.startswith("closed form")
+    reference_error = 0.0 if exact else float(
+        np.max(np.asarray(ref.error_estimate)[free] / scale) * TIGHT / LOOSE)
+    points, order = [], backend.scheme(mech, settings).order
+    study = ConvergenceStudy(system.id, sc.name, simulator, backend.version(), order, points,
+                             None, reference_error=reference_error)
+    support = backend.support(mech)
+    if not support.ok:
+        study.unsupported = f"{simulator} cannot express {system.id}: {support.reason}"
+        return study
+    for dt, k in zip(dts, multiples):
+        q_ref = ref.q[::k, free]
+        try:
+            run = backend.simulate(mech, ref.q[0], ref.qd[0], T, dt, settings)
+        except Exception as exc:  # an engine's failure is a result of the study
+            study.failure = f"dt = {dt:g}: {type(exc).__name__}: {exc}"
+            return study
+        n = min(len(run.t), len(q_ref))
+        err, _ = metrics.trajectory_errors(run.q[:n, free], q_ref[:n], scale)
+        points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1))
         order = run.integrator_order
-    return ConvergenceStudy(system_id, scenario, simulator, backend.version(), order, points,
-                            observed_order([p.dt for p in points], [p.error for p in points]))
+    study.integrator_order = order
+    falling = falling_part(points, REFERENCE_MARGIN * reference_error)
+    study.fitted_steps = [p.dt for p in falling]
+    if len(falling) >= MIN_FIT_POINTS:
+        study.observed_order = observed_order([p.dt for p in falling],
+                                              [p.error for p in falling])
+    else:
+        floor = falling[-1]
+        study.flattened = (f"the error stops falling below dt = {floor.dt:g} (at "
+                           f"{floor.error:.2g} of the amplitude; reference error "
+                           f"{reference_error:.2g}): {len(falling)} falling point(s), "
+                           f"{MIN_FIT_POINTS} needed for a fit")
+    return study
+
+
+def judge_order(study: ConvergenceStudy) -> Metric:
+    """The metric ``convergence.order``: |fitted - declared order| against
+    ORDER_TOLERANCE; unresolved where the curve flattened; failed for a failed study. A
+    declared expected failure that passes is an unexpected pass (strict)."""
+    system = get_system(study.system)
+    if study.unsupported:
+        return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "unsupported",
+                      study.unsupported, "order")
+    if study.failure:
+        return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "fail",
+                      study.failure, "order")
+    if study.observed_order is None:
+        return _judge(system, study.simulator, ORDER_METRIC, float("nan"),
+                      tolerances.Gate(ORDER_TOLERANCE, study.flattened), "order")
+    metric = _judge(system, study.simulator, ORDER_METRIC,
+                    abs(study.observed_order - study.integrator_order), ORDER_TOLERANCE,
+                    "order")
+    if metric.status == "pass" and metric.reason:
+        metric.status = "xpass"  # declared an expected failure, and it passed
+    return metric
+
+
+def _study_item(item: tuple) -> dict:
+    system_id, simulator, dts, t_end = item
+    study = convergence(system_id, simulator, None, dts, t_end)
+    return {**study.as_dict(), "metric": judge_order(study).as_dict()}
+
+
+def convergence_matrix(systems: Sequence[str], simulators: Sequence[str],
+                       dts: Sequence[float] = DEFAULT_STEPS,
+                       t_end: float | None = DEFAULT_T_END,
+                       scheduler: str | None = None, workers: int | None = None) -> list[dict]:
+    """Every system x engine as one item of the sweep (local pool, or a Dask cluster at
+    `scheduler`); the studies as dictionaries with their judged `metric`, in matrix
+    order."""
+    from .sweep import sweep
+
+    items = [(s, e, tuple(dts), t_end) for s in systems for e in simulators]
+    return sweep(_study_item, items, scheduler=scheduler, workers=workers)

@@ -37,9 +37,10 @@ def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
     returned comparisons), the mechanism's drawing and the errata entries, made here in
     parallel on the derivation and models this process already built. Returns the
     comparisons and the job's CPU seconds."""
-    system, sims, dt, variants, out = args
+    system, sims, dt, variants, out, settings = args
     start = time.process_time()
-    found = [run(system, sim, dt=dt, keep_series=True) for sim in sims]
+    found = [run(system, sim, dt=dt, keep_series=True, settings=settings.get(sim))
+             for sim in sims]
     if variants:
         for v in get_system(system).variants:
             # engines that do not build the variant give an "unsupported" row, with why
@@ -66,10 +67,12 @@ def _isolated_job(args) -> tuple[list[Comparison], float]:
 # --- finished jobs, kept for `run --resume` ---------------------------------------------
 
 
-def _job_request(system: str, sims: list[str], dt: float, variants: bool) -> tuple:
+def _job_request(system: str, sims: list[str], dt: float, variants: bool,
+                 settings: Mapping[str, dict]) -> tuple:
     """What a finished job answers: the system (its content key: description and
-    derivation code), the engines, the step and whether variants ran."""
-    return (system, cache_key(get_system(system)), tuple(sims), dt, variants)
+    derivation code), the engines, the step, whether variants ran and the settings."""
+    return (system, cache_key(get_system(system)), tuple(sims), dt, variants,
+            json.dumps(settings, sort_keys=True))
 
 
 def _job_path(out: Path, system: str) -> Path:
@@ -96,11 +99,12 @@ def _load_job(out: Path, request: tuple) -> tuple[list[Comparison], float] | Non
 
 
 def reusable_jobs(out: Path, systems: Iterable[str], simulators: Iterable[str],
-                  dt: float = DEFAULT_DT, variants: bool = False) -> list[str]:
+                  dt: float = DEFAULT_DT, variants: bool = False,
+                  settings: Mapping[str, dict] | None = None) -> list[str]:
     """The systems whose finished job `out` holds for this request (`run --resume`)."""
     sims = list(simulators)
     return [s for s in systems
-            if _load_job(out, _job_request(s, sims, dt, variants)) is not None]
+            if _load_job(out, _job_request(s, sims, dt, variants, settings or {})) is not None]
 
 
 def estimated_cost(system_id: str) -> float:
@@ -132,7 +136,8 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
                workers: int | None = None,
                progress: Callable[[Comparison], None] | None = None,
                variants: bool = False, out: Path | None = None,
-               resume: bool = False) -> list[Comparison]:
+               resume: bool = False,
+               settings: Mapping[str, dict] | None = None) -> list[Comparison]:
     """Every system on every simulator, in `systems` order. With several workers the
     systems are dispatched longest first (`schedule`, with the job costs of the last run
     into `out`) to a process pool; each system is one job (its references and derivation
@@ -144,14 +149,16 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
     the saved jobs that answer the same request (`reusable_jobs`) and runs only the
     others. A job whose worker process dies (a segfault in an engine) loses no
     other job: it runs again engine by engine, each comparison in a worker of its own
-    (`_isolated_job`)."""
+    (`_isolated_job`). `settings` maps an engine to the settings it runs with (its
+    defaults for the others)."""
     systems = list(systems)
+    settings = dict(settings or {})
     sims = list(simulators)
     workers = workers or min(2, os.cpu_count() or 1)
     workers = max(1, min(workers, len(systems)))
     batches: dict[int, list[Comparison]] = {}
     costs: dict[str, float] = {}
-    requests = {s: _job_request(s, sims, dt, variants) for s in systems}
+    requests = {s: _job_request(s, sims, dt, variants, settings) for s in systems}
 
     def collect(i, job, fresh=True):
         batches[i], costs[systems[i]] = job
@@ -171,12 +178,13 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
     crashed = []
     if workers <= 1 or len(todo) <= 1:
         for i in todo:
-            collect(i, _one_system((systems[i], sims, dt, variants, out)))
+            collect(i, _one_system((systems[i], sims, dt, variants, out, settings)))
     else:
         rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
         order = sorted(todo, key=lambda i: rank[systems[i]])
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(_one_system, (systems[i], sims, dt, variants, out)): i
+            futures = {pool.submit(_one_system,
+                                   (systems[i], sims, dt, variants, out, settings)): i
                        for i in order}
             for fut in as_completed(futures):
                 try:
@@ -184,7 +192,7 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
                 except BrokenProcessPool:
                     crashed.append(futures[fut])
     for i in sorted(crashed):
-        collect(i, _isolated_job((systems[i], sims, dt, variants, out)))
+        collect(i, _isolated_job((systems[i], sims, dt, variants, out, settings)))
     if out is not None:
         results_folder.save_job_costs(out, costs)
     # in the order of `systems`, whatever order the jobs finished in

@@ -211,19 +211,31 @@ def load_system(out: Path, system_id: str) -> dict:
 
 def load_results(out: Path) -> tuple[dict, list[Comparison]]:
     """(provenance, comparisons) of results.json, without their series (`load_series`)."""
-    doc = json.loads((out / RESULTS).read_text())
-    comparisons = []
-    for c in doc["comparisons"]:
-        metrics = [Metric(name=m["name"], value=m["value"], tolerance=m["tolerance"],
-                          passed=m["passed"], status=m["status"], reason=m.get("reason", ""),
-                          unit=m["unit"], detail=m.get("detail", {}))
-                   for m in c["metrics"]]
-        comparisons.append(Comparison(
-            system=c["system"], simulator=c["simulator"], engine_version=c["engine_version"],
-            settings=c["settings"], parameters=c["parameters"], dt=c["dt"], metrics=metrics,
-            supported=c["supported"], reason=c["reason"], wall_time=c["wall_time_s"],
-            simulated_time=c["simulated_time_s"], variant=c["variant"]))
-    return doc["provenance"], comparisons
+    return comparisons_from_document(json.loads((out / RESULTS).read_text()), str(out))
+
+
+def comparisons_from_document(doc: dict, source: str = "results") -> tuple[dict, list[Comparison]]:
+    """(provenance, comparisons) of a results document as `matrix.write_results` wrote it
+    (a ValueError naming `source` when it is not one)."""
+    try:
+        comparisons = []
+        for c in doc["comparisons"]:
+            metrics = [Metric(name=m["name"], value=m["value"], tolerance=m["tolerance"],
+                              passed=m["passed"], status=m["status"],
+                              reason=m.get("reason", ""), unit=m["unit"],
+                              detail=m.get("detail", {}), expected=m.get("expected", False))
+                       for m in c["metrics"]]
+            comparisons.append(Comparison(
+                system=c["system"], simulator=c["simulator"],
+                engine_version=c["engine_version"], settings=c["settings"],
+                parameters=c["parameters"], dt=c["dt"], metrics=metrics,
+                supported=c["supported"], reason=c["reason"], wall_time=c["wall_time_s"],
+                simulated_time=c["simulated_time_s"], variant=c["variant"],
+                incidents=c.get("incidents", [])))
+        return doc["provenance"], comparisons
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f"{source}: not a results document of mbfidelity (missing "
+                         f"{exc})") from exc
 
 
 # --- job costs -------------------------------------------------------------------------

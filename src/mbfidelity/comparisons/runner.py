@@ -23,6 +23,7 @@ from ..analytic.steady_state import (excitation_frequencies, observable_function
 from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
+from ..systems.model import inertia_matrix
 from . import checks, metrics, tolerances
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
 
@@ -223,6 +224,8 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
                           eq, variant)
     _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
                          variant)
+    if mech.spatial:
+        _compare_stored_inertia(system, backend, mech, merged, result)
     if chosen_variant is None:
         _strict_expectations(system, result)
     else:
@@ -230,6 +233,32 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
             if m.status != "pass":
                 m.status, m.reason = "measured", chosen_variant.reason
     return result
+
+
+#: a stored tensor is the description's up to the rounding of one diagonalisation
+INERTIA_TOLERANCE = 1e-12
+
+
+def _compare_stored_inertia(system, backend, mech, settings, result) -> None:
+    """Each body's central tensor as the engine stored it (principal moments and axes,
+    read back from the built model) against the description's: the largest entry of the
+    difference, relative to the largest entry of the tensor. The detail lists both."""
+    stored = backend.stored_inertia(mech, settings)
+    for body in mech.bodies:
+        if body.name not in stored:
+            continue
+        moments, axes = stored[body.name]
+        tensor = np.array(inertia_matrix(body).tolist(), dtype=float)
+        rebuilt = axes @ np.diag(moments) @ axes.T
+        scale = max(float(np.max(np.abs(tensor))), 1e-300)
+        value = float(np.max(np.abs(rebuilt - tensor))) / scale
+        metric = _judge(system, backend.id, f"inertia.{body.name}", value, INERTIA_TOLERANCE)
+        own_moments, own_axes = np.linalg.eigh(tensor)
+        metric.detail = {"engine_principal_moments": [float(v) for v in moments],
+                         "engine_principal_axes": axes.T.tolist(),
+                         "description_principal_moments": [float(v) for v in own_moments],
+                         "description_principal_axes": own_axes.T.tolist()}
+        result.metrics.append(metric)
 
 
 def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) -> None:

@@ -6,6 +6,7 @@ expected failures."""
 from __future__ import annotations
 
 import html
+import json
 import os
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -84,6 +85,15 @@ bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} mi
 {% if expected[sys] %}<p>Declared expected failures:</p><ul>{% for e in expected[sys] %}<li><b>{{ e.simulator }}</b>, {{ e.metric }}: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
+{% if strutt %}<h2>The Strutt chart of eq. 83</h2>
+<p>Stability of Mathieu's equation as printed (§8.4, Fig. 28) from Floquet theory{% if strutt_engines %},
+and each engine's classification by simulation ({{ strutt_engines }}){% endif %}
+(written by <code>mbfidelity strutt --out DIR</code>; <code>make report</code> writes it).</p>
+<img src="strutt.png">{% endif %}
+{% if convergence %}<h2>Convergence and work-precision</h2>
+<p>Each engine's error against the step, its fitted order next to the declared one, and its
+error against CPU seconds: <a href="convergence.html">convergence.html</a> (written by
+<code>mbfidelity convergence --out DIR</code>; <code>make report</code> writes it).</p>{% endif %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
 <p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
 (written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
@@ -207,11 +217,25 @@ def write_report(out: Path, workers: int | None = None) -> Path:
                            titles={s: _title(s) for s in systems}, versions=versions,
                            explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
                            expected={s: _expected(s) for s in systems},
-                           liftoff=liftoff)
+                           liftoff=liftoff,
+                           convergence=(out / "convergence.json").exists(),
+                           strutt=(out / "strutt.png").exists(),
+                           strutt_engines=_strutt_engines(out))
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def _strutt_engines(out: Path) -> str:
+    """Each engine's agreement with eq. 83 in the saved Strutt chart, as text ("" when
+    no engine classified it)."""
+    path = out / "strutt.json"
+    if not path.exists():
+        return ""
+    engines = json.loads(path.read_text()).get("simulation", {}).get("engines", {})
+    return "; ".join(f"{e}: {s['agreement_with_eq83']:.1%} of {s['decided_points']} points "
+                     f"agree" for e, s in engines.items())
 
 
 def _render_figures(out: Path, rows: dict[str, list], workers: int | None) -> dict[str, list]:

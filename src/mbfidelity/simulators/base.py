@@ -214,6 +214,11 @@ class Backend(ABC):
     #: per element kind, the cases the backend can build (contract point 5); a kind that
     #: is missing is unsupported
     EXPRESSIONS: ClassVar[Mapping[str, tuple[Expression, ...]]] = {}
+    #: why the backend does not build spatial mechanisms (model convention 10); empty
+    #: when it does
+    SPATIAL_REASON: ClassVar[str] = (
+        "its translation is planar: a spatial mechanism (full inertia tensor, hinges "
+        "about any axis) has no build in this backend")
 
     @abstractmethod
     def available(self) -> tuple[bool, str]:
@@ -245,6 +250,13 @@ class Backend(ABC):
         raise NotImplementedError(f"{self.id} declares several cases of {kind} but does "
                                   "not choose among them")
 
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """A spatial mechanism's central inertia as the engine stored it, read back from
+        the built model: per body, (principal moments, principal axes as the columns of a
+        rotation in the body's frame). Empty where the backend does not read it back."""
+        return {}
+
     def translation_reason(self, mechanism: Mechanism) -> str:
         """Why the engine's structure cannot hold the mechanism although no single element
         is unsupported (empty string: it can)."""
@@ -253,7 +265,9 @@ class Backend(ABC):
     def support(self, mechanism: Mechanism) -> Support:
         """Contract point 5: from the description's checks, the engine's structure and the
         declared expression of every element."""
-        reason = description_reason(mechanism) or self.translation_reason(mechanism)
+        reason = (description_reason(mechanism)
+                  or (self.SPATIAL_REASON if mechanism.spatial else "")
+                  or self.translation_reason(mechanism))
         if reason:
             return Support(False, reason)
         for kind, element in elements(mechanism):

@@ -13,6 +13,10 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   axis scales the slide), generalized forces map with ``T^T``;
 - massless link bodies are kept as zero-mass links (the tree accepts them while the
   mass matrix stays regular, i.e. while a massive descendant carries the coordinates);
+- a spatial mechanism (model convention 10; open trees of massive bodies on relative
+  counter-clockwise hinges about a link axis, without offset) gets RevoluteX/Y/Z links
+  whose frames sit at the joints, aligned with their parents, with the full 3 x 3
+  central tensor in ``linkInertiasCOM`` (stored as given: `stored_inertia`);
 - gravity is the tree's own gravity vector; a `CoordinateForce` whose law is affine in
   COORD/COORD_RATE and free of TIME uses the tree's PD terms (C++), any other law is a
   Python ``forceUserFunction`` of the tree (called at every integrator stage with the
@@ -97,6 +101,7 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
     Revolute,
+    inertia_matrix,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
@@ -208,6 +213,55 @@ class _Geometry:
         return u @ row + const + self.beta[body]
 
 
+_AXIS_JOINTS = {(1.0, 0.0, 0.0): "RevoluteX", (0.0, 1.0, 0.0): "RevoluteY",
+                (0.0, 0.0, 1.0): "RevoluteZ"}
+
+
+def _hinge_axis(j: Revolute) -> tuple[float, ...]:
+    axis = np.array([num(v) for v in (j.axis if j.axis is not None else (0, 0, 1))])
+    return tuple(float(v) for v in axis / np.linalg.norm(axis))
+
+
+def _spatial_reason(mech: Mechanism) -> str:
+    """Why the spatial tree cannot hold a spatial mechanism (empty: it can)."""
+    if mech.constraints:
+        return "closure constraints in a spatial mechanism"
+    for j in mech.joints:
+        if isinstance(j, Prismatic):
+            return f"joint {j.name}: the spatial tree has hinges only"
+        if j.absolute or j.clockwise or num(j.angle_offset) != 0:
+            return (f"joint {j.name}: the spatial tree takes relative, counter-clockwise "
+                    "hinges without offset")
+        if _hinge_axis(j) not in _AXIS_JOINTS:
+            return (f"joint {j.name}: the tree's hinges turn about a link axis (RevoluteX, "
+                    f"Y or Z), not about {_hinge_axis(j)}")
+    if any(b.massless for b in mech.bodies):
+        return "a massless body in a spatial mechanism"
+    if any(isinstance(f, PointToPoint) for f in mech.forces):
+        return "a point-to-point element in a spatial mechanism"
+    return ""
+
+
+def _spatial_tree(mech: Mechanism, exu) -> tuple[list, list, list, list, list]:
+    """(joint types, joint offsets, central tensors, centres of mass, gravity) of a
+    spatial open tree of hinges: each link frame at its joint, aligned with its parent
+    (model convention 10), the body's full 3 x 3 tensor about its centre of mass."""
+    def column(v):
+        return [float(num(c)) for c in v] + [0.0] * (3 - len(v))
+
+    types, offsets, tensors, coms = [], [], [], []
+    com_of = {WORLD: [0.0, 0.0, 0.0]}
+    for j in mech.joints:
+        types.append(getattr(exu.JointType, _AXIS_JOINTS[_hinge_axis(j)]))
+        offsets.append([a + b for a, b in zip(com_of[j.parent], column(j.parent_anchor))])
+        com_of[j.child] = [-c for c in column(j.child_anchor)]
+        coms.append(com_of[j.child])
+        tensors.append(np.array(inertia_matrix(mech.body(j.child)).tolist(), dtype=float))
+    up = np.array(column(mech.up))
+    gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
+    return types, offsets, tensors, coms, gravity
+
+
 def _geometry(mech: Mechanism) -> _Geometry:
     n = len(mech.joints)
     link_of: dict[str, int] = {}
@@ -222,8 +276,9 @@ def _geometry(mech: Mechanism) -> _Geometry:
         p = j.parent
         parents.append(link_of[p] if p != WORLD else -1)
         link_of[j.child] = i
-        parent_anchor = np.array([num(v) for v in j.parent_anchor])
-        child_anchor = np.array([num(v) for v in j.child_anchor])
+        # in-plane components (a spatial tree's 3-D ones: `_spatial_tree`)
+        parent_anchor = np.array([num(v) for v in j.parent_anchor][:2])
+        child_anchor = np.array([num(v) for v in j.child_anchor][:2])
         offset = num(j.angle_offset)
         # the joint point in the parent's link frame
         offsets.append(com[p] + rot(-beta[p]) @ parent_anchor)
@@ -409,6 +464,25 @@ class ExudynBackend(Backend):
         ),
     }
 
+    SPATIAL_REASON = ""
+
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """The tree's linkInertiasCOM as stored (a full 3 x 3 tensor, not diagonalised),
+        in principal form."""
+        cfg = self.resolve_settings(settings)
+        zeros = np.zeros(len(mechanism.joints))
+        _, mbs, _, _, tree, _, _ = self._build(mechanism, zeros, zeros, cfg)
+        tensors = np.array(mbs.GetObjectParameter(tree, "linkInertiasCOM"), dtype=float)
+        out = {}
+        for j, tensor in zip(mechanism.joints, tensors.reshape(-1, 3, 3)):
+            values, axes = np.linalg.eigh(tensor)
+            out[j.child] = (values, axes)
+        return out
+
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        return _spatial_reason(mechanism) if mechanism.spatial else ""
+
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
         if kind == PRESCRIBED:
@@ -448,6 +522,12 @@ class ExudynBackend(Backend):
                        for t in geo.types]
         inertias = [np.diag([0.0, 0.0, geo.inertia[b]]) for b in bodies]
         coms = [[*geo.com[b], 0.0] for b in bodies]
+        offsets = [[*o, 0.0] for o in geo.offsets]
+        transformations = [_rot3(a) for a in geo.rotations]
+        gravity = [0.0, -geo.gravity, 0.0]
+        if mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
+            joint_types, offsets, inertias, coms, gravity = _spatial_tree(mech, exu)
+            transformations = [np.eye(3)] * n
 
         # coordinate forces: native PD terms where the law is affine and maps to one
         # engine coordinate, the rest through one Python user function of the tree
@@ -473,10 +553,10 @@ class ExudynBackend(Backend):
                 python_laws.append((i, law.law))
 
         tree_args = dict(
-            nodeNumber=node, gravity=[0.0, -geo.gravity, 0.0], baseOffset=[0.0, 0.0, 0.0],
+            nodeNumber=node, gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
             jointTypes=joint_types, linkParents=geo.parents,
-            jointTransformations=exu.Matrix3DList([_rot3(a) for a in geo.rotations]),
-            jointOffsets=exu.Vector3DList([[*o, 0.0] for o in geo.offsets]),
+            jointTransformations=exu.Matrix3DList(transformations),
+            jointOffsets=exu.Vector3DList(offsets),
             linkInertiasCOM=exu.Matrix3DList(inertias), linkCOMs=exu.Vector3DList(coms),
             linkMasses=[geo.mass[b] for b in bodies],
         )
@@ -724,6 +804,54 @@ class ExudynBackend(Backend):
             settings["linearization_relative_epsilon"])
         s.linearSolver.ignoreSingularJacobian = False
         return s
+
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone Python script, what it does not reproduce): every node, object,
+        marker and load of the system `simulate` builds, as the dictionaries Exudyn
+        reports for them (mbs.GetObject(i), ...), added back in the same order, the
+        simulation settings as their dictionary, then `SolveDynamic` and the
+        description's coordinates at the end (simulators/script_export.py). Python user
+        functions (force laws, prescribed motion) cannot be written out: they are left
+        out of the items and listed."""
+        from .script_export import exudyn_script
+
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        solver = self._checked_solver(mechanism, cfg)
+        q0, qd0 = self._driven_state(mechanism, q0, qd0)
+        exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
+        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
+        driven = self._add_prescribed(mbs, mechanism, node, geo)
+        data = mbs.systemData
+        items = [(kind, get(i)) for kind, count, get in (
+            ("Node", data.NumberOfNodes(), mbs.GetNode),
+            ("Object", data.NumberOfObjects(), mbs.GetObject),
+            ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
+            ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
+        sim = self._simulation_settings(exu, cfg, 1.0, int(round(1.0 / dt)))
+        sim.timeIntegration.generalizedAlpha.computeInitialAccelerations = not driven
+        if closures or driven:
+            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
+                cfg["constrained_spectral_radius"])
+        outside = []
+        if mechanism.forces:
+            outside.append("the force laws computed in Python user functions: "
+                           + ", ".join(f.name for f in mechanism.forces))
+        if driven:
+            outside.append("the prescribed motions' offset user functions and the "
+                           "consistent start the harness computes: "
+                           + ", ".join(p.name for p in mechanism.prescribed))
+        text = exudyn_script(
+            title=(f"The mechanism as mbfidelity builds it in Exudyn {self.version()}, from "
+                   f"the initial state of scenario {name!r}, solver {solver}.\nBackend "
+                   f"settings:\n" + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
+            items=items, simulation=sim.GetDictionary(), solver=solver, node=int(node),
+            coordinates=coordinates, T=geo.T, c=geo.c, dt=dt, not_in_script=outside)
+        return text, outside
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         solver = self._solver_for(mechanism, self.resolve_settings(settings))

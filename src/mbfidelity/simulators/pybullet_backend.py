@@ -12,6 +12,11 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   angles (``absolute=True``), clockwise coordinates and non-unit prismatic axes make the
   engine's joint values an affine map of the description coordinates, ``jv = A q + b``;
   states map back with ``A^-1`` and generalized forces map as ``tau = A^-T Q``.
+- A spatial mechanism (model convention 10; open trees of massive bodies on relative
+  counter-clockwise hinges without offset): link frames at the 3-D anchors aligned with
+  the parent, hinge axes from the description, the full central tensor as its principal
+  moments (``localInertiaDiagonal``) and principal axes (the inertial frame's
+  orientation), read back by `stored_inertia`; gravity along -up.
 - ``Prismatic``: axis in the x-y plane of the joint frame (the parent axis rotated by
   ``-angle_offset``), normalised (its length goes into ``A``).
 - Massless bodies are links of mass 0 and inertia 0: Featherstone's articulated-body
@@ -94,8 +99,11 @@ from ..systems.model import (
     Mechanism,
     PointOnLine,
     PointOnPoint,
+    PointToPoint,
+    Prismatic,
     Revolute,
     RollingContact,
+    inertia_matrix,
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import (
@@ -161,6 +169,9 @@ class _Link:
     inertial_position: list[float]  # centre of mass in the link frame
     axis: list[float]               # joint axis in the joint (= link) frame
     axis_parent: np.ndarray         # unit prismatic axis in the parent body frame (2,)
+    #: a spatial body's principal moments and the quaternion of its principal axes in the
+    #: link frame (None: the planar inertia on every axis, identity frame)
+    principal: tuple[list[float], list[float]] | None = None
 
 
 @dataclass
@@ -285,6 +296,54 @@ def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
                     (float(u[0]), float(u[1])))
 
 
+def _spatial_reason(mech: Mechanism) -> str:
+    """Why the spatial build cannot hold a spatial mechanism (empty: it can)."""
+    if mech.constraints:
+        return "closure constraints in a spatial mechanism"
+    for j in mech.joints:
+        if isinstance(j, Revolute) and (j.absolute or j.clockwise):
+            return f"joint {j.name}: the spatial build takes relative, counter-clockwise hinges"
+        if num(j.angle_offset) != 0:
+            return f"joint {j.name}: the spatial build takes no angle offset"
+        if isinstance(j, Prismatic):
+            return f"joint {j.name}: the spatial build has hinges only"
+    if any(b.massless for b in mech.bodies):
+        return "a massless body in a spatial mechanism (the spatial build folds none)"
+    if any(isinstance(f, PointToPoint) for f in mech.forces):
+        return "a point-to-point element in a spatial mechanism (the spatial build has none)"
+    return ""
+
+
+def principal_inertia(tensor: np.ndarray) -> tuple[list[float], list[float]]:
+    """(principal moments, quaternion x y z w of the principal axes) of a symmetric
+    3 x 3 central tensor: the eigenvectors, made a right-handed frame."""
+    values, vectors = np.linalg.eigh(tensor)
+    if np.linalg.det(vectors) < 0:
+        vectors[:, 2] = -vectors[:, 2]
+    from scipy.spatial.transform import Rotation
+
+    return [float(v) for v in values], [float(v) for v in Rotation.from_matrix(vectors).as_quat()]
+
+
+def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
+    """The link of joint i of a spatial open tree: joint frame at the anchor, aligned with
+    the parent (no orientation offset, model convention 10), hinge about the
+    description's axis, the body's full tensor given by its principal moments and axes."""
+    j = mech.joints[i]
+    body = mech.body(j.child)
+    pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
+              for a in (j.parent_anchor, j.child_anchor))
+    axis = np.array([num(v) for v in (j.axis if j.axis is not None else (0, 0, 1))])
+    tensor = np.array(inertia_matrix(body).tolist(), dtype=float)
+    return _Link(name=j.name, body=j.child, parent=parent, revolute=True,
+                 mass=num(body.mass), inertia=float(tensor[2, 2]),
+                 position=[float(v) for v in pa - np.array([*parent_anchor, 0.0][:3])],
+                 orientation=[0.0, 0.0, 0.0, 1.0],
+                 inertial_position=[float(v) for v in -ca],
+                 axis=[float(v) for v in axis / np.linalg.norm(axis)],
+                 axis_parent=np.zeros(2), principal=principal_inertia(tensor))
+
+
 class _Plan:
     """Numeric translation of a (numeric) mechanism into PyBullet terms.
 
@@ -300,6 +359,9 @@ class _Plan:
         self.coords = mech.coordinates
         self.n = len(self.coords)
         self.gravity = num(mech.gravity)
+        up = np.array([num(u) for u in mech.up], dtype=float)
+        self.gravity_vector = ((0.0, -self.gravity, 0.0) if not mech.spatial
+                               else tuple(-self.gravity * up / np.linalg.norm(up)))
         masses = [num(b.mass) for b in mech.bodies]
         inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
@@ -330,6 +392,12 @@ class _Plan:
                 axis = [c * axis_parent[0] - s * axis_parent[1],
                         s * axis_parent[0] + c * axis_parent[1], 0.0]
             mass, inertia = num(body.mass), num(body.inertia)
+            if mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
+                self.links.append(_spatial_link(mech, i, link_of[j.parent],
+                                                anchor_of[j.parent]))
+                link_of[j.child] = i
+                anchor_of[j.child] = tuple(-v for v in self.links[-1].inertial_position)
+                continue
             if body.massless:
                 mass, inertia = massless_mass, 0.0
                 if body.name not in parents and body.name in constrained:
@@ -706,6 +774,11 @@ class PyBulletBackend(Backend):
         ),
     }
 
+    SPATIAL_REASON = ""
+
+    def translation_reason(self, mechanism: Mechanism) -> str:
+        return _spatial_reason(mechanism) if mechanism.spatial else ""
+
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
         if kind == PRESCRIBED:
@@ -735,15 +808,18 @@ class PyBulletBackend(Backend):
         each plan link, {joint index: (x link, y link)})."""
         masses, positions, orientations, inertial, parents, types, axes = [], [], [], [], [], [], []
         shapes: list[int] = []
+        inertial_orientations: list[list[float]] = []
         collision = dict(collision or {})
         engine_index: list[int] = [-1] * len(plan.links)
         virtual: dict[int, tuple[int, int]] = {}
 
-        def add(mass, pos, orn, ipos, parent, jtype, axis, shape=-1) -> int:
+        def add(mass, pos, orn, ipos, parent, jtype, axis, shape=-1,
+                iorn=(0.0, 0.0, 0.0, 1.0)) -> int:
             masses.append(mass)
             positions.append(pos)
             orientations.append(orn)
             inertial.append(ipos)
+            inertial_orientations.append(list(iorn))
             parents.append(parent + 1)  # createMultiBody counts links from 1; 0 = base
             types.append(jtype)
             axes.append(axis)
@@ -762,7 +838,8 @@ class PyBulletBackend(Backend):
                 parent, pos = vy, [0.0, 0.0, 0.0]
             jtype = p.JOINT_REVOLUTE if lk.revolute else p.JOINT_PRISMATIC
             engine_index[i] = add(lk.mass, pos, lk.orientation, lk.inertial_position,
-                                  parent, jtype, lk.axis, collision.get(i, -1))
+                                  parent, jtype, lk.axis, collision.get(i, -1),
+                                  *([lk.principal[1]] if lk.principal else []))
         fixed: list[int] = []
         if fixed_shapes is not None:
             host, host_shapes = fixed_shapes
@@ -781,7 +858,7 @@ class PyBulletBackend(Backend):
             linkMasses=masses, linkCollisionShapeIndices=shapes,
             linkVisualShapeIndices=[-1] * nl, linkPositions=positions,
             linkOrientations=orientations, linkInertialFramePositions=inertial,
-            linkInertialFrameOrientations=[[0, 0, 0, 1]] * nl, linkParentIndices=parents,
+            linkInertialFrameOrientations=inertial_orientations, linkParentIndices=parents,
             linkJointTypes=types, linkJointAxis=axes, physicsClientId=cid, **extra)
         if body < 0:
             raise RuntimeError("pybullet createMultiBody failed")
@@ -804,13 +881,14 @@ class PyBulletBackend(Backend):
             p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
             else p.ACTIVATION_STATE_DISABLE_SLEEPING), physicsClientId=cid)
         for i, lk in enumerate(plan.links):
+            diagonal = lk.principal[0] if lk.principal else [lk.inertia] * 3
             if settings["explicit_inertia"]:
                 p.changeDynamics(body, engine_index[i], mass=float(lk.mass),
-                                 localInertiaDiagonal=[lk.inertia] * 3, physicsClientId=cid)
+                                 localInertiaDiagonal=diagonal, physicsClientId=cid)
             info = p.getDynamicsInfo(body, engine_index[i], physicsClientId=cid)
             if settings["explicit_inertia"] and (
                     abs(info[0] - lk.mass) > 1e-12 * max(1.0, lk.mass)
-                    or abs(info[2][2] - lk.inertia) > 1e-12 * max(1.0, lk.inertia)):
+                    or abs(info[2][2] - diagonal[2]) > 1e-12 * max(1.0, diagonal[2])):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
             moving = sorted(set(range(nl)) - set(getattr(plan, "fixed_links", ())
@@ -820,12 +898,12 @@ class PyBulletBackend(Backend):
                                         forces=[0.0] * len(moving), physicsClientId=cid)
         return body, engine_index, virtual
 
-    def _connect(self, p, settings: dict, dt: float, gravity: float,
+    def _connect(self, p, settings: dict, dt: float, gravity: Sequence[float],
                  constrained: bool = False) -> int:
         cid = p.connect(p.DIRECT)
         if cid < 0:
             raise RuntimeError("pybullet connect(DIRECT) failed")
-        p.setGravity(0.0, -gravity, 0.0, physicsClientId=cid)
+        p.setGravity(*gravity, physicsClientId=cid)
         p.setTimeStep(dt, physicsClientId=cid)
         p.setPhysicsEngineParameter(
             fixedTimeStep=dt, numSubSteps=0,
@@ -1060,7 +1138,7 @@ class PyBulletBackend(Backend):
                 c for c in mechanism.constraints if c is not rolling[0]))
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
         n = plan.n
-        cid = self._connect(p, cfg, dt, plan.gravity,
+        cid = self._connect(p, cfg, dt, plan.gravity_vector,
                             constrained=bool(plan.closures) or contact is not None)
         try:
             shapes, ring = (self._contact_shapes(p, cid, plan, cfg) if contact is not None
@@ -1228,6 +1306,48 @@ class PyBulletBackend(Backend):
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
+
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone Python script, what it does not reproduce): the build `simulate`
+        makes, recorded call by call (simulators/script_export.py), from the first
+        initial state, then stepping and the description's coordinates at the end."""
+        import pybullet
+
+        from .script_export import Recorder, script
+
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        recorder = Recorder(pybullet)
+        world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
+        try:
+            outside = []
+            if self._inputs(pybullet, world, dt) is not None:
+                laws = [e.name for e in mechanism.forces]
+                outside.append("the force laws' joint and point forces (TORQUE_CONTROL and "
+                               f"applyExternalForce before every step): {', '.join(laws)}")
+            if mechanism.prescribed:
+                outside.append("the prescribed motions' velocity motors, set before every "
+                               "step: " + ", ".join(p.name for p in mechanism.prescribed))
+            n = world.plan.n
+            text = script(
+                title=(f"The mechanism as mbfidelity builds it in PyBullet "
+                       f"{self.version()}, from the initial state of scenario {name!r}.\n"
+                       f"Backend settings:\n" + "\n".join(f"  {k} = {v!r}"
+                                                           for k, v in cfg.items())),
+                module="pybullet", connect="pybullet.connect(pybullet.DIRECT)",
+                client_id=world.cid, calls=recorder.calls,
+                step="pybullet.stepSimulation(physicsClientId=cid)",
+                read=(f"[s[0] for s in pybullet.getJointStates({world.body}, "
+                      f"{list(world.eidx[:n])}, physicsClientId=cid)]"),
+                coordinates=coordinates, T=world.plan.map.T, c=world.plan.map.c, dt=dt,
+                not_in_script=outside)
+        finally:
+            pybullet.disconnect(physicsClientId=world.cid)
+        return text, outside
 
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
@@ -1561,6 +1681,26 @@ class PyBulletBackend(Backend):
             reactions[name] = R
         return reactions
 
+    def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """getDynamicsInfo of each link: its local inertia diagonal and inertial frame
+        orientation (a spatial link's frame is aligned with its body's)."""
+        import pybullet as p
+
+        cfg = self.resolve_settings(settings)
+        plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
+        cid = self._connect(p, cfg, 1e-3, plan.gravity_vector)
+        try:
+            body, eidx, _ = self._build(p, cid, plan, cfg)
+            out = {}
+            for i, lk in enumerate(plan.links[:plan.n]):
+                info = p.getDynamicsInfo(body, eidx[i], physicsClientId=cid)
+                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=cid))
+                out[lk.body] = (np.array(info[2], dtype=float), R.reshape(3, 3))
+            return out
+        finally:
+            p.disconnect(physicsClientId=cid)
+
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
@@ -1577,7 +1717,7 @@ class PyBulletBackend(Backend):
         plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
         n = plan.n
         h_rel = float(cfg["linearize_step"])
-        cid = self._connect(p, cfg, dt, plan.gravity)
+        cid = self._connect(p, cfg, dt, plan.gravity_vector)
         try:
             body, eidx, _ = self._build(p, cid, plan, cfg)
             jv_eq = plan.joint_values(np.asarray(q_eq, dtype=float))

@@ -1416,6 +1416,9 @@ class PymunkBackend(Backend):
             return cases[1] if substituted else cases[0]
         return cases[1] if any(p.name == element.name for p in layout.pitches) else cases[0]
 
+    SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
+                      "tensor, hinges about horizontal axes) has no expression in it")
+
     def translation_reason(self, mechanism: Mechanism) -> str:
         layout = _plan(mechanism, self.default_settings())
         return layout if isinstance(layout, str) else ""
@@ -1770,6 +1773,41 @@ class PymunkBackend(Backend):
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
+
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone Python script, what it does not reproduce): the space `simulate`
+        builds, read back body by body and constraint by constraint
+        (simulators/script_export.py), stepped as `simulate` steps it; it prints the
+        engine bodies' states (the description's coordinates are computed from them by
+        the harness's compiled functions, which are not written out)."""
+        from .script_export import pymunk_script
+
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        layout, comp, space, bodies, balanced, movers = self._prepare(
+            mechanism, np.asarray(q0, float), np.asarray(qd0, float), cfg, float(dt))
+        outside = []
+        if comp.loads_math is not None:
+            outside.append("the force laws' body forces and torques, set before every "
+                           "step: " + ", ".join(f.name for f in mechanism.forces))
+        if layout.drives:
+            outside.append("the prescribed motions' moving targets and kinematic drivers: "
+                           + ", ".join(p.name for p in mechanism.prescribed))
+        if any(c.pre_solve is not None for c in space.constraints):
+            outside.append("the pre-solve callbacks that move rolling pitch points")
+        text = pymunk_script(
+            title=(f"The mechanism as mbfidelity builds it in Pymunk {self.version()}, from "
+                   f"the initial state of scenario {name!r}.\nBackend settings:\n"
+                   + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
+            space=space, first_iterations=max(int(cfg["iterations"]),
+                                              int(cfg["start_iterations"])),
+            iterations=int(cfg["iterations"]),
+            names=dict(zip(bodies, layout.engine)), dt=dt, not_in_script=outside)
+        return text, outside
 
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,

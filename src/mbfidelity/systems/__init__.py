@@ -2,11 +2,24 @@
 
 Each module defines ``SYSTEM = System(...)``. Adding a mechanism means adding a module
 here and nothing else (the pattern of dm_control's suite).
+
+A user's own mechanisms, written the same way, join the catalog from outside the
+package: module files named in the environment variable ``MBFIDELITY_SYSTEM_PATH``
+(separated by the platform's path separator; the command line's ``--system-path FILE``
+sets it, so worker processes see them too), and modules or systems registered under the
+entry-point group ``mbfidelity.systems`` by an installed package. A module that cannot
+be loaded, defines no ``SYSTEM``, or reuses an id is refused with one ValueError naming
+the file and the problem.
 """
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import importlib.util
+import os
 import pkgutil
+import sys
+from pathlib import Path
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from types import SimpleNamespace
@@ -205,11 +218,6 @@ class System:
     #: a parameter on which the operating equilibrium's stability turns (the belt speed
     #: of a self-excited system, §7.2): `analyze` reports where it changes stability
     stability_parameter: str | None = None
-    #: (lambda, gamma, values) -> parameter values at which the linearization about the
-    #: operating point is Mathieu's equation as printed (monograph eq. 83), with time
-    #: scaled by the excitation's frequency: the mechanism that draws the Strutt chart by
-    #: simulation (comparisons/strutt_engine.py)
-    mathieu_map: Callable[[float, float, Mapping[str, float]], dict] | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
@@ -404,6 +412,10 @@ def _compiled(expr, symbols: SimpleNamespace):
     return law
 
 
+SYSTEM_PATH_VARIABLE = "MBFIDELITY_SYSTEM_PATH"
+ENTRY_POINT_GROUP = "mbfidelity.systems"
+
+
 def _discover() -> dict[str, System]:
     found: dict[str, System] = {}
     for info in pkgutil.iter_modules(__path__):
@@ -416,7 +428,53 @@ def _discover() -> dict[str, System]:
                 raise ValueError(f"module {info.name} defines system {system.id}")
             object.__setattr__(system, "module_doc", module.__doc__ or "")
             found[system.id] = system
+    for source, module in _user_modules():
+        _register_user_system(found, source, module)
     return dict(sorted(found.items()))
+
+
+def _user_modules():
+    """(where it came from, module or System) of every user mechanism."""
+    for entry in os.environ.get(SYSTEM_PATH_VARIABLE, "").split(os.pathsep):
+        if entry:
+            yield entry, _load_module_file(Path(entry))
+    for point in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+        source = f"entry point {point.name} = {point.value} ({ENTRY_POINT_GROUP})"
+        try:
+            yield source, point.load()
+        except Exception as exc:  # a user's module: any error is reported, in one line
+            raise ValueError(f"{source}: cannot be loaded: {type(exc).__name__}: {exc}") from exc
+
+
+def _load_module_file(path: Path):
+    if not path.is_file() or path.suffix != ".py":
+        raise ValueError(f"{path}: not a Python file (a mechanism module, like those in "
+                         f"mbfidelity/systems/)")
+    name = f"mbfidelity_user_systems.{path.stem}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses and pickling look modules up by name
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # a user's module: any error is reported, in one line
+        del sys.modules[name]
+        raise ValueError(f"{path}: cannot be loaded: {type(exc).__name__}: {exc}") from exc
+    return module
+
+
+def _register_user_system(found: dict[str, System], source: str, module) -> None:
+    system = module if isinstance(module, System) else getattr(module, "SYSTEM", None)
+    if not isinstance(system, System):
+        raise ValueError(f"{source}: defines no SYSTEM = mbfidelity.systems.System(...)")
+    if system.id in found:
+        raise ValueError(f"{source}: system id {system.id!r} is already in the catalog")
+    try:
+        system.mechanism  # the description must build from its parameters' symbols
+    except Exception as exc:  # a user's module: any error is reported, in one line
+        raise ValueError(f"{source}: {system.id}'s build fails: {type(exc).__name__}: "
+                         f"{exc}") from exc
+    object.__setattr__(system, "module_doc", getattr(module, "__doc__", None) or "")
+    found[system.id] = system
 
 
 _REGISTRY: dict[str, System] | None = None

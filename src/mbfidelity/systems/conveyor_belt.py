@@ -28,6 +28,8 @@ stability statement (the reduced damping c + Ft'(v0) changes sign at the thresho
 printed numbers (x_eq = 11.5 mm at v0 = 0.29 m/s, the threshold 0.3 m/s, a velocity
 amplitude of about 0.3 m/s on the limit cycle) are hand facts (tests/hand/conveyor_belt.py).
 """
+import math
+
 import sympy as sp
 
 from . import Expectation, PrintedFormula, System, coordinate_symbols
@@ -39,7 +41,7 @@ PARAMETERS = (
     Parameter("k", 500.0, "N/m", "spring constant", "MECHANISMS.md C; §7.2"),
     Parameter("c", 2.0, "N s/m", "viscous damping", "MECHANISMS.md C; §7.2",
               domain="nonnegative"),
-    Parameter("alpha", "25*pi/180", "rad", "inclination of the belt (25 degrees)",
+    Parameter("alpha", math.radians(25.0), "rad", "inclination of the belt (25 degrees)",
               "MECHANISMS.md C; §7.2"),
     Parameter("v0", 0.29, "m/s", "speed of the belt (Fig. 23; the scenarios span "
               "0.29-0.31)", "MECHANISMS.md C; §7.2, Fig. 22-23"),
@@ -63,6 +65,13 @@ FIRST_ORDER_NEUTRAL = (
     "At the threshold the motion neither grows nor decays for 40 s: semi-implicit Euler's "
     "first-order trajectory bound (w h) + (w h)^2 (1 + w T) (comparisons/tolerances.py) "
     "exceeds a tenth of the amplitude at dt = 1e-3 s; at dt = 2.5e-4 s it resolves.")
+
+FIRST_ORDER_MIXED = (
+    "Semi-implicit Euler on this weakly (negatively) damped oscillation: its O(h) "
+    "distortion of the orbit and its O(h^2 w T) phase drift are of one size at the studied "
+    "steps and partly cancel in the error's maximum, so the error falls irregularly with "
+    "the step (by 1.4 to 2.5 per halving) and no single order fits (mbfidelity "
+    "convergence).")
 
 #: the belt speeds of Fig. 22: unstable, critical and stable rest state
 BELT_SPEEDS = (0.29, 0.30, 0.31)
@@ -161,6 +170,8 @@ SYSTEM = System(
     stability_parameter="v0",
     expectations=(
         Expectation("*", "v0_0_29.trajectory_*", "unresolved", STICK_SLIP_DRIFT),
+        *(Expectation(engine, "convergence.order", "unresolved", FIRST_ORDER_MIXED)
+          for engine in ("pybullet", "pymunk")),
         *(Expectation(engine, metric, "unresolved", FIRST_ORDER_NEUTRAL)
           for engine in ("pybullet", "pymunk")
           for metric in ("v0_0_30.trajectory_*", "v0_0_30.final_amplitude")),

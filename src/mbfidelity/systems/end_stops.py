@@ -103,6 +103,13 @@ def printed(P):
     )
 
 
+CORNER_ORDER = (
+    "A fixed-step RK4 (MuJoCo's, Exudyn's RK44) does not locate the stops' corners: each "
+    "step across one, where the law's slope jumps by k2, leaves a velocity error of order "
+    "h^2 (comparisons/tolerances.py, corner_velocity_error), so the motion converges at "
+    "order 2 while the scheme declares 4 (mbfidelity convergence). The first-order "
+    "engines keep their order.")
+
 SYSTEM = System(
     id="end_stops",
     title="Block between spring-damper pairs with elastic end stops",
@@ -120,5 +127,7 @@ SYSTEM = System(
     exact_solution="oscillator_with_elastic_stops",
     expectations=tuple(
         Expectation(engine, "fig2.band_entry_time", "unresolved", GRAZING_CONTACT)
-        for engine in ("pybullet", "pymunk")),
+        for engine in ("pybullet", "pymunk")) + tuple(
+        Expectation(engine, "convergence.order", "xfail", CORNER_ORDER)
+        for engine in ("mujoco", "exudyn")),
 )

@@ -1,4 +1,5 @@
-"""The engine-neutral description of a planar mechanism.
+"""The engine-neutral description of a mechanism: planar, or spatial (3-D) with the planar
+ones as its special case.
 
 A mechanism is data: rigid bodies, the joints that give its generalized coordinates, force
 elements, applied loads, and (later mechanisms) closure constraints. The analytic layer
@@ -33,6 +34,16 @@ Conventions (all backends and the analytic layer honour them):
    that imposes it (the actuator, acting between the joint's parent and child, positive
    in the direction of increasing coordinate: N along a slide, N m about a hinge) is an
    output, reported under the element's name. The other coordinates are the free ones.
+10. Spatial (3-D) mechanisms use the same elements with three-component vectors: a body
+   may carry its full central inertia tensor (`Body.inertia_tensor`, 3 x 3, body axes;
+   `inertia` is then its zz entry), a `Revolute` may turn about any `axis` (three
+   components, in the parent's frame, which is also the child's since the rotation is
+   about it: R_child = R_parent Rot(axis, q + angle_offset)), a `Prismatic` may slide
+   along a three-component axis, anchors may have three components, and the mechanism
+   states which way is up (`Mechanism.up`, gravity along -up). A mechanism that uses none
+   of these is planar (`Mechanism.spatial` is false) and follows conventions 1-5 exactly.
+   Body frames coincide with the parent's frame at q = 0 (no orientation offset): a body
+   whose principal axes are turned gives its tensor in those parent-aligned axes.
 """
 from __future__ import annotations
 
@@ -44,6 +55,8 @@ import sympy as sp
 
 Expr = Union[sp.Expr, float, int]
 Vec = tuple[Expr, Expr]
+Vec3 = tuple[Expr, Expr, Expr]
+Tensor3 = tuple[Vec3, Vec3, Vec3]
 
 WORLD = "world"
 TIME = sp.Symbol("t", real=True)
@@ -126,9 +139,33 @@ class Body:
     mass: Expr
     inertia: Expr
     shapes: tuple[Shape, ...] = ()
+    #: full central inertia tensor in body axes (convention 10); None: planar body
+    inertia_tensor: Tensor3 | None = None
+
+    def __post_init__(self) -> None:
+        tensor = self.inertia_tensor
+        if tensor is None:
+            return
+        if len(tensor) != 3 or any(len(row) != 3 for row in tensor):
+            raise ValueError(f"body {self.name}: the inertia tensor must be 3 x 3")
+        for i in range(3):
+            for j in range(i):
+                if sp.simplify(sp.sympify(tensor[i][j]) - sp.sympify(tensor[j][i])) != 0:
+                    raise ValueError(f"body {self.name}: the inertia tensor must be symmetric")
+        if sp.simplify(sp.sympify(tensor[2][2]) - sp.sympify(self.inertia)) != 0:
+            raise ValueError(f"body {self.name}: inertia must be the tensor's zz entry")
+
+    @classmethod
+    def spatial(cls, name: str, mass: Expr, tensor: Tensor3,
+                shapes: tuple[Shape, ...] = ()) -> "Body":
+        """A body given by its full central inertia tensor (body axes)."""
+        return cls(name, mass, tensor[2][2], shapes, inertia_tensor=tensor)
 
     @property
     def massless(self) -> bool:
+        if self.inertia_tensor is not None:
+            return sp.sympify(self.mass) == 0 and all(
+                sp.sympify(v) == 0 for row in self.inertia_tensor for v in row)
         return sp.sympify(self.mass) == 0 and sp.sympify(self.inertia) == 0
 
 
@@ -143,6 +180,8 @@ class Revolute:
     angle_offset: Expr = 0
     absolute: bool = False
     clockwise: bool = False
+    #: hinge axis in the parent's frame (three components, convention 10); None: z
+    axis: Vec3 | None = None
 
 
 @dataclass(frozen=True)
@@ -333,8 +372,8 @@ def coordinate_spring_damper(k: Expr, q0: Expr, c: Expr = 0) -> dict:
 
 @dataclass(frozen=True)
 class Mechanism:
-    """A planar mechanism (data only). Coordinates are the joints' coordinates in joint
-    order."""
+    """A mechanism, planar or spatial (convention 10), as data. Coordinates are the
+    joints' coordinates in joint order."""
 
     bodies: tuple[Body, ...]
     joints: tuple[Joint, ...]
@@ -345,6 +384,18 @@ class Mechanism:
     independent: tuple[str, ...] | None = None
     #: coordinates imposed as functions of time, with their actuators (convention 9)
     prescribed: tuple[Prescribed, ...] = ()
+    #: the world's up direction; gravity acts along -up (convention 10)
+    up: Vec3 = (0, 1, 0)
+
+    @property
+    def spatial(self) -> bool:
+        """Whether the mechanism uses any 3-D element (convention 10)."""
+        vectors = [a for j in self.joints for a in (j.parent_anchor, j.child_anchor)]
+        vectors += [j.axis for j in self.joints if isinstance(j, Prismatic)]
+        return (any(b.inertia_tensor is not None for b in self.bodies)
+                or any(isinstance(j, Revolute) and j.axis is not None for j in self.joints)
+                or any(len(v) == 3 for v in vectors)
+                or tuple(sp.sympify(u) for u in self.up) != (0, 1, 0))
 
     def __post_init__(self) -> None:
         names = [b.name for b in self.bodies]
@@ -398,6 +449,18 @@ class Mechanism:
                              "not supported: prescribe a coordinate of an open tree")
         if len(driven) == len(coords) and coords:
             raise ValueError("every coordinate is prescribed: nothing is free to move")
+        if self.spatial:
+            if self.constraints:
+                raise ValueError("closure constraints in a spatial mechanism are not "
+                                 "supported: describe an open tree")
+            if len(self.up) != 3:
+                raise ValueError(f"up must have three components, got {self.up}")
+            for j in self.joints:
+                if isinstance(j, Revolute) and j.axis is not None and len(j.axis) != 3:
+                    raise ValueError(f"joint {j.name}: a hinge axis has three components")
+                if isinstance(j, Revolute) and j.absolute and j.parent != WORLD:
+                    raise ValueError(f"joint {j.name}: an absolute angle in a spatial "
+                                     "mechanism must hang from the world")
         if self.independent is not None:
             unknown = set(self.independent) - set(coords)
             if unknown:
@@ -501,6 +564,7 @@ class Mechanism:
             constraints=tuple(ev_constraint(c) for c in self.constraints),
             independent=self.independent,
             prescribed=tuple(replace(p, motion=ev(p.motion)) for p in self.prescribed),
+            up=ev(self.up),
         )
 
 
@@ -519,6 +583,28 @@ def rotation(theta: Expr) -> sp.Matrix:
 
 def as_column(v: Vec) -> sp.Matrix:
     return sp.Matrix([sp.sympify(v[0]), sp.sympify(v[1])])
+
+
+def as_column3(v: Vec | Vec3) -> sp.Matrix:
+    """A planar or spatial vector as a 3 x 1 column (planar: z = 0)."""
+    return sp.Matrix([sp.sympify(c) for c in v] + [sp.Integer(0)] * (3 - len(v)))
+
+
+def rotation3(axis: Vec3, angle: Expr) -> sp.Matrix:
+    """Rotation by `angle` about `axis` (Rodrigues' formula; the axis is normalised)."""
+    u = as_column3(axis)
+    norm = sp.sqrt(sum(c**2 for c in u))
+    u = u / norm
+    K = sp.Matrix([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
+    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
+
+
+def inertia_matrix(body: Body) -> sp.Matrix:
+    """The body's central inertia as a 3 x 3 matrix (planar body: diag(0, 0, inertia),
+    the in-plane moments playing no part in planar motion)."""
+    if body.inertia_tensor is None:
+        return sp.diag(0, 0, sp.sympify(body.inertia))
+    return sp.Matrix([[sp.sympify(v) for v in row] for row in body.inertia_tensor])
 
 
 @dataclass(frozen=True)

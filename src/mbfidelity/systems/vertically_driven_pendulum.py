@@ -98,21 +98,6 @@ def printed(P):
     )
 
 
-#: angular frequency of the pivot in the Strutt chart by simulation: one period per second
-STRUTT_OMEGA = 2 * 3.141592653589793
-
-
-def mathieu_values(lam: float, gamma: float, values) -> dict:
-    """Parameter values at which eq. 81 (about hanging) is eq. 83 at (lambda, gamma):
-    with y = Y cos(Omega t) and time scaled by Omega, eq. 81 reads
-    phi'' + (g / (L_e Omega^2) - (Y / L_e) cos(Omega t)) phi = 0, L_e = (I_G + m l^2)/(m l),
-    so Omega = STRUTT_OMEGA, g = lambda L_e Omega^2 and Y = -gamma L_e. A negative lambda
-    is a negative g: the inverted pendulum of eq. 82 written in the hanging coordinate."""
-    length = (values["I_G"] + values["m"] * values["l"] ** 2) / (values["m"] * values["l"])
-    return {**dict(values), "Omega": STRUTT_OMEGA, "g": lam * length * STRUTT_OMEGA**2,
-            "Y": -gamma * length}
-
-
 SYSTEM = System(
     id="vertically_driven_pendulum",
     title="Pendulum whose pivot is moved vertically (Kapitza, Mathieu)",
@@ -149,7 +134,6 @@ SYSTEM = System(
                        ("mujoco", "pybullet", "exudyn", "pymunk"))
     + (Expectation("pybullet", "hanging.actuator_actuator", "xfail", PYBULLET_VERTICAL_MOTOR),),
     excitation_frequencies=lambda P: (P.Omega,),
-    mathieu_map=mathieu_values,
     notes="Inverted position Floquet-stable for Y^2 Omega^2 > 2 g L_e to leading order "
           "(L_e = (I_G + m l^2)/(m l)); parametric resonance about hanging near "
           "Omega = 2 sqrt(g / L_e).",

@@ -88,4 +88,5 @@ def measure(run: ScenarioRun) -> None:
             hi, sig_hi = mid, sig
     found = 0.5 * (lo + hi)
     run.series[label] = np.array([found, p_star, lo, hi])
-    run.judge(label, abs(found - p_star) / p_star, shift + (hi - lo) / (2 * p_star))
+    metric = run.judge(label, abs(found - p_star) / p_star, shift + (hi - lo) / (2 * p_star))
+    metric.detail = {"analytic": p_star, "engine": found, "bracket": [lo, hi]}

@@ -1,0 +1,357 @@
+"""The Python API: what the command line does, as functions returning the typed results
+the CLI prints as JSON (each has ``as_dict()``). The CLI is a thin layer over it.
+
+    import mbfidelity
+    doc = mbfidelity.analyze(system_id, {"m": 2.0})        # equilibria, M, C, K, modes
+    result = mbfidelity.compare(system_id, "mujoco")   # a Comparison (ids: mbfidelity list)
+    result.passed, [m.name for m in result.metrics if m.status == "fail"]
+    outcome = mbfidelity.check(systems=[system_id], sims=["mujoco"], out="gates")
+    outcome.passed, outcome.verdicts
+    mbfidelity.diff("gates-before", "gates")                     # a ResultsDiff
+
+Errors in the input (an unknown system or engine, a parameter outside its domain, a bad
+setting) raise ValueError with one line that names the problem.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Iterable, Mapping
+
+from .comparisons.diff import ResultsDiff, diff_runs, holds
+from .comparisons.runner import DEFAULT_DT, Comparison
+
+__all__ = ["analyze", "compare", "run", "check", "diff", "export", "Verdict", "CheckResult",
+           "DEFAULT_DT"]
+
+
+def _system(system_id: str):
+    from .systems import get_system
+
+    try:
+        return get_system(system_id)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+
+
+def _backend(simulator: str):
+    from .simulators import get_backend
+
+    try:
+        return get_backend(simulator)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+
+
+def _checked_parameters(system, params: Mapping[str, float] | None) -> None:
+    """Every parameter set the comparison will use (with each scenario's values)."""
+    try:
+        for sc in system.scenarios:
+            system.parameter_values(params, scenario=sc)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+
+
+def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
+    """What `mbfidelity analyze --json` prints: the equilibria with their stability (and
+    modes), the operating point's linearization M, C, K (arrays) and modes, the printed
+    formulas against the derivation; a floating mechanism's relative equilibrium, a
+    self-excited one's stability threshold, a driven one's steady state."""
+    import numpy as np
+
+    from .analytic.errata import errata
+    from .analytic.linear import (find_equilibria, operating_equilibrium,
+                                  oscillatory_instability)
+
+    system = _system(system_id)
+    try:
+        values, derived = system.resolve_parameters(params)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+    coords = list(system.coordinates)
+    try:
+        eqs = find_equilibria(system, values)
+        op = operating_equilibrium(system, values)
+    except (ValueError, TypeError, RuntimeError, np.linalg.LinAlgError) as exc:
+        from .analytic.floquet import driven_floquet_summary, periodic_coefficients
+
+        if system.driven and periodic_coefficients(system, values):
+            return _floquet_document(system, values, derived, str(exc),
+                                     driven_floquet_summary(system, values))
+        raise ValueError(f"{system.id} with these parameters has no assembled equilibrium "
+                         f"near its operating point ({exc})") from None
+
+    def modes(eq) -> list[dict]:
+        return [m.as_dict() for m in eq.modes]
+
+    equilibria = []
+    for e in eqs:
+        item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
+        if e.stable or oscillatory_instability(e.eigenvalues):
+            # a self-excited mode has a frequency and a negative damping ratio
+            item["modes"] = modes(e)
+        if not e.stable:
+            item["eigenvalues"] = [[s.real, s.imag] for s in e.eigenvalues]
+        equilibria.append(item)
+    doc = {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": coords, "parameters": values, "derived_parameters": list(derived),
+        "equilibria": equilibria,
+        "operating_point": dict(zip(coords, op.q.tolist())),
+        "linearization": {"q": dict(zip(coords, op.q.tolist())), "M": op.M, "C": op.C,
+                          "K": op.K},
+        "stable": op.stable,
+        "modes": modes(op),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
+    if not op.stable:
+        doc["growth_rate"] = float(max(s.real for s in op.eigenvalues))
+    if system.driven:
+        _parametric_stability(system, values, coords, doc)
+    if op.acceleration is not None:
+        doc["static_equilibrium"] = None
+        doc["relative_equilibrium"] = _relative_equilibrium(system, coords, op)
+    if system.stability_parameter:
+        from .analytic.stability import stability_threshold
+
+        doc["stability_threshold"] = stability_threshold(system, values).as_dict()
+    if system.driven:
+        from .analytic.steady_state import steady_state
+
+        response = steady_state(system, values)
+        doc["free_coordinates"] = list(system.mechanism.independent_coordinates)
+        doc["prescribed"] = {p.coordinate: str(p.motion) for p in system.mechanism.prescribed}
+        doc["linearization"]["about"] = ("rest state of the free coordinates with the "
+                                         "excitation off: " + ", ".join(
+                                             f"{k} = {v:g}" for k, v in system.unexcited.items()))
+        doc["steady_state"] = [h.as_dict() for h in response.harmonics]
+        if response.reason:
+            doc["steady_state_note"] = response.reason
+        else:
+            doc["steady_state_harmonic_residual"] = response.harmonic_residual
+    return doc
+
+
+def _parametric_stability(system, values: dict, coords: list, doc: dict) -> None:
+    """A parametric-only excitation (monograph §8.4; analytic.floquet.parametrically_excited):
+    the rest states of the unexcited system stay solutions with the excitation on, and the
+    excitation makes their variational equations' coefficients periodic, so each rest state
+    is judged by its Floquet multipliers over one excitation period: `floquet_multipliers`,
+    `floquet` and `stable` of each equilibrium (and `floquet_multipliers`,
+    `operating_point_floquet` and `stable` of the operating point) are Floquet's;
+    the linearization and its modes stay those with the excitation off."""
+    import numpy as np
+
+    from .analytic.floquet import driven_floquet, parametrically_excited
+
+    if not parametrically_excited(system, values):
+        return
+    results = driven_floquet(system, values)
+    doc["parametric_excitation"] = (
+        "the excitation makes the coefficients of the variational equations about the rest "
+        "states periodic in time (monograph §8.4): 'stable' is Floquet's verdict over one "
+        "excitation period; the linearization and modes are those with the excitation off")
+    for item in doc["equilibria"] + [None]:
+        q = np.array([(item["q"] if item else doc["operating_point"])[c] for c in coords])
+        match = [r for rest, r in results if np.allclose(rest, q, atol=1e-6)
+                 or np.allclose(np.mod(rest - q + np.pi, 2 * np.pi) - np.pi, 0, atol=1e-6)]
+        if not match:
+            continue
+        floquet = match[0].as_dict()
+        target = item if item is not None else doc
+        target["floquet_multipliers"] = floquet["floquet_multipliers"]
+        # the document's own "floquet" names a periodic-coefficient system's list
+        target["floquet" if item is not None else "operating_point_floquet"] = floquet
+        target["stable"] = match[0].stable
+
+
+def _floquet_document(system, values: dict, derived, reason: str, floquet: list) -> dict:
+    """`analyze` of a driven system whose variational equations have periodic coefficients
+    (no constant linearization): the Floquet multipliers about each unexcited rest state
+    over one excitation period."""
+    from .analytic.errata import errata
+
+    return {
+        "system": system.id, "title": system.title, "source": system.source,
+        "coordinates": list(system.coordinates), "parameters": values,
+        "derived_parameters": list(derived),
+        "free_coordinates": list(system.mechanism.independent_coordinates),
+        "prescribed": {p.coordinate: str(p.motion) for p in system.mechanism.prescribed},
+        "linearization": None,
+        "periodic_coefficients": reason,
+        "floquet": floquet,
+        "stable": bool(floquet) and all(r["verdict"] == "stable" for r in floquet),
+        "printed_vs_derived": [e.as_dict() for e in errata(system)],
+    }
+
+
+def _relative_equilibrium(system, coords: list, op) -> dict:
+    """What `analyze` says of a floating mechanism (Italian notes §5.3.1)."""
+    acceleration = dict(zip(coords, op.acceleration.tolist()))
+    rigid = [dict(zip(coords, col.tolist())) for col in op.rigid.T]
+    moving = ", ".join(f"{c}'' = {a:.9g}" for c, a in acceleration.items() if a)
+    return {
+        "acceleration": acceleration,
+        "rigid_directions": rigid,
+        "note": ((f"no static equilibrium in absolute coordinates: {system.id} has no "
+                  f"ground, and its loads have a resultant that only the inertia of the "
+                  f"whole balances ({moving}); reported instead: the relative equilibrium "
+                  f"(Italian notes §5.3.1), the configuration that moves rigidly with that "
+                  f"uniform acceleration, linearized about that motion"
+                  if moving else
+                  f"{system.id} has no ground, and its loads have no resultant here: its "
+                  f"relative equilibrium (Italian notes §5.3.1) is at rest")
+                 + "; its rigid-body mode has zero frequency, and 'stable' judges the "
+                   "relative motion"),
+    }
+
+
+def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None, *,
+            dt: float = DEFAULT_DT, t_end: float | None = None,
+            settings: Mapping | None = None, variant: str | None = None,
+            timeout: float | None = 900.0) -> Comparison:
+    """One system on one engine: every scenario's metrics against their gates. The engine
+    runs in a worker process; a crash or a run past `timeout` seconds is recorded as an
+    incident of a failed comparison (None: in this process, no time limit)."""
+    from .comparisons.runner import compare as compare_here
+    from .comparisons.runner import isolated_compare
+
+    system = _system(system_id)
+    _backend(simulator)
+    _checked_parameters(system, params)
+    if not dt > 0 or (t_end is not None and not t_end > 0):
+        raise ValueError("dt and t_end must be positive")
+    if timeout is None:
+        return compare_here(system.id, simulator, params, dt=dt, t_end=t_end,
+                            settings=settings, variant=variant)
+    return isolated_compare(system.id, simulator, params, dt=dt, t_end=t_end,
+                            timeout=timeout, settings=settings, variant=variant)
+
+
+def _matrix(systems: Iterable[str] | None, sims: Iterable[str] | None,
+            installed_only: bool) -> tuple[list[str], list[str]]:
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = list(systems or all_systems())
+    for s in sys_ids:
+        _system(s)
+    backends = all_backends()
+    if sims:
+        sim_ids = list(sims)
+        for e in sim_ids:
+            _backend(e)
+            ok, why = backends[e].available()
+            if not ok:
+                raise ValueError(f"{e} is not installed: {why}")
+    else:
+        sim_ids = [e for e, b in backends.items() if b.available()[0] or not installed_only]
+    return sys_ids, sim_ids
+
+
+def _validated_settings(settings: Mapping[str, Mapping] | None) -> dict[str, dict]:
+    out = {}
+    for engine, chosen in (settings or {}).items():
+        backend = _backend(engine)
+        try:
+            backend.resolve_settings(chosen)
+        except (KeyError, ValueError) as exc:
+            raise ValueError(f"settings for {engine}: {exc.args[0] if exc.args else exc}") \
+                from None
+        out[engine] = dict(chosen)
+    return out
+
+
+def run(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
+        out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+        settings: Mapping[str, Mapping] | None = None, variants: bool = False,
+        resume: bool = False, report: bool = True) -> list[Comparison]:
+    """The matrix systems x engines (default: all of both). With `out`, the results
+    (results.json, results.csv) and, with `report`, the HTML report are written there.
+    `settings` maps an engine to its settings."""
+    from .comparisons.matrix import run_matrix, write_results
+
+    sys_ids, sim_ids = _matrix(systems, sims, installed_only=False)
+    if not dt > 0:
+        raise ValueError("dt must be positive")
+    chosen = _validated_settings(settings)
+    out = Path(out) if out is not None else None
+    results = run_matrix(sys_ids, sim_ids, dt=dt, variants=variants, out=out, resume=resume,
+                         settings=chosen)
+    if out is not None:
+        write_results(results, out)
+        if report:
+            from .reports.html import write_report
+
+            write_report(out)
+    return results
+
+
+@dataclass
+class Verdict:
+    """One system on one engine in a check."""
+    system: str
+    simulator: str
+    engine_version: str
+    #: pass | fail | unsupported
+    verdict: str
+    #: the metrics that failed the comparison
+    failing: list[str] = field(default_factory=list)
+    reason: str = ""
+    incidents: list[str] = field(default_factory=list)
+
+
+@dataclass
+class CheckResult:
+    passed: bool
+    results: str
+    verdicts: list[Verdict]
+    diff: ResultsDiff | None = None
+
+    def as_dict(self) -> dict:
+        return {"passed": self.passed, "results": self.results,
+                "verdicts": [asdict(v) for v in self.verdicts],
+                "diff": self.diff.as_dict() if self.diff else None}
+
+
+def check(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
+          out: str | Path = "mbfidelity-check", *, baseline: str | Path | None = None,
+          dt: float = DEFAULT_DT, settings: Mapping[str, Mapping] | None = None,
+          report: bool = False) -> CheckResult:
+    """The gates against the installed engines (default: every installed one): a verdict
+    per system x engine and the results in `out`. Passed when every gate passes or is
+    declared and, with a `baseline` (a results folder or results.json), none got worse
+    than there."""
+    if baseline is not None:
+        folder = Path(baseline)
+        if not (folder / "results.json" if folder.is_dir() else folder).exists():
+            raise ValueError(f"baseline {baseline}: no results.json there")
+    results = run(*_matrix(systems, sims, installed_only=True), out=out, dt=dt,
+                  settings=settings, report=report)
+    verdicts = [Verdict(c.system, c.simulator, c.engine_version,
+                        "unsupported" if not c.supported else "pass" if c.passed else "fail",
+                        [m.name for m in c.metrics if not holds(m)], c.reason,
+                        [i["outcome"] for i in c.incidents])
+                for c in results]
+    changes = diff_runs(Path(baseline), Path(out)) if baseline is not None else None
+    passed = all(v.verdict != "fail" for v in verdicts) and not (changes and changes.worse)
+    return CheckResult(passed, str(Path(out).resolve()), verdicts, changes)
+
+
+def diff(old: str | Path, new: str | Path) -> ResultsDiff:
+    """What changed between two runs (results folders or results.json files)."""
+    return diff_runs(Path(old), Path(new))
+
+
+def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float] | None = None,
+           *, settings: Mapping | None = None, dt: float = DEFAULT_DT) -> tuple[str, list[str]]:
+    """(the engine's model file as text, what the file alone does not reproduce): MuJoCo's
+    MJCF with a keyframe per scenario and the coordinate map."""
+    from .comparisons.export import export_model
+
+    system = _system(system_id)
+    _backend(simulator)
+    _checked_parameters(system, params)
+    if not dt > 0:
+        raise ValueError("dt must be positive")
+    return export_model(system.id, simulator, params, settings, dt)

@@ -1,0 +1,83 @@
+"""The convergence page: for every mechanism, the error against the step and the error
+against the CPU seconds of the stepping (work-precision) of each engine on one figure, and
+the table of fitted against declared orders, rendered from the saved convergence.json
+(`mbfidelity convergence --out DIR`)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jinja2
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+CONVERGENCE = "convergence.json"
+
+TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">
+<title>mbfidelity convergence</title><style>
+body{font-family:sans-serif;margin:2em;max-width:1300px}
+table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
+th{background:#f0f0f0}.pass{background:#dff5df}.fail,.xpass{background:#f8d0d0}.xfail,.unresolved{background:#fbeec8}.unsupported{background:#e6e6e6}
+img{max-width:100%}
+</style></head><body>
+<h1>Convergence and work-precision</h1>
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }} · steps {{ doc.steps|join(", ") }} s over
+{{ doc.t_end }} s of each system's first scenario. Error: max |q - q_ref| over the run, relative to the
+amplitude. The order is fitted on the steps whose error still falls (by {{ doc.min_decrease }} per halving
+at least) and stays {{ doc.reference_margin }} times above the reference's own error; it must match the
+order the engine declares within {{ doc.order_tolerance }}.</p>
+<table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}: fitted / declared order</th>{% endfor %}</tr>
+{% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
+{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s %}<td class="{{ s.metric.status }}" title="{{ s.metric.reason or s.flattened or s.failure or s.unsupported }}">
+{{ "%.2f"|format(s.observed_order) if s.observed_order is not none else "-" }} / {{ s.integrator_order }} {{ s.metric.status }}</td>{% else %}<td>-</td>{% endif %}{% endfor %}</tr>{% endfor %}
+</table>
+{% for sys in systems %}<h2 id="{{ sys }}">{{ sys }}</h2>
+<ul>{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s and (s.metric.reason or s.flattened or s.failure) %}<li><b>{{ sim }}</b> ({{ s.metric.status }}): {{ s.failure or s.metric.reason or s.flattened }}</li>{% endif %}{% endfor %}</ul>
+<img src="{{ figures[sys] }}">{% endfor %}
+</body></html>""")
+
+
+def _figure(system: str, studies: list[dict], out: Path) -> str:
+    fig, (steps, work) = plt.subplots(1, 2, figsize=(11, 4))
+    for s in studies:
+        points = [p for p in s["points"] if p["error"] > 0]
+        if not points:
+            continue
+        line, = steps.loglog([p["dt"] for p in points], [p["error"] for p in points], "o-",
+                             label=f"{s['simulator']} (order {s['integrator_order']})")
+        # the declared order's slope through the coarsest point
+        dt0, e0 = points[0]["dt"], points[0]["error"]
+        steps.loglog([p["dt"] for p in points],
+                     [e0 * (p["dt"] / dt0) ** s["integrator_order"] for p in points], ":",
+                     color=line.get_color(), lw=0.8)
+        work.loglog([max(p["cpu_time"], 1e-6) for p in points], [p["error"] for p in points],
+                    "o-", color=line.get_color(), label=s["simulator"])
+    steps.set_xlabel("step dt [s]")
+    steps.set_ylabel("max |q - q_ref| / amplitude")
+    steps.set_title("error against the step (dotted: declared order)")
+    steps.legend(fontsize=7)
+    work.set_xlabel("CPU seconds of stepping")
+    work.set_title("work-precision")
+    work.legend(fontsize=7)
+    fig.suptitle(system)
+    fig.tight_layout()
+    name = f"convergence-{system}.png"
+    fig.savefig(out / name, dpi=80)
+    plt.close(fig)
+    return name
+
+
+def write_convergence_page(out: Path) -> Path:
+    """convergence.html and its figures in `out`, from the convergence.json saved there."""
+    doc = json.loads((out / CONVERGENCE).read_text())
+    systems = list(dict.fromkeys(s["system"] for s in doc["studies"]))
+    sims = list(dict.fromkeys(s["simulator"] for s in doc["studies"]))
+    by = {sys: {s["simulator"]: s for s in doc["studies"] if s["system"] == sys}
+          for sys in systems}
+    figures = {sys: _figure(sys, list(by[sys].values()), out) for sys in systems}
+    page = out / "convergence.html"
+    page.write_text(TEMPLATE.render(doc=doc, systems=systems, sims=sims, by=by,
+                                    figures=figures))
+    return page
