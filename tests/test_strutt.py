@@ -77,4 +77,3 @@ def test_strutt_command_json_and_figure(tmp_path):
     assert (tmp_path / "strutt.png").stat().st_size > 0
     bad = CliRunner().invoke(app, ["strutt", "--lambda", "2,1"])
     assert bad.exit_code == 2
-

@@ -19,11 +19,8 @@ CODES = {"stable": 0, "unstable": 1, "marginal": 2}
 MARKERS = ("x", "+", "1", "o")
 
 
-def write_strutt_figure(points: list[dict], path: Path,
-                        disagreements: list[tuple[float, float]] | None = None,
-                        engine: str | None = None) -> Path:
-    """Draw the chart from `points` (each with lambda, gamma, verdict) into `path` (PNG);
-    with an `engine`, its `disagreements` with Floquet (lambda, gamma) are marked."""
+def write_strutt_figure(points: list[dict], path: Path) -> Path:
+    """Draw the chart from `points` (each with lambda, gamma, verdict) into `path` (PNG)."""
     lambdas = np.unique([p["lambda"] for p in points])
     gammas = np.unique([p["gamma"] for p in points])
     grid = np.full((len(gammas), len(lambdas)), np.nan)
@@ -43,14 +40,8 @@ def write_strutt_figure(points: list[dict], path: Path,
         ax.legend(fontsize=7, loc="upper left")
     ax.set_xlabel("lambda")
     ax.set_ylabel("gamma")
-    title = "Strutt chart of eq. 83 (Floquet): green stable, red unstable, grey marginal"
-    if engine is not None:
-        marks = np.array(disagreements or [], float).reshape(-1, 2)
-        ax.scatter(marks[:, 0], marks[:, 1], marker="x", color="black", s=18,
-                   label=f"{engine} disagrees ({len(marks)})")
-        ax.legend(loc="upper left", fontsize=8)
-        title += f"\n{engine}'s verdicts by simulation: crosses where they differ"
-    ax.set_title(title, fontsize=9)
+    ax.set_title("Strutt chart of eq. 83 (Floquet): green stable, red unstable, grey marginal",
+                 fontsize=9)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
