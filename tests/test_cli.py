@@ -163,3 +163,54 @@ def test_engine_failure_is_recorded_not_raised():
                               "--t-end", "3"])
     assert res.exit_code == 1, res.output
     assert "crashed" in res.output and "Traceback" not in res.output
+
+
+# Kapitza (Landau & Lifshitz, Mechanics §30), for eq. 80 with the equivalent length
+# L_e = (I_G + m l^2)/(m l): the inverted position is stable to leading order in Y/L_e when
+# Y^2 Omega^2 > 2 g L_e, and otherwise leaves at the rate of the averaged (effective)
+# potential, sqrt(g/L_e - Y^2 Omega^2 / (2 L_e^2)). Defaults (MECHANISMS.md D): m = 1,
+# l = 0.2, I_G = 0.001, Omega = 2 pi 50: Y = 0.01 gives a ratio Y^2 Omega^2/(2 g L_e) of
+# 2.45 (stable), Y = 0.005 one of 0.61 (unstable); the O(Y/L_e) corrections are 0.05 at most.
+def _kapitza_rate(Y, m=1.0, l=0.2, I_G=0.001, W=2 * np.pi * 50, g=9.81):
+    L_e = (I_G + m * l * l) / (m * l)
+    return np.sqrt(g / L_e - (Y * W) ** 2 / (2 * L_e**2))
+
+
+@pytest.mark.parametrize("Y, inverted_stable", [(0.01, True), (0.005, False)])
+def test_analyze_parametric_excitation_reports_floquet_per_rest_state(Y, inverted_stable):
+    doc = _json(["analyze", "vertically_driven_pendulum", "--param", f"Y={Y}", "--json"])
+    assert "parametric_excitation" in doc
+    by_angle = {round(e["q"]["phi"] / np.pi) % 2: e for e in doc["equilibria"]}
+    assert set(by_angle) == {0, 1}  # hanging and inverted (§8.3: phi_eq = n pi)
+    inverted, hanging = by_angle[1], by_angle[0]
+    assert inverted["stable"] is inverted_stable
+    assert hanging["stable"] is True and doc["stable"] is True  # the operating point  # far below the first tongue (Omega >> 2 omega0)
+    assert len(inverted["floquet_multipliers"]) == 2
+    f = inverted["floquet"]
+    assert f["period"] == pytest.approx(1 / 50, rel=1e-12)
+    if not inverted_stable:
+        rate = np.log(f["floquet_max_abs_multiplier"]) / f["period"]
+        assert rate == pytest.approx(_kapitza_rate(Y), rel=0.05)
+
+
+def test_analyze_parametric_excitation_text_names_the_floquet_verdicts():
+    res = runner.invoke(app, ["analyze", "vertically_driven_pendulum"])
+    assert res.exit_code == 0, res.output
+    assert res.output.count("Floquet stable") == 2
+
+
+# Fig. 11, eq. 14: l phi'' + 2 l' phi' + g phi = 0 about phi = 0 with l = l0 - h_a sin(Omega t).
+# Parametric resonance (Landau & Lifshitz, Mechanics §27): the first instability tongue is
+# centred on Omega = 2 w0, w0 = sqrt(g/l0), its width proportional to h_a/l0; above it
+# (Omega = 3 w0 lies beyond the first tongue, and the others are at 2 w0 / n) the motion
+# stays bounded: over one period the monodromy's determinant is (l(0)/l(T))^2 = 1, so the
+# multipliers sit on the unit circle.
+@pytest.mark.parametrize("ratio, stable", [(2.0, False), (3.0, True)])
+def test_analyze_variable_length_pendulum_tongue(ratio, stable):
+    w0 = np.sqrt(9.81 / 1.0)
+    doc = _json(["analyze", "variable_length_pendulum", "--param", f"Omega={ratio * w0}",
+                 "--json"])
+    hanging = [e for e in doc["equilibria"] if abs(e["q"]["phi"]) < 1e-9]
+    assert len(hanging) == 1 and hanging[0]["stable"] is stable
+    mu = np.array([complex(*m) for m in hanging[0]["floquet_multipliers"]])
+    assert abs(np.prod(mu) - 1.0) < 1e-8

@@ -107,3 +107,22 @@ def test_driven_system_with_constant_coefficients_gives_exp_of_its_matrix():
     assert np.allclose(np.sort_complex(result.multipliers), np.sort_complex(expected),
                        atol=1e-9)
     assert result.verdict == "stable"
+
+
+def test_periodic_growth_rate_reads_a_floquet_solution():
+    # x = (1 + 0.3 cos(W t)) exp(sigma t) + the decaying partner exp(-sigma t): the per-period
+    # maxima grow by exactly exp(sigma T) once the partner has faded
+    from mbfidelity.comparisons.checks.floquet import periodic_growth_rate
+
+    sigma, W = 2.0, 40.0
+    T = 2 * np.pi / W
+    t = np.arange(0.0, 3.0, 1e-4)
+    x = 1e-4 * ((1 + 0.3 * np.cos(W * t)) * np.exp(sigma * t) + np.exp(-sigma * t))
+    assert periodic_growth_rate(t, np.abs(x), T, sigma) == pytest.approx(sigma, rel=2e-3)
+
+
+def test_periodic_growth_rate_needs_linear_periods():
+    from mbfidelity.comparisons.checks.floquet import periodic_growth_rate
+
+    t = np.arange(0.0, 1.0, 1e-3)
+    assert periodic_growth_rate(t, np.full_like(t, 1.0), 0.1, 1.0) is None  # never linear

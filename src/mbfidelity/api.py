@@ -106,6 +106,8 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
     }
     if not op.stable:
         doc["growth_rate"] = float(max(s.real for s in op.eigenvalues))
+    if system.driven:
+        _parametric_stability(system, values, coords, doc)
     if op.acceleration is not None:
         doc["static_equilibrium"] = None
         doc["relative_equilibrium"] = _relative_equilibrium(system, coords, op)
@@ -128,6 +130,39 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
         else:
             doc["steady_state_harmonic_residual"] = response.harmonic_residual
     return doc
+
+
+def _parametric_stability(system, values: dict, coords: list, doc: dict) -> None:
+    """A parametric-only excitation (monograph §8.4; analytic.floquet.parametrically_excited):
+    the rest states of the unexcited system stay solutions with the excitation on, and the
+    excitation makes their variational equations' coefficients periodic, so each rest state
+    is judged by its Floquet multipliers over one excitation period: `floquet_multipliers`,
+    `floquet` and `stable` of each equilibrium (and `floquet_multipliers`,
+    `operating_point_floquet` and `stable` of the operating point) are Floquet's;
+    the linearization and its modes stay those with the excitation off."""
+    import numpy as np
+
+    from .analytic.floquet import driven_floquet, parametrically_excited
+
+    if not parametrically_excited(system, values):
+        return
+    results = driven_floquet(system, values)
+    doc["parametric_excitation"] = (
+        "the excitation makes the coefficients of the variational equations about the rest "
+        "states periodic in time (monograph §8.4): 'stable' is Floquet's verdict over one "
+        "excitation period; the linearization and modes are those with the excitation off")
+    for item in doc["equilibria"] + [None]:
+        q = np.array([(item["q"] if item else doc["operating_point"])[c] for c in coords])
+        match = [r for rest, r in results if np.allclose(rest, q, atol=1e-6)
+                 or np.allclose(np.mod(rest - q + np.pi, 2 * np.pi) - np.pi, 0, atol=1e-6)]
+        if not match:
+            continue
+        floquet = match[0].as_dict()
+        target = item if item is not None else doc
+        target["floquet_multipliers"] = floquet["floquet_multipliers"]
+        # the document's own "floquet" names a periodic-coefficient system's list
+        target["floquet" if item is not None else "operating_point_floquet"] = floquet
+        target["stable"] = match[0].stable
 
 
 def _floquet_document(system, values: dict, derived, reason: str, floquet: list) -> dict:

@@ -200,7 +200,15 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(doc["relative_equilibrium"]["note"])
     for e in equilibria:
         kind = "relative equilibrium" if "relative_equilibrium" in doc else "equilibrium"
+        if "floquet" in e:  # a parametric excitation: Floquet's verdict (api.analyze)
+            f = e["floquet"]
+            typer.echo(f"{kind} {e['q']}: Floquet {f['verdict']} (|mu|max = "
+                       f"{f['floquet_max_abs_multiplier']:.9g} +- {f['floquet_error']:.1e} "
+                       f"over the period {f['period']:.6g} s)")
+            continue
         typer.echo(f"{kind} {e['q']}: {'stable' if e['stable'] else 'unstable'}")
+    if "parametric_excitation" in doc:
+        typer.echo(f"parametric excitation: {doc['parametric_excitation']}")
     typer.echo(f"at {doc['operating_point']}:")
     for key in ("M", "C", "K"):
         typer.echo(f"  {key} = {np.array2string(getattr(op, key), precision=6)}")

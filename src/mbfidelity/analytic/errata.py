@@ -325,11 +325,19 @@ def _compare(system: System, pf: PrintedFormula, rng) -> tuple[float, str, dict]
                 "|s| rad/s)" if pf.kind == "frequency" else "zeta)")
         elif pf.kind == "constraint_force":
             name, expr = pf.expr
-            derived_text = f"from the multipliers of constraint {name!r}"
+            actuator = name.startswith("actuator:")
+            derived_text = (f"the force of {name[len('actuator:'):]!r} on its coordinate"
+                            if actuator else f"from the multipliers of constraint {name!r}")
             exprs = list(expr) if isinstance(expr, (list, tuple, sp.MatrixBase)) else [expr]
             for q, qd, t in _random_states(system, values, rng):
                 qdd, lam = model.dynamics(q, qd, t)
-                f = model.constraint_forces(q[None, :], lam[None, :])[name][0]
+                if actuator:  # a prescribed coordinate's actuator force (§9.6)
+                    qdd = model.acceleration(q, qd, t)  # the prescribed q'' included
+                    f = np.atleast_1d(model.actuator_forces(
+                        q[None, :], qd[None, :], qdd[None, :], np.array([t]))[
+                        name[len("actuator:"):]][0])
+                else:
+                    f = model.constraint_forces(q[None, :], lam[None, :])[name][0]
                 env = _env(system, values, q, qd, qdd, t)
                 printed = np.array([float(sp.sympify(e).xreplace(env)) for e in exprs])
                 worst = max(worst, float(np.max(np.abs(printed - f[:len(printed)])))

@@ -192,3 +192,29 @@ def driven_floquet_summary(system, values) -> list[dict]:
              "moduli": [float(abs(m)) for m in r.multipliers],
              "verdict": r.verdict, "margin": r.margin, "error": r.error}
             for q, r in driven_floquet(system, values)]
+
+
+def parametrically_excited(system, values) -> bool:
+    """Whether the system is excited parametrically only (§8.4): every rest state of the
+    unexcited system stays a solution with the excitation on (the excitation does not
+    force the free coordinates there), and about one of them the variational equations'
+    coefficients vary with time. Then the linearization with the excitation off does not
+    judge stability, and Floquet theory (`driven_floquet`) does. A system the excitation
+    also forces keeps its forced steady state as the analysis (analytic/steady_state.py)."""
+    from .linear import _PROBE_TIMES, TIME_INVARIANCE, _driven_blocks, driven_rest_states
+    from .numeric import numeric_model
+
+    if not system.mechanism.prescribed:
+        return False
+    model = numeric_model(system.id, dict(values))
+    free = model.independent
+    varying = False
+    for q in driven_rest_states(system, values, only_operating=False):
+        blocks = [_driven_blocks(model, q[free], t) for t in _PROBE_TIMES]
+        flat = [np.concatenate([b.ravel() for b in block[:3]]) for block in blocks]
+        scale = max(float(np.max(np.abs(flat[0]))), 1e-300)
+        if any(float(np.max(np.abs(block[3]))) > TIME_INVARIANCE * scale for block in blocks):
+            return False  # forced there
+        varying = varying or any(float(np.max(np.abs(b - flat[0]))) > TIME_INVARIANCE * scale
+                                 for b in flat[1:])
+    return varying

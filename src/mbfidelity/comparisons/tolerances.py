@@ -229,6 +229,18 @@ def growth_rate_tolerance(w: float, h: float, order: int) -> float:
     return (w * h if order == 1 else (w * h) ** order) + FIT_RESOLUTION
 
 
+def floquet_growth_tolerance(w: float, h: float, order: int, estimator: float) -> float:
+    """Relative error of a parametric growth rate ln|mu|max / T read from an engine's run
+    (comparisons/checks/floquet.py). The scheme's one-period map is the monodromy to
+    within a relative (w h)^p per step (w h for semi-implicit Euler), w the fastest of the
+    excitation and the Floquet exponents, so ln|mu| moves by that over each of the T/h
+    steps, relative to the growth over the period: the same relative bound as a constant-
+    coefficient eigenvalue. Plus `estimator`, the error of the per-period-maxima estimator
+    on the exact motion of the same scenario (the decaying partner and the periodic factor
+    p(t) are not exactly removed by a straight line through the maxima)."""
+    return growth_rate_tolerance(w, h, order) + estimator
+
+
 #: largest quadrature error, in units of h^2 times the ramp's slope, of a step whose
 #: acceleration has a corner inside it, by integrator order (see the module docstring)
 CORNER_QUADRATURE = {1: 1 / 2, 2: 1 / 8, 3: 1 / 8, 4: 1 / 24}

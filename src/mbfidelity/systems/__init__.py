@@ -62,7 +62,9 @@ class PrintedFormula:
       "frequency"         natural angular frequency (rad/s) at the operating point
       "damping_ratio"     damping ratio at the operating point
       "constraint_force"  (constraint name, expression or list of expressions in q, q_dot,
-                          q_ddot): its physical force (simulators/base.py point 6)
+                          q_ddot): its physical force (simulators/base.py point 6); the
+                          name "actuator:<name>" compares a prescribed coordinate's
+                          actuator force on that coordinate instead
       "constraint"        list of printed constraint equations Phi(q) = 0 (closure, slot,
                           rolling), each row an expression in q; its zero set must be the
                           mechanism's (rows in any order, sign or scale)
