@@ -504,8 +504,10 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
                                                                 help="system ids"),
                     sims: Optional[List[str]] = typer.Option(
                         None, "--sims", help="simulator ids (default: every installed one)"),
-                    steps: str = typer.Option("4e-3,2e-3,1e-3,5e-4", "--steps",
-                                              help="the steps, s (multiples of the finest)"),
+                    steps: Optional[str] = typer.Option(
+                        None, "--steps", help="the steps, s (multiples of the finest; "
+                                              "default: 4, 2, 1, 0.5 ms, scaled down for a "
+                                              "fast motion)"),
                     t_end: float = typer.Option(2.0, "--t-end", help="simulated time, s"),
                     out: Optional[Path] = typer.Option(
                         None, "--out", help="also write convergence.json, convergence.html "
@@ -530,19 +532,21 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
     for e in sim_ids:
         if e not in all_backends():
             _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
-    try:
-        dts = sorted({float(x) for x in steps.split(",") if x}, reverse=True)
-    except ValueError:
-        _fail(f"--steps expects numbers A,B,...; got {steps!r}")
-    if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
-        _fail(f"--steps needs at least {conv.MIN_FIT_POINTS} positive steps; got {steps!r}")
+    dts = None
+    if steps is not None:
+        try:
+            dts = sorted({float(x) for x in steps.split(",") if x}, reverse=True)
+        except ValueError:
+            _fail(f"--steps expects numbers A,B,...; got {steps!r}")
+        if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
+            _fail(f"--steps needs at least {conv.MIN_FIT_POINTS} positive steps; got {steps!r}")
     if not t_end > 0:
         _fail("--t-end must be positive")
     try:
         studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
     except ValueError as exc:
         _fail(str(exc))
-    doc = {"provenance": provenance(), "steps": dts, "t_end": t_end,
+    doc = {"provenance": provenance(), "steps": dts or "automatic", "t_end": t_end,
            "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
            "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
     failed = [s for s in studies if s["metric"]["status"] in ("fail", "xpass")

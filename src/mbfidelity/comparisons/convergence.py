@@ -4,7 +4,10 @@ sequence of halved steps, the observed order fitted on a log-log scale next to t
 the engine's scheme declares, and the CPU seconds of each run (work-precision).
 
 The reference is solved once, at the finest step, and sampled at each coarser one (the
-steps are integer multiples of the finest). An error within REFERENCE_MARGIN times the
+steps are integer multiples of the finest). The default steps are DEFAULT_STEPS, scaled
+down where the motion's fastest frequency w puts the coarsest beyond the scheme's
+asymptotic range (w h <= tolerances.asymptotic_limit, as for the gates); given steps beyond
+it are run and drawn but not fitted. An error within REFERENCE_MARGIN times the
 reference's own error (its tight solve's, estimated as the tight-loose difference scaled
 by the ratio of their tolerances) measures the reference as much as the engine: those
 points are left out of the fit (a closed-form reference has none). Where the error stops falling with the step, something
@@ -29,7 +32,8 @@ from ..systems import get_system
 from . import metrics, tolerances
 from .runner import Metric, _judge
 
-#: the steps of a study (s): halvings, each an integer multiple of the finest
+#: the steps of a study (s): halvings, each an integer multiple of the finest; scaled down
+#: where the motion is too fast for them (`automatic_steps`)
 DEFAULT_STEPS = (4e-3, 2e-3, 1e-3, 5e-4)
 #: a halving that lowers the error by less than this factor has reached a floor (an order
 #: of 0.6 and above still lowers it by 1.5 per halving)
@@ -77,6 +81,9 @@ class ConvergenceStudy:
     failure: str = ""
     #: why the engine cannot build the mechanism, when it cannot
     unsupported: str = ""
+    #: the motion's fastest angular frequency w (rad/s): steps with w h beyond the
+    #: scheme's asymptotic range are not fitted
+    frequency: float = 0.0
 
     @property
     def order_matches(self) -> bool | None:
@@ -112,11 +119,25 @@ def falling_part(points: Sequence[ConvergencePoint],
     return kept
 
 
+def automatic_steps(w: float, order: int) -> tuple[float, ...]:
+    """DEFAULT_STEPS, scaled down (halvings kept) so that the coarsest step is within the
+    scheme's asymptotic range w h <= tolerances.asymptotic_limit(order), where the error's
+    leading term, hence its order, dominates."""
+    coarsest = min(DEFAULT_STEPS[0], tolerances.asymptotic_limit(order) / w) if w > 0 else \
+        DEFAULT_STEPS[0]
+    return tuple(coarsest * dt / DEFAULT_STEPS[0] for dt in DEFAULT_STEPS)
+
+
 def convergence(system_id: str, simulator: str, scenario: str | None = None,
-                dts: Sequence[float] = DEFAULT_STEPS, t_end: float | None = DEFAULT_T_END,
+                dts: Sequence[float] | None = None, t_end: float | None = DEFAULT_T_END,
                 settings: Mapping | None = None) -> ConvergenceStudy:
     """The study of one engine on one scenario (default: the system's first), over
-    `t_end` seconds (None: the scenario's)."""
+    `t_end` seconds (None: the scenario's), at the steps `dts` (None: `automatic_steps`
+    for the motion's fastest frequency). Steps outside the asymptotic range are run and
+    shown but not fitted."""
+    from ..analytic.steady_state import excitation_frequencies
+    from .runner import characteristic_frequency
+
     system = get_system(system_id)
     sc = system.scenario(scenario) if scenario else system.scenarios[0]
     values = system.parameter_values(scenario=sc)
@@ -124,13 +145,23 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     mech = system.numeric_mechanism(values)
     eq = operating_equilibrium(system, values)
     T = sc.t_end if t_end is None else min(t_end, sc.t_end)
+    support = backend.support(mech)
+    order = backend.scheme(mech, settings).order if support.ok else 0
+    free = [i for i, c in enumerate(system.coordinates)
+            if c not in system.mechanism.driven_coordinates]
+    # the motion's fastest frequency, as the gates take it (runner.characteristic_frequency),
+    # from a reference at the default step
+    probe = reference(system, sc, values, DEFAULT_STEPS[2], T)
+    w = characteristic_frequency(eq.modes, probe.q[:, free], probe.qd[:, free], eq.q[free])
+    if system.driven:
+        w = max([w] + excitation_frequencies(system, values))
+    dts = tuple(sorted(dts if dts is not None else automatic_steps(w, max(order, 1)),
+                       reverse=True))
     finest = min(dts)
     multiples = [int(round(dt / finest)) for dt in dts]
     if any(abs(k * finest - dt) > 1e-9 * dt for k, dt in zip(multiples, dts)):
         raise ValueError(f"the steps {list(dts)} must be integer multiples of the finest")
     ref = reference(system, sc, values, finest, T)
-    free = [i for i, c in enumerate(system.coordinates)
-            if c not in system.mechanism.driven_coordinates]
     scale = metrics.amplitude(ref.q[:, free], eq.q[free])
     # a closed form is exact to round-off (its error_estimate is DOP853's distance to it);
     # a DOP853 reference's own error is its tight solve's, about the tight-loose
@@ -138,10 +169,9 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     exact = ref.method.startswith("closed form")
     reference_error = 0.0 if exact else float(
         np.max(np.asarray(ref.error_estimate)[free] / scale) * TIGHT / LOOSE)
-    points, order = [], backend.scheme(mech, settings).order
+    points: list[ConvergencePoint] = []
     study = ConvergenceStudy(system.id, sc.name, simulator, backend.version(), order, points,
-                             None, reference_error=reference_error)
-    support = backend.support(mech)
+                             None, reference_error=reference_error, frequency=w)
     if not support.ok:
         study.unsupported = f"{simulator} cannot express {system.id}: {support.reason}"
         return study
@@ -157,11 +187,17 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
         points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1))
         order = run.integrator_order
     study.integrator_order = order
-    falling = falling_part(points, REFERENCE_MARGIN * reference_error)
+    limit = tolerances.asymptotic_limit(order)
+    asymptotic = [p for p in points if w * p.dt <= limit * (1 + 1e-9)]
+    falling = falling_part(asymptotic, REFERENCE_MARGIN * reference_error) if asymptotic \
+        else []
     study.fitted_steps = [p.dt for p in falling]
     if len(falling) >= MIN_FIT_POINTS:
         study.observed_order = observed_order([p.dt for p in falling],
                                               [p.error for p in falling])
+    elif len(asymptotic) < MIN_FIT_POINTS:
+        study.flattened = (f"{len(asymptotic)} step(s) within the asymptotic range w h <= "
+                           f"{limit:g} (w = {w:.4g} rad/s), {MIN_FIT_POINTS} needed for a fit")
     else:
         floor = falling[-1]
         study.flattened = (f"the error stops falling below dt = {floor.dt:g} (at "
@@ -194,13 +230,14 @@ def judge_order(study: ConvergenceStudy) -> Metric:
 
 
 def _study_item(item: tuple) -> dict:
+    """One system x engine (`dts` None: automatic steps)."""
     system_id, simulator, dts, t_end = item
     study = convergence(system_id, simulator, None, dts, t_end)
     return {**study.as_dict(), "metric": judge_order(study).as_dict()}
 
 
 def convergence_matrix(systems: Sequence[str], simulators: Sequence[str],
-                       dts: Sequence[float] = DEFAULT_STEPS,
+                       dts: Sequence[float] | None = None,
                        t_end: float | None = DEFAULT_T_END,
                        scheduler: str | None = None, workers: int | None = None) -> list[dict]:
     """Every system x engine as one item of the sweep (local pool, or a Dask cluster at
@@ -208,5 +245,5 @@ def convergence_matrix(systems: Sequence[str], simulators: Sequence[str],
     order."""
     from .sweep import sweep
 
-    items = [(s, e, tuple(dts), t_end) for s in systems for e in simulators]
+    items = [(s, e, tuple(dts) if dts else None, t_end) for s in systems for e in simulators]
     return sweep(_study_item, items, scheduler=scheduler, workers=workers)

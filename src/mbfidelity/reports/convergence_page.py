@@ -23,7 +23,7 @@ th{background:#f0f0f0}.pass{background:#dff5df}.fail,.xpass{background:#f8d0d0}.
 img{max-width:100%}
 </style></head><body>
 <h1>Convergence and work-precision</h1>
-<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }} · steps {{ doc.steps|join(", ") }} s over
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }} · steps {{ doc.steps|join(", ") if doc.steps is not string else "4, 2, 1 and 0.5 ms, scaled down where the motion is too fast for them (w h within the scheme's asymptotic range)" }} over
 {{ doc.t_end }} s of each system's first scenario. Error: max |q - q_ref| over the run, relative to the
 amplitude. The order is fitted on the steps whose error still falls (by {{ doc.min_decrease }} per halving
 at least) and stays {{ doc.reference_margin }} times above the reference's own error; it must match the

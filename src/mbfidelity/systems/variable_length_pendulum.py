@@ -109,7 +109,12 @@ SYSTEM = System(
     ),
     unexcited={"h_a": 0.0},
     expectations=(Expectation("pybullet", "pumped.trajectory_max", "xfail",
-                              PYBULLET_TIME_VARYING_INERTIA),),
+                              PYBULLET_TIME_VARYING_INERTIA),
+                  Expectation("mujoco", "convergence.order", "unresolved",
+                              "At 4-0.5 ms RK4's error meets the reference's own (about 5e-11 "
+                              "of the amplitude) after one halving, too few points above it "
+                              "for a fit; at 20, 10, 5 and 2.5 ms the order is 3.99 "
+                              "(measured, mbfidelity convergence --steps)."),),
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Parametric resonance at Omega = 2 sqrt(g/l0): the swing grows at the Floquet rate "
           "ln|mu|max / T about phi = 0.",

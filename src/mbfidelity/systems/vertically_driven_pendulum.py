@@ -132,7 +132,13 @@ SYSTEM = System(
     expectations=tuple(Expectation(engine, "inverted_*", "unresolved",
                                    FAST_SHAKING) for engine in
                        ("mujoco", "pybullet", "exudyn", "pymunk"))
-    + (Expectation("pybullet", "hanging.actuator_actuator", "xfail", PYBULLET_VERTICAL_MOTOR),),
+    + (Expectation("pybullet", "hanging.actuator_actuator", "xfail", PYBULLET_VERTICAL_MOTOR),
+       Expectation("pybullet", "convergence.order", "xfail",
+                   "PyBullet's error here falls as dt^1.86 (0.64 to 0.08 ms, within w h <= "
+                   "0.2 of the 50 Hz shaking; measured, mbfidelity convergence), faster than "
+                   "the first order its semi-implicit Euler declares, while Pymunk's same "
+                   "scheme shows 1.08: the cause (the velocity-motor route that imposes the "
+                   "pivot, or the first step's start term) is not established.")),
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Inverted position Floquet-stable for Y^2 Omega^2 > 2 g L_e to leading order "
           "(L_e = (I_G + m l^2)/(m l)); parametric resonance about hanging near "
