@@ -22,6 +22,8 @@ does not change stability); about the inverted position λ = -g / (L_e Omega^2) 
 with the excitation on is Floquet's (analytic/floquet.py), the inverted one stable for a
 fast, large enough shaking (Kapitza: Y^2 Omega^2 > 2 g L_e to leading order in Y / L_e).
 """
+import math
+
 import sympy as sp
 
 from . import Expectation, PrintedFormula, System, coordinate_symbols
@@ -58,7 +60,7 @@ PARAMETERS = (
               "chosen here"),
     Parameter("Y", 0.01, "m", "amplitude of the pivot motion y(t) = Y cos(Omega t)",
               "MECHANISMS.md D", domain="real"),
-    Parameter("Omega", "2*pi*50", "rad/s", "angular frequency of the pivot motion",
+    Parameter("Omega", 2 * math.pi * 50, "rad/s", "angular frequency of the pivot motion",
               "MECHANISMS.md D"),
     Parameter("phi0", 0.05, "rad", "initial angle (released from rest), measured from the "
               "rest state the scenario starts near", "chosen here", domain="real"),
