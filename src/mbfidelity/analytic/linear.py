@@ -222,15 +222,18 @@ def _regular(model: NumericModel, q: np.ndarray, start: np.ndarray, chart: bool 
 
 
 def _full_search_starts(system: System, values, op: np.ndarray) -> list[np.ndarray]:
-    """Starts over every angular coordinate (dependent ones included), 4 per period, for
+    """Starts over every angular coordinate (dependent ones included), 5 per period, for
     closed loops whose other assembly branches no chart of independent coordinates
-    reaches."""
+    reaches. An odd count: an even one starts at op + pi, the mirror pose of a symmetric
+    loop, where Newton's first steps are ill-conditioned and the basin a start falls into
+    changed with the machine's floating point (the five-bar mobile's second minimum was
+    missed from 4 per period on one machine, found on another)."""
     axes = []
     for i, j in enumerate(system.mechanism.joints):
         if isinstance(j, Prismatic):
             axes.append([op[i]])
         else:
-            axes.append(op[i] + np.linspace(-np.pi, np.pi, 4, endpoint=False))
+            axes.append(op[i] + np.linspace(-np.pi, np.pi, 5, endpoint=False))
     return [np.array(p) for p in itertools.product(*axes)]
 
 

@@ -99,8 +99,14 @@ def engine_growth(simulator: str, lam: float, gamma: float, periods: int = PERIO
     return float(np.max(np.abs(psi)) / PERTURBATION) if np.all(np.isfinite(psi)) else float("inf")
 
 
+#: the sweep's name for eq. 83 itself (its rows run in the sweep like the engines')
+EXACT = "eq83"
+
+
 def _row(item: tuple) -> list[float]:
     simulator, points, periods, steps = item
+    if simulator == EXACT:
+        return [exact_growth(lam, gamma, periods, steps) for lam, gamma in points]
     return [engine_growth(simulator, lam, gamma, periods, steps) for lam, gamma in points]
 
 
@@ -123,21 +129,25 @@ def engine_chart(points: list[dict], simulators: list[str], scheduler: str | Non
     the grid, items of the sweep facility (a local pool or a Dask cluster)."""
     from .sweep import sweep
 
-    for p in points:
-        p["exact_growth"] = exact_growth(p["lambda"], p["gamma"], periods, steps_per_period)
-        p["exact_class"] = classify(p["exact_growth"])
-        p["decided"] = decided(p["exact_growth"])
-        p["engines"] = {}
+    if EXACT in simulators:
+        raise ValueError(f"{EXACT!r} is the reference, not an engine")
     rows: dict[float, list[dict]] = {}
     for p in points:
+        p["engines"] = {}
         rows.setdefault(p["gamma"], []).append(p)
-    jobs = [(sim, row) for sim in simulators for row in rows.values()]
+    # the reference rows in the same sweep: no serial work before the engines' rows
+    jobs = [(sim, row) for sim in (EXACT, *simulators) for row in rows.values()]
     results = sweep(_row, [(sim, [(p["lambda"], p["gamma"]) for p in row], periods,
                             steps_per_period) for sim, row in jobs],
                     scheduler=scheduler, workers=workers)
     for (sim, row), growths in zip(jobs, results):
         for p, growth in zip(row, growths):
-            p["engines"][sim] = {"growth": growth, "class": classify(growth)}
+            if sim == EXACT:
+                p["exact_growth"] = growth
+                p["exact_class"] = classify(growth)
+                p["decided"] = decided(growth)
+            else:
+                p["engines"][sim] = {"growth": growth, "class": classify(growth)}
     judged = [p for p in points if p["decided"]]
     # Floquet's verdict seen within the run: unstable points that grow, stable ones that
     # stay bounded (a slow instability may not show in PERIODS periods)
