@@ -265,10 +265,12 @@ def _validated_settings(settings: Mapping[str, Mapping] | None) -> dict[str, dic
 def run(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
         out: str | Path | None = None, *, dt: float = DEFAULT_DT,
         settings: Mapping[str, Mapping] | None = None, variants: bool = False,
-        resume: bool = False, report: bool = True) -> list[Comparison]:
+        resume: bool = False, report: bool = True,
+        scheduler: str | None = None) -> list[Comparison]:
     """The matrix systems x engines (default: all of both). With `out`, the results
     (results.json, results.csv) and, with `report`, the HTML report are written there.
-    `settings` maps an engine to its settings."""
+    `settings` maps an engine to its settings; `scheduler`, a Dask scheduler's address,
+    runs the systems on that cluster (same results as the local pool)."""
     from .comparisons.matrix import run_matrix, write_results
 
     sys_ids, sim_ids = _matrix(systems, sims, installed_only=False)
@@ -277,7 +279,7 @@ def run(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
     chosen = _validated_settings(settings)
     out = Path(out) if out is not None else None
     results = run_matrix(sys_ids, sim_ids, dt=dt, variants=variants, out=out, resume=resume,
-                         settings=chosen)
+                         settings=chosen, scheduler=scheduler)
     if out is not None:
         write_results(results, out)
         if report:

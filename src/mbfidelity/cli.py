@@ -319,6 +319,9 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
                                     "--out: reuse the systems it finished"),
         setting: Optional[List[str]] = typer.Option(
             None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
+        scheduler: Optional[str] = typer.Option(
+            None, "--scheduler", help="a Dask scheduler's address: the systems run on that "
+                                      "cluster (default: a local process pool)"),
         ) -> None:
     """The whole matrix: results (CSV, JSON) and the HTML report."""
     _use_cache(no_cache)
@@ -348,7 +351,7 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
         results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
-                             out=out, resume=resume, settings=settings)
+                             out=out, resume=resume, settings=settings, scheduler=scheduler)
     write_results(results, out)
     index = write_report(out)
     elapsed = time.perf_counter() - start

@@ -55,6 +55,50 @@ def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
     return found, time.process_time() - start
 
 
+def _portable_system(args) -> tuple[list[Comparison], float]:
+    """`_one_system` for a worker that may not share this machine's disk: the series stay
+    in the returned comparisons, and the caller saves them (`_save_portable`)."""
+    system, sims, dt, variants, _, settings = args
+    return _one_system((system, sims, dt, variants, None, settings))
+
+
+def _save_portable(out: Path | None, system: str, job: tuple[list[Comparison], float]) -> None:
+    if out is None:
+        return
+    for row, comps in results_folder.rows_of(job[0]).items():
+        results_folder.save_series(out, row, comps)
+    for c in job[0]:
+        c.series = {}
+    results_folder.save_system(out, system)
+
+
+def _run_on_cluster(scheduler: str, order: list[int], systems: list[str], common: tuple,
+                    out: Path | None, collect: Callable) -> list[int]:
+    """The jobs `order` (indices into `systems`) on an existing Dask cluster, one task per
+    system, longest first; each finished job is collected as it completes. A job whose
+    worker died on every try (dask's KilledWorker) is returned, to run again engine by
+    engine like a crashed local job."""
+    from dask.distributed import Client, KilledWorker
+    from dask.distributed import as_completed as completed
+
+    sims, dt, variants, settings = common
+    crashed = []
+    with Client(scheduler) as client:
+        futures = {client.submit(_portable_system,
+                                 (systems[i], sims, dt, variants, None, settings),
+                                 pure=False): i for i in order}
+        for fut in completed(list(futures)):
+            i = futures[fut]
+            try:
+                job = fut.result()
+            except KilledWorker:
+                crashed.append(i)
+                continue
+            _save_portable(out, systems[i], job)
+            collect(i, job)
+    return crashed
+
+
 def _isolated_job(args) -> tuple[list[Comparison], float]:
     """A job whose worker died, again, each comparison in a worker of its own with a
     wall-clock budget: the one that kills its worker is recorded as crashed (or
@@ -137,7 +181,8 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
                progress: Callable[[Comparison], None] | None = None,
                variants: bool = False, out: Path | None = None,
                resume: bool = False,
-               settings: Mapping[str, dict] | None = None) -> list[Comparison]:
+               settings: Mapping[str, dict] | None = None,
+               scheduler: str | None = None) -> list[Comparison]:
     """Every system on every simulator, in `systems` order. With several workers the
     systems are dispatched longest first (`schedule`, with the job costs of the last run
     into `out`) to a process pool; each system is one job (its references and derivation
@@ -150,7 +195,9 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
     others. A job whose worker process dies (a segfault in an engine) loses no
     other job: it runs again engine by engine, each comparison in a worker of its own
     (`_isolated_job`). `settings` maps an engine to the settings it runs with (its
-    defaults for the others)."""
+    defaults for the others). With `scheduler` (a Dask scheduler's address) the jobs run
+    on that cluster instead of the local pool, one task per system, with the same
+    results; the workers need not share this machine's disk (`_run_on_cluster`)."""
     systems = list(systems)
     settings = dict(settings or {})
     sims = list(simulators)
@@ -176,7 +223,11 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
         else:
             todo.append(i)
     crashed = []
-    if workers <= 1 or len(todo) <= 1:
+    if scheduler and todo:
+        rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
+        crashed = _run_on_cluster(scheduler, sorted(todo, key=lambda i: rank[systems[i]]),
+                                  systems, (sims, dt, variants, settings), out, collect)
+    elif workers <= 1 or len(todo) <= 1:
         for i in todo:
             collect(i, _one_system((systems[i], sims, dt, variants, out, settings)))
     else:
