@@ -106,6 +106,7 @@ from ..systems.model import (
 from ..analytic.linear import quadratic_eigenvalues
 from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
 from .plan import (
+    spatial_tree_reason,
     BODY,
     PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
@@ -223,22 +224,15 @@ def _hinge_axis(j: Revolute) -> tuple[float, ...]:
 
 
 def _spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial tree cannot hold a spatial mechanism (empty: it can)."""
-    if mech.constraints:
-        return "closure constraints in a spatial mechanism"
+    """Why the spatial tree cannot hold a spatial mechanism (empty: it can): besides the
+    common conditions, its hinges turn about a link axis."""
+    common = spatial_tree_reason(mech, closures=False, slides=False)
+    if common:
+        return common
     for j in mech.joints:
-        if isinstance(j, Prismatic):
-            return f"joint {j.name}: the spatial tree has hinges only"
-        if j.absolute or j.clockwise or num(j.angle_offset) != 0:
-            return (f"joint {j.name}: the spatial tree takes relative, counter-clockwise "
-                    "hinges without offset")
         if _hinge_axis(j) not in _AXIS_JOINTS:
             return (f"joint {j.name}: the tree's hinges turn about a link axis (RevoluteX, "
                     f"Y or Z), not about {_hinge_axis(j)}")
-    if any(b.massless for b in mech.bodies):
-        return "a massless body in a spatial mechanism"
-    if any(isinstance(f, PointToPoint) for f in mech.forces):
-        return "a point-to-point element in a spatial mechanism"
     return ""
 
 

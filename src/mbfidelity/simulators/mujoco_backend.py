@@ -112,6 +112,7 @@ from .base import (
     Setting,
 )
 from .plan import (
+    spatial_tree_reason,
     BODY,
     PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
@@ -470,11 +471,7 @@ def _spatial_body_xml(plan: _Plan, native_joint: set, joint_native: dict[int, li
     pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
               for a in (j.parent_anchor, j.child_anchor))
     lines = [f'{ind}<body name="{name}" pos="{_fmt(*(pa - ca))}">']
-    extra = ""
-    if i in native_joint:
-        a, k, c = joint_native[i]
-        ref = -a / k if k != 0 else 0.0
-        extra = f' stiffness="{_fmt(-k)}" springref="{_fmt(ref)}" damping="{_fmt(-c)}"'
+    extra = _native_joint_law(i, native_joint, joint_native)
     if isinstance(j, Revolute):
         axis = [num(v) for v in (j.axis if j.axis is not None else (0, 0, 1))]
         lines.append(f'{ind}  <joint name="{j.name}" type="hinge" axis="{_fmt(*axis)}" '
@@ -494,18 +491,20 @@ def _spatial_body_xml(plan: _Plan, native_joint: set, joint_native: dict[int, li
     return lines
 
 
+def _native_joint_law(i: int, native_joint, joint_native: dict[int, list[float]]) -> str:
+    """The joint attributes of a linear law a + k q + c q' on joint i that MuJoCo applies
+    itself (stiffness about springref, damping); empty when the law is not native."""
+    if i not in native_joint:
+        return ""
+    a, k, c = joint_native[i]
+    ref = -a / k if k != 0 else 0.0
+    return f' stiffness="{_fmt(-k)}" springref="{_fmt(ref)}" damping="{_fmt(-c)}"'
+
+
 def _spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial build cannot hold a spatial mechanism (empty: it can)."""
-    for j in mech.joints:
-        if isinstance(j, Revolute) and (j.absolute or j.clockwise):
-            return f"joint {j.name}: the spatial build takes relative, counter-clockwise hinges"
-        if num(j.angle_offset) != 0:
-            return f"joint {j.name}: the spatial build takes no angle offset"
-    if any(b.massless for b in mech.bodies):
-        return "a massless body in a spatial mechanism (the spatial build folds none)"
-    if any(isinstance(f, PointToPoint) for f in mech.forces):
-        return "a point-to-point element in a spatial mechanism (the spatial build has none)"
-    return ""
+    """Why the spatial build cannot hold a spatial mechanism (empty: it can): closures
+    become equalities, slides slide joints."""
+    return spatial_tree_reason(mech, closures=True, slides=True)
 
 
 def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
@@ -584,11 +583,7 @@ def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
         for i in plan.chains[name]:
             j = mech.joints[i]
             anchor, axis = janchor[j.name]
-            extra = ""
-            if i in native_joint:
-                a, k, c = joint_native[i]
-                ref = -a / k if k != 0 else 0.0
-                extra = f' stiffness="{_fmt(-k)}" springref="{_fmt(ref)}" damping="{_fmt(-c)}"'
+            extra = _native_joint_law(i, native_joint, joint_native)
             if isinstance(j, Revolute):
                 loc = RbT @ (anchor - p)
                 lines.append(f'{ind}  <joint name="{j.name}" type="hinge" axis="0 0 1" '

@@ -474,3 +474,25 @@ def point_state(st: tuple[float, ...], local) -> tuple[float, float, float, floa
     c, s = math.cos(th), math.sin(th)
     rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
     return x + rx, y + ry, vx - w * ry, vy + w * rx
+
+
+def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str:
+    """Why an engine's spatial build (model convention 10) cannot hold a spatial
+    mechanism, empty when it can: every such build takes relative, counter-clockwise
+    hinges without an angle offset, folds no massless body and has no point-to-point
+    element; `closures` and `slides` say whether it takes closure constraints and
+    prismatic joints."""
+    if mech.constraints and not closures:
+        return "closure constraints in a spatial mechanism"
+    for j in mech.joints:
+        if isinstance(j, Prismatic) and not slides:
+            return f"joint {j.name}: the spatial build has hinges only"
+        if isinstance(j, Revolute) and (j.absolute or j.clockwise):
+            return f"joint {j.name}: the spatial build takes relative, counter-clockwise hinges"
+        if num(j.angle_offset) != 0:
+            return f"joint {j.name}: the spatial build takes no angle offset"
+    if any(b.massless for b in mech.bodies):
+        return "a massless body in a spatial mechanism (the spatial build folds none)"
+    if any(isinstance(f, PointToPoint) for f in mech.forces):
+        return "a point-to-point element in a spatial mechanism (the spatial build has none)"
+    return ""

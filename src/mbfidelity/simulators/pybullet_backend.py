@@ -119,6 +119,7 @@ from .base import (
     Setting,
 )
 from .plan import (
+    spatial_tree_reason,
     BODY,
     PRESCRIBED,
     motions,
@@ -298,20 +299,7 @@ def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
 
 def _spatial_reason(mech: Mechanism) -> str:
     """Why the spatial build cannot hold a spatial mechanism (empty: it can)."""
-    if mech.constraints:
-        return "closure constraints in a spatial mechanism"
-    for j in mech.joints:
-        if isinstance(j, Revolute) and (j.absolute or j.clockwise):
-            return f"joint {j.name}: the spatial build takes relative, counter-clockwise hinges"
-        if num(j.angle_offset) != 0:
-            return f"joint {j.name}: the spatial build takes no angle offset"
-        if isinstance(j, Prismatic):
-            return f"joint {j.name}: the spatial build has hinges only"
-    if any(b.massless for b in mech.bodies):
-        return "a massless body in a spatial mechanism (the spatial build folds none)"
-    if any(isinstance(f, PointToPoint) for f in mech.forces):
-        return "a point-to-point element in a spatial mechanism (the spatial build has none)"
-    return ""
+    return spatial_tree_reason(mech, closures=False, slides=False)
 
 
 def principal_inertia(tensor: np.ndarray) -> tuple[list[float], list[float]]:
