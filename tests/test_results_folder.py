@@ -73,3 +73,20 @@ def test_check_series_are_saved_and_drawn(tmp_path):
     assert len(errors) == len(gates) == len(checks["stop_events_reference"]) > 0
     assert (tmp_path / "end_stops-fig2-checks.png").stat().st_size > 0
     assert "end_stops-fig2-checks.png" in (tmp_path / "index.html").read_text()
+
+
+def test_every_catalog_mechanism_is_drawn(tmp_path):
+    """The report's drawing of each system at its operating point (`make report` once
+    stopped on the first spatial one: 3-D points into a planar polygon). A spatial
+    mechanism is drawn on the two world axes its points spread along most."""
+    from mbfidelity.comparisons.results_folder import mechanism_geometry
+    from mbfidelity.reports.html import draw_mechanism
+    from mbfidelity.systems import all_systems, get_system
+
+    for system_id in all_systems():
+        geometry = mechanism_geometry(system_id)
+        assert len(geometry["view"]) == 2
+        if not get_system(system_id).mechanism.spatial:
+            assert geometry["view"] == [0, 1]
+        name = draw_mechanism(geometry, tmp_path)
+        assert (tmp_path / name).stat().st_size > 0

@@ -174,6 +174,14 @@ def mechanism_geometry(system_id: str) -> dict:
             if isinstance(shape, Segment):
                 items.append({"kind": "segment",
                               "points": [world(b.name, shape.a), world(b.name, shape.b)]})
+            elif isinstance(shape, Circle) and mech.spatial:
+                # a circle in the body's plane, tilted in space: its points, projected
+                # by the drawing like any other
+                cx, cy = (float(v) for v in shape.center)
+                r = float(shape.radius)
+                items.append({"kind": "polygon", "points": [
+                    world(b.name, (cx + r * np.cos(t), cy + r * np.sin(t)))
+                    for t in np.linspace(0, 2 * np.pi, 24, endpoint=False)]})
             elif isinstance(shape, Circle):
                 items.append({"kind": "circle", "center": world(b.name, shape.center),
                               "radius": float(shape.radius)})
@@ -188,7 +196,20 @@ def mechanism_geometry(system_id: str) -> dict:
     for j in mech.joints:
         items.append({"kind": "joint", "at": world(j.parent, j.parent_anchor)})
     return {"system": system_id, "coordinates": list(system.coordinates),
-            "operating_point": [float(v) for v in eq.q], "items": items}
+            "operating_point": [float(v) for v in eq.q], "items": items,
+            "view": _view(mech, items)}
+
+
+def _view(mech, items: list[dict]) -> list[int]:
+    """The two world axes a drawing shows: x and y for a planar mechanism; for a spatial
+    one, the two along which its drawn points spread most (in axis order)."""
+    if not mech.spatial:
+        return [0, 1]
+    points = np.array([p + [0.0] * (3 - len(p)) for item in items
+                       for p in item.get("points", []) + [item[k] for k in ("at", "center")
+                                                          if k in item]])
+    spread = np.ptp(points, axis=0)
+    return sorted(int(k) for k in np.argsort(-spread, kind="stable")[:2])
 
 
 def save_system(out: Path, system_id: str) -> None:

@@ -399,28 +399,36 @@ def draw_mechanism(geometry: dict, out: Path) -> str:
     """The mechanism at its operating equilibrium, from its saved geometry
     (`results_folder.mechanism_geometry`)."""
     system_id = geometry["system"]
+    # the world axes drawn (a side view of a spatial mechanism; older folders: x, y)
+    i, j = geometry.get("view", [0, 1])
+
+    def at(p):
+        p = list(p) + [0.0] * (3 - len(p))  # a world anchor may be given in the plane
+        return p[i], p[j]
     fig, ax = plt.subplots(figsize=(4, 4))
     for item in geometry["items"]:
         kind = item["kind"]
         if kind == "segment":
-            a, c = item["points"]
+            a, c = (at(p) for p in item["points"])
             ax.plot([a[0], c[0]], [a[1], c[1]], "-", lw=4, color="tab:blue", alpha=0.7)
         elif kind == "circle":
-            ax.add_patch(CirclePatch(item["center"], item["radius"], fill=False, lw=2,
+            ax.add_patch(CirclePatch(at(item["center"]), item["radius"], fill=False, lw=2,
                                      color="tab:green"))
         elif kind == "polygon":
-            ax.add_patch(Polygon(item["points"], closed=True, fill=False, lw=2,
-                                 color="tab:orange"))
+            ax.add_patch(Polygon([at(p) for p in item["points"]], closed=True, fill=False,
+                                 lw=2, color="tab:orange"))
         elif kind == "centre_of_mass":
-            ax.plot(*item["at"], "k+", ms=8)
+            ax.plot(*at(item["at"]), "k+", ms=8)
         elif kind == "joint":
-            ax.plot(*item["at"], "o", color="k", ms=5, mfc="white")
+            ax.plot(*at(item["at"]), "o", color="k", ms=5, mfc="white")
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.2)
-    at = ", ".join(f"{c} = {v:.4g}" for c, v in zip(geometry["coordinates"],
+    ax.set_xlabel("xyz"[i], fontsize=7)
+    ax.set_ylabel("xyz"[j], fontsize=7)
+    pose = ", ".join(f"{c} = {v:.4g}" for c, v in zip(geometry["coordinates"],
                                                      geometry["operating_point"]))
-    ax.set_title(f"{system_id} at {at}", fontsize=7)
+    ax.set_title(f"{system_id} at {pose}", fontsize=7)
     name = f"{system_id}-drawing.png"
     fig.savefig(out / name, dpi=80)
     plt.close(fig)
