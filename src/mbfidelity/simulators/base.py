@@ -88,6 +88,7 @@ conventions 1-8) into one engine and runs it. The contract:
     `NO_BEAM_ELEMENT`. `beam_size_reason(beam, kind, N)` says why N elements of that kind
     cannot carry the beam (empty: they can), and `beam_frequencies(beam, kind, N, count,
     settings)` returns `BeamModes`: the first `count` natural frequencies (Hz) of bending
+    (fewer when N elements have fewer bending modes)
     of the `Beam` (systems/_continua.py; straight, gravity off, simply supported, a point
     mass on the node at x = a) built of N equal elements of that kind, with a label of
     the facility that gave them (the engine's eigenvalue solver, or a free-vibration fit
