@@ -1295,13 +1295,13 @@ class ExudynBackend(Backend):
         # axial stiffness: any positive value (held coordinates); a slender bar's order
         EA = _AXIAL_FACTOR * EI / l**2
         if kind == ANCF_CABLE:
-            template = ObjectANCFCable2D(physicsMassPerLength=rho, physicsBendingStiffness=EI,
-                                         physicsAxialStiffness=EA)
+            template = ObjectANCFCable2D(massPerLength=rho, bendingStiffness=EI,
+                                         axialStiffness=EA)
         else:
             template = ObjectBeamGeometricallyExact2D(
-                physicsMassPerLength=rho, physicsCrossSectionInertia=_GE_ROTARY_FACTOR * rho * l**2,
-                physicsBendingStiffness=EI, physicsAxialStiffness=EA,
-                physicsShearStiffness=_GE_SHEAR_FACTOR * EI / l**2)
+                massPerLength=rho, crossSectionInertia=_GE_ROTARY_FACTOR * rho * l**2,
+                bendingStiffness=EI, axialStiffness=EA,
+                shearStiffness=_GE_SHEAR_FACTOR * EI / l**2)
         SC = exu.SystemContainer()
         mbs = SC.AddSystem()
         built = exudyn.beams.GenerateBeamElementsAlongLine(mbs, [0.0, 0.0, 0.0], [l, 0.0, 0.0],
