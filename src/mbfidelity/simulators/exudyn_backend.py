@@ -145,10 +145,13 @@ _SOLVER_ORDER = {
 ANCF_CABLE = "ANCFCable2D"
 GEOMETRICALLY_EXACT = "BeamGeometricallyExact2D"
 #: the geometrically exact element's shear stiffness, GA = factor EI / l^2: high, so that
-#: its Timoshenko limit lies 5e-6 n^2 below Euler-Bernoulli (far below its error at N <= 32)
+#: its Timoshenko limit lies 5e-6 n^2 lower by shear (far below its error at N <= 32)
 _GE_SHEAR_FACTOR = 1e6
-#: its rotary inertia per length, factor rho l^2 (must be positive; negligible, 5e-8 n^2)
-_GE_ROTARY_FACTOR = 1e-8
+#: its rotary inertia per length, factor rho l^2: it must be positive (the rotation
+#: coordinates carry it) and lowers the frequencies by about (n pi)^2 factor / 2 = 5e-6 n^2;
+#: 1e-8 put the rotary modes so high that the eigensolver's round-off reached 4e-5 on the
+#: first mode at N = 32 with the block (measured against 1e-6; 1e-4 shows in the orders)
+_GE_ROTARY_FACTOR = 1e-6
 #: axial stiffness EA = factor EI / l^2 (the axial coordinates are held; any positive value)
 _AXIAL_FACTOR = 1e4
 #: solvers that handle algebraic (constraint) equations; Exudyn's explicit solvers stop
@@ -1265,10 +1268,11 @@ class ExudynBackend(Backend):
                              f"{_GE_SHEAR_FACTOR:g} EI/l^2 and rotary inertia "
                              f"{_GE_ROTARY_FACTOR:g} rho l^2 per length, whose first "
                              "frequencies lie below Euler-Bernoulli's by about "
-                             "(n pi)^2 EI / (2 GA l^2) = 5e-6 n^2 (shear; rotary inertia "
-                             "5e-8 n^2): far below the element's own error up to N = 32"),
-            order=2, limit="Timoshenko beam of large shear stiffness (Euler-Bernoulli as GA "
-                           "-> infinity)"),
+                             "(n pi)^2 EI / (2 GA l^2) = 5e-6 n^2 (shear) plus as much "
+                             "(rotary inertia): far below the element's own error up to "
+                             "N = 32"),
+            order=2, limit="Timoshenko beam of large shear stiffness and small rotary inertia "
+                           "(Euler-Bernoulli as GA -> infinity, rotary inertia -> 0)"),
     }
 
     def beam_frequencies(self, beam: Beam, kind: str, elements: int, count: int = 3,
@@ -1280,12 +1284,15 @@ class ExudynBackend(Backend):
         the ANCF slope's x component) are held as well: about the straight beam they
         decouple from bending, so this only removes the axial modes from the list and the
         round-off of the stiff axial terms (measured: ANCF bending frequencies equal with and
-        without them to 1e-11 at EA = 1e4 EI/l^2, to 9e-9 at 1e8 EI/l^2; the
-        geometrically exact element's move by up to 1e-4 with them free, not monotone in
-        EA, a numerical effect)."""
+        without them to 1e-11 at EA = 1e4 EI/l^2, to 9e-9 at 1e8 EI/l^2; the geometrically
+        exact element's to 3e-6, its eigensolver's round-off, at EA = 1e2..1e6 EI/l^2).
+        No setting applies (no time integration)."""
         reason = self.beam_size_reason(beam, kind, elements)
         if reason:
             raise ValueError(f"exudyn {kind}: {reason}")
+        if settings:
+            raise ValueError(f"exudyn {kind}: the eigenvalue route takes no settings; got "
+                             f"{sorted(settings)}")
         import exudyn as exu
         import exudyn.beams
         from exudyn.itemInterface import (ObjectANCFCable2D, ObjectBeamGeometricallyExact2D,

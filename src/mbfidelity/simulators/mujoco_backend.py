@@ -1769,8 +1769,9 @@ class MujocoBackend(Backend):
     def beam_frequencies(self, beam: Beam, kind: str, elements: int, count: int = 3,
                          settings: Mapping | None = None) -> BeamModes:
         """N flex edges along x (vertices i l / N, the end vertices pinned; gravity and
-        contacts off), the point mass added to the vertex at x = a (MjSpec, recompiled:
-        MuJoCo keeps a compiled vertex's mass in its own tables). MuJoCo spreads a
+        contacts off), the point mass added to the vertex at x = a (in the MjSpec, then
+        recompiled: raising ``body_mass`` of the compiled model left MuJoCo's mass matrix
+        unchanged, measured). MuJoCo spreads a
         flexcomp's mass equally over all N + 1 vertices, pinned ones included, so the
         flexcomp gets rho l (N + 1) / N and each moving vertex carries rho l / N.
 
@@ -1786,11 +1787,17 @@ class MujocoBackend(Backend):
         squares on all samples (linear prediction), and omega = 2 sin(theta / 2) / h
         inverts the semi-implicit Euler's dispersion (cos theta = 1 - (omega h)^2 / 2 for a
         linear undamped mode), which otherwise adds (omega h)^2 / 24. The fit's own error
-        (`resolution`) is its distance to the linearization: measured 1e-12..5e-8, far below
-        the element's error (>= 8e-4 at N = 32)."""
+        (`resolution`) is taken as its distance to the linearization, which bounds it:
+        measured 1e-12..5e-8 (the linear prediction's residual is ~1e-14 of the record, so
+        most of that distance is the linearization's round-off), far below the element's
+        error (>= 8e-4 at N = 32). No setting applies: the route fixes its integrator and
+        step."""
         reason = self.beam_size_reason(beam, kind, elements)
         if reason:
             raise ValueError(f"mujoco {kind}: {reason}")
+        if settings:
+            raise ValueError(f"mujoco {kind}: the flex route takes no settings (its "
+                             f"integrator and step are fixed); got {sorted(settings)}")
         import mujoco
         import scipy.linalg
 
