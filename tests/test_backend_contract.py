@@ -151,3 +151,23 @@ def test_bare_loop_runs_the_model_of_simulate(engine):
     mech = system.numeric_mechanism(system.parameter_values())
     seconds = backend.bare_loop(mech, np.array([0.5]), np.array([0.0]), 0.2, 1e-3)
     assert isinstance(seconds, float) and seconds >= 0.0
+
+
+# --- flexible elements (contract point 12) ---------------------------------------------
+
+from mbfidelity.simulators.base import NO_BEAM_ELEMENT, UNSUPPORTED, BeamElement  # noqa: E402
+
+
+@pytest.mark.parametrize("backend", BACKENDS, ids=lambda b: b.id)
+def test_flexible_elements_are_declared(backend):
+    """Every backend declares its flexible elements, or one unsupported entry with the
+    reason; a supported kind names the order it converges at and its limit."""
+    declared = backend.BEAM_ELEMENTS
+    assert declared and all(isinstance(e, BeamElement) and e.expression.how
+                            for e in declared.values())
+    for kind, e in declared.items():
+        if e.expression.level == UNSUPPORTED:
+            assert kind == NO_BEAM_ELEMENT and len(declared) == 1
+        else:
+            assert e.order and e.order > 0 and e.limit
+    assert backend.beam_element("no such kind").expression.level == UNSUPPORTED

@@ -1,4 +1,5 @@
-"""Command line (DESIGN.md): list, analyze, compare, run, errata, strutt; and the users'
+"""Command line (DESIGN.md): list, analyze, compare, run, errata, strutt, convergence,
+beams (the engines' flexible elements against the exact beam of §6.1); and the users'
 gates: check (the gates against the installed engines, optionally against a baseline) and
 diff (what changed between two runs)."""
 from __future__ import annotations
@@ -570,6 +571,77 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
         if out is not None:
             typer.echo(f"page: {page.resolve()}")
     raise typer.Exit(1 if failed else 0)
+
+
+@app.command("beams")
+def beams_cmd(sim: Optional[List[str]] = typer.Option(
+                  None, "--sim", help="simulator ids (repeatable or A,B; default: every "
+                                      "backend, those without flexible elements say why)"),
+              elements: str = typer.Option("2,4,8,16,32", "--elements",
+                                           help="numbers of elements N, A,B,..."),
+              param: Optional[List[str]] = typer.Option(
+                  None, "--param", help="NAME=VALUE of the beam (l, EI, rho, m, c); "
+                                        "default: m = 0 and m = 1, c = 0.5 (§6.1)"),
+              modes: int = typer.Option(3, "--modes", help="frequencies per point"),
+              as_json: bool = typer.Option(False, "--json"),
+              out: Optional[Path] = typer.Option(
+                  None, "--out", help="also write beams.json and beams.png there"),
+              ) -> None:
+    """The engines' own flexible elements against the exact beam of §6.1 (Fig. 17): the
+    first natural frequencies of the simply supported beam with a point mass, built of N
+    elements of each kind, their relative errors and the fitted convergence order."""
+    from .comparisons.flexible_beams import DEFAULT_CASES, beams_document
+    from .simulators import all_backends
+    from .systems._continua import Beam
+
+    sims = _split(sim)
+    for e in sims:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    try:
+        sizes = [int(x) for x in elements.split(",") if x]
+    except ValueError:
+        _fail(f"--elements expects integers A,B,...; got {elements!r}")
+    if not sizes or any(n < 1 for n in sizes):
+        _fail(f"--elements expects positive integers; got {elements!r}")
+    if modes < 1:
+        _fail("--modes must be at least 1")
+    given = _parse_params(param)
+    cases = [given] if "m" in given else [{**case, **given} for case in DEFAULT_CASES]
+    try:
+        beams = [Beam.from_parameters(case) for case in cases]
+    except (TypeError, ValueError) as exc:
+        _fail(str(exc))
+    doc = beams_document(beams, sims or None, sorted(set(sizes)), modes)
+    if out is not None:
+        from .reports.beams_figure import BEAMS, FIGURE, write_beams_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / BEAMS).write_text(json.dumps(doc, indent=1, default=_jsonable))
+        figure = write_beams_figure(json.loads((out / BEAMS).read_text()), out / FIGURE)
+    if as_json:
+        _json(doc)
+        return
+    for case in doc["cases"]:
+        beam = case["beam"]
+        typer.echo(f"m = {beam['point_mass']:g} kg at a = {beam['point_position']:g} m; exact "
+                   + ", ".join(f"{f:.6g}" for f in case["exact_hz"]) + " Hz")
+        for s in case["series"]:
+            name = f"  {s['simulator']} {s['kind']}"
+            if s["unsupported"]:
+                typer.echo(f"{name}: unsupported: {s['unsupported']}")
+                continue
+            typer.echo(f"{name} ({s['level']}, declared order {s['declared_order']})")
+            for p in s["points"]:
+                if "relative_error" not in p:
+                    typer.echo(f"    N = {p['N']:3d}: {p.get('skipped') or p.get('failure')}")
+                    continue
+                typer.echo(f"    N = {p['N']:3d}: " + "  ".join(
+                    f"{e:+.2e}" if e is not None else "    -    " for e in p["relative_error"]))
+            typer.echo("    order:   " + "  ".join(
+                f"{o:9.2f}" if o is not None else "    -    " for o in s["fitted_order"]))
+    if out is not None:
+        typer.echo(f"figure: {figure.resolve()}")
 
 
 @app.command("check")

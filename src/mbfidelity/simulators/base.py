@@ -77,6 +77,23 @@ conventions 1-8) into one engine and runs it. The contract:
     map between description coordinates and engine joint values, forward kinematics),
     and settings are validated here; a backend translates the plan into its engine,
     steps it and reads out.
+12. Flexible elements (optional): a backend declares in `BEAM_ELEMENTS`, per kind of the
+    engine's own flexible (beam) element, a `BeamElement`: its `Expression` (exact: the
+    element discretizes the Euler-Bernoulli beam itself; soft: it converges to a
+    neighbouring model, e.g. a Timoshenko beam of finite shear stiffness; substitute: the
+    engine puts another construct in the beam's place, e.g. a discrete elastic rod with
+    lumped masses; unsupported: the engine has none, with the reason), the order in the
+    number of elements N at which its frequencies are expected to converge, and the model
+    they converge to. An engine without any declares one unsupported entry under
+    `NO_BEAM_ELEMENT`. `beam_size_reason(beam, kind, N)` says why N elements of that kind
+    cannot carry the beam (empty: they can), and `beam_frequencies(beam, kind, N, count,
+    settings)` returns `BeamModes`: the first `count` natural frequencies (Hz) of bending
+    (fewer when N elements have fewer bending modes)
+    of the `Beam` (systems/_continua.py; straight, gravity off, simply supported, a point
+    mass on the node at x = a) built of N equal elements of that kind, with a label of
+    the facility that gave them (the engine's eigenvalue solver, or a free-vibration fit
+    where it has none that works), the route's own relative error per mode (round-off, the
+    fit's error) and what the route adds (settings, step).
 """
 from __future__ import annotations
 
@@ -89,6 +106,7 @@ from typing import ClassVar, Mapping, Sequence
 import numpy as np
 
 from ..systems import Expectation
+from ..systems._continua import Beam
 from ..systems.model import Mechanism
 from .plan import description_reason, element_kind, elements
 
@@ -201,6 +219,35 @@ class RunResult:
 
 
 @dataclass(frozen=True)
+class BeamElement:
+    """One kind of an engine's own flexible element (contract point 12): how it expresses
+    the Euler-Bernoulli beam (`expression`), the order p of its frequencies' convergence,
+    error ~ N^-p (None where unsupported), and the model it converges to."""
+
+    expression: Expression
+    order: float | None = None
+    limit: str = ""
+
+
+@dataclass
+class BeamModes:
+    """Frequencies of a discretized beam (contract point 12): `frequency_hz` (first
+    `count`, ascending), the facility used (`method`), per mode the route's own relative
+    error (`resolution`: the eigensolver's round-off, a fit's error; an error against the
+    continuum below it measures the route, not the element) and what the route adds
+    (`extra`: step, settings, cross-checks)."""
+
+    frequency_hz: list[float]
+    method: str
+    resolution: list[float] = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+
+
+#: the key of the one unsupported entry of an engine without flexible elements
+NO_BEAM_ELEMENT = "none"
+
+
+@dataclass(frozen=True)
 class Linearization:
     eigenvalues: np.ndarray  # continuous time, 1/s
     method: str
@@ -294,6 +341,36 @@ class Backend(ABC):
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         return None
+
+    #: per kind of the engine's own flexible element, its declaration (contract point 12)
+    BEAM_ELEMENTS: ClassVar[Mapping[str, BeamElement]] = {
+        NO_BEAM_ELEMENT: BeamElement(Expression(UNSUPPORTED, "no flexible element declared"))}
+
+    def beam_element(self, kind: str) -> BeamElement:
+        """The declaration of one kind; an undeclared kind is unsupported."""
+        if kind not in self.BEAM_ELEMENTS:
+            return BeamElement(Expression(UNSUPPORTED, f"{self.id} declares no flexible "
+                                                       f"element {kind!r}; declared: "
+                                                       f"{', '.join(self.BEAM_ELEMENTS)}"))
+        return self.BEAM_ELEMENTS[kind]
+
+    def beam_size_reason(self, beam: Beam, kind: str, elements: int) -> str:
+        """Why `elements` elements of `kind` cannot carry `beam` (empty: they can). The
+        point mass needs a node at x = a; the kind must be supported."""
+        declared = self.beam_element(kind).expression
+        if declared.level == UNSUPPORTED:
+            return declared.how
+        if elements < 1:
+            return f"N = {elements}: at least one element is needed"
+        if beam.point_mass > 0 and beam.node_of_point_mass(elements) is None:
+            return (f"N = {elements}: no node at a = {beam.point_position:g} "
+                    f"(c = {beam.c:g}) to carry the point mass")
+        return ""
+
+    def beam_frequencies(self, beam: Beam, kind: str, elements: int, count: int = 3,
+                         settings: Mapping | None = None) -> BeamModes:
+        """See contract point 12 (an engine without flexible elements raises)."""
+        raise NotImplementedError(f"{self.id}: {self.beam_element(kind).expression.how}")
 
     # helpers shared by backends
     def resolve_settings(self, settings: Mapping | None) -> dict:

@@ -104,7 +104,8 @@ from ..systems.model import (
     inertia_matrix,
 )
 from ..analytic.linear import quadratic_eigenvalues
-from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, UNSUPPORTED, Backend, Expression, Linearization, RunResult, Setting
+from ..systems._continua import Beam
+from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, SOFT, UNSUPPORTED, Backend, BeamElement, BeamModes, Expression, Linearization, RunResult, Setting
 from .plan import (
     spatial_tree_reason,
     BODY,
@@ -141,6 +142,19 @@ _SOLVER_ORDER = {
     "GeneralizedAlpha": 2,
     "TrapezoidalIndex2": 2,
 }
+#: the engine's own beam elements (contract point 12)
+ANCF_CABLE = "ANCFCable2D"
+GEOMETRICALLY_EXACT = "BeamGeometricallyExact2D"
+#: the geometrically exact element's shear stiffness, GA = factor EI / l^2: high, so that
+#: its Timoshenko limit lies 5e-6 n^2 lower by shear (far below its error at N <= 32)
+_GE_SHEAR_FACTOR = 1e6
+#: its rotary inertia per length, factor rho l^2: it must be positive (the rotation
+#: coordinates carry it) and lowers the frequencies by about (n pi)^2 factor / 2 = 5e-6 n^2;
+#: 1e-8 put the rotary modes so high that the eigensolver's round-off reached 4e-5 on the
+#: first mode at N = 32 with the block (measured against 1e-6; 1e-4 shows in the orders)
+_GE_ROTARY_FACTOR = 1e-6
+#: axial stiffness EA = factor EI / l^2 (the axial coordinates are held; any positive value)
+_AXIAL_FACTOR = 1e4
 #: solvers that handle algebraic (constraint) equations; Exudyn's explicit solvers stop
 #: with "contains constraints that cannot be solved"
 _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
@@ -1232,6 +1246,94 @@ class ExudynBackend(Backend):
                    "multipliers": lam.tolist(), "equilibrium_residual": residual,
                    "constraint_rank": rank},
         )
+
+
+    # --- flexible elements (contract point 12) ----------------------------------------------
+    BEAM_ELEMENTS = {
+        ANCF_CABLE: BeamElement(
+            Expression(EXACT, "ObjectANCFCable2D: the Euler-Bernoulli beam element (cubic "
+                              "Hermite position and slope per node, consistent mass); its "
+                              "frequencies converge to the beam's from above"),
+            order=4, limit="Euler-Bernoulli"),
+        GEOMETRICALLY_EXACT: BeamElement(
+            Expression(SOFT, "ObjectBeamGeometricallyExact2D: a shear-deformable (Reissner) "
+                             "element with linear interpolation; it converges to a "
+                             "Timoshenko beam, here of shear stiffness GA = "
+                             f"{_GE_SHEAR_FACTOR:g} EI/l^2 and rotary inertia "
+                             f"{_GE_ROTARY_FACTOR:g} rho l^2 per length, whose first "
+                             "frequencies lie below Euler-Bernoulli's by about "
+                             "(n pi)^2 EI / (2 GA l^2) = 5e-6 n^2 (shear) plus as much "
+                             "(rotary inertia): far below the element's own error up to "
+                             "N = 32"),
+            order=2, limit="Timoshenko beam of large shear stiffness and small rotary inertia "
+                           "(Euler-Bernoulli as GA -> infinity, rotary inertia -> 0)"),
+    }
+
+    def beam_frequencies(self, beam: Beam, kind: str, elements: int, count: int = 3,
+                         settings: Mapping | None = None) -> BeamModes:
+        """N elements of `kind` along x (`exudyn.beams.GenerateBeamElementsAlongLine`), the
+        point mass an ``ObjectMassPoint2D`` on the node at x = a, and the frequencies from
+        ``mbs.ComputeODE2Eigenvalues`` (dense, omega^2) with the supports as constrained
+        coordinates: y = 0 at both end nodes. The axial coordinates (every node's x, and
+        the ANCF slope's x component) are held as well: about the straight beam they
+        decouple from bending, so this only removes the axial modes from the list and the
+        round-off of the stiff axial terms (measured: ANCF bending frequencies equal with and
+        without them to 1e-11 at EA = 1e4 EI/l^2, to 9e-9 at 1e8 EI/l^2; the geometrically
+        exact element's to 3e-6, its eigensolver's round-off, at EA = 1e2..1e6 EI/l^2).
+        No setting applies (no time integration)."""
+        reason = self.beam_size_reason(beam, kind, elements)
+        if reason:
+            raise ValueError(f"exudyn {kind}: {reason}")
+        if settings:
+            raise ValueError(f"exudyn {kind}: the eigenvalue route takes no settings; got "
+                             f"{sorted(settings)}")
+        import exudyn as exu
+        import exudyn.beams
+        from exudyn.itemInterface import (ObjectANCFCable2D, ObjectBeamGeometricallyExact2D,
+                                          ObjectMassPoint2D)
+
+        l, EI, rho = beam.length, beam.EI, beam.rho
+        # axial stiffness: any positive value (held coordinates); a slender bar's order
+        EA = _AXIAL_FACTOR * EI / l**2
+        if kind == ANCF_CABLE:
+            template = ObjectANCFCable2D(massPerLength=rho, bendingStiffness=EI,
+                                         axialStiffness=EA)
+        else:
+            template = ObjectBeamGeometricallyExact2D(
+                massPerLength=rho, crossSectionInertia=_GE_ROTARY_FACTOR * rho * l**2,
+                bendingStiffness=EI, axialStiffness=EA,
+                shearStiffness=_GE_SHEAR_FACTOR * EI / l**2)
+        SC = exu.SystemContainer()
+        mbs = SC.AddSystem()
+        built = exudyn.beams.GenerateBeamElementsAlongLine(mbs, [0.0, 0.0, 0.0], [l, 0.0, 0.0],
+                                                            elements, template)
+        nodes = list(built["nodes"])
+        if beam.point_mass > 0:
+            mbs.AddObject(ObjectMassPoint2D(mass=beam.point_mass,
+                                            nodeNumber=nodes[beam.node_of_point_mass(elements)]))
+        mbs.Assemble()
+        first = [mbs.GetNodeODE2Index(n) for n in nodes]
+        # node coordinates: ANCF (x, y, x', y'), geometrically exact (x, y, theta)
+        axial = first + ([i + 2 for i in first] if kind == ANCF_CABLE else [])
+        held = sorted(set(axial + [first[0] + 1, first[-1] + 1]))
+        t0 = time.process_time()
+        omega2, _ = mbs.ComputeODE2Eigenvalues(constrainedCoordinates=held)
+        cpu = time.process_time() - t0
+        omega2 = np.sort(np.asarray(omega2, dtype=float))
+        count = min(count, len(omega2))
+        # a dense symmetric eigensolver's round-off in omega_k^2 is about eps omega_max^2,
+        # relative eps omega_max^2 / omega_k^2 (taken for omega_k as well, conservatively)
+        roundoff = [float(np.finfo(float).eps * omega2[-1] / w2) for w2 in omega2[:count]]
+        return BeamModes(
+            [float(math.sqrt(w2) / (2 * math.pi)) for w2 in omega2[:count]],
+            "exudyn mbs.ComputeODE2Eigenvalues (dense, constrained coordinates: supports "
+            "and axial coordinates held)",
+            roundoff,
+            {"coordinates": len(omega2),
+             "axial_stiffness": EA, "cpu_time": cpu,
+             **({"shear_stiffness": _GE_SHEAR_FACTOR * EI / l**2,
+                 "rotary_inertia_per_length": _GE_ROTARY_FACTOR * rho * l**2}
+                if kind == GEOMETRICALLY_EXACT else {})})
 
 
 BACKEND = ExudynBackend()

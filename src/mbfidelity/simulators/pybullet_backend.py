@@ -112,7 +112,9 @@ from .base import (
     EXACT,
     SUBSTITUTE,
     UNSUPPORTED,
+    NO_BEAM_ELEMENT,
     Backend,
+    BeamElement,
     Expression,
     Linearization,
     RunResult,
@@ -1777,6 +1779,19 @@ class PyBulletBackend(Backend):
                     "forces through calculateJacobian), which inverse dynamics omits"),
             extra={"M": M.tolist(), "K": K.tolist(), "C": C.tolist(),
                    "coordinates": "engine joint values"})
+
+
+    # --- flexible elements (contract point 12) ----------------------------------------------
+    BEAM_ELEMENTS = {
+        NO_BEAM_ELEMENT: BeamElement(Expression(
+            UNSUPPORTED, "PyBullet has no beam element: its deformables (loadSoftBody) are "
+                         "soft bodies loaded from meshes, FEM tetrahedra (Neo-Hookean or "
+                         "corotated) or mass-spring cloth with bending springs, none with a "
+                         "bending stiffness EI of a 1-D rod; Bullet's C++ rope "
+                         "(btSoftBodyHelpers::CreateRope) is not exposed in pybullet. A beam "
+                         "there can only be a chain of rigid segments with hinge springs "
+                         "(the discretized model of issue 12)")),
+    }
 
 
 BACKEND = PyBulletBackend()

@@ -127,7 +127,9 @@ from .base import (
     EXACT,
     SUBSTITUTE,
     UNSUPPORTED,
+    NO_BEAM_ELEMENT,
     Backend,
+    BeamElement,
     Expression,
     Linearization,
     RunResult,
@@ -1988,6 +1990,16 @@ class PymunkBackend(Backend):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         # Chipmunk has no linearization facility (SIMULATORS.md)
         return None
+
+
+    # --- flexible elements (contract point 12) ----------------------------------------------
+    BEAM_ELEMENTS = {
+        NO_BEAM_ELEMENT: BeamElement(Expression(
+            UNSUPPORTED, "Pymunk (Chipmunk2D) simulates rigid bodies only: no flexible or "
+                         "deformable element of any kind. A beam there is a chain of rigid "
+                         "segments with rotational springs (the discretized model of issue "
+                         "12)")),
+    }
 
 
 BACKEND = PymunkBackend()
