@@ -228,3 +228,20 @@ def test_full_study_orders():
                 continue
             for order in s["fitted_order"]:
                 assert order is not None and abs(order - s["declared_order"]) < 0.3, s["kind"]
+
+
+def test_the_report_shows_the_saved_beam_study(tmp_path):
+    """`make report` writes the study into the results folder; the index shows it from
+    the saved figure alone."""
+    _need("exudyn")
+    from mbfidelity.reports.html import write_report
+
+    runner = CliRunner()
+    res = runner.invoke(app, ["run", "--systems", "mass_spring_damper", "--sims", "pymunk",
+                              "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert "beams.png" not in (tmp_path / "index.html").read_text()
+    res = runner.invoke(app, ["beams", "--sim", "exudyn", "--elements", "4,8",
+                              "--param", "m=1", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert '<img src="beams.png">' in write_report(tmp_path).read_text()

@@ -94,6 +94,11 @@ and each engine's classification by simulation ({{ strutt_engines }}){% endif %}
 <p>Each engine's error against the step, its fitted order next to the declared one, and its
 error against CPU seconds: <a href="convergence.html">convergence.html</a> (written by
 <code>mbfidelity convergence --out DIR</code>; <code>make report</code> writes it).</p>{% endif %}
+{% if beams %}<h2>Flexible beams: the engines' own elements against the continuum</h2>
+<p>The simply supported beam with a block (§6.1, Fig. 17) in each engine's flexible elements,
+N = 2 to 32, against the exact Euler-Bernoulli frequencies (written by
+<code>mbfidelity beams --out DIR</code>; <code>make report</code> writes it).</p>
+<img src="beams.png">{% endif %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
 <p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
 (written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
@@ -220,6 +225,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
                            liftoff=liftoff,
                            convergence=(out / "convergence.json").exists(),
                            strutt=(out / "strutt.png").exists(),
+                           beams=(out / "beams.png").exists(),
                            strutt_engines=_strutt_engines(out))
     index = out / "index.html"
     index.write_text(page)
