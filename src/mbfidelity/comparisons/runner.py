@@ -189,6 +189,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     backend = get_backend(simulator)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
+    system = system.with_structure(base_values)  # built for the user's number of elements
     ok, why = backend.available()
     if not ok:
         return Comparison(system.id, simulator, "", {}, base_values, dt, supported=False,
