@@ -217,6 +217,15 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                    f"f_d = {m['damped_frequency_hz']:.9g} Hz")
     if not doc["stable"]:
         typer.echo(f"  unstable: fastest growth rate {doc['growth_rate']:.9g} 1/s")
+    if "continuum" in doc:
+        c, chain = doc["continuum"], doc["continuum"]["discretization"]
+        typer.echo(f"  exact continuum ({c['model']}): "
+                   + ", ".join(f"{f:.9g}" for f in c["frequency_hz"]) + " Hz")
+        for r in doc["rayleigh"]:
+            typer.echo(f"  Rayleigh {r['label']} ({r['shape']}): {r['frequency_hz']:.9g} Hz, "
+                       f"{r['relative_error']:+.3e} against the exact first frequency")
+        typer.echo(f"  chain of {chain['parameter']} = {chain[chain['parameter']]} against the "
+                   f"continuum: " + ", ".join(f"{e:+.3e}" for e in chain["relative_error"]))
     if "stability_threshold" in doc:
         th = doc["stability_threshold"]
         if th["value"] is None:
