@@ -196,3 +196,24 @@ def test_convergence_study_to_32_elements():
     assert last.N == 32
     for err, c, b in zip(last.relative_error, study.leading_error, betas):
         assert err / (c / 32**2) == pytest.approx(1, abs=(b / 32) ** 2)
+
+
+def test_discretization_command():
+    """`mbfidelity discretization` prints the study; N = 1 and 2 against the hand forms."""
+    from typer.testing import CliRunner
+
+    from mbfidelity.cli import app
+
+    res = CliRunner().invoke(app, ["discretization", SYSTEM_ID, "--counts", "1,2",
+                                   "--param", "m=0.8", "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.output)
+    v = _values(1, m=0.8)
+    assert [r["N"] for r in doc["rows"]] == [1, 2]
+    assert doc["rows"][0]["frequency_hz"][0] == pytest.approx(
+        HAND.one_element_frequency(v) / (2 * math.pi), rel=1e-12)
+    np.testing.assert_allclose(doc["rows"][1]["frequency_hz"],
+                               np.array(HAND.two_element_frequencies(_values(2, m=0.8)))
+                               / (2 * math.pi), rtol=1e-10)
+    bad = CliRunner().invoke(app, ["discretization", SYSTEM_ID, "--counts", "2,0"])
+    assert bad.exit_code == 2 and "parameter N must be an integer >= 1" in bad.output
