@@ -217,3 +217,24 @@ def test_discretization_command():
                                / (2 * math.pi), rtol=1e-10)
     bad = CliRunner().invoke(app, ["discretization", SYSTEM_ID, "--counts", "2,0"])
     assert bad.exit_code == 2 and "parameter N must be an integer >= 1" in bad.output
+
+
+def test_declarations_follow_the_structure():
+    """An expectation's `when` is a relation of the structural parameters: the chain's
+    fastest mode, hence w h at the default step, grows with N, so the declarations that
+    hold at N = 8 do not at N = 1 (where every gate resolves and passes)."""
+    from mbfidelity.comparisons.runner import expectations
+    from mbfidelity.systems import Expectation
+
+    s = get_system(SYSTEM_ID)
+
+    def mujocos(system):
+        return [g[0].metric for g in expectations(system, "mujoco")
+                if g[0] in s.expectations and g[0].simulator == "mujoco"]
+
+    assert mujocos(s.with_structure({"N": 1})) == []
+    assert mujocos(s) == ["pulled.*", "relaxed.*"]  # N = 8: the trajectories
+    assert mujocos(s.with_structure({"N": 16})) == ["pulled.*", "relaxed.*",
+                                                    "frequency.fit_mode*", "damping.fit_mode*"]
+    with pytest.raises(ValueError, match="relation of the structural parameters"):
+        Expectation("*", "*", "xfail", "probe", when="M > 2").applies({"N": 3})

@@ -106,7 +106,8 @@ def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...
     own (mechanism-specific), each one declaration, then those the backend's declared
     soft or substitute expressions of the system's elements imply
     (`simulators.base.expected_failures`), each a group of patterns declared together."""
-    return tuple((e,) for e in system.expectations) + _declared(system.id, simulator)
+    return tuple((e,) for e in system.expectations if e.applies(system.structure)) + _declared(
+        system.id, simulator)
 
 
 @lru_cache(maxsize=None)

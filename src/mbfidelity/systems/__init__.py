@@ -173,12 +173,26 @@ class Expectation:
     its range of w h, or above the ceiling a gate can discriminate: comparisons/
     tolerances.py), so it is measured and shown, not judged (strict too: a declaration
     whose metrics all resolve is reported, and their passes become unexpected).
-    `simulator` and `metric` are fnmatch patterns ("*" matches all)."""
+    `simulator` and `metric` are fnmatch patterns ("*" matches all). `when`: a relation
+    of the system's structural parameters (``"N >= 5"``) outside which the declaration
+    does not apply: a chain's fastest mode, hence w h at the default step, grows with its
+    number of elements."""
 
     simulator: str
     metric: str
     kind: str
     reason: str
+    when: str | None = None
+
+    def applies(self, structure: Mapping[str, int]) -> bool:
+        """Whether the declaration holds for a system built with `structure`."""
+        if self.when is None:
+            return True
+        verdict = sp.sympify(self.when, locals={k: sp.Integer(v) for k, v in structure.items()})
+        if verdict not in (sp.true, sp.false):
+            raise ValueError(f"expectation condition {self.when!r} must be a relation of the "
+                             f"structural parameters {sorted(structure) or '(none)'}")
+        return bool(verdict)
 
 
 @dataclass(frozen=True)
