@@ -99,16 +99,16 @@ def build(P) -> Mechanism:
     return Mechanism(bodies=tuple(bodies), joints=tuple(joints), forces=tuple(forces))
 
 
-def static_stretch(P, i: int):
+def static_stretch(P, i: int) -> sp.Expr:
     """Segment i's stretch at rest: the weight below it over its stiffness N k."""
     return P.g * (P.m + P.rho * P.l * (P.N - i + sp.Rational(1, 2)) / P.N) / (P.N * P.k)
 
 
-def operating_point(P):
+def operating_point(P) -> dict[str, sp.Expr]:
     return {f"u{i}": static_stretch(P, i) for i in range(1, P.N + 1)}
 
 
-def pulled(P):
+def pulled(P) -> dict[str, sp.Expr]:
     """The static equilibrium plus the end load's static shape (eq. 69): every segment
     stretched by z0 / N more, the block z0 below its rest position."""
     return {f"u{i}": static_stretch(P, i) + P.z0 / P.N for i in range(1, P.N + 1)}
