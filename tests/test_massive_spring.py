@@ -56,6 +56,8 @@ def test_N_shapes_the_mechanism_and_its_id():
         assert special.with_structure(s.parameter_values()) is s
     with pytest.raises(KeyError, match="structural parameters are N"):
         get_system(f"{SYSTEM_ID}@M=3")
+    with pytest.raises(KeyError, match="parameter N must be an integer >= 1, got 2.5"):
+        get_system(f"{SYSTEM_ID}@N=2.5")
 
 
 def test_every_cache_tells_the_structures_apart():

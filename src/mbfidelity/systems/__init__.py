@@ -600,4 +600,7 @@ def get_system(system_id: str) -> System:
             values[name] = float(value)
         except ValueError:
             raise KeyError(f"unknown system {system_id!r}: {name} must be an integer") from None
-    return system.with_structure(values)
+    try:
+        return system.with_structure(values)
+    except ValueError as exc:
+        raise KeyError(f"unknown system {system_id!r}: {exc}") from None
