@@ -33,7 +33,10 @@ def _random_values(system_id, seed):
     base = s.parameter_values()
     while True:
         # every parameter drawn, those with formula defaults too (given explicitly)
-        values = {name: v * rng.uniform(0.5, 2.0) if v else v for name, v in base.items()}
+        # (a structural parameter, the number of elements of a chain, stays: it is an
+        # integer that shapes the mechanism, not a physical value)
+        values = {name: v * rng.uniform(0.5, 2.0) if v and name not in s.structure else v
+                  for name, v in base.items()}
         values = getattr(HAND[system_id], "relations", lambda v: v)(values)
         if s.is_valid(values) and valid(values):
             return values

@@ -72,8 +72,9 @@ def _overrides(system_id, low, high):
     s = get_system(system_id)
     base = s.parameter_values()
     factors = st.floats(low, high)
+    # a structural parameter (an integer number of elements) is not scaled
     parts = {p.name: st.one_of(st.none(), factors) if p.derived else factors
-             for p in s.all_parameters if base[p.name] != 0}
+             for p in s.all_parameters if base[p.name] != 0 and not p.structural}
     return st.fixed_dictionaries(parts).map(
         lambda drawn: {name: base[name] * f for name, f in drawn.items() if f is not None})
 

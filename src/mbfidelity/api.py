@@ -68,6 +68,7 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
         values, derived = system.resolve_parameters(params)
     except KeyError as exc:
         raise ValueError(exc.args[0]) from None
+    system = system.with_structure(values)  # built for the user's number of elements
     coords = list(system.coordinates)
     try:
         eqs = find_equilibria(system, values)
@@ -106,6 +107,8 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
     }
     if not op.stable:
         doc["growth_rate"] = float(max(s.real for s in op.eigenvalues))
+    if system.continuum:
+        _continuum(system, values, op, doc)
     if system.driven:
         _parametric_stability(system, values, coords, doc)
     if op.acceleration is not None:
@@ -130,6 +133,28 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
         else:
             doc["steady_state_harmonic_residual"] = response.harmonic_residual
     return doc
+
+
+def _continuum(system, values: dict, op, doc: dict) -> None:
+    """A discretized continuum (monograph §6, `System.continuum`): the exact continuum's
+    first frequencies (`continuum`), the printed Rayleigh estimates against the exact
+    first frequency (`rayleigh`), and the chain's error against the continuum at this
+    number of elements, with the leading error C_n / N^2 derived for its lumping."""
+    from .analytic.continuum import continuum_summary
+    from .analytic.discretization import structural_parameter
+
+    summary = continuum_summary(system.continuum, values)
+    name = structural_parameter(system)
+    N = int(values[name])
+    chain = [m.frequency_hz for m in op.modes if m.frequency_hz > 0][:len(summary.frequency_hz)]
+    doc["continuum"] = summary.as_dict()
+    doc["continuum"]["discretization"] = {
+        "parameter": name, name: N, "frequency_hz": chain,
+        "relative_error": [(f - e) / e for f, e in zip(chain, summary.frequency_hz)],
+        "predicted_relative_error": (None if summary.leading_error is None else
+                                     [c / N**2 for c in summary.leading_error[:len(chain)]]),
+    }
+    doc["rayleigh"] = [r.as_dict() for r in summary.rayleigh]
 
 
 def _parametric_stability(system, values: dict, coords: list, doc: dict) -> None:

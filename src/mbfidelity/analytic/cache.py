@@ -2,8 +2,9 @@
 source code of their compiled numeric functions.
 
 An entry is keyed by the content it depends on: the system's module and the rest of
-`systems/` that is not another mechanism (the description), the derivation and
-compilation code of `analytic/`, and the SymPy and Python versions. Any change to them
+`systems/` that is not another mechanism (the description), the structural parameters
+it is built for (`System.structure_tag`: the number of elements of a chain), the
+derivation and compilation code of `analytic/`, and the SymPy and Python versions. Any change to them
 gives a new key, so an entry is never stale; old keys are simply not read again.
 
 Location: ``$MBFIDELITY_CACHE_DIR`` if set, otherwise the user cache directory of
@@ -54,14 +55,18 @@ def _file_digest(path: str) -> bytes:
     return hashlib.sha256(Path(path).read_bytes()).digest()
 
 
-def system_key(module_file: str) -> str:
-    """Content key of one mechanism's entries (see the module docstring)."""
+def system_key(module_file: str, structure: str = "") -> str:
+    """Content key of one mechanism's entries (see the module docstring). `structure`
+    ("N=16"): the structural parameters the mechanism is built for, part of the key
+    (a chain of 16 elements is another derivation than one of 8)."""
     import sympy
 
     here = Path(__file__).parent
     systems_dir = Path(module_file).parent
     h = hashlib.sha256()
     h.update(f"{FORMAT}|sympy {sympy.__version__}|python {sys.version_info[:2]}".encode())
+    if structure:
+        h.update(f"|structure {structure}".encode())
     # the description machinery: systems/ files that are not mechanism modules
     shared = sorted(p for p in systems_dir.glob("*.py")
                     if p.name.startswith("_") or p.name == "model.py")

@@ -20,6 +20,8 @@ refined with Brent's method; every scan has a hard bound and raises when it is h
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Callable, Mapping
 
 import numpy as np
 import scipy.optimize
@@ -116,3 +118,98 @@ def spring_with_end_mass_frequencies(k: float, spring_mass: float, m: float, cou
     else:
         betas = spring_with_end_mass_betas(spring_mass / m, count)
     return [beta * math.sqrt(k / spring_mass) for beta in betas]
+
+
+# --- the continua of the catalog's discretized systems (System.continuum) ---------------
+
+
+@dataclass(frozen=True)
+class RayleighEstimate:
+    """A first-frequency estimate by Rayleigh's method, coded as printed."""
+
+    label: str
+    shape: str
+    frequency_hz: float
+    #: (estimate - exact) / exact, against the continuum's first frequency: positive,
+    #: Rayleigh's quotient being an upper bound
+    relative_error: float
+
+    def as_dict(self) -> dict:
+        return {"label": self.label, "shape": self.shape, "frequency_hz": self.frequency_hz,
+                "relative_error": self.relative_error}
+
+
+@dataclass(frozen=True)
+class ContinuumSummary:
+    """What the exact continuum says of a discretized system's parameters: its first
+    natural frequencies, the monograph's Rayleigh estimates, and the leading coefficient
+    C_n of the discretization's relative error C_n / N^2 (N elements), mode by mode, as
+    derived for the system's lumping (None where not derived)."""
+
+    model: str
+    description: str
+    frequency_hz: list[float]
+    rayleigh: list[RayleighEstimate]
+    leading_error: list[float] | None = None
+
+    def as_dict(self) -> dict:
+        return {"model": self.model, "description": self.description,
+                "frequency_hz": self.frequency_hz,
+                "discretization_leading_error": self.leading_error}
+
+
+def rayleigh_massive_spring(k: float, spring_mass: float, m: float) -> float:
+    """§6.2 eq. 69-70 as printed: with the linear shape z = (x/l) z_a of a static end load,
+    m_red = m + rho l / 3 and k_red = k, so f0 = sqrt(k / (m + rho l / 3)) / (2 pi) (Hz)."""
+    return math.sqrt(k / (m + spring_mass / 3)) / (2 * math.pi)
+
+
+def lumped_spring_error_coefficients(spring_mass: float, m: float, count: int = 3) -> list[float]:
+    """Leading coefficients C_n of the lumped chain's relative frequency error,
+    w_N / w - 1 = C_n / N^2 + O(N^-4), for the spring of mass M_s cut into N segments of
+    stiffness N k with half of each segment's mass at each end node (the ground's half
+    lost, the end node m + M_s / (2N)).
+
+    Derivation (by hand): node displacements u_j = sin(j theta) satisfy every interior
+    node's equation when w^2 = (4 N^2 k / M_s) sin^2(theta / 2); the end node's equation
+    then reduces to tan(N theta) = (M_s / m) cot(theta / 2) / (2 N). With theta = b / N and
+    r = M_s / m: b tan(b) (2N/b) tan(b / 2N) = r, i.e. f(b) (1 + b^2 / (12 N^2)) = r with
+    f(b) = b tan b, to O(N^-4). Against the exact root beta of f(beta) = r, b = beta + d
+    with d = -r beta^2 / (12 N^2 f'(beta)), f'(beta) = (r + r^2 + beta^2) / beta; and
+    w_N = 2 N sqrt(k / M_s) sin(b / 2N) = b sqrt(k / M_s) (1 - b^2 / (24 N^2)). So
+    C_n = -beta_n^2 (1/24 + r / (12 (r + r^2 + beta_n^2))): the bare rod's dispersion
+    -beta^2/24 (m -> 0) plus the end mass's share; m >> M_s gives -r/12, the N = 1 chain's
+    k / (m + M_s/2) against k / (m + M_s/3). Negative: the lumped nodes carry more of the
+    spring's mass through the motion than the continuum does, so the chain's frequencies
+    lie below the continuum's."""
+    r = spring_mass / m
+    return [-beta**2 * (1 / 24 + r / (12 * (r + r**2 + beta**2)))
+            for beta in spring_with_end_mass_betas(r, count)]
+
+
+def spring_with_end_mass(values: Mapping[str, float], count: int = 3) -> ContinuumSummary:
+    """The spring of stiffness k, length l, mass rho per length with the end block m
+    (§6.2, Fig. 18): parameters k, l, rho, m."""
+    k, spring_mass, m = values["k"], values["rho"] * values["l"], values["m"]
+    exact = [w / (2 * math.pi) for w in spring_with_end_mass_frequencies(k, spring_mass, m, count)]
+    estimate = rayleigh_massive_spring(k, spring_mass, m)
+    return ContinuumSummary(
+        model="spring_with_end_mass",
+        description="rod of stiffness k and mass rho l fixed at one end with a mass m at "
+                    "the other: beta tan(beta) = rho l / m, w = beta sqrt(k / (rho l))",
+        frequency_hz=exact,
+        rayleigh=[RayleighEstimate("eq. 69-70", "z(x) = (x/l) z_a, static end load",
+                                   estimate, (estimate - exact[0]) / exact[0])],
+        leading_error=lumped_spring_error_coefficients(spring_mass, m, count))
+
+
+#: the continuum models a system may name (`System.continuum`)
+CONTINUA: dict[str, Callable[..., ContinuumSummary]] = {
+    "spring_with_end_mass": spring_with_end_mass,
+}
+
+
+def continuum_summary(name: str, values: Mapping[str, float], count: int = 3) -> ContinuumSummary:
+    if name not in CONTINUA:
+        raise ValueError(f"no continuum model {name!r}; known: {', '.join(CONTINUA)}")
+    return CONTINUA[name](values, count)

@@ -339,6 +339,22 @@ class Derivation:
                     self._explicit_dependent = dict(sols[0])
         return self._explicit_dependent
 
+    @property
+    def linear_statics(self) -> bool:
+        """Whether the static problem is linear: the autonomous generalized forces at rest
+        (q' = 0) and the constraint equations affine in q (their Jacobians free of q; an
+        expression that is affine only after simplification counts as not). Its
+        equilibria are then one affine set, a single point where the stiffness is
+        regular, which Newton reaches from any start. Cached."""
+        if not hasattr(self, "_linear_statics"):
+            coordinates = set(self.q)
+            rest = {v: 0 for v in self.qd}
+            forces = self.Q_autonomous.xreplace(rest)
+            rows = list(forces.jacobian(self.q)) + list(self.Phi_q)
+            self._linear_statics = not any(sp.sympify(e).free_symbols & coordinates
+                                           for e in rows)
+        return self._linear_statics
+
     def reduced_dynamics(self):
         """(q(q_i), S, M_r, rhs_r) symbolically when `explicit_dependent` exists:
         q'' = S q_i'' + Sdot q_i', M_r q_i'' = rhs_r = S^T (Q - h - M Sdot q_i')."""
@@ -477,7 +493,7 @@ class Derivation:
 
 def cache_key(system: System) -> str:
     """Content key of the system's persistent cache entries (`analytic.cache`)."""
-    return cache.system_key(inspect.getsourcefile(system.build))
+    return cache.system_key(inspect.getsourcefile(system.build), system.structure_tag)
 
 
 @lru_cache(maxsize=None)

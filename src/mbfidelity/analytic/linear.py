@@ -126,9 +126,18 @@ def linearize(model: NumericModel, q_eq: np.ndarray) -> Equilibrium:
                        modes_from_eigenvalues(s))
 
 
+#: most starting points of a product grid; beyond it (more than 4 angular or 5 linear
+#: independent coordinates: a chain of N elements has 5^N) the starts vary one coordinate
+#: at a time (`_search_grid`), a number linear in the coordinates
+MAX_GRID_STARTS = 4096
+
+
 def _search_grid(system: System, values, op: np.ndarray) -> list[np.ndarray]:
     """Starting points over the independent coordinates: 8 angles per period for angular
-    ones; for linear ones the operating value and points around it inside the limits."""
+    ones; for linear ones the operating value and points around it inside the limits.
+    Every combination when there are at most MAX_GRID_STARTS of them; otherwise each
+    coordinate's points with the others at the operating point (every catalog mechanism
+    but the discretized chains stays within the product grid)."""
     mech = system.mechanism
     independent = set(mech.independent_coordinates)
     axes = []
@@ -144,7 +153,7 @@ def _search_grid(system: System, values, op: np.ndarray) -> list[np.ndarray]:
             axes.append(pts or [op[i]])
         else:
             axes.append(op[i] + np.linspace(-np.pi, np.pi, 8, endpoint=False))
-    return [np.array(p) for p in itertools.product(*axes)]
+    return _product_or_axes(axes, op)
 
 
 def _admissible(system: System, values, q: np.ndarray) -> bool:
@@ -234,7 +243,22 @@ def _full_search_starts(system: System, values, op: np.ndarray) -> list[np.ndarr
             axes.append([op[i]])
         else:
             axes.append(op[i] + np.linspace(-np.pi, np.pi, 5, endpoint=False))
-    return [np.array(p) for p in itertools.product(*axes)]
+    return _product_or_axes(axes, op)
+
+
+def _product_or_axes(axes: list, op: np.ndarray) -> list[np.ndarray]:
+    """Every combination of the axes' points when there are at most MAX_GRID_STARTS of
+    them; otherwise each axis's points with the other coordinates at the operating point
+    (a number of starts linear in the coordinates)."""
+    if int(np.prod([len(a) for a in axes], dtype=float)) <= MAX_GRID_STARTS:
+        return [np.array(p) for p in itertools.product(*axes)]
+    starts = []
+    for i, points in enumerate(axes):
+        for x in points:
+            start = np.array(op, dtype=float)
+            start[i] = x
+            starts.append(start)
+    return starts
 
 
 def _solve_full(model: NumericModel, start: np.ndarray) -> np.ndarray | None:
@@ -370,6 +394,7 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     first when it is an equilibrium. Closed loops are also searched in all coordinates
     and multipliers, so that equilibria on other assembly branches are found. A driven
     system's are the rest states of its free coordinates with the excitation off."""
+    system = system.with_structure(values)  # the chain of the number of elements in values
     if system.mechanism.prescribed:
         return _driven_equilibria(system, values, only_operating=False)
     if system.rigid_directions(system.symbols):
@@ -380,11 +405,15 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     model = numeric_model(system.id, values)
     op = system.operating_values(values)
     found: list[np.ndarray] = []
+    # a linear static problem has one equilibrium (or one family, reported once): Newton
+    # reaches it from the operating point, and a grid would only find it again
+    starts = [op] if model.derivation.linear_statics else (
+        [op] + _search_grid(system, values, op))
     # grid starts may sit on singular poses of the chart (Newton then fails there and
     # the start is dropped): numpy's warnings would only say so on stderr
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        candidates = [_solve_static(model, s) for s in [op] + _search_grid(system, values, op)]
+        candidates = [_solve_static(model, s) for s in starts]
         if model.constrained and any(isinstance(c, (PointOnPoint, PointOnLine))
                                      for c in system.mechanism.constraints):
             candidates += [_solve_full(model, s)
@@ -435,6 +464,7 @@ def _same_family(model: NumericModel, a: np.ndarray, b: np.ndarray) -> bool:
 
 def operating_equilibrium(system: System, values) -> Equilibrium:
     """The equilibrium the monograph studies (the system's operating point, refined)."""
+    system = system.with_structure(values)  # the chain of the number of elements in values
     if system.mechanism.prescribed:
         found = _driven_equilibria(system, values, only_operating=True)
         if not found:

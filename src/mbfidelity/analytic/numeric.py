@@ -614,6 +614,11 @@ def _numeric_cached(system_id: str, items: tuple) -> NumericModel:
 
 
 def numeric_model(system_id: str, values: Mapping[str, float]) -> NumericModel:
+    """The system's compiled model bound to `values`; for the structure in `values`
+    (a system with structural parameters: `System.with_structure`)."""
+    system = get_system(system_id)
+    if system.structure:
+        system_id = system.with_structure(values).id
     return _numeric_cached(system_id, tuple(sorted(values.items())))
 
 

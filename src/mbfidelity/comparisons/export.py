@@ -26,6 +26,7 @@ def export_model(system_id: str, simulator: str, params: Mapping[str, float] | N
         raise ValueError(f"no export for {simulator}: its build is not recorded as a file or "
                          f"a script (export exists for MuJoCo's MJCF and the other engines' scripts)")
     values = system.parameter_values(params)
+    system = system.with_structure(values)  # built for the user's number of elements
     mech = system.numeric_mechanism(values)
     support = backend.support(mech)
     if not support.ok:

@@ -106,7 +106,8 @@ def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...
     own (mechanism-specific), each one declaration, then those the backend's declared
     soft or substitute expressions of the system's elements imply
     (`simulators.base.expected_failures`), each a group of patterns declared together."""
-    return tuple((e,) for e in system.expectations) + _declared(system.id, simulator)
+    return tuple((e,) for e in system.expectations if e.applies(system.structure)) + _declared(
+        system.id, simulator)
 
 
 @lru_cache(maxsize=None)
@@ -189,6 +190,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     backend = get_backend(simulator)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
+    system = system.with_structure(base_values)  # built for the user's number of elements
     ok, why = backend.available()
     if not ok:
         return Comparison(system.id, simulator, "", {}, base_values, dt, supported=False,

@@ -39,6 +39,10 @@ from .model import (
 #: checks as MECHANISMS.md names them
 CHECK_KINDS = ("trajectory", "reaction", "frequency")
 
+#: separates a catalog id from the structural parameters of one of its specialisations
+#: (``massive spring with N = 16 elements`` is ``<id>@N=16``; `System.with_structure`)
+STRUCTURE_MARK = "@"
+
 
 def coordinate_symbols(name: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
     """(q, q_dot, q_ddot) symbols of a coordinate, as used in printed formulas."""
@@ -169,12 +173,26 @@ class Expectation:
     its range of w h, or above the ceiling a gate can discriminate: comparisons/
     tolerances.py), so it is measured and shown, not judged (strict too: a declaration
     whose metrics all resolve is reported, and their passes become unexpected).
-    `simulator` and `metric` are fnmatch patterns ("*" matches all)."""
+    `simulator` and `metric` are fnmatch patterns ("*" matches all). `when`: a relation
+    of the system's structural parameters (``"N >= 5"``) outside which the declaration
+    does not apply: a chain's fastest mode, hence w h at the default step, grows with its
+    number of elements."""
 
     simulator: str
     metric: str
     kind: str
     reason: str
+    when: str | None = None
+
+    def applies(self, structure: Mapping[str, int]) -> bool:
+        """Whether the declaration holds for a system built with `structure`."""
+        if self.when is None:
+            return True
+        verdict = sp.sympify(self.when, locals={k: sp.Integer(v) for k, v in structure.items()})
+        if verdict not in (sp.true, sp.false):
+            raise ValueError(f"expectation condition {self.when!r} must be a relation of the "
+                             f"structural parameters {sorted(structure) or '(none)'}")
+        return bool(verdict)
 
 
 @dataclass(frozen=True)
@@ -218,6 +236,11 @@ class System:
     #: a parameter on which the operating equilibrium's stability turns (the belt speed
     #: of a self-excited system, §7.2): `analyze` reports where it changes stability
     stability_parameter: str | None = None
+    #: a discretized continuum (monograph §6): the name of its exact continuum model in
+    #: mbfidelity.analytic.continuum (`CONTINUA`), whose frequencies and Rayleigh
+    #: estimates `analyze` reports next to the chain's modes; the number of elements is
+    #: the system's structural parameter
+    continuum: str | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
@@ -244,7 +267,66 @@ class System:
 
     @cached_property
     def symbols(self) -> SimpleNamespace:
-        return SimpleNamespace(**{p.name: p.symbol for p in self.all_parameters})
+        """The parameters as SymPy symbols, for `build` and the other description
+        functions; a structural parameter is its integer instead (it shapes the
+        mechanism: `with_structure`)."""
+        return SimpleNamespace(**{p.name: int(p.default) if p.structural else p.symbol
+                                  for p in self.all_parameters})
+
+    # --- structural parameters -----------------------------------------------------------
+    # A parameter of domain "count" (the number of elements of a discretized continuum)
+    # shapes the mechanism: its coordinates, bodies and derivation. A System is built for
+    # one value of each (its defaults); `with_structure` gives the System built for other
+    # values: the same description with those defaults and the id
+    # "<catalog id>@<name>=<value>,...", so that everything keyed by the id (the
+    # in-process caches, the persistent cache through `structure_tag`, results rows)
+    # tells the structures apart, and `get_system` resolves such an id.
+
+    @cached_property
+    def structure(self) -> dict[str, int]:
+        """The structural parameters this System is built for (name -> integer)."""
+        return {p.name: int(p.default) for p in self.all_parameters if p.structural}
+
+    @property
+    def structure_tag(self) -> str:
+        """"name=value,..." of the structure ("" without structural parameters)."""
+        return ",".join(f"{k}={v}" for k, v in sorted(self.structure.items()))
+
+    @property
+    def catalog_id(self) -> str:
+        """The id in the catalog (without the structure of a specialisation)."""
+        return self.id.split(STRUCTURE_MARK, 1)[0]
+
+    def with_structure(self, values: Mapping[str, float]) -> "System":
+        """The System built for the structural parameters in `values` (others ignored;
+        absent ones keep this System's): itself when they are its own. Each value is
+        validated (an integer >= 1, ValueError otherwise). The specialisations of a
+        catalog system are kept, one object per structure."""
+        current = self.structure
+        if not current:
+            return self
+        known = {p.name: p for p in self.all_parameters}
+        wanted = dict(current)
+        for name in current:
+            if name in values:
+                value = float(values[name])
+                known[name].validate(value)
+                wanted[name] = int(value)
+        if wanted == current:
+            return self
+        base = self.__dict__.get("_catalog_system", self)
+        if wanted == base.structure:
+            return base
+        kept = base.__dict__.setdefault("_specialisations", {})
+        key = tuple(sorted(wanted.items()))
+        if key not in kept:
+            tag = ",".join(f"{k}={v}" for k, v in key)
+            special = replace(base, id=f"{base.id}{STRUCTURE_MARK}{tag}", parameters=tuple(
+                replace(p, default=wanted[p.name]) if p.structural else p
+                for p in base.parameters))
+            special.__dict__["_catalog_system"] = base
+            kept[key] = special
+        return kept[key]
 
     @cached_property
     def mechanism(self) -> Mechanism:
@@ -359,13 +441,17 @@ class System:
         return tuple(out)
 
     def subs(self, values: Mapping[str, float]) -> dict[sp.Symbol, float]:
-        return {getattr(self.symbols, k): v for k, v in values.items()}
+        """Parameter symbol -> value (structural parameters are no symbols: left out)."""
+        structural = self.structure
+        return {getattr(self.symbols, k): v for k, v in values.items() if k not in structural}
 
     def numeric_mechanism(self, values: Mapping[str, float],
                           variant: str | None = None) -> Mechanism:
         """The mechanism with numbers for the parameters; with `variant`, the variant's
         constraints in place of the description's of the same name (what an engine
-        builds for the variant)."""
+        builds for the variant). Built for the structure in `values`."""
+        if self.structure and self.with_structure(values) is not self:
+            return self.with_structure(values).numeric_mechanism(values, variant)
         mech = self.mechanism
         if variant:
             instead = {c.name: c for c in self.variant(variant).constraints(self.symbols)}
@@ -385,8 +471,13 @@ class System:
     def initial_state(self, scenario: Scenario, values: Mapping[str, float]):
         import numpy as np
 
-        q0 = np.array([self.evaluate(scenario.q0.get(c, 0), values) for c in self.coordinates])
-        qd0 = np.array([self.evaluate(scenario.qd0.get(c, 0), values) for c in self.coordinates])
+        if self.structure and self.with_structure(values) is not self:
+            return self.with_structure(values).initial_state(scenario, values)
+        # a function of the parameters where the coordinates depend on the structure
+        q0_of, qd0_of = (x(self.symbols) if callable(x) else x
+                         for x in (scenario.q0, scenario.qd0))
+        q0 = np.array([self.evaluate(q0_of.get(c, 0), values) for c in self.coordinates])
+        qd0 = np.array([self.evaluate(qd0_of.get(c, 0), values) for c in self.coordinates])
         return q0, qd0
 
     def evaluate(self, expr, values: Mapping[str, float]) -> float:
@@ -397,6 +488,8 @@ class System:
     def operating_values(self, values: Mapping[str, float]):
         import numpy as np
 
+        if self.structure and self.with_structure(values) is not self:
+            return self.with_structure(values).operating_values(values)
         op = self.operating_point(self.symbols)
         return np.array([self.evaluate(op.get(c, 0), values) for c in self.coordinates])
 
@@ -488,7 +581,26 @@ def all_systems() -> dict[str, System]:
 
 
 def get_system(system_id: str) -> System:
+    """The catalog's system, or (``<id>@<name>=<value>,...``) its specialisation to
+    those structural parameters (`System.with_structure`)."""
     systems = all_systems()
-    if system_id not in systems:
+    catalog_id, mark, tag = system_id.partition(STRUCTURE_MARK)
+    if catalog_id not in systems:
         raise KeyError(f"unknown system {system_id!r}; valid: {', '.join(systems)}")
-    return systems[system_id]
+    system = systems[catalog_id]
+    if not mark:
+        return system
+    values = {}
+    for item in tag.split(","):
+        name, equals, value = item.partition("=")
+        if name not in system.structure or not equals:
+            raise KeyError(f"unknown system {system_id!r}: {catalog_id}'s structural "
+                           f"parameters are {', '.join(system.structure) or 'none'}")
+        try:
+            values[name] = float(value)
+        except ValueError:
+            raise KeyError(f"unknown system {system_id!r}: {name} must be an integer") from None
+    try:
+        return system.with_structure(values)
+    except ValueError as exc:
+        raise KeyError(f"unknown system {system_id!r}: {exc}") from None

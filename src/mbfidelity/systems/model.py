@@ -82,8 +82,18 @@ class Parameter:
     unit: str
     meaning: str
     source: str = "MECHANISMS.md"
-    #: "positive", "nonnegative" or "real": checked on every value (given or derived).
+    #: "positive", "nonnegative" or "real": checked on every value (given or derived);
+    #: "count": a structural parameter, an integer >= 1 that shapes the mechanism itself
+    #: (the number of elements of a discretized continuum): `build` receives it as a
+    #: Python int, never as a symbol (`System.with_structure`)
     domain: str = "positive"
+
+    def __post_init__(self) -> None:
+        if self.domain == "count" and (isinstance(self.default, str)
+                                       or int(self.default) != self.default
+                                       or self.default < 1):
+            raise ValueError(f"parameter {self.name}: a count's default must be an integer "
+                             f">= 1, not {self.default!r}")
 
     @property
     def derived(self) -> bool:
@@ -91,7 +101,16 @@ class Parameter:
         return isinstance(self.default, str)
 
     @property
+    def structural(self) -> bool:
+        """Whether the value shapes the mechanism (domain "count")."""
+        return self.domain == "count"
+
+    @property
     def symbol(self) -> sp.Symbol:
+        if self.domain == "count":
+            # never in an expression (build gets the integer); a placeholder argument
+            # of the compiled functions, like every parameter
+            return sp.Symbol(self.name, integer=True, positive=True)
         if self.domain == "positive":
             return sp.Symbol(self.name, positive=True)
         if self.domain == "nonnegative":
@@ -105,6 +124,8 @@ class Parameter:
             raise ValueError(f"parameter {self.name} must be > 0, got {value}")
         if self.domain == "nonnegative" and not value >= 0:
             raise ValueError(f"parameter {self.name} must be >= 0, got {value}")
+        if self.domain == "count" and not (value >= 1 and value == int(value)):
+            raise ValueError(f"parameter {self.name} must be an integer >= 1, got {value:g}")
 
 
 # --- drawing / contact geometry (body frame) -------------------------------------------
@@ -611,11 +632,13 @@ def inertia_matrix(body: Body) -> sp.Matrix:
 class Scenario:
     """One run of a mechanism: initial state (expressions of parameters), duration,
     parameter values it sets (the user's --param values win over them), and the checks
-    that apply to it."""
+    that apply to it. The initial state may be a function of the parameters (as `build`
+    gets them) giving the mapping, for a mechanism whose coordinates depend on a
+    structural parameter (the N nodes of a chain)."""
 
     name: str
-    q0: Mapping[str, Expr]
-    qd0: Mapping[str, Expr] = field(default_factory=dict)
+    q0: Mapping[str, Expr] | Callable[..., Mapping[str, Expr]]
+    qd0: Mapping[str, Expr] | Callable[..., Mapping[str, Expr]] = field(default_factory=dict)
     t_end: float = 10.0
     overrides: Mapping[str, float] = field(default_factory=dict)
     checks: tuple[str, ...] = ("trajectory",)
