@@ -31,7 +31,7 @@ def main() -> None:
     for workers in (1, 2):
         points = strutt_chart(args.grid, args.grid).points()
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster:
+                          dashboard_address=":0") as cluster:
             start = time.perf_counter()
             doc = engine_chart(points, sims, scheduler=cluster.scheduler_address)
             wall = time.perf_counter() - start

@@ -16,7 +16,7 @@ def test_dask_local_cluster_equals_local_pool():
     distributed = pytest.importorskip("dask.distributed")
     local = sweep(mathieu_point, POINTS, workers=2)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:
         remote = sweep(mathieu_point, POINTS, scheduler=cluster.scheduler_address)
     assert remote == local
     assert [(p["lambda"], p["gamma"]) for p in remote] == [tuple(map(float, p)) for p in POINTS]
@@ -37,7 +37,7 @@ def test_the_matrix_on_a_dask_cluster_equals_the_local_pool(tmp_path):
     res = CliRunner().invoke(app, args + ["--out", str(local)])
     assert res.exit_code == 0, res.output
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:
         res = CliRunner().invoke(app, args + ["--out", str(remote), "--scheduler",
                                               cluster.scheduler_address])
     assert res.exit_code == 0, res.output
