@@ -233,3 +233,45 @@ def test_declarations_follow_the_structure():
                                                     "frequency.fit_mode*", "damping.fit_mode*"]
     with pytest.raises(ValueError, match="relation of the structural parameters"):
         Expectation("*", "*", "xfail", "probe", when="M > 2").applies({"N": 3})
+
+
+def test_each_engines_chain_against_the_hand_and_the_continuum(tmp_path):
+    """Issue 12 items 4-5 for §6.2: each engine builds the chain for N = 2 and 12, its own
+    linearization gives the hand-derived frequencies (the N-element frequency equation of
+    tests/hand) within the linearization gate (1e-6: central differences, see
+    comparisons/tolerances.py), and its error against the continuum is then the chain's,
+    C_1 / N^2 within the (beta/N)^2 of the next term; Pymunk has no linearization and
+    says so. The figure is drawn from the saved study."""
+    res = CliRunner().invoke(app, ["discretization", SYSTEM_ID, "--counts", "2,12",
+                                   "--sim", "mujoco", "--sim", "pybullet", "--sim", "exudyn",
+                                   "--sim", "pymunk", "--json", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.output)
+    exact = doc["exact_hz"][0]
+    v = _values(12)
+    beta = 2 * math.pi * exact / math.sqrt(v["k"] / (v["rho"] * v["l"]))  # w = beta sqrt(k/(rho l))
+    for sim in ("mujoco", "pybullet", "exudyn"):
+        rows = doc["engines"][sim]["rows"]
+        assert [r["N"] for r in rows] == [2, 12] and all(r["passed"] for r in rows)
+        for r in rows:
+            hand = np.array(HAND.frequencies(_values(r["N"])))[:len(r["frequency_hz"])]
+            np.testing.assert_allclose(r["frequency_hz"], hand / (2 * math.pi), rtol=1e-6)
+        twelve = rows[1]["error_vs_continuum"][0]
+        predicted = doc["leading_error"][0] / 12**2
+        assert abs(twelve / predicted - 1) <= (beta / 12) ** 2
+    assert doc["engines"]["pymunk"]["rows"] == []
+    assert "no linearization" in doc["engines"]["pymunk"]["reason"]
+    assert (tmp_path / "discretization-massive_spring.png").stat().st_size > 0
+
+
+def test_the_report_shows_a_saved_discretization_study(tmp_path):
+    from mbfidelity.reports.html import write_report
+
+    runner = CliRunner()
+    res = runner.invoke(app, ["run", "--systems", "mass_spring_damper", "--sims", "pymunk",
+                              "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["discretization", SYSTEM_ID, "--counts", "2,4", "--sim",
+                              "exudyn", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert '<img src="discretization-massive_spring.png">' in write_report(tmp_path).read_text()

@@ -518,12 +518,21 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                                                                  help="NAME=VALUE"),
                        counts: str = typer.Option("2,4,8,16,32", "--counts",
                                                   help="numbers of elements, comma-separated"),
+                       sims: Optional[List[str]] = typer.Option(
+                           None, "--sim", help="also each engine's build of the chain, "
+                                               "from its own linearization (repeatable)"),
+                       out: Optional[Path] = typer.Option(
+                           None, "--out", help="also write discretization-SYSTEM.json and "
+                                               ".png there"),
                        as_json: bool = typer.Option(False, "--json"),
                        ) -> None:
     """A discretized continuum (monograph §6) against its exact one: the first three
     frequencies for each number of elements, their errors, the fitted order and the
-    leading error derived for the lumping."""
+    leading error derived for the lumping; with --sim, each engine's chain against the
+    derived one (exit 1 when an engine misses its linearization gate)."""
+    from .analytic.continuum import continuum_summary
     from .analytic.discretization import discretization_study
+    from .simulators import all_backends
 
     system = _system(system_id)
     values, _ = _values(system, _parse_params(param))
@@ -535,10 +544,28 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         study = discretization_study(system, values, chosen)
     except ValueError as exc:
         _fail(str(exc))
+    engines = _split(sims)
+    for e in engines:
+        if e not in all_backends():
+            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     doc = study.as_dict()
+    doc["rayleigh"] = [r.as_dict() for r in
+                       continuum_summary(system.continuum, values).rayleigh]
+    if engines:
+        from .comparisons.discretization_engines import engine_discretization
+
+        doc["engines"] = engine_discretization(system, values, study, engines)
+    failed = [f"{e}@{study.parameter}={r['N']}" for e, x in doc.get("engines", {}).items()
+              for r in x["rows"] if not r["passed"]]
+    if out is not None:
+        from .reports.discretization_figure import figure_name, write_discretization_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / f"discretization-{study.system}.json").write_text(json.dumps(doc, indent=1))
+        write_discretization_figure(doc, out / figure_name(study.system))
     if as_json:
         _json(doc)
-        return
+        raise typer.Exit(1 if failed else 0)
     typer.echo(f"{study.system}: exact continuum "
                + ", ".join(f"{f:.9g}" for f in study.exact_hz) + " Hz")
     for row in study.rows:
@@ -550,6 +577,22 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     if study.leading_error is not None:
         typer.echo("  derived leading error C_n (error = C_n / N^2): "
                    + ", ".join(f"{c:.6g}" for c in study.leading_error))
+    for r in doc["rayleigh"]:
+        typer.echo(f"  Rayleigh {r['label']}: {r['frequency_hz']:.9g} Hz "
+                   f"({r['relative_error']:+.3e})")
+    for e, x in doc.get("engines", {}).items():
+        if x["reason"]:
+            typer.echo(f"  {e}: {x['reason']}")
+            continue
+        for r in x["rows"]:
+            typer.echo(f"  {e} {study.parameter} = {r['N']:3d}: against the chain "
+                       + ", ".join(f"{v:+.1e}" for v in r["error_vs_chain"])
+                       + f" (gate {r['gate_vs_chain']:.0e}); against the continuum "
+                       + ", ".join(f"{v:+.3e}" for v in r["error_vs_continuum"])
+                       + ("" if r["passed"] else "  FAILED"))
+    if out is not None:
+        typer.echo(f"figure: {out / figure_name(study.system)}")
+    raise typer.Exit(1 if failed else 0)
 
 
 @app.command("convergence")

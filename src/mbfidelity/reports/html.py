@@ -99,6 +99,12 @@ error against CPU seconds: <a href="convergence.html">convergence.html</a> (writ
 N = 2 to 32, against the exact Euler-Bernoulli frequencies (written by
 <code>mbfidelity beams --out DIR</code>; <code>make report</code> writes it).</p>
 <img src="beams.png">{% endif %}
+{% if discretizations %}<h2>Discretized continua against the exact ones</h2>
+<p>Each chain of N elements as derived, each engine's build of it (its own linearization) and
+the printed Rayleigh estimates, against the exact continuum (§6; written by
+<code>mbfidelity discretization SYSTEM --sim ... --out DIR</code>; <code>make report</code>
+writes them).</p>
+{% for fig in discretizations %}<img src="{{ fig }}">{% endfor %}{% endif %}
 {% if errata %}<h2>Errata: printed formulas against the derivation</h2>
 <p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
 (written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
@@ -226,6 +232,8 @@ def write_report(out: Path, workers: int | None = None) -> Path:
                            convergence=(out / "convergence.json").exists(),
                            strutt=(out / "strutt.png").exists(),
                            beams=(out / "beams.png").exists(),
+                           discretizations=sorted(p.name for p in
+                                                  out.glob("discretization-*.png")),
                            strutt_engines=_strutt_engines(out))
     index = out / "index.html"
     index.write_text(page)
