@@ -367,6 +367,17 @@ class Backend(ABC):
                     f"(c = {beam.c:g}) to carry the point mass")
         return ""
 
+    def check_beam_request(self, beam: Beam, kind: str, elements: int,
+                           settings: Mapping | None, route: str) -> None:
+        """ValueError naming the engine and kind when `elements` elements of `kind` cannot
+        carry `beam`, or when settings are given to a `route` that takes none."""
+        reason = self.beam_size_reason(beam, kind, elements)
+        if reason:
+            raise ValueError(f"{self.id} {kind}: {reason}")
+        if settings:
+            raise ValueError(f"{self.id} {kind}: {route} takes no settings; got "
+                             f"{sorted(settings)}")
+
     def beam_frequencies(self, beam: Beam, kind: str, elements: int, count: int = 3,
                          settings: Mapping | None = None) -> BeamModes:
         """See contract point 12 (an engine without flexible elements raises)."""

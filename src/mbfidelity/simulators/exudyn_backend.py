@@ -1281,12 +1281,7 @@ class ExudynBackend(Backend):
         without them to 1e-11 at EA = 1e4 EI/l^2, to 9e-9 at 1e8 EI/l^2; the geometrically
         exact element's to 3e-6, its eigensolver's round-off, at EA = 1e2..1e6 EI/l^2).
         No setting applies (no time integration)."""
-        reason = self.beam_size_reason(beam, kind, elements)
-        if reason:
-            raise ValueError(f"exudyn {kind}: {reason}")
-        if settings:
-            raise ValueError(f"exudyn {kind}: the eigenvalue route takes no settings; got "
-                             f"{sorted(settings)}")
+        self.check_beam_request(beam, kind, elements, settings, "the eigenvalue route")
         import exudyn as exu
         import exudyn.beams
         from exudyn.itemInterface import (ObjectANCFCable2D, ObjectBeamGeometricallyExact2D,

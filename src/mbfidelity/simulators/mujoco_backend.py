@@ -1787,12 +1787,7 @@ class MujocoBackend(Backend):
         most of that distance is the linearization's round-off), far below the element's
         error (>= 8e-4 at N = 32). No setting applies: the route fixes its integrator and
         step."""
-        reason = self.beam_size_reason(beam, kind, elements)
-        if reason:
-            raise ValueError(f"mujoco {kind}: {reason}")
-        if settings:
-            raise ValueError(f"mujoco {kind}: the flex route takes no settings (its "
-                             f"integrator and step are fixed); got {sorted(settings)}")
+        self.check_beam_request(beam, kind, elements, settings, "the flex route (its integrator and step are fixed)")
         import mujoco
         import scipy.linalg
 
