@@ -24,9 +24,8 @@ import math
 import time
 from typing import Sequence
 
-import numpy as np
-
 from ..analytic.continuum import beam_with_point_mass_frequencies
+from ..analytic.discretization import fitted_order
 from ..simulators import all_backends
 from ..simulators.base import UNSUPPORTED, Backend
 from ..systems._continua import Beam
@@ -52,13 +51,6 @@ def exact_frequencies_hz(beam: Beam, count: int = MODES) -> list[float]:
     """The first `count` natural frequencies (Hz) of the continuum (analytic/continuum.py)."""
     return [w / (2 * math.pi) for w in beam_with_point_mass_frequencies(
         beam.EI, beam.rho, beam.length, beam.point_mass, beam.point_position, count)]
-
-
-def fitted_order(elements: Sequence[int], errors: Sequence[float]) -> float:
-    """The order p of |error| ~ N^-p, by least squares on the log-log points."""
-    x = np.log(np.asarray(elements, dtype=float))
-    y = np.log(np.abs(np.asarray(errors, dtype=float)))
-    return float(-np.polyfit(x, y, 1)[0])
 
 
 def _fit_modes(points: list[dict], count: int) -> tuple[list, list, list]:

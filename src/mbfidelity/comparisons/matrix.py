@@ -47,29 +47,25 @@ def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
             found += [run(system, sim, dt=dt, keep_series=True, variant=v.name)
                       for sim in sims]
     if out is not None:
-        for row, comps in results_folder.rows_of(found).items():
-            results_folder.save_series(out, row, comps)
-        for c in found:
-            c.series = {}
-        results_folder.save_system(out, system)
+        _save_report_files(out, system, found)
     return found, time.process_time() - start
+
+
+def _save_report_files(out: Path, system: str, found: list[Comparison]) -> None:
+    """What the report shows of a system, saved in `out`: each comparison's series (then
+    dropped from it), the mechanism's drawing and the errata entries."""
+    for row, comps in results_folder.rows_of(found).items():
+        results_folder.save_series(out, row, comps)
+    for c in found:
+        c.series = {}
+    results_folder.save_system(out, system)
 
 
 def _portable_system(args) -> tuple[list[Comparison], float]:
     """`_one_system` for a worker that may not share this machine's disk: the series stay
-    in the returned comparisons, and the caller saves them (`_save_portable`)."""
+    in the returned comparisons, and the caller saves them (`_save_report_files`)."""
     system, sims, dt, variants, _, settings = args
     return _one_system((system, sims, dt, variants, None, settings))
-
-
-def _save_portable(out: Path | None, system: str, job: tuple[list[Comparison], float]) -> None:
-    if out is None:
-        return
-    for row, comps in results_folder.rows_of(job[0]).items():
-        results_folder.save_series(out, row, comps)
-    for c in job[0]:
-        c.series = {}
-    results_folder.save_system(out, system)
 
 
 def _run_on_cluster(scheduler: str, order: list[int], systems: list[str], common: tuple,
@@ -94,7 +90,8 @@ def _run_on_cluster(scheduler: str, order: list[int], systems: list[str], common
             except KilledWorker:
                 crashed.append(i)
                 continue
-            _save_portable(out, systems[i], job)
+            if out is not None:
+                _save_report_files(out, systems[i], job[0])
             collect(i, job)
     return crashed
 
@@ -223,16 +220,18 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
         else:
             todo.append(i)
     crashed = []
-    if scheduler and todo:
+
+    def longest_first() -> list[int]:
         rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
-        crashed = _run_on_cluster(scheduler, sorted(todo, key=lambda i: rank[systems[i]]),
-                                  systems, (sims, dt, variants, settings), out, collect)
+        return sorted(todo, key=lambda i: rank[systems[i]])
+    if scheduler and todo:
+        crashed = _run_on_cluster(scheduler, longest_first(), systems,
+                                  (sims, dt, variants, settings), out, collect)
     elif workers <= 1 or len(todo) <= 1:
         for i in todo:
             collect(i, _one_system((systems[i], sims, dt, variants, out, settings)))
     else:
-        rank = {s: k for k, s in enumerate(schedule(systems, results_folder.load_job_costs(out)))}
-        order = sorted(todo, key=lambda i: rank[systems[i]])
+        order = longest_first()
         with ProcessPoolExecutor(max_workers=workers) as pool:
             futures = {pool.submit(_one_system,
                                    (systems[i], sims, dt, variants, out, settings)): i

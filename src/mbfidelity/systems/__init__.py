@@ -450,8 +450,9 @@ class System:
         """The mechanism with numbers for the parameters; with `variant`, the variant's
         constraints in place of the description's of the same name (what an engine
         builds for the variant). Built for the structure in `values`."""
-        if self.structure and self.with_structure(values) is not self:
-            return self.with_structure(values).numeric_mechanism(values, variant)
+        built = self.with_structure(values)
+        if built is not self:
+            return built.numeric_mechanism(values, variant)
         mech = self.mechanism
         if variant:
             instead = {c.name: c for c in self.variant(variant).constraints(self.symbols)}
@@ -471,8 +472,9 @@ class System:
     def initial_state(self, scenario: Scenario, values: Mapping[str, float]):
         import numpy as np
 
-        if self.structure and self.with_structure(values) is not self:
-            return self.with_structure(values).initial_state(scenario, values)
+        built = self.with_structure(values)
+        if built is not self:
+            return built.initial_state(scenario, values)
         # a function of the parameters where the coordinates depend on the structure
         q0_of, qd0_of = (x(self.symbols) if callable(x) else x
                          for x in (scenario.q0, scenario.qd0))
@@ -488,8 +490,9 @@ class System:
     def operating_values(self, values: Mapping[str, float]):
         import numpy as np
 
-        if self.structure and self.with_structure(values) is not self:
-            return self.with_structure(values).operating_values(values)
+        built = self.with_structure(values)
+        if built is not self:
+            return built.operating_values(values)
         op = self.operating_point(self.symbols)
         return np.array([self.evaluate(op.get(c, 0), values) for c in self.coordinates])
 
