@@ -67,7 +67,8 @@ def test_equilibria_counted_by_hand(system_id):
     s = get_system(system_id)
     eqs = find_equilibria(s, s.parameter_values())
     total, stable = HAND[system_id].EQUILIBRIA
-    assert len(eqs) == total
+    # total None: the hand counts only the stable ones (the folded discretized beam)
+    assert len(eqs) == total if total is not None else len(eqs) >= stable
     assert sum(e.stable for e in eqs) == stable
 
 
@@ -111,9 +112,16 @@ def test_two_routes_to_the_linearization_agree(system_id):
         _two_routes_driven(s, v)
         return
     model = numeric_model(system_id, v)
+    compared = 0
     for eq in find_equilibria(s, v):
         M1, C1, K1 = model.linearization(eq.q)
-        energy = model.energy_linearization(eq.q)
+        try:
+            energy = model.energy_linearization(eq.q)
+        except RuntimeError:
+            # the chart of the independent coordinates folds within the difference step
+            # (a dependent angle at a turning point: a folded chain's end segment upright)
+            assert not eq.stable
+            continue
         if energy is None:  # a load without a potential: linearized Q (§5.3.4, eq. 5.59)
             energy = quadratic_forms_linearization(s, v, eq.q)
         M2, C2, K2 = energy
@@ -124,6 +132,8 @@ def test_two_routes_to_the_linearization_agree(system_id):
         np.testing.assert_allclose(M1, M2, atol=1e-12 * np.abs(M1).max())
         np.testing.assert_allclose(K1, K2, atol=(1e-6 if numeric else 1e-12) * scale)
         np.testing.assert_allclose(C1, C2, atol=1e-12 * max(np.abs(C1).max(), 1.0))
+        compared += 1
+    assert compared
 
 
 def _two_routes_driven(s, v):

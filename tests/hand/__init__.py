@@ -4,7 +4,7 @@ independently of the code under test. Each module defines:
 - ``frequencies(v) -> list[float]``: undamped natural angular frequencies (rad/s) at the
   operating equilibrium for parameter values ``v``, worked out by hand;
 - ``EQUILIBRIA = (total, stable)``: equilibria within one period of each angle, counted by
-  hand at the default parameters;
+  hand at the default parameters (total None where only the stable ones are counted);
 - ``MISPRINTS``: labels of printed formulas that the hand derivation shows to be wrong,
   each with the reason in a comment;
 - optionally ``relations(v) -> dict``: the values tied by the relations under which the

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import sympy as sp
+from sympy.simplify.fu import TR10i
 
 from ..systems import System, coordinate_symbols, get_system
 from . import cache
@@ -85,7 +86,24 @@ class Derivation:
             self._energies()
         self._forces()
         self._constraints()
-        self.residual = (self.M * self.qdd + self.h - self.Q).applyfunc(sp.expand)
+        residual = self.M * self.qdd + self.h - self.Q
+        self.residual = residual.applyfunc(sp.expand) if mechanism.simplify else residual
+
+    def _tidy(self, expr):
+        """simplify, unless the mechanism opts out (`Mechanism.simplify`: long chains)."""
+        return sp.simplify(expr) if self.mechanism.simplify else expr
+
+    def _tidy_inertia(self, expr):
+        """A mass-matrix entry: simplify, or for a long chain a cheap canonical form that
+        keeps its derivatives small: expanded, sin(x)^2 -> 1 - cos(x)^2, and the pairs
+        cos a cos b + sin a sin b (and the sine pairs) combined into cos(a - b), sin(a - b)
+        (fu's TR10i). Each step is polynomial in the entry's length."""
+        if self.mechanism.simplify:
+            return sp.simplify(expr)
+        squared_sine = sp.Wild("x")
+        expr = sp.expand(sp.expand(expr).replace(sp.sin(squared_sine) ** 2,
+                                                 1 - sp.cos(squared_sine) ** 2))
+        return sp.factor_terms(TR10i(expr))
 
     # --- kinematics ----------------------------------------------------------------------
     def _poses(self) -> dict[str, Pose]:
@@ -104,7 +122,7 @@ class Derivation:
             else:  # pragma: no cover - the Joint union is closed
                 raise TypeError(j)
             position = anchor - rotation(angle) * as_column(j.child_anchor)
-            poses[j.child] = Pose(position.applyfunc(sp.simplify), sp.simplify(angle))
+            poses[j.child] = Pose(position.applyfunc(self._tidy), self._tidy(angle))
         return poses
 
     def _joint_values(self) -> sp.Matrix:
@@ -112,7 +130,7 @@ class Derivation:
         vals = []
         for j, qj in zip(self.mechanism.joints, self.q):
             if isinstance(j, Revolute):
-                vals.append(sp.simplify(self.poses[j.child].angle - self.poses[j.parent].angle
+                vals.append(self._tidy(self.poses[j.child].angle - self.poses[j.parent].angle
                                         - j.angle_offset))
             else:
                 vals.append(qj)
@@ -186,7 +204,7 @@ class Derivation:
             Jw = sp.Matrix([[sp.diff(pose.angle, qi) for qi in self.q]])
             M += b.mass * (Jv.T * Jv) + b.inertia * (Jw.T * Jw)
             V += b.mass * mech.gravity * pose.position[1]
-        self.M = M.applyfunc(sp.simplify)
+        self.M = M.applyfunc(self._tidy_inertia)
         self._bias_forces()
         self.V_gravity = V
 
@@ -202,24 +220,25 @@ class Derivation:
             Jw = self.angular_velocity(b.name).jacobian(self.qd)
             M += b.mass * (Jv.T * Jv) + Jw.T * inertia_matrix(b) * Jw
             V += b.mass * mech.gravity * (up.T * pose.position)[0]
-        self.M = M.applyfunc(sp.simplify)
+        self.M = M.applyfunc(self._tidy)
         self._bias_forces()
         self.V_gravity = V
 
     def _bias_forces(self) -> None:
         """T = q'.M q'/2 and h = (dM/dt) q' - dT/dq."""
-        self.T = sp.expand((self.qd.T * self.M * self.qd)[0] / 2)
+        T = (self.qd.T * self.M * self.qd)[0] / 2
+        self.T = sp.expand(T) if self.mechanism.simplify else T
         # h = (dM/dt) q' - dT/dq
         Mdot = sp.zeros(self.n, self.n)
         for k in range(self.n):
             Mdot += self.M.diff(self.q[k]) * self.qd[k]
         dT_dq = sp.Matrix([sp.diff(self.T, qi) for qi in self.q])
-        self.h = (Mdot * self.qd - dT_dq).applyfunc(sp.simplify)
+        self.h = (Mdot * self.qd - dT_dq).applyfunc(self._tidy)
 
     # --- forces --------------------------------------------------------------------------
     def element_length(self, f: PointToPoint) -> tuple[sp.Expr, sp.Matrix]:
         d = self.point(f.body_b, f.point_b) - self.point(f.body_a, f.point_a)
-        length = sp.sqrt(sp.simplify((d.T * d)[0]))
+        length = sp.sqrt(self._tidy((d.T * d)[0]))
         return length, d
 
     def gravity_vector(self) -> sp.Matrix:
@@ -252,12 +271,12 @@ class Derivation:
                 continue
             V += Vf if Vf is not None else 0
             D += Df if Df is not None else 0
-        self.Q = Q.applyfunc(sp.simplify)
+        self.Q = Q.applyfunc(self._tidy)
         #: generalized forces without the explicitly time-dependent elements e(t) (the
         #: system whose equilibria are studied, monograph §8, eq. 78)
-        self.Q_autonomous = Q_autonomous.applyfunc(sp.simplify)
-        self.V = sp.simplify(V)
-        self.D = sp.simplify(D)
+        self.Q_autonomous = Q_autonomous.applyfunc(self._tidy)
+        self.V = self._tidy(V)
+        self.D = self._tidy(D)
         self.energy_route = energy_route and self._energy_route_consistent()
         self.conservative = self.energy_route and self.D == 0 and not any(
             TIME in sp.sympify(e).free_symbols for e in self.Q)
@@ -275,10 +294,13 @@ class Derivation:
             D = sp.sympify(f.dissipation).xreplace(subs) if f.dissipation is not None else None
             return Q, V, D
         if isinstance(f, CoordinateForce):
-            i = self.mechanism.coordinates.index(f.coordinate)
-            subs = {COORD: self.q[i], COORD_RATE: self.qd[i]}
+            weights = f.weights(self.mechanism.coordinates)
+            subs = {COORD: sum(s * self.q[i] for i, s in weights.items()),
+                    COORD_RATE: sum(s * self.qd[i] for i, s in weights.items())}
             Q = sp.zeros(self.n, 1)
-            Q[i] = sp.sympify(f.force).xreplace(subs)
+            force = sp.sympify(f.force).xreplace(subs)
+            for i, s in weights.items():
+                Q[i] = s * force
             V = sp.sympify(f.potential).xreplace(subs) if f.potential is not None else None
             D = sp.sympify(f.dissipation).xreplace(subs) if f.dissipation is not None else None
             return Q, V, D
@@ -288,7 +310,8 @@ class Derivation:
         """Q_autonomous must equal -dV/dq - dD/dq' for the energy route to apply."""
         grad = sp.Matrix([sp.diff(self.V, qi) for qi in self.q])
         dgrad = sp.Matrix([sp.diff(self.D, v) for v in self.qd])
-        diff = (self.Q_autonomous + grad + dgrad).applyfunc(sp.simplify)
+        diff = (self.Q_autonomous + grad + dgrad).applyfunc(
+            sp.simplify if self.mechanism.simplify else sp.expand)
         return all(e == 0 for e in diff)
 
     # --- constraints ---------------------------------------------------------------------
@@ -324,7 +347,8 @@ class Derivation:
         sympy solves the constraints uniquely (None otherwise). Cached."""
         if not hasattr(self, "_explicit_dependent"):
             self._explicit_dependent = None
-            if self.m:
+            # an unsimplified chain's loop is no case for sympy's solve (it does not return)
+            if self.m and self.mechanism.simplify:
                 dep = [self.q[i] for i in self.dependent]
                 # sympy's solve does not return on trigonometric loops of several unknowns
                 # (the five-bar loop): try it only when it is a single unknown or linear
@@ -388,7 +412,7 @@ class Derivation:
             normal = sp.Matrix([-u[1], u[0]]) / sp.sqrt(
                 sp.sympify(c.direction[0]) ** 2 + sp.sympify(c.direction[1]) ** 2)
             d = self.point(c.body, c.point) - self.point(c.line_body, c.line_point)
-            return [sp.simplify((normal.T * d)[0])]
+            return [self._tidy((normal.T * d)[0])]
         if isinstance(c, LinearCoupling):
             names = self.mechanism.coordinates
             return [sum(coef * self.q[names.index(n)] for n, coef in c.coefficients) - c.constant]
@@ -475,7 +499,7 @@ class Derivation:
             return tension * unit if in_a else -tension * unit
         if isinstance(f, CoordinateForce):
             owner = self.mechanism.joints[self.mechanism.coordinates.index(f.coordinate)]
-            if owner is not joint or isinstance(owner, Revolute):
+            if owner is not joint or isinstance(owner, Revolute) or f.relative_to:
                 # internal to the subtree or a torque only
                 return sp.zeros(3 if self.spatial else 2, 1)
             i = self.mechanism.coordinates.index(f.coordinate)

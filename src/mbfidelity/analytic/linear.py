@@ -27,7 +27,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..systems import System
-from ..systems.model import PointOnLine, PointOnPoint, Prismatic
+from ..systems.model import CoordinateForce, PointOnLine, PointOnPoint, Prismatic
 from .numeric import NumericModel, numeric_model
 
 #: relative size below which the real part of an eigenvalue counts as zero (conservative
@@ -166,17 +166,29 @@ def _admissible(system: System, values, q: np.ndarray) -> bool:
             if (lo is not None and not q[i] > lo + margin) or (
                     hi is not None and not q[i] < hi - margin):
                 return False
+    # a couple's hinge (`CoordinateForce.relative_to`) within one period of its value,
+    # like every other angle: a hinge wound past half a turn is another winding
+    coords = system.mechanism.coordinates
+    for f in system.mechanism.forces:
+        if isinstance(f, CoordinateForce) and f.relative_to is not None:
+            if abs(q[coords.index(f.coordinate)] - q[coords.index(f.relative_to)]) > np.pi:
+                return False
     return True
 
 
 def wrap_angles(system: System, q: np.ndarray, op: np.ndarray) -> np.ndarray:
-    """Angular coordinates into (op - pi, op + pi]."""
+    """Angular coordinates into (op - pi, op + pi]; angles joined by couples
+    (`Mechanism.wrap_groups`) shift with the first of their group."""
     q = np.array(q, dtype=float)
-    for i, name in enumerate(system.coordinates):
-        if system.mechanism.angular(name):
-            q[i] = op[i] - ((op[i] - q[i] + np.pi) % (2 * np.pi) - np.pi)
-            if abs(q[i] - op[i] + np.pi) < 1e-12:
-                q[i] = op[i] + np.pi
+    for group in system.mechanism.wrap_groups():
+        i = group[0]
+        wrapped = op[i] - ((op[i] - q[i] + np.pi) % (2 * np.pi) - np.pi)
+        if abs(wrapped - op[i] + np.pi) < 1e-12:
+            wrapped = op[i] + np.pi
+        shift = wrapped - q[i]
+        q[i] = wrapped
+        for k in group[1:]:
+            q[k] += shift
     return q
 
 

@@ -542,15 +542,32 @@ class ExudynBackend(Backend):
         P = np.zeros(n)
         D = np.zeros(n)
         f_const = np.zeros(n)
-        python_laws: list[tuple[int, Callable[..., float]]] = []
+        python_laws: list[tuple[dict[int, int], Callable[..., float]]] = []
         for f in mech.forces:
             if not isinstance(f, CoordinateForce):
+                continue
+            weights = f.weights(mech.coordinates)
+            law = ForceLaw.of(f)
+            aff = law.linear if settings["native_linear_laws"] else None
+            if f.relative_to is not None:
+                # a couple: COORD = w . q = (w T) . u + w . c; native on engine
+                # coordinate j when w T = r_j e_j and w . c = 0 (a hinge's own value)
+                r = sum(sign * geo.T[i] for i, sign in weights.items())
+                r[np.abs(r) < 1e-12] = 0.0
+                nz = np.flatnonzero(r)
+                offset = sum(sign * geo.c[i] for i, sign in weights.items())
+                if aff is not None and len(nz) == 1 and offset == 0:
+                    j, s = int(nz[0]), float(r[nz[0]])
+                    a0, ax, av = aff
+                    f_const[j] += s * a0
+                    P[j] += -s * s * ax
+                    D[j] += -s * s * av
+                else:
+                    python_laws.append((weights, law.law))
                 continue
             i = mech.coordinates.index(f.coordinate)
             row = geo.T[i]
             single = np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0
-            law = ForceLaw.of(f)
-            aff = law.linear if settings["native_linear_laws"] else None
             if aff is not None and single:
                 s = row[i]  # q_i = s u_i, so Q_u = s F(s u, s u_t)
                 a0, ax, av = aff
@@ -558,7 +575,7 @@ class ExudynBackend(Backend):
                 P[i] += -s * s * ax
                 D[i] += -s * s * av
             else:
-                python_laws.append((i, law.law))
+                python_laws.append((weights, law.law))
 
         tree_args = dict(
             nodeNumber=node, gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
@@ -770,13 +787,19 @@ class ExudynBackend(Backend):
         return uf
 
     @staticmethod
-    def _coordinate_user_function(geo: _Geometry, laws: list[tuple[int, Callable[..., float]]]):
+    def _coordinate_user_function(geo: _Geometry,
+                                  laws: list[tuple[dict[int, int], Callable[..., float]]]):
+        """Each law acts on COORD = sum(sign q_i) with force sign * F on each q_i
+        (`CoordinateForce.weights`)."""
         T, c, n = geo.T, geo.c, geo.n
+        laws = [(tuple(w.items()), law) for w, law in laws]
         if np.array_equal(T, np.eye(n)) and not np.any(c):
             def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
                 out = [0.0] * n
-                for i, law in laws:
-                    out[i] += law(u[i], u_t[i], t)
+                for w, law in laws:
+                    F = law(sum(s * u[i] for i, s in w), sum(s * u_t[i] for i, s in w), t)
+                    for i, s in w:
+                        out[i] += s * F
                 return out
             return uf
 
@@ -784,8 +807,10 @@ class ExudynBackend(Backend):
             q = T @ np.asarray(u) + c
             qd = T @ np.asarray(u_t)
             F = np.zeros(n)
-            for i, law in laws:
-                F[i] += law(q[i], qd[i], t)
+            for w, law in laws:
+                force = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
+                for i, s in w:
+                    F[i] += s * force
             return (T.T @ F).tolist()
         return uf_mapped
 
@@ -1087,7 +1112,7 @@ class ExudynBackend(Backend):
                 total -= on_a if in_a else -on_a
             elif isinstance(f, CoordinateForce):
                 i = mech.coordinates.index(f.coordinate)
-                if mech.joints[i] is not joint or isinstance(joint, Revolute):
+                if mech.joints[i] is not joint or isinstance(joint, Revolute) or f.relative_to:
                     continue
                 law = ForceLaw.of(f).law
                 force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])

@@ -177,6 +177,30 @@ class _Coord:
     j: int  # description joint index
     native: tuple[float, float, float] | None  # (a, b, c) in engine units of joint j
     law: Callable[..., float]
+    #: COORD = row . (v - b) over the engine joint values v, and the joint forces are
+    #: row * force (None: row j of A^-1, a force on the coordinate of joint j)
+    row: np.ndarray | None = None
+
+
+def _relative_coord(f: CoordinateForce, law: ForceLaw, lin, coordinates, Ainv: np.ndarray,
+                    b: np.ndarray, joint_native: dict[int, list[float]]) -> _Coord:
+    """A couple between two coordinates (`relative_to`): COORD = w . q = u . (v - b) with
+    u = w A^-1; native on joint j when u is u_j e_j and b_j = 0 (two absolute angles of
+    hinged bodies: their hinge's own value)."""
+    w = np.zeros(len(coordinates))
+    for i, sign in f.weights(coordinates).items():
+        w[i] = sign
+    u = w @ Ainv
+    u[np.abs(u) < 1e-12] = 0.0
+    nz = np.flatnonzero(u)
+    if lin is not None and len(nz) == 1 and b[nz[0]] == 0:
+        j, s = int(nz[0]), float(u[nz[0]])
+        a, k, c = lin
+        spec = (a * s, k * s * s, c * s * s)
+        acc = joint_native.setdefault(j, [0.0, 0.0, 0.0])
+        acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
+        return _Coord(f, j, spec, law.law, u)
+    return _Coord(f, coordinates.index(f.coordinate), None, law.law, u)
 
 
 @dataclass
@@ -400,6 +424,10 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             i = mech.coordinates.index(f.coordinate)
             lin = law.linear if native else None
             spec = None
+            if f.relative_to is not None:
+                plan.coord.append(_relative_coord(f, law, lin, mech.coordinates, Ainv, b,
+                                                  joint_native))
+                continue
             single = np.count_nonzero(A[i]) == 1 and b[i] == 0
             if lin is not None and single:
                 s = A[i, i]  # v = s q: force F on q is F/s on v
@@ -782,7 +810,7 @@ class _Compiled:
         for e in plan.coord:
             if e.native is not None:
                 continue
-            row = plan.Ainv[e.j]
+            row = plan.Ainv[e.j] if e.row is None else e.row
             nz = np.flatnonzero(row)
             ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
             const = float(-row @ plan.b)

@@ -192,7 +192,8 @@ class _PointForce:
 
 @dataclass
 class _CoordForce:
-    index: int
+    #: {coordinate index: sign} (`CoordinateForce.weights`)
+    weights: dict[int, int]
     law: Callable[[float, float, float], float]
     time_dependent: bool
 
@@ -487,7 +488,7 @@ class _Plan:
             law = ForceLaw.of(f)
             if isinstance(f, CoordinateForce):
                 self.coord_forces.append(_CoordForce(
-                    self.coords.index(f.coordinate), law.law, law.time_dependent))
+                    f.weights(self.coords), law.law, law.time_dependent))
             else:
                 self.point_forces.append(_PointForce(
                     f.name, link_of[f.body_a],
@@ -526,7 +527,11 @@ class _Plan:
         for cf in self.coord_forces:
             if autonomous and cf.time_dependent:
                 continue
-            Q[cf.index] += cf.law(q[cf.index], qd[cf.index], t)
+            w = cf.weights
+            force = cf.law(sum(s * q[i] for i, s in w.items()),
+                           sum(s * qd[i] for i, s in w.items()), t)
+            for i, s in w.items():
+                Q[i] += s * force
         return self.AinvT @ Q
 
 

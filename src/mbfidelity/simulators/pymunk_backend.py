@@ -936,6 +936,12 @@ def _element_loads(mech: Mechanism, kin: _Kinematics):
             u = d / length
             loads.append((f.body_b, -tension * u, pb, 0))
             loads.append((f.body_a, tension * u, pa, 0))
+        elif f.relative_to is not None:  # a couple: +F on one coordinate, -F on the other
+            weights = f.weights(mech.coordinates)
+            x = sum(sign * coords[i] for i, sign in weights.items())
+            value = sp.sympify(f.force).xreplace({COORD: x, COORD_RATE: kin.rate(x)})
+            for i, sign in weights.items():
+                loads += _coordinate_loads(mech.joints[i], sign * value, kin)
         else:
             i = mech.coordinates.index(f.coordinate)
             j = mech.joints[i]

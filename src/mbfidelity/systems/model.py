@@ -249,13 +249,27 @@ class CoordinateForce:
     """Generalized force on one coordinate (torsional/linear spring-damper, custom law,
     applied load e(t)). `force` is an expression of COORD, COORD_RATE, TIME and
     parameters, positive in the direction of increasing coordinate. It acts between the
-    parent and the child of the joint that owns the coordinate."""
+    parent and the child of the joint that owns the coordinate.
+
+    With `relative_to`, COORD is the difference q[coordinate] - q[relative_to] and the
+    element is a couple: +force on `coordinate`, -force on `relative_to`. Two absolute
+    angles of hinged bodies make it the hinge's torsional spring-damper (the relative
+    rotation is the engine's joint value)."""
 
     name: str
     coordinate: str
     force: Expr
     potential: Expr | None = None
     dissipation: Expr | None = None
+    relative_to: str | None = None
+
+    def weights(self, coordinates: Sequence[str]) -> dict[int, int]:
+        """{coordinate index: sign}: COORD = sum(sign q[i]), and the generalized force
+        is force * sign on each."""
+        out = {coordinates.index(self.coordinate): 1}
+        if self.relative_to is not None:
+            out[coordinates.index(self.relative_to)] = -1
+        return out
 
     @property
     def time_dependent(self) -> bool:
@@ -407,6 +421,10 @@ class Mechanism:
     prescribed: tuple[Prescribed, ...] = ()
     #: the world's up direction; gravity acts along -up (convention 10)
     up: Vec3 = (0, 1, 0)
+    #: False for long chains (N segments in a row): SymPy's simplify of nested angle
+    #: sums grows exponentially with N, so the derivation keeps its exact unsimplified
+    #: expressions (lambdify's common-subexpression elimination compacts them)
+    simplify: bool = True
 
     @property
     def spatial(self) -> bool:
@@ -437,6 +455,15 @@ class Mechanism:
         for f in self.forces:
             if isinstance(f, CoordinateForce) and f.coordinate not in coords:
                 raise ValueError(f"force {f.name}: unknown coordinate {f.coordinate}")
+            if isinstance(f, CoordinateForce) and f.relative_to is not None and (
+                    f.relative_to not in coords or f.relative_to == f.coordinate):
+                raise ValueError(f"force {f.name}: relative_to {f.relative_to!r} must be "
+                                 f"another coordinate of the mechanism")
+            if isinstance(f, CoordinateForce) and f.relative_to is not None and not all(
+                    isinstance(self.joints[coords.index(c)], Revolute)
+                    for c in (f.coordinate, f.relative_to)):
+                raise ValueError(f"force {f.name}: relative_to joins two hinge angles "
+                                 f"(a torsional couple)")
         for c in self.constraints:
             used = ([name for name, _ in c.coefficients]
                     if isinstance(c, (LinearCoupling, RollingContact)) else [])
@@ -526,6 +553,20 @@ class Mechanism:
 
     def angular(self, coordinate: str) -> bool:
         return isinstance(self.joints[self.coordinates.index(coordinate)], Revolute)
+
+    def wrap_groups(self) -> list[list[int]]:
+        """Angular coordinates that shift by 2 pi together: those joined by couples
+        (`CoordinateForce.relative_to`: a wound hinge spring is another state), each
+        group in coordinate order; an angle without couples is its own group."""
+        coords = self.coordinates
+        group = {i: {i} for i, c in enumerate(coords) if self.angular(c)}
+        for f in self.forces:
+            if isinstance(f, CoordinateForce) and f.relative_to is not None:
+                a, b = coords.index(f.coordinate), coords.index(f.relative_to)
+                merged = group[a] | group[b]
+                for i in merged:
+                    group[i] = merged
+        return sorted({tuple(sorted(g)) for g in group.values()})
 
     def subtree(self, body: str) -> list[str]:
         """The body and everything hanging from it."""
