@@ -549,31 +549,28 @@ class ExudynBackend(Backend):
             weights = f.weights(mech.coordinates)
             law = ForceLaw.of(f)
             aff = law.linear if settings["native_linear_laws"] else None
-            if f.relative_to is not None:
-                # a couple: COORD = w . q = (w T) . u + w . c; native on engine
-                # coordinate j when w T = r_j e_j and w . c = 0 (a hinge's own value)
+            # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
+            target = None
+            if f.relative_to is None:
+                i = mech.coordinates.index(f.coordinate)
+                row = geo.T[i]
+                if np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0:
+                    target = i, row[i]  # q_i = s u_i
+            else:
+                # a couple: COORD = w . q = (w T) . u + w . c, one engine coordinate when
+                # w T = r_j e_j and w . c = 0 (a hinge's own value)
                 r = sum(sign * geo.T[i] for i, sign in weights.items())
                 r[np.abs(r) < 1e-12] = 0.0
                 nz = np.flatnonzero(r)
                 offset = sum(sign * geo.c[i] for i, sign in weights.items())
-                if aff is not None and len(nz) == 1 and offset == 0:
-                    j, s = int(nz[0]), float(r[nz[0]])
-                    a0, ax, av = aff
-                    f_const[j] += s * a0
-                    P[j] += -s * s * ax
-                    D[j] += -s * s * av
-                else:
-                    python_laws.append((weights, law.law))
-                continue
-            i = mech.coordinates.index(f.coordinate)
-            row = geo.T[i]
-            single = np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0
-            if aff is not None and single:
-                s = row[i]  # q_i = s u_i, so Q_u = s F(s u, s u_t)
+                if len(nz) == 1 and offset == 0:
+                    target = int(nz[0]), float(r[nz[0]])
+            if aff is not None and target is not None:
+                j, s = target
                 a0, ax, av = aff
-                f_const[i] += s * a0
-                P[i] += -s * s * ax
-                D[i] += -s * s * av
+                f_const[j] += s * a0
+                P[j] += -s * s * ax
+                D[j] += -s * s * av
             else:
                 python_laws.append((weights, law.law))
 

@@ -182,25 +182,25 @@ class _Coord:
     row: np.ndarray | None = None
 
 
-def _relative_coord(f: CoordinateForce, law: ForceLaw, lin, coordinates, Ainv: np.ndarray,
-                    b: np.ndarray, joint_native: dict[int, list[float]]) -> _Coord:
-    """A couple between two coordinates (`relative_to`): COORD = w . q = u . (v - b) with
-    u = w A^-1; native on joint j when u is u_j e_j and b_j = 0 (two absolute angles of
-    hinged bodies: their hinge's own value)."""
+def _native_target(f: CoordinateForce, coordinates, A: np.ndarray, Ainv: np.ndarray,
+                   b: np.ndarray) -> tuple[tuple[int, float] | None, np.ndarray | None]:
+    """(j, s) when the law's argument is one engine joint value, v_j = s COORD (else
+    None), and the row u with COORD = u . (v - b) (None: row i of A^-1, the coordinate's
+    own). A couple (`relative_to`) has COORD = w . q, so u = w A^-1: one joint j when u
+    is u_j e_j and b_j = 0 (two absolute angles of hinged bodies: their hinge's value)."""
+    i = coordinates.index(f.coordinate)
+    if f.relative_to is None:
+        single = np.count_nonzero(A[i]) == 1 and b[i] == 0
+        return ((i, A[i, i]) if single else None), None
     w = np.zeros(len(coordinates))
-    for i, sign in f.weights(coordinates).items():
-        w[i] = sign
+    for k, sign in f.weights(coordinates).items():
+        w[k] = sign
     u = w @ Ainv
     u[np.abs(u) < 1e-12] = 0.0
     nz = np.flatnonzero(u)
-    if lin is not None and len(nz) == 1 and b[nz[0]] == 0:
-        j, s = int(nz[0]), float(u[nz[0]])
-        a, k, c = lin
-        spec = (a * s, k * s * s, c * s * s)
-        acc = joint_native.setdefault(j, [0.0, 0.0, 0.0])
-        acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-        return _Coord(f, j, spec, law.law, u)
-    return _Coord(f, coordinates.index(f.coordinate), None, law.law, u)
+    if len(nz) == 1 and b[nz[0]] == 0:
+        return (int(nz[0]), 1.0 / float(u[nz[0]])), u
+    return None, u
 
 
 @dataclass
@@ -421,21 +421,17 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             law = ForceLaw.of(f)
             if autonomous and law.time_dependent:
                 continue
-            i = mech.coordinates.index(f.coordinate)
+            j = mech.coordinates.index(f.coordinate)
             lin = law.linear if native else None
             spec = None
-            if f.relative_to is not None:
-                plan.coord.append(_relative_coord(f, law, lin, mech.coordinates, Ainv, b,
-                                                  joint_native))
-                continue
-            single = np.count_nonzero(A[i]) == 1 and b[i] == 0
-            if lin is not None and single:
-                s = A[i, i]  # v = s q: force F on q is F/s on v
+            target, row = _native_target(f, mech.coordinates, A, Ainv, b)
+            if lin is not None and target is not None:
+                j, s = target  # v_j = s COORD: force F on COORD is F/s on v_j
                 a, kq, cq = lin
                 spec = (a / s, kq / s**2, cq / s**2)
-                acc = joint_native.setdefault(i, [0.0, 0.0, 0.0])
+                acc = joint_native.setdefault(j, [0.0, 0.0, 0.0])
                 acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-            plan.coord.append(_Coord(f, i, spec, law.law))
+            plan.coord.append(_Coord(f, j, spec, law.law, row))
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
     # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
     for i, (a, k, c) in joint_native.items():
