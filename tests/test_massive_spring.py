@@ -217,7 +217,7 @@ def test_discretization_command():
 def test_declarations_follow_the_structure():
     """An expectation's `when` is a relation of the structural parameters: the chain's
     fastest mode, hence w h at the default step, grows with N, so the declarations that
-    hold at N = 8 do not at N = 1 (where every gate resolves and passes)."""
+    hold at N = 16 do not at N = 8 (where every mode-by-mode gate resolves)."""
     from mbfidelity.comparisons.runner import expectations
     from mbfidelity.systems import Expectation
 
@@ -228,8 +228,11 @@ def test_declarations_follow_the_structure():
                 if g[0] in s.expectations and g[0].simulator == "mujoco"]
 
     assert mujocos(s.with_structure({"N": 1})) == []
-    assert mujocos(s) == ["pulled.*", "relaxed.*"]  # N = 8: the trajectories
-    assert mujocos(s.with_structure({"N": 16})) == ["pulled.*", "relaxed.*",
+    assert mujocos(s) == []  # N = 8
+    assert mujocos(s.with_structure({"N": 16})) == ["frequency.fit_mode*", "damping.fit_mode*"]
+    assert mujocos(s.with_structure({"N": 23})) == ["pulled.*", "frequency.fit_mode*",
+                                                    "damping.fit_mode*"]
+    assert mujocos(s.with_structure({"N": 26})) == ["pulled.*", "relaxed.*",
                                                     "frequency.fit_mode*", "damping.fit_mode*"]
     with pytest.raises(ValueError, match="relation of the structural parameters"):
         Expectation("*", "*", "xfail", "probe", when="M > 2").applies({"N": 3})

@@ -29,6 +29,20 @@ faster forcing).
   a(t). So T above is the effective duration max_t t a(t)/a(0), taken from the
   reference's own envelope (`effective_duration`): T itself for a sustained motion,
   1/(e zeta w) for an exponential decay, in between for a saturating damper.
+* Trajectory of a nearly linear motion, mode by mode. Near a stable equilibrium the
+  motion is a sum of modes, and each mode's error follows its own frequency: coordinate c
+  carries mode j with amplitude A_cj (from the initial state's modal coordinates), whose
+  error is A_cj e_j with e_j the bound above at w = |s_j| (the same order, duration and
+  damping). A mode outside the range of w h where its bound holds is still a bounded
+  oscillation in a stable scheme (|R(s h)| <= 1 for RK4 and the trapezoidal and
+  generalized-alpha rules; semi-implicit Euler's invariant ellipse stretches the amplitude
+  by at most 1/sqrt(1 - (w h / 2)^2)): its error is at most twice its amplitude times that
+  stretch. Gate: max_c sum_j A_cj e_j / a_c (a_c the coordinate's amplitude, as in the
+  metric), plus twice the largest departure of the reference from the linear prediction
+  (the nonlinear part of the motion, which the modes do not describe: at most the engine's
+  own plus the reference's), plus the other allowances. It is used where it is tighter
+  than the fastest-mode bound (a chain of segments released mostly in its first mode, the
+  fast modes barely excited), for undriven motions about a stable static equilibrium.
 * Reactions: a force error follows the acceleration error, w^2 times the position error,
   so relative to the force amplitude it has the same bound.
 * Period: the phase drift per period is (w h)^p times 2 pi at most; for semi-implicit
@@ -38,8 +52,13 @@ faster forcing).
   same as the trajectory (energy error is first order in the state error).
 * Frequency from the engine's own continuous-time linearization (central differences
   with step 1e-6: truncation 1e-12, round-off 1e-16/1e-6 = 1e-10): FD_FREQUENCY = 1e-6.
-  From a discrete transition matrix of an order-p scheme: (w h)^p.
-* Frequency and damping ratio from a free-vibration fit: (w h)^p of the integrator plus
+  From a discrete transition matrix of an order-p scheme: (w_j h)^p for mode j, at its own
+  frequency w_j (the map moves each eigenvalue by its own scheme error).
+* Frequency and damping ratio from a free-vibration fit: (w_j h)^p of the integrator at
+  the released mode's own frequency (each mode is released alone, the others enter at the
+  amplitude squared; semi-implicit Euler: (w_j h)^2 + zeta_j w_j h, as for the period, its
+  frequency being 2 arcsin(w h / 2) / h undamped, and its damping ratio off by zeta w h
+  relative at most), plus
   FIT_RESOLUTION, the precision of a least-squares sinusoid fit over tens of periods of a
   sampled record, and the amplitude dependence of the frequency at the test amplitude
   (a pendulum's frequency shifts by amplitude^2/16: 6e-8 at 1e-3 rad).
@@ -190,6 +209,26 @@ def trajectory_tolerance(w: float, h: float, order: int, t_end: float, zeta: flo
     return (w * h) ** order * (1.0 + w * t_end)
 
 
+def modal_trajectory_tolerance(amplitudes: "np.ndarray", omegas: "np.ndarray",
+                               zetas: "np.ndarray", scale: "np.ndarray", h: float, order: int,
+                               t_end: float) -> float:
+    """max_c sum_j amplitudes[c, j] e_j / scale[c] (module docstring: mode by mode), e_j
+    the trajectory bound at omegas[j] inside the bound's range of w h, twice the mode's
+    largest amplitude in the scheme outside it (inf beyond its stability limit)."""
+    import numpy as np
+
+    limit = asymptotic_limit(order)
+    errors = []
+    for w, zeta in zip(omegas, zetas):
+        if w * h <= limit:
+            errors.append(trajectory_tolerance(w, h, order, t_end, max(zeta, 0.0)))
+        elif order == 1:
+            errors.append(2.0 / np.sqrt(1.0 - (w * h / 2) ** 2) if w * h < 2 else np.inf)
+        else:
+            errors.append(2.0)
+    return float(np.max(np.asarray(amplitudes) @ np.asarray(errors) / np.asarray(scale)))
+
+
 def period_tolerance(w: float, h: float, order: int, period: float, zeta: float = 0.0) -> float:
     # semi-implicit Euler: second order, plus zeta w h from damping (see above)
     if order == 1:
@@ -197,7 +236,10 @@ def period_tolerance(w: float, h: float, order: int, period: float, zeta: float 
     return (w * h) ** order + (h / period) ** 2
 
 
-def fit_tolerance(w: float, h: float, order: int) -> float:
+def fit_tolerance(w: float, h: float, order: int, zeta: float) -> float:
+    # semi-implicit Euler's frequency is second order, plus zeta w h from damping (above)
+    if order == 1:
+        return (w * h) ** 2 + abs(zeta) * w * h + FIT_RESOLUTION
     return (w * h) ** order + FIT_RESOLUTION
 
 

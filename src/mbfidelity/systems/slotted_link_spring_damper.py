@@ -193,6 +193,18 @@ def slot_force(P):
             + (F_molla + F_c) * sp.tan(phi))
 
 
+PYBULLET_DAMPS_THE_FIRST_MODE = (
+    "PyBullet damps the first mode, which the damper does not reach (zeta = 0 in the "
+    "linearization): its free-vibration fit gives zeta = 1.69e-3, 8.4e-4 and 4.2e-4 at "
+    "dt = 1e-3, 5e-4 and 2.5e-4 s (mbfidelity compare slotted_link_spring_damper --sim "
+    "pybullet --dt ...), first order in the step, 0.17 w h, while its frequency is within "
+    "5e-6. Semi-implicit Euler keeps an undamped mode undamped only where its map is "
+    "symplectic; PyBullet integrates reduced coordinates with a configuration-dependent "
+    "mass matrix and the damper's force from the step's start (non-proportional damping "
+    "couples the modes of its discrete map at first order), so it is not. Pymunk's fit of "
+    "the same mode has no such damping.")
+
+
 SYSTEM = System(
     id="slotted_link_spring_damper",
     title="Solid in a vertical slot driven by a spring-damper pin through its own slot",
@@ -229,6 +241,7 @@ SYSTEM = System(
         Expectation("mujoco", "*.constraint_*", "xfail", MUJOCO_MASSLESS_PIN),
         Expectation("mujoco", "frequency.*", "xfail", MUJOCO_MASSLESS_PIN),
         Expectation("mujoco", "damping.*", "xfail", MUJOCO_MASSLESS_PIN),
+        Expectation("pybullet", "damping.fit_mode1", "xfail", PYBULLET_DAMPS_THE_FIRST_MODE),
         Expectation("pybullet", "undamped.trajectory_*", "xfail", SEMI_IMPLICIT_DRIFT),
         Expectation("pybullet", "undamped.energy_drift", "xfail", SEMI_IMPLICIT_DRIFT),
         Expectation("pybullet", "undamped.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),

@@ -91,7 +91,7 @@ SYSTEM = System(
     unexcited={"e": 0.0},
     exact_solution="unbalanced_rotor_eq86",
     excitation_frequencies=lambda P: (P.omega,),
-    expectations=(coarse_first_order("ratio_*", "frequency.fit_*", "damping.fit_*")
+    expectations=(coarse_first_order("ratio_*")
                   + coarse_second_order("ratio_*.trajectory_*", "ratio_*.imposed_*",
                                         "ratio_*.actuator_*")
                   + (Expectation("exudyn", "ratio_*.steady_state_*", "unresolved",
