@@ -163,6 +163,9 @@ class Condition:
     meaning: str
 
 
+EXPECTATION_KINDS = ("xfail", "unsupported", "unresolved", "judged")
+
+
 @dataclass(frozen=True)
 class Expectation:
     """An exception as data (scikit-learn's common-check pattern).
@@ -172,7 +175,10 @@ class Expectation:
     kind "unresolved": at the default step the metric's error bound says nothing (outside
     its range of w h, or above the ceiling a gate can discriminate: comparisons/
     tolerances.py), so it is measured and shown, not judged (strict too: a declaration
-    whose metrics all resolve is reported, and their passes become unexpected).
+    whose metrics all resolve is reported, and their passes become unexpected);
+    kind "judged": the metric is judged by its gate (a failure fails) although a
+    backend-wide declaration (simulators/base.py `expected_failures`) expects it to fail:
+    the reason says why that backend's floor lies below this system's gate.
     `simulator` and `metric` are fnmatch patterns ("*" matches all). `when`: a relation
     of the system's structural parameters (``"N >= 5"``) outside which the declaration
     does not apply: a chain's fastest mode, hence w h at the default step, grows with its
@@ -183,6 +189,11 @@ class Expectation:
     kind: str
     reason: str
     when: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in EXPECTATION_KINDS:
+            raise ValueError(f"expectation kind {self.kind!r} is not one of "
+                             f"{', '.join(EXPECTATION_KINDS)}")
 
     def applies(self, structure: Mapping[str, int]) -> bool:
         """Whether the declaration holds for a system built with `structure`."""
