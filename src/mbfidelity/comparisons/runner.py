@@ -320,7 +320,7 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
     """A trajectory check started near every stable equilibrium other than the operating
     point (the monograph studies one; the others are where a user's mechanism may rest):
     the independent coordinates NEAR_EQUILIBRIUM_OFFSET away from it, from rest, for
-    NEAR_EQUILIBRIUM_T_END s. Named eq<k>_small after the equilibrium's index in
+    NEAR_EQUILIBRIUM_T_END s (or the system's `near_equilibrium_t_end`). Named eq<k>_small after the equilibrium's index in
     `analyze`. Returns (scenario, equilibrium) pairs."""
     from ..systems.model import Scenario
 
@@ -340,7 +340,8 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
                 1.0 if system.mechanism.angular(c) else max(abs(eq.q[i]), 0.1))
             q0[c] = float(eq.q[i] + (step if i in model.independent else 0.0))
         pretty = ", ".join(f"{c} = {x:.4g}" for c, x in zip(system.coordinates, eq.q))
-        out.append((Scenario(f"eq{k}_small", q0, t_end=NEAR_EQUILIBRIUM_T_END, checks=checks,
+        t_end = system.near_equilibrium_t_end or NEAR_EQUILIBRIUM_T_END
+        out.append((Scenario(f"eq{k}_small", q0, t_end=t_end, checks=checks,
                              description=f"near the stable equilibrium ({pretty}), "
                                          f"{NEAR_EQUILIBRIUM_OFFSET} off, from rest"), eq))
     return out

@@ -252,6 +252,11 @@ class System:
     #: estimates `analyze` reports next to the chain's modes; the number of elements is
     #: the system's structural parameter
     continuum: str | None = None
+    #: duration (s) of the generated releases near the other stable equilibria
+    #: (comparisons/runner.py `near_equilibrium_scenarios`); None: the runner's default.
+    #: A stiff chain sets a few periods of its first mode: over the default its fast
+    #: modes alone cost a minute of reference
+    near_equilibrium_t_end: float | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
 
