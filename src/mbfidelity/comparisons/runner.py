@@ -320,8 +320,9 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
     """A trajectory check started near every stable equilibrium other than the operating
     point (the monograph studies one; the others are where a user's mechanism may rest):
     the independent coordinates NEAR_EQUILIBRIUM_OFFSET away from it, from rest, for
-    NEAR_EQUILIBRIUM_T_END s (or the system's `near_equilibrium_t_end`). Named eq<k>_small after the equilibrium's index in
-    `analyze`. Returns (scenario, equilibrium) pairs."""
+    NEAR_EQUILIBRIUM_T_END s (or the system's `near_equilibrium_t_end`). Named
+    eq<k>_small after the equilibrium's index in `analyze`. Returns (scenario,
+    equilibrium) pairs."""
     from ..systems.model import Scenario
 
     if system.mechanism.prescribed:
