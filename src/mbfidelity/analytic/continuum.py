@@ -20,7 +20,7 @@ refined with Brent's method; every scan has a hard bound and raises when it is h
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Mapping
 
 import numpy as np
@@ -203,9 +203,52 @@ def spring_with_end_mass(values: Mapping[str, float], count: int = 3) -> Continu
         leading_error=lumped_spring_error_coefficients(spring_mass, m, count))
 
 
+def rayleigh_beam_block_load_shape(EI: float, rho: float, l: float, m: float, c: float) -> float:
+    """§6.1 eq. 66-68 as printed: the static deflection under a load at a = c l as the
+    assumed shape; k_red = 3 EI / (c^2 (1 - c)^2 l^3) at the block, and the beam's mass
+    reduced to the block's point by (2 + 4c - c^2 - 6c^3 + 3c^4) / (105 c^2 (1 - c)^2).
+    Returns the estimate of the first angular frequency (rad/s)."""
+    stiffness = 3 * EI / ((1 - c) ** 2 * c**2 * l**3)
+    mass = m + (2 + 4 * c - c**2 - 6 * c**3 + 3 * c**4) / (105 * (1 - c) ** 2 * c**2) * rho * l
+    return math.sqrt(stiffness / mass)
+
+
+def rayleigh_beam_own_weight_shape(EI: float, rho: float, l: float, m: float, c: float) -> float:
+    """§6.1 as printed, the second shape: the static deflection under the beam's own
+    uniform weight, y ~ x/l - 2 (x/l)^3 + (x/l)^4, referred to the block's point
+    (s = c - 2c^3 + c^4): k_red = 24 EI / (5 s^2 l^3), the beam's reduced mass
+    31 rho l / (630 s^2). Returns the first angular frequency's estimate (rad/s)."""
+    s = c - 2 * c**3 + c**4
+    stiffness = 24 * EI / (5 * s**2 * l**3)
+    mass = m + 31 / (630 * s**2) * rho * l
+    return math.sqrt(stiffness / mass)
+
+
+def beam_with_point_mass(values: Mapping[str, float], count: int = 3) -> ContinuumSummary:
+    """The simply supported beam of length l, stiffness EI, mass rho per length with a
+    block m at mid-span (§6.1, Fig. 17, the catalog's c = 1/2): parameters l, EI, rho, m.
+    The leading error of the rigid-segment chain is not derived (None)."""
+    EI, rho, l, m, c = values["EI"], values["rho"], values["l"], values["m"], 0.5
+    exact = [w / (2 * math.pi)
+             for w in beam_with_point_mass_frequencies(EI, rho, l, m, c * l, count)]
+    estimates = [
+        RayleighEstimate("eq. 66-68", "static deflection under the block's load",
+                         rayleigh_beam_block_load_shape(EI, rho, l, m, c) / (2 * math.pi), 0.0),
+        RayleighEstimate("§6.1, own weight", "static deflection under the beam's weight",
+                         rayleigh_beam_own_weight_shape(EI, rho, l, m, c) / (2 * math.pi), 0.0)]
+    return ContinuumSummary(
+        model="beam_with_point_mass",
+        description="Euler-Bernoulli beam, simply supported, with a point mass at mid-span: "
+                    "the 4 x 4 matching determinant of the mode shapes on both sides",
+        frequency_hz=exact,
+        rayleigh=[replace(r, relative_error=(r.frequency_hz - exact[0]) / exact[0])
+                  for r in estimates])
+
+
 #: the continuum models a system may name (`System.continuum`)
 CONTINUA: dict[str, Callable[..., ContinuumSummary]] = {
     "spring_with_end_mass": spring_with_end_mass,
+    "beam_with_point_mass": beam_with_point_mass,
 }
 
 

@@ -1,0 +1,127 @@
+"""A simply supported beam carrying a block at mid-span (monograph §6.1, Fig. 17,
+eq. 62-68), as a chain of N rigid segments with hinge springs.
+
+The monograph's system: an Euler-Bernoulli beam of length l, bending stiffness EI and
+mass rho per length, pinned at x = 0 and on a roller at x = l, with a block m at
+a = c l. Rayleigh's method with two static shapes (the deflection under the block's
+weight, eq. 66-68, and under the beam's own weight) estimates its first frequency; the
+exact continuum comes from the mode shapes on both sides of the block
+(`analytic/continuum.py`, model "beam_with_point_mass"). The catalog's block sits at
+mid-span, c = 1/2, the only position this chain takes (`c` is not a parameter here).
+
+The discretized model (N elements, even, a structural parameter: `--param N=16`)::
+
+     pin O                 block m at the node x = l/2               roller
+      o----seg1----o----seg2----[m]----seg3----o----seg4----o  ->  slides on y = 0
+      phi1 (absolute)  phi2 (relative)  ...                phiN (relative, dependent)
+
+Each segment is a rigid bar of length h = l/N, mass rho h and central moment
+rho h^3 / 12; consecutive segments are hinged, with a rotational spring EI / h on their
+relative angle (the beam's bending energy EI kappa^2 / 2 over a length h, with the
+curvature kappa = phi / h concentrated at the hinge). The block is a point mass at the end
+of segment N/2 (a point mass at a hinge belongs to either body: the kinetic energy is the
+same), so that segment's centre of mass and central moment include it. The roller holds
+the end of segment N on the line y = 0 (one constraint): phiN is dependent, phi1 ...
+phi(N-1) independent. Gravity (0, -g) sags the chain under the block's and its own
+weight: the operating point is that static deflection, found from the straight chain.
+
+Equilibria (counted by hand in tests/hand/beam_with_block.py): at rest each hinge's
+spring moment (EI/h) phi_i equals the moment of the loads beyond it, at most
+(m + rho l) g l; at the defaults that bounds every relative angle by 0.05 rad (N = 4),
+so the chain is nearly straight and its end on y = 0 puts it along +x (the beam between
+its supports) or along -x (the same beam mirrored, the roller at x = -l): two equilibria,
+both stable.
+"""
+import sympy as sp
+
+from . import Expectation, System
+from .model import (Body, Circle, CoordinateForce, Mechanism, Parameter, PointOnLine,
+                    Revolute, Scenario, Segment, coordinate_spring_damper)
+
+PARAMETERS = (
+    Parameter("l", 1.0, "m", "span between the supports", "MECHANISMS.md B; Fig. 17"),
+    Parameter("EI", 100.0, "N m^2", "bending stiffness", "MECHANISMS.md B; Fig. 17"),
+    Parameter("rho", 1.0, "kg/m", "mass per length of the beam", "MECHANISMS.md B; Fig. 17"),
+    Parameter("m", 1.0, "kg", "mass of the block at mid-span (the catalog also runs m = 0)",
+              "MECHANISMS.md B", domain="nonnegative"),
+    Parameter("N", 4, "1", "number of rigid segments (even: the block sits on the middle "
+              "node; structural: it sets the coordinates; 4 keeps the checks fast)",
+              "chosen here", domain="count"),
+    Parameter("y0", 0.002, "m", "extra deflection of the block's node beyond the static "
+              "one in the 'pushed' scenario", "chosen here", domain="real"),
+)
+
+#: radius of the drawn block (m): drawing only
+BLOCK = 0.03
+
+
+def _segment(P, i: int):
+    """(mass, central moment, centre of mass from the segment's left end) of segment i."""
+    h = P.l / P.N
+    if i != P.N // 2:
+        return P.rho * h, P.rho * h**3 / 12, h / 2
+    mass = P.rho * h + P.m
+    x_c = (P.rho * h * h / 2 + P.m * h) / mass
+    inertia = P.rho * h**3 / 12 + P.rho * h * (h / 2 - x_c) ** 2 + P.m * (h - x_c) ** 2
+    return mass, inertia, x_c
+
+
+def build(P) -> Mechanism:
+    N = P.N
+    if N % 2:
+        raise ValueError(f"beam_with_block: N = {N} elements leave no node at mid-span for "
+                         f"the block; N must be even")
+    h = P.l / N
+    bodies, joints, forces = [], [], []
+    previous_end = None
+    for i in range(1, N + 1):
+        mass, inertia, x_c = _segment(P, i)
+        shapes = [Segment((-x_c, 0), (h - x_c, 0), 0.01)]
+        if i == N // 2:
+            shapes.append(Circle((h - x_c, 0), BLOCK))
+        bodies.append(Body(f"seg{i}", mass, inertia, tuple(shapes)))
+        if i == 1:
+            joints.append(Revolute("pin", "world", "seg1", "phi1", child_anchor=(-x_c, 0)))
+        else:
+            joints.append(Revolute(f"hinge{i}", f"seg{i - 1}", f"seg{i}", f"phi{i}",
+                                   parent_anchor=previous_end, child_anchor=(-x_c, 0)))
+            forces.append(CoordinateForce(f"bending{i}", f"phi{i}",
+                                          **coordinate_spring_damper(P.EI / h, 0)))
+        previous_end = (h - x_c, 0)
+    return Mechanism(
+        bodies=tuple(bodies), joints=tuple(joints), forces=tuple(forces),
+        constraints=(PointOnLine("roller", f"seg{N}", previous_end, "world", (P.l, 0),
+                                 (1, 0)),),
+        independent=tuple(f"phi{i}" for i in range(1, N)))
+
+
+def operating_point(P) -> dict:
+    """The straight chain (refined to the sagged equilibrium by the search)."""
+    return {}
+
+
+def pushed(P) -> dict:
+    """The straight chain with the middle node y0 lower: the two halves turned by
+    -+2 y0 / l (a triangle, whose kinks at the pin, the block and the roller load the
+    three hinges there; the static sag is added by the release)."""
+    N = P.N
+    angle = 2 * P.y0 / P.l
+    q = {"phi1": -angle}
+    q[f"phi{N // 2 + 1}"] = 2 * angle
+    return q
+
+
+SYSTEM = System(
+    id="beam_with_block",
+    title="Simply supported beam with a block at mid-span, as a chain of N rigid segments",
+    source="monograph §6.1, Fig. 17, eq. 62-68",
+    parameters=PARAMETERS,
+    build=build,
+    operating_point=operating_point,
+    scenarios=(
+        Scenario("pushed", pushed, t_end=2.0,
+                 description="from rest, the block's node y0 = 2 mm below the straight "
+                             "line, the halves straight: mostly the first mode"),
+    ),
+    continuum="beam_with_point_mass",
+)
