@@ -13,20 +13,26 @@ The discretized model (N elements, even, a structural parameter: `--param N=16`)
 
      pin O                 block m at the node x = l/2               roller
       o----seg1----o----seg2----[m]----seg3----o----seg4----o  ->  slides on y = 0
-      phi1 (absolute)  phi2 (relative)  ...                phiN (relative, dependent)
+      th1          th2          ...                         thN (dependent)
 
 Each segment is a rigid bar of length h = l/N, mass rho h and central moment
 rho h^3 / 12; consecutive segments are hinged, with a rotational spring EI / h on their
-relative angle (the beam's bending energy EI kappa^2 / 2 over a length h, with the
-curvature kappa = phi / h concentrated at the hinge). The block is a point mass at the end
-of segment N/2 (a point mass at a hinge belongs to either body: the kinetic energy is the
-same), so that segment's centre of mass and central moment include it. The roller holds
-the end of segment N on the line y = 0 (one constraint): phiN is dependent, phi1 ...
-phi(N-1) independent. Gravity (0, -g) sags the chain under the block's and its own
-weight: the operating point is that static deflection, found from the straight chain.
+relative rotation th(i) - th(i-1) (the beam's bending energy EI kappa^2 / 2 over a
+length h, with the curvature kappa = (th(i) - th(i-1)) / h concentrated at the hinge).
+The coordinates are the segments' absolute angles (from +x): the mass matrix then couples
+segments i, j through cos(th_i - th_j) alone, and the derivation grows as N^3, not
+exponentially as with nested relative angles (`Mechanism.simplify` is off: SymPy's
+simplify does not finish on the chain beyond N = 4). The springs are couples between
+consecutive angles (`CoordinateForce.relative_to`): in every engine, the hinge's own
+joint spring. The block is a point mass at the end of segment N/2 (a point mass at a
+hinge belongs to either body: the kinetic energy is the same), so that segment's centre
+of mass and central moment include it. The roller holds the end of segment N on the line
+y = 0 (one constraint): thN is dependent, th1 ... th(N-1) independent. Gravity (0, -g)
+sags the chain under the block's and its own weight: the operating point is that static
+deflection, found from the straight chain.
 
 Equilibria (counted by hand in tests/hand/beam_with_block.py): at rest each hinge's
-spring moment (EI/h) phi_i equals the moment of the loads beyond it, at most
+spring moment (EI/h)(th_i - th_(i-1)) equals the moment of the loads beyond it, at most
 (m + rho l) g l; at the defaults that bounds every relative angle by 0.05 rad (N = 4),
 so the chain is nearly straight and its end on y = 0 puts it along +x (the beam between
 its supports) or along -x (the same beam mirrored, the roller at x = -l): two equilibria,
@@ -81,18 +87,19 @@ def build(P) -> Mechanism:
             shapes.append(Circle((h - x_c, 0), BLOCK))
         bodies.append(Body(f"seg{i}", mass, inertia, tuple(shapes)))
         if i == 1:
-            joints.append(Revolute("pin", "world", "seg1", "phi1", child_anchor=(-x_c, 0)))
+            joints.append(Revolute("pin", "world", "seg1", "th1", child_anchor=(-x_c, 0)))
         else:
-            joints.append(Revolute(f"hinge{i}", f"seg{i - 1}", f"seg{i}", f"phi{i}",
-                                   parent_anchor=previous_end, child_anchor=(-x_c, 0)))
-            forces.append(CoordinateForce(f"bending{i}", f"phi{i}",
+            joints.append(Revolute(f"hinge{i}", f"seg{i - 1}", f"seg{i}", f"th{i}",
+                                   parent_anchor=previous_end, child_anchor=(-x_c, 0),
+                                   absolute=True))
+            forces.append(CoordinateForce(f"bending{i}", f"th{i}", relative_to=f"th{i - 1}",
                                           **coordinate_spring_damper(P.EI / h, 0)))
         previous_end = (h - x_c, 0)
     return Mechanism(
         bodies=tuple(bodies), joints=tuple(joints), forces=tuple(forces),
         constraints=(PointOnLine("roller", f"seg{N}", previous_end, "world", (P.l, 0),
                                  (1, 0)),),
-        independent=tuple(f"phi{i}" for i in range(1, N)))
+        independent=tuple(f"th{i}" for i in range(1, N)), simplify=False)
 
 
 def operating_point(P) -> dict:
@@ -104,11 +111,8 @@ def pushed(P) -> dict:
     """The straight chain with the middle node y0 lower: the two halves turned by
     -+2 y0 / l (a triangle, whose kinks at the pin, the block and the roller load the
     three hinges there; the static sag is added by the release)."""
-    N = P.N
     angle = 2 * P.y0 / P.l
-    q = {"phi1": -angle}
-    q[f"phi{N // 2 + 1}"] = 2 * angle
-    return q
+    return {f"th{i}": -angle if i <= P.N // 2 else angle for i in range(1, P.N + 1)}
 
 
 SYSTEM = System(
