@@ -145,11 +145,18 @@ FAST_MODE_FITS = (
     "((w h)^2/24), MuJoCo 2.0e-4 and 6.2e-4; the first mode's fit is judged, and every "
     "mode of the engines' linearizations (MuJoCo, Exudyn) within 1e-7.")
 
+SOFT_ROLLER_BELOW_THE_GATE = (
+    "MuJoCo's roller is a slider body held by a soft equality (SOFT_EQUALITY: 1e-6 to 1e-5 "
+    "of a trajectory's amplitude), far below this release's mode-by-mode gate (9.0e-3, "
+    "from the fast modes' share of the release): the metrics are judged. Measured: 9.3e-4 "
+    "at dt = 1e-3 s, RK4's phase error on the fastest mode (w h = 0.54), and 2.4e-6 at "
+    "dt = 1e-4 s.")
+
 FIRST_ORDER_RELEASE_BOUND = (
     "Semi-implicit Euler's bound on the first mode alone, w h + (w h)^2 (1 + w T) at "
     "w = 54.6 rad/s over the 0.5 s release, is 0.14 of the amplitude at dt = 1e-3 s, "
     "beyond what a gate can tell apart (0.1). Measured maximum errors: 3.9e-2 (PyBullet), "
-    "3.2e-2 (Pymunk); at dt = 5e-4 s the bound is 0.05.")
+    "3.2e-2 (Pymunk); at dt = 5e-4 s the bound is 0.048.")
 
 
 SYSTEM = System(
@@ -173,6 +180,7 @@ SYSTEM = System(
                       when="N >= 4")
           for engine in ("mujoco", "exudyn", "pybullet", "pymunk")
           for kind in ("frequency", "damping")),
+        Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
         *(Expectation(engine, "released.*", "unresolved", FIRST_ORDER_RELEASE_BOUND)
           for engine in ("pybullet", "pymunk")),
     ),
