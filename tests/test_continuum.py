@@ -157,3 +157,48 @@ def test_rayleigh_estimate_of_the_massive_spring_bounds_the_exact_frequency():
         assert estimate >= exact * (1 - 1e-12)
         excess.append(estimate / exact - 1)
     assert excess == sorted(excess)
+
+
+def test_printed_rayleigh_coefficients_of_section_6_are_the_integrals_of_their_shapes():
+    """Errata check of §6.1 eq. 62-68 and §6.2 eq. 69-70, derived here by integration
+    (SymPy) for any block position c = a/l: the static deflection under a load at a
+    (eq. 63 at x = a, eq. 66 on both sides) gives the printed reduced mass (eq. 67) and
+    stiffness (eq. 68, equal to eq. 65); the uniform-load shape gives 31/630 and 24/5 over
+    (c - 2c^3 + c^4)^2; the spring's linear shape (eq. 69) gives a third of its mass
+    (eq. 70). No misprint: each printed coefficient is the integral, identically in c."""
+    import sympy as sp
+
+    x, l, a, c, EI, F = sp.symbols("x l a c EI F", positive=True)
+    b = l - a
+    # the load-point shape from the beam's own static solution (F at a, pinned ends),
+    # not from eq. 66: y = F b x (l^2 - b^2 - x^2) / (6 EI l) left of the load
+    left = F * b * x * (l**2 - b**2 - x**2) / (6 * EI * l)
+    right = F * a * (l - x) * (2 * l * x - x**2 - a**2) / (6 * EI * l)
+    y_a = left.subs(x, a)
+    assert sp.simplify(y_a - F * b**2 * a**2 / (3 * EI * l)) == 0  # eq. 64's z_a
+    assert sp.simplify(right.subs(x, a) - y_a) == 0
+    assert sp.simplify(sp.diff(left, x).subs(x, a) - sp.diff(right, x).subs(x, a)) == 0
+    w_left, w_right = sp.simplify(left / y_a), sp.simplify(right / y_a)
+    assert sp.simplify(w_left - x * (2 * l * a - a**2 - x**2) / (2 * (l - a) * a**2)) == 0
+    assert sp.simplify(w_right - (l - x) * (2 * l * x - a**2 - x**2)
+                       / (2 * (l - a) ** 2 * a)) == 0  # eq. 66 as printed
+    mass = (sp.integrate(w_left**2, (x, 0, a)) + sp.integrate(w_right**2, (x, a, l))) / l
+    stiffness = (sp.integrate(sp.diff(w_left, x, 2) ** 2, (x, 0, a))
+                 + sp.integrate(sp.diff(w_right, x, 2) ** 2, (x, a, l)))
+    printed_mass = (2 + 4 * c - c**2 - 6 * c**3 + 3 * c**4) / (105 * (1 - c) ** 2 * c**2)
+    assert sp.simplify(mass.subs(a, c * l) - printed_mass) == 0  # eq. 67
+    assert sp.simplify(stiffness.subs(a, c * l) - 3 / ((1 - c) ** 2 * c**2 * l**3)) == 0
+    assert printed_mass.subs(c, sp.Rational(1, 2)) == sp.Rational(17, 35)  # "0,4857"
+    # the uniform-load shape, from EI y'''' = rho g with pinned ends
+    u = x / l
+    uniform = (u - 2 * u**3 + u**4) / (c - 2 * c**3 + c**4)
+    assert sp.simplify(sp.diff(uniform, x, 4) * l**4 * (c - 2 * c**3 + c**4) - 24) == 0
+    assert [sp.simplify(uniform.subs(x, 0)), sp.simplify(uniform.subs(x, l)),
+            sp.simplify(sp.diff(uniform, x, 2).subs(x, 0)),
+            sp.simplify(sp.diff(uniform, x, 2).subs(x, l))] == [0, 0, 0, 0]
+    s = c - 2 * c**3 + c**4
+    assert sp.simplify(sp.integrate(uniform**2, (x, 0, l)) / l - sp.Rational(31, 630) / s**2) == 0
+    assert sp.simplify(sp.integrate(sp.diff(uniform, x, 2) ** 2, (x, 0, l))
+                       - sp.Rational(24, 5) / (s**2 * l**3)) == 0
+    # §6.2: the spring's shape x/l (eq. 69) reduces its mass to a third (eq. 70)
+    assert sp.integrate((x / l) ** 2, (x, 0, l)) / l == sp.Rational(1, 3)

@@ -36,7 +36,13 @@ spring moment (EI/h)(th_i - th_(i-1)) equals the moment of the loads beyond it, 
 (m + rho l) g l; at the defaults that bounds every relative angle by 0.05 rad (N = 4),
 so the chain is nearly straight and its end on y = 0 puts it along +x (the beam between
 its supports) or along -x (the same beam mirrored, the roller at x = -l): two equilibria,
-both stable.
+both stable. (The search also finds folded chains held by the roller's force: unstable.)
+
+The trajectory check ('released') starts the chain at rest on the static deflection under
+the block's weight alone (eq. 66's shape), so the beam's own weight moves it: about the
+full sag, mostly in the first mode. Its fast modes are the beam's higher bending modes,
+barely excited; the trajectory gate counts each mode's share with its own bound
+(comparisons/tolerances.py).
 """
 import sympy as sp
 
