@@ -555,6 +555,13 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         from .comparisons.discretization_engines import engine_discretization
 
         doc["engines"] = engine_discretization(system, values, study, engines)
+        from .comparisons.flexible_beams import beam_of, beam_study
+
+        beam = beam_of(system.continuum, values)
+        if beam is not None:
+            # the variants: the same beam of each engine's own flexible elements (no
+            # gravity: modal work about the straight beam)
+            doc["flexible"] = beam_study(beam, engines, chosen)
     failed = [f"{e}@{study.parameter}={r['N']}" for e, x in doc.get("engines", {}).items()
               for r in x["rows"] if not r["passed"]]
     if out is not None:
@@ -590,6 +597,17 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                        + f" (gate {r['gate_vs_chain']:.0e}); against the continuum "
                        + ", ".join(f"{v:+.3e}" for v in r["error_vs_continuum"])
                        + ("" if r["passed"] else "  FAILED"))
+    for x in doc.get("flexible", {}).get("series", []):
+        name = f"  {x['simulator']} {x['kind']} (own element)"
+        if x["unsupported"]:
+            typer.echo(f"{name}: {x['unsupported']}")
+            continue
+        for p in x["points"]:
+            typer.echo(f"{name} {study.parameter} = {p['N']:3d}: "
+                       + (", ".join(f"{v:+.3e}" for v in p["relative_error"] if v is not None)
+                          if "relative_error" in p else p.get("skipped") or p.get("failure")))
+        typer.echo(f"{name}: fitted order "
+                   + ", ".join("-" if o is None else f"{o:.2f}" for o in x["fitted_order"]))
     if out is not None:
         typer.echo(f"figure: {out / figure_name(study.system)}")
     raise typer.Exit(1 if failed else 0)

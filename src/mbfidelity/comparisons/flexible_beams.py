@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Sequence
+from typing import Mapping, Sequence
 
 from ..analytic.continuum import beam_with_point_mass_frequencies
 from ..analytic.discretization import fitted_order
@@ -142,6 +142,16 @@ def beam_study(beam: Beam, simulators: Sequence[str] | None = None,
               for s in ids for kind in backends[s].BEAM_ELEMENTS]
     return {"beam": beam.as_dict(), "exact_hz": exact, "modes": count,
             "elements": [int(n) for n in elements], "series": series}
+
+
+def beam_of(continuum: str | None, values: Mapping[str, float]) -> Beam | None:
+    """The `Beam` that a system's continuum model describes (its flexible-element variants:
+    the same beam built of each engine's own elements), or None for another continuum.
+    The catalog's beam (§6.1) has its block at mid-span."""
+    if continuum != "beam_with_point_mass":
+        return None
+    return Beam(length=float(values["l"]), EI=float(values["EI"]), rho=float(values["rho"]),
+                point_mass=float(values["m"]), point_position=float(values["l"]) / 2)
 
 
 def beams_document(cases: Sequence[Beam], simulators: Sequence[str] | None = None,

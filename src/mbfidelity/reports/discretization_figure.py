@@ -14,6 +14,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 MARKERS = ("o", "s", "^", "v", "D")
+#: the engines' own flexible elements (variants of a beam): dashed, filled markers
+FLEXIBLE_STYLES = ("x--", "+--", "*--", "1--", "2--")
 
 
 def figure_name(system: str) -> str:
@@ -37,6 +39,14 @@ def write_discretization_figure(doc: dict, path: Path) -> Path:
             if pts:
                 ax.loglog(*zip(*pts), MARKERS[i % len(MARKERS)], mfc="none", ms=7 + 2 * i,
                           label=f"{sim} (its linearization)")
+        for i, x in enumerate(doc.get("flexible", {}).get("series", [])):
+            pts = [(p["N"], abs(p["relative_error"][k])) for p in x["points"]
+                   if "relative_error" in p and p["relative_error"][k] is not None]
+            if pts and not x["unsupported"]:
+                order = x["fitted_order"][k]
+                ax.loglog(*zip(*pts), FLEXIBLE_STYLES[i % len(FLEXIBLE_STYLES)], ms=5,
+                          label=f"{x['simulator']} {x['kind']}, own element"
+                                + (f" (order {order:.2f})" if order is not None else ""))
         if k == 0:
             for r in doc.get("rayleigh", []):
                 ax.axhline(abs(r["relative_error"]), ls="--", color="tab:red",

@@ -1,0 +1,103 @@
+"""§6.1, Fig. 17, eq. 62-68: the simply supported beam with a block at mid-span as a chain of
+N rigid segments (issue 12): the description against the hand's second derivation
+(tests/hand/beam_with_block.py), the exact continuum, the printed Rayleigh estimates, and
+the engines' chains and own flexible elements."""
+import json
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from mbfidelity.analytic.discretization import discretization_study
+from mbfidelity.analytic.reference import consistent_initial_state
+from mbfidelity.cli import app
+from mbfidelity.systems import get_system
+
+from hand import facts
+
+SYSTEM_ID = "beam_with_block"
+
+
+@pytest.fixture(scope="module")
+def system():
+    return get_system(SYSTEM_ID)
+
+
+def test_an_odd_N_leaves_no_node_for_the_block(system):
+    res = CliRunner().invoke(app, ["analyze", SYSTEM_ID, "--param", "N=3"])
+    assert res.exit_code != 0
+    assert "N must be even" in res.output
+
+
+def test_analyze_gives_the_continuum_both_rayleigh_estimates_and_the_chains_modes():
+    """The issue's acceptance: `analyze --json --param N=...` has the exact continuum
+    (9.0394 Hz at the defaults: 1.5708 sqrt(EI/(rho l^4)) for m = 0, §6.1), both printed
+    Rayleigh estimates above it, and the chain's modes (those of the hand's chain)."""
+    res = CliRunner().invoke(app, ["analyze", SYSTEM_ID, "--json", "--param", "N=6",
+                                   "--param", "m=0"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.output)
+    exact = doc["continuum"]["frequency_hz"]
+    assert len(exact) == 3
+    assert exact[0] == pytest.approx(math.pi / 2 * math.sqrt(100.0), rel=1e-9)  # pi^2/2pi
+    assert [r["label"] for r in doc["rayleigh"]] == ["eq. 66-68", "§6.1, own weight"]
+    # §6.1 prints 1.5822 and 1.5719 sqrt(EI/(rho l^4)) for c = 1/2, m = 0
+    assert [r["frequency_hz"] / 10.0 for r in doc["rayleigh"]] == pytest.approx(
+        [1.5822, 1.5719], abs=5e-5)
+    assert all(r["relative_error"] > 0 for r in doc["rayleigh"])  # upper bounds
+    v = get_system(SYSTEM_ID).parameter_values({"N": 6, "m": 0.0})
+    hand = np.asarray(facts()[SYSTEM_ID].frequencies(v)) / (2 * math.pi)  # rad/s
+    assert [m["frequency_hz"] for m in doc["modes"]] == pytest.approx(hand[:len(doc["modes"])],
+                                                                      rel=1e-9)
+
+
+def test_the_chain_converges_to_the_continuum_at_second_order(system):
+    """The hinge springs EI/h concentrate the curvature at the nodes: a central-difference
+    discretization of EI y'''' (second order), so the first frequency's error falls as
+    N^-2, here from below (the chain is softer than the beam). Successive orders for
+    N = 2, 4, 8 within 0.2 of 2: the next term of the error is smaller by O(N^-2), which
+    shifts the order estimated from N = 2 and 4 by about that much."""
+    study = discretization_study(system, system.parameter_values(), [2, 4, 8], modes=1)
+    errors = [row.relative_error[0] for row in study.rows]
+    assert all(e < 0 for e in errors)
+    orders = [math.log2(errors[i] / errors[i + 1]) for i in range(2)]
+    assert orders == pytest.approx([2.0, 2.0], abs=0.2)
+
+
+def test_the_release_starts_on_the_static_deflection_under_the_block(system):
+    """The 'released' scenario: the middle node m g l^3 / (48 EI) below the supports'
+    line (eq. 64 at a = l/2), the roller's end on y = 0, from rest."""
+    sc = next(s for s in system.scenarios if s.name == "released")
+    v = system.parameter_values(scenario=sc)
+    q0, qd0 = consistent_initial_state(system, sc, v)
+    h = v["l"] / v["N"]
+    th = np.asarray(q0)
+    y_nodes = np.concatenate([[0.0], np.cumsum(h * np.sin(th))])
+    half = int(v["N"]) // 2
+    assert -y_nodes[half] == pytest.approx(v["m"] * v["g"] * v["l"] ** 3 / (48 * v["EI"]),
+                                           rel=1e-12)
+    assert abs(y_nodes[-1]) < 1e-12
+    assert np.all(np.asarray(qd0) == 0)
+
+
+def test_discretization_sets_each_engines_chain_and_own_elements_beside_the_exact_beam(
+        tmp_path):
+    """Issue 12 item 4: `discretization --sim` gives, for each N, the engine's chain against
+    the derived one (its linearization gate) and against the continuum, and the engine's
+    own flexible elements (Exudyn's ANCF cable and geometrically exact beam) on the same
+    axes, each converging toward the exact value."""
+    res = CliRunner().invoke(app, ["discretization", SYSTEM_ID, "--counts", "2,4",
+                                   "--sim", "exudyn", "--out", str(tmp_path), "--json"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.output)
+    rows = doc["engines"]["exudyn"]["rows"]
+    assert [r["N"] for r in rows] == [2, 4] and all(r["passed"] for r in rows)
+    kinds = {x["kind"]: x for x in doc["flexible"]["series"] if x["simulator"] == "exudyn"}
+    assert kinds, "Exudyn declares flexible elements"
+    for x in kinds.values():
+        if x["unsupported"]:
+            continue
+        errors = [abs(p["relative_error"][0]) for p in x["points"] if "relative_error" in p]
+        assert errors and errors[-1] < errors[0] < 0.3
+    assert (tmp_path / "discretization-beam_with_block.png").stat().st_size > 0
