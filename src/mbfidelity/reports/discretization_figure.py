@@ -16,6 +16,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 MARKERS = ("o", "s", "^", "v", "D")
 #: the engines' own flexible elements (variants of a beam): dashed, filled markers
 FLEXIBLE_STYLES = ("x--", "+--", "*--", "1--", "2--")
+#: their colours (the Rayleigh lines are red)
+FLEXIBLE_COLOURS = ("tab:green", "tab:purple", "tab:brown", "tab:olive", "tab:cyan")
 
 
 def figure_name(system: str) -> str:
@@ -45,6 +47,7 @@ def write_discretization_figure(doc: dict, path: Path) -> Path:
             if pts and not x["unsupported"]:
                 order = x["fitted_order"][k]
                 ax.loglog(*zip(*pts), FLEXIBLE_STYLES[i % len(FLEXIBLE_STYLES)], ms=5,
+                          color=FLEXIBLE_COLOURS[i % len(FLEXIBLE_COLOURS)],
                           label=f"{x['simulator']} {x['kind']}, own element"
                                 + (f" (order {order:.2f})" if order is not None else ""))
         if k == 0:
