@@ -119,3 +119,33 @@ def test_the_soft_roller_is_judged_where_its_floor_is_below_the_gate(system):
     assert _judge(system, "mujoco", name, 2e-2, 9e-3).status == "fail"
     with pytest.raises(ValueError, match="expectation kind"):
         type(expectation_for(system, "mujoco", name))("mujoco", name, "judge", "typo")
+
+
+@pytest.mark.parametrize("N", [2, 4, 8])
+def test_without_the_block_the_chain_is_the_hand_closed_form_of_fourth_order(N):
+    """m = 0 and (nearly) no gravity: the derived chain's modes are the hand's closed form
+    (tests/hand/beam_with_block.py `bare_chain_frequency`, any N) to 1e-9 (g = 1e-6 leaves
+    a sag of 1e-8 rad whose geometric effect is of its square); their error against the
+    continuum, w_k (k pi/l)^2 sqrt(EI/rho), is then -(k pi/N)^4/1440 at leading order
+    (fourth order: the block at mid-span brings the second order back, for the modes that
+    move it)."""
+    hand = facts()[SYSTEM_ID]
+    res = CliRunner().invoke(app, ["analyze", SYSTEM_ID, "--json", "--param", f"N={N}",
+                                   "--param", "m=0", "--param", "g=1e-6"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.output)
+    v = get_system(SYSTEM_ID).parameter_values({"N": N, "m": 0.0, "g": 1e-6})
+    got = [m["frequency_hz"] * 2 * math.pi for m in doc["modes"]]
+    assert len(got) == N - 1
+    expected = [hand.bare_chain_frequency(v, k) for k in range(1, N)]
+    assert got == pytest.approx(expected, rel=1e-9)
+    for k, w in enumerate(expected, start=1):
+        phi = k * math.pi / N
+        if phi > math.pi / 4:
+            continue  # the expansion below is asymptotic: modes with 8 nodes or more
+        exact = (k * math.pi / v["l"]) ** 2 * math.sqrt(v["EI"] / v["rho"])
+        # the series (SymPy): 1 - phi^4/1440 - phi^6/6048 - 19 phi^8/1382400 - ...; the
+        # third term's coefficient relative to the first, 19 * 1440 / 1382400 = 0.0198,
+        # doubled for the rest at phi <= pi/4
+        ratio = (w / exact - 1) / (-phi**4 / 1440)
+        assert ratio - 1 == pytest.approx(1440 / 6048 * phi**2, abs=0.04 * phi**4)

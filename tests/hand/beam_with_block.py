@@ -122,3 +122,27 @@ def frequencies(v):
 
 def two_segment_frequency_without_gravity(v) -> float:
     return math.sqrt(32 * v["EI"] / v["l"] ** 3 / (v["m"] + v["rho"] * v["l"] / 3))
+
+
+def bare_chain_frequency(v, k: int) -> float:
+    """The k-th angular frequency of the chain without the block (m = 0) and without
+    gravity, for any N, in closed form.
+
+    Small transverse node displacements y_i (y_0 = y_N = 0, the roller sliding along x at
+    second order): segment i turns by (y_i - y_(i-1))/h, so the hinge at node i bends by
+    (y_(i+1) - 2 y_i + y_(i-1))/h and V = (EI / 2h^3) sum_i (second difference of y)^2;
+    a segment's kinetic energy (centre speed (y'_(i-1) + y'_i)/2, central moment rho h^3/12)
+    is (rho h / 6)(y'_(i-1)^2 + y'_(i-1) y'_i + y'_i^2), the consistent mass of a linear
+    element. Both operators are symmetric Toeplitz with ends that vanish, so y_i =
+    sin(k pi i / N) is a mode: with phi = k pi / N, the second difference has eigenvalue
+    -4 sin^2(phi/2) and the mass rho h (2 + cos phi)/3, so
+
+        w_k^2 = 48 EI sin^4(phi/2) / (rho h^4 (2 + cos phi)).
+
+    Against the continuum's w_k = (k pi / l)^2 sqrt(EI/rho): the ratio is (2 sin(phi/2)/
+    phi)^2 sqrt(3/(2 + cos phi)) = 1 - phi^4/1440 - ..., the second-order terms of the
+    stiffness (-phi^2/12) and of the mass (+phi^2/12) cancelling: fourth order in 1/N."""
+    h = v["l"] / v["N"]
+    phi = k * math.pi / v["N"]
+    return math.sqrt(48 * v["EI"] * math.sin(phi / 2) ** 4
+                     / (v["rho"] * h**4 * (2 + math.cos(phi))))
