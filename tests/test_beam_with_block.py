@@ -149,3 +149,26 @@ def test_without_the_block_the_chain_is_the_hand_closed_form_of_fourth_order(N):
         # doubled for the rest at phi <= pi/4
         ratio = (w / exact - 1) / (-phi**4 / 1440)
         assert ratio - 1 == pytest.approx(1440 / 6048 * phi**2, abs=0.04 * phi**4)
+
+
+def test_a_declaration_may_hold_for_some_block_masses_only(system):
+    """`Expectation.when` may name any parameter: Exudyn's release bound on the beam
+    resolves from m = 0.95 up (measured: 0.096 at 0.95, 0.101 at 0.94), so its declaration
+    applies below that mass only, evaluated at the values of the comparison under way."""
+    from mbfidelity.comparisons import runner
+
+    [declared] = [e for e in system.expectations
+                  if e.simulator == "exudyn" and e.metric == "released.*"]
+    assert declared.applies(system.structure, {"m": 0.0})
+    assert not declared.applies(system.structure, {"m": 1.0})
+
+    def exudyn_release_declared(values):
+        token = runner._COMPARED_VALUES.set(values)
+        try:
+            return any(g[0] is declared for g in runner.expectations(system, "exudyn"))
+        finally:
+            runner._COMPARED_VALUES.reset(token)
+
+    assert exudyn_release_declared(system.parameter_values({"m": 0.0}))
+    assert not exudyn_release_declared(system.parameter_values())  # m = 1
+    assert not exudyn_release_declared(None)  # outside a comparison: the defaults

@@ -234,7 +234,7 @@ def test_declarations_follow_the_structure():
                                                     "damping.fit_mode*"]
     assert mujocos(s.with_structure({"N": 26})) == ["pulled.*", "relaxed.*",
                                                     "frequency.fit_mode*", "damping.fit_mode*"]
-    with pytest.raises(ValueError, match="relation of the structural parameters"):
+    with pytest.raises(ValueError, match="relation of the parameters"):
         Expectation("*", "*", "xfail", "probe", when="M > 2").applies({"N": 3})
 
 

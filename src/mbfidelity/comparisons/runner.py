@@ -5,6 +5,7 @@ import datetime
 import fnmatch
 import platform
 import subprocess
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -101,13 +102,22 @@ class Comparison:
         }
 
 
+#: the parameter values of the comparison under way (`compare`), at which a declaration's
+#: `when` is evaluated; outside a comparison, the system's defaults
+_COMPARED_VALUES: ContextVar[Mapping[str, float] | None] = ContextVar("compared_values",
+                                                                      default=None)
+
+
 def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
     """The declarations that judge `simulator` on `system`, in matching order: the system's
     own (mechanism-specific), each one declaration, then those the backend's declared
     soft or substitute expressions of the system's elements imply
     (`simulators.base.expected_failures`), each a group of patterns declared together."""
-    return tuple((e,) for e in system.expectations if e.applies(system.structure)) + _declared(
-        system.id, simulator)
+    values = _COMPARED_VALUES.get()
+    if values is None:
+        values = system.parameter_values()
+    return tuple((e,) for e in system.expectations
+                 if e.applies(system.structure, values)) + _declared(system.id, simulator)
 
 
 @lru_cache(maxsize=None)
@@ -187,9 +197,19 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     the metrics are then measurements of the variant's own error (status "measured"
     where the description's gate is not met)."""
     system = get_system(system_id)
-    backend = get_backend(simulator)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
+    token = _COMPARED_VALUES.set(base_values)
+    try:
+        return _compare(system, simulator, params, dt, t_end, settings, scenarios,
+                        keep_series, variant, chosen_variant, base_values)
+    finally:
+        _COMPARED_VALUES.reset(token)
+
+
+def _compare(system, simulator, params, dt, t_end, settings, scenarios, keep_series, variant,
+             chosen_variant, base_values) -> Comparison:
+    backend = get_backend(simulator)
     system = system.with_structure(base_values)  # built for the user's number of elements
     ok, why = backend.available()
     if not ok:

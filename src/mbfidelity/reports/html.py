@@ -326,7 +326,8 @@ def _title(shown: str) -> str:
 def _expected(shown: str) -> list:
     system = get_system(base_id(shown))
     if shown == system.id:
-        return [e for e in system.expectations if e.applies(system.structure)]
+        return [e for e in system.expectations
+                if e.applies(system.structure, system.parameter_values())]
     v = system.variant(shown[len(system.id) + 1:-1])
     return [SimpleNamespace(simulator=", ".join(v.settings), metric="(measured, not gated)",
                             reason=v.reason)]

@@ -180,9 +180,9 @@ class Expectation:
     backend-wide declaration (simulators/base.py `expected_failures`) expects it to fail:
     the reason says why that backend's floor lies below this system's gate.
     `simulator` and `metric` are fnmatch patterns ("*" matches all). `when`: a relation
-    of the system's structural parameters (``"N >= 5"``) outside which the declaration
+    of the system's parameters (``"N >= 5"``, ``"m < 0.8"``) outside which the declaration
     does not apply: a chain's fastest mode, hence w h at the default step, grows with its
-    number of elements."""
+    number of elements; a lighter block raises the beam's first frequency."""
 
     simulator: str
     metric: str
@@ -195,14 +195,19 @@ class Expectation:
             raise ValueError(f"expectation kind {self.kind!r} is not one of "
                              f"{', '.join(EXPECTATION_KINDS)}")
 
-    def applies(self, structure: Mapping[str, int]) -> bool:
-        """Whether the declaration holds for a system built with `structure`."""
+    def applies(self, structure: Mapping[str, int],
+                values: Mapping[str, float] | None = None) -> bool:
+        """Whether the declaration holds for a system built with `structure`, compared at
+        the parameter `values` (a `when` may name any parameter: a bound that resolves
+        for one block mass may not for another)."""
         if self.when is None:
             return True
-        verdict = sp.sympify(self.when, locals={k: sp.Integer(v) for k, v in structure.items()})
+        names = {k: sp.Float(v) for k, v in (values or {}).items()}
+        names.update({k: sp.Integer(v) for k, v in structure.items()})
+        verdict = sp.sympify(self.when, locals=names)
         if verdict not in (sp.true, sp.false):
             raise ValueError(f"expectation condition {self.when!r} must be a relation of the "
-                             f"structural parameters {sorted(structure) or '(none)'}")
+                             f"parameters {sorted(names) or '(none)'}")
         return bool(verdict)
 
 

@@ -166,6 +166,16 @@ FIRST_ORDER_RELEASE_BOUND = (
     "3.2e-2 (Pymunk); at dt = 5e-4 s the bound is 0.048.")
 
 
+SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK = (
+    "With a lighter block the first mode is faster (15.7 Hz without it, against 8.7 Hz "
+    "with m = 1) and the release from the block-load deflection smaller, so Exudyn's "
+    "second-order bound, (w h)^2 (1 + w T) mode by mode, passes 0.1 of the amplitude over "
+    "the 0.5 s release below m = 0.95 (0.101 at m = 0.94, 0.096 at m = 0.95, 0.51 at "
+    "m = 0), where a pass would mean nothing. Measured maximum errors: 1.98e-2 (m = 0.94), "
+    "9.1e-2 (m = 0); the bound's leading coefficient is 1 where the trapezoidal rule's "
+    "phase error is 1/12 of it.")
+
+
 SYSTEM = System(
     id="beam_with_block",
     title="Simply supported beam with a block at mid-span, as a chain of N rigid segments",
@@ -189,6 +199,8 @@ SYSTEM = System(
           for engine in ("mujoco", "exudyn", "pybullet", "pymunk")
           for kind in ("frequency", "damping")),
         Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
+        Expectation("exudyn", "released.*", "unresolved", SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK,
+                    when="m < 0.95"),
         *(Expectation(engine, "released.*", "unresolved", FIRST_ORDER_RELEASE_BOUND)
           for engine in ("pybullet", "pymunk")),
     ),
