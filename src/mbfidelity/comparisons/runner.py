@@ -402,18 +402,17 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     ref_err = float(np.max(ref.error_estimate[free] / scale_free))
     zeta = max((max(m.damping_ratio, 0.0) for m in eq.modes), default=0.0)
     T_eff = tolerances.effective_duration(ref.t, metrics.envelope(ref.q, eq.q, scale))
-    bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + sum(
-        allowance(system, sc, values, ref, eq, dt, order)
-        for allowance in checks.trajectory_allowances(sc.checks))
+    allowances = sum(allowance(system, sc, values, ref, eq, dt, order)
+                     for allowance in checks.trajectory_allowances(sc.checks))
+    bound = tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta) + allowances
     if system.driven and eq.stable:
         driven = _driven_trajectory_bound(system, values, eq, dt, order, T_eff, zeta)
         if driven is not None:
             bound = min(bound, driven)
     tol = tolerances.gate(bound + ref_err, w, dt, order, tolerances.MAX_TRAJECTORY_TOLERANCE)
     if not system.driven:
-        modal = _modal_trajectory_gate(
-            system, values, eq, ref, free, scale_free, dt, order, T_eff,
-            ref_err + bound - tolerances.trajectory_tolerance(w, dt, order, T_eff, zeta))
+        modal = _modal_trajectory_gate(system, values, eq, ref, free, scale_free, dt, order,
+                                       T_eff, allowances + ref_err)
         if modal is not None and (tol.unresolved or modal.tolerance < tol.tolerance):
             tol = modal
     n = min(len(run.t), len(ref.t))
