@@ -598,16 +598,7 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                        + ", ".join(f"{v:+.3e}" for v in r["error_vs_continuum"])
                        + ("" if r["passed"] else "  FAILED"))
     for x in doc.get("flexible", {}).get("series", []):
-        name = f"  {x['simulator']} {x['kind']} (own element)"
-        if x["unsupported"]:
-            typer.echo(f"{name}: {x['unsupported']}")
-            continue
-        for p in x["points"]:
-            typer.echo(f"{name} {study.parameter} = {p['N']:3d}: "
-                       + (", ".join(f"{v:+.3e}" for v in p["relative_error"] if v is not None)
-                          if "relative_error" in p else p.get("skipped") or p.get("failure")))
-        typer.echo(f"{name}: fitted order "
-                   + ", ".join("-" if o is None else f"{o:.2f}" for o in x["fitted_order"]))
+        _echo_flexible_series(x)
     if out is not None:
         typer.echo(f"figure: {out / figure_name(study.system)}")
     raise typer.Exit(1 if failed else 0)
@@ -737,21 +728,26 @@ def beams_cmd(sim: Optional[List[str]] = typer.Option(
         typer.echo(f"m = {beam['point_mass']:g} kg at a = {beam['point_position']:g} m; exact "
                    + ", ".join(f"{f:.6g}" for f in case["exact_hz"]) + " Hz")
         for s in case["series"]:
-            name = f"  {s['simulator']} {s['kind']}"
-            if s["unsupported"]:
-                typer.echo(f"{name}: unsupported: {s['unsupported']}")
-                continue
-            typer.echo(f"{name} ({s['level']}, declared order {s['declared_order']})")
-            for p in s["points"]:
-                if "relative_error" not in p:
-                    typer.echo(f"    N = {p['N']:3d}: {p.get('skipped') or p.get('failure')}")
-                    continue
-                typer.echo(f"    N = {p['N']:3d}: " + "  ".join(
-                    f"{e:+.2e}" if e is not None else "    -    " for e in p["relative_error"]))
-            typer.echo("    order:   " + "  ".join(
-                f"{o:9.2f}" if o is not None else "    -    " for o in s["fitted_order"]))
+            _echo_flexible_series(s)
     if out is not None:
         typer.echo(f"figure: {figure.resolve()}")
+
+
+def _echo_flexible_series(s: dict) -> None:
+    """One engine x flexible element kind of a beam study: its errors per N, its orders."""
+    name = f"  {s['simulator']} {s['kind']}"
+    if s["unsupported"]:
+        typer.echo(f"{name}: unsupported: {s['unsupported']}")
+        return
+    typer.echo(f"{name} ({s['level']}, declared order {s['declared_order']})")
+    for p in s["points"]:
+        if "relative_error" not in p:
+            typer.echo(f"    N = {p['N']:3d}: {p.get('skipped') or p.get('failure')}")
+            continue
+        typer.echo(f"    N = {p['N']:3d}: " + "  ".join(
+            f"{e:+.2e}" if e is not None else "    -    " for e in p["relative_error"]))
+    typer.echo("    order:   " + "  ".join(
+        f"{o:9.2f}" if o is not None else "    -    " for o in s["fitted_order"]))
 
 
 @app.command("check")

@@ -150,8 +150,7 @@ def beam_of(continuum: str | None, values: Mapping[str, float]) -> Beam | None:
     The catalog's beam (§6.1) has its block at mid-span."""
     if continuum != "beam_with_point_mass":
         return None
-    return Beam(length=float(values["l"]), EI=float(values["EI"]), rho=float(values["rho"]),
-                point_mass=float(values["m"]), point_position=float(values["l"]) / 2)
+    return Beam.from_parameters({name: values[name] for name in ("l", "EI", "rho", "m")})
 
 
 def beams_document(cases: Sequence[Beam], simulators: Sequence[str] | None = None,

@@ -5,6 +5,7 @@ import datetime
 import fnmatch
 import platform
 import subprocess
+from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -108,6 +109,15 @@ _COMPARED_VALUES: ContextVar[Mapping[str, float] | None] = ContextVar("compared_
                                                                       default=None)
 
 
+@contextmanager
+def _declarations_judged_at(values: Mapping[str, float]):
+    token = _COMPARED_VALUES.set(values)
+    try:
+        yield
+    finally:
+        _COMPARED_VALUES.reset(token)
+
+
 def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
     """The declarations that judge `simulator` on `system`, in matching order: the system's
     own (mechanism-specific), each one declaration, then those the backend's declared
@@ -199,62 +209,53 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     system = get_system(system_id)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
-    token = _COMPARED_VALUES.set(base_values)
-    try:
-        return _compare(system, simulator, params, dt, t_end, settings, scenarios,
-                        keep_series, variant, chosen_variant, base_values)
-    finally:
-        _COMPARED_VALUES.reset(token)
-
-
-def _compare(system, simulator, params, dt, t_end, settings, scenarios, keep_series, variant,
-             chosen_variant, base_values) -> Comparison:
-    backend = get_backend(simulator)
-    system = system.with_structure(base_values)  # built for the user's number of elements
-    ok, why = backend.available()
-    if not ok:
-        return Comparison(system.id, simulator, "", {}, base_values, dt, supported=False,
-                          reason=f"engine not available: {why}", variant=variant or "")
-    if chosen_variant is not None and simulator not in chosen_variant.settings:
-        return Comparison(system.id, simulator, backend.version(), {}, base_values, dt,
-                          supported=False, variant=variant,
-                          reason=f"variant {variant!r} is built in "
-                                 f"{', '.join(chosen_variant.settings)} only")
-    wanted = {**(chosen_variant.settings[simulator] if chosen_variant else {}),
-              **(settings or {})}
-    merged = backend.resolve_settings(wanted)
-    result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt,
-                        variant=variant or "")
-    mech = system.numeric_mechanism(base_values, variant)
-    support = backend.support(mech)
-    unsupported = expectation_for(system, simulator, "*")
-    if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
-        result.supported = False
-        result.reason = support.reason if not support.ok else unsupported.reason
+    with _declarations_judged_at(base_values):
+        backend = get_backend(simulator)
+        system = system.with_structure(base_values)  # built for the user's number of elements
+        ok, why = backend.available()
+        if not ok:
+            return Comparison(system.id, simulator, "", {}, base_values, dt, supported=False,
+                              reason=f"engine not available: {why}", variant=variant or "")
+        if chosen_variant is not None and simulator not in chosen_variant.settings:
+            return Comparison(system.id, simulator, backend.version(), {}, base_values, dt,
+                              supported=False, variant=variant,
+                              reason=f"variant {variant!r} is built in "
+                                     f"{', '.join(chosen_variant.settings)} only")
+        wanted = {**(chosen_variant.settings[simulator] if chosen_variant else {}),
+                  **(settings or {})}
+        merged = backend.resolve_settings(wanted)
+        result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt,
+                            variant=variant or "")
+        mech = system.numeric_mechanism(base_values, variant)
+        support = backend.support(mech)
+        unsupported = expectation_for(system, simulator, "*")
+        if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
+            result.supported = False
+            result.reason = support.reason if not support.ok else unsupported.reason
+            return result
+        _refuse_unstable_step(system, backend, mech, merged, base_values, dt)
+        every = [(sc, None) for sc in system.scenarios] + near_equilibrium_scenarios(system,
+                                                                                    base_values)
+        by_name = {sc.name: (sc, eq) for sc, eq in every}
+        for name in scenarios or ():
+            if name not in by_name:
+                raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
+                                 f"{', '.join(by_name)}")
+        for name in scenarios or by_name:
+            sc, eq = by_name[name]
+            _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
+                              eq, variant)
+        _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
+                             variant)
+        if mech.spatial:
+            _compare_stored_inertia(system, backend, mech, merged, result)
+        if chosen_variant is None:
+            _strict_expectations(system, result)
+        else:
+            for m in result.metrics:
+                if m.status != "pass":
+                    m.status, m.reason = "measured", chosen_variant.reason
         return result
-    _refuse_unstable_step(system, backend, mech, merged, base_values, dt)
-    every = [(sc, None) for sc in system.scenarios] + near_equilibrium_scenarios(system,
-                                                                                base_values)
-    by_name = {sc.name: (sc, eq) for sc, eq in every}
-    for name in scenarios or ():
-        if name not in by_name:
-            raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
-                             f"{', '.join(by_name)}")
-    for name in scenarios or by_name:
-        sc, eq = by_name[name]
-        _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
-                          eq, variant)
-    _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
-                         variant)
-    if mech.spatial:
-        _compare_stored_inertia(system, backend, mech, merged, result)
-    if chosen_variant is None:
-        _strict_expectations(system, result)
-    else:
-        for m in result.metrics:
-            if m.status != "pass":
-                m.status, m.reason = "measured", chosen_variant.reason
-    return result
 
 
 #: a stored tensor is the description's up to the rounding of one diagonalisation

@@ -229,18 +229,20 @@ def modal_trajectory_tolerance(amplitudes: "np.ndarray", omegas: "np.ndarray",
     return float(np.max(np.asarray(amplitudes) @ np.asarray(errors) / np.asarray(scale)))
 
 
-def period_tolerance(w: float, h: float, order: int, period: float, zeta: float = 0.0) -> float:
-    # semi-implicit Euler: second order, plus zeta w h from damping (see above)
+def scheme_frequency_error(w: float, h: float, order: int, zeta: float) -> float:
+    """Relative shift of a mode's frequency by the scheme: (w h)^p; semi-implicit Euler's is
+    second order, plus zeta w h from damping (see above)."""
     if order == 1:
-        return (w * h) ** 2 + zeta * w * h + (h / period) ** 2
-    return (w * h) ** order + (h / period) ** 2
+        return (w * h) ** 2 + abs(zeta) * w * h
+    return (w * h) ** order
+
+
+def period_tolerance(w: float, h: float, order: int, period: float, zeta: float = 0.0) -> float:
+    return scheme_frequency_error(w, h, order, zeta) + (h / period) ** 2
 
 
 def fit_tolerance(w: float, h: float, order: int, zeta: float) -> float:
-    # semi-implicit Euler's frequency is second order, plus zeta w h from damping (above)
-    if order == 1:
-        return (w * h) ** 2 + abs(zeta) * w * h + FIT_RESOLUTION
-    return (w * h) ** order + FIT_RESOLUTION
+    return scheme_frequency_error(w, h, order, zeta) + FIT_RESOLUTION
 
 
 def discrete_linearization_tolerance(w: float, h: float, order: int) -> float:

@@ -20,6 +20,14 @@ MARKERS = ("o", "s", "^", "v", "D", "x")
 TOP = 10.0
 
 
+def mode_points(series: dict, k: int) -> list[tuple[int, float]]:
+    """(N, |relative error|) of mode k over a flexible-element series' points (those with
+    an error to draw on a log scale)."""
+    return [(p["N"], abs(p["relative_error"][k])) for p in series["points"]
+            if "relative_error" in p and p["relative_error"][k] is not None
+            and p["relative_error"][k] != 0]
+
+
 def write_beams_figure(doc: dict, path: Path) -> Path:
     """Draw the study `doc` (as `beams_document` returns it) into `path` (PNG)."""
     cases = doc["cases"]
@@ -31,9 +39,7 @@ def write_beams_figure(doc: dict, path: Path) -> Path:
         drawn = [s for s in case["series"] if not s["unsupported"]]
         for k, ax in enumerate(row):
             for i, s in enumerate(drawn):
-                pts = [(p["N"], abs(p["relative_error"][k])) for p in s["points"]
-                       if "relative_error" in p and p["relative_error"][k] is not None
-                       and p["relative_error"][k] != 0]
+                pts = mode_points(s, k)
                 if not pts:
                     continue
                 order = s["fitted_order"][k]

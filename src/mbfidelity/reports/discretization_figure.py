@@ -13,6 +13,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from .beams_figure import mode_points  # noqa: E402
+
 MARKERS = ("o", "s", "^", "v", "D")
 #: the engines' own flexible elements (variants of a beam): dashed, filled markers
 FLEXIBLE_STYLES = ("x--", "+--", "*--", "1--", "2--")
@@ -42,8 +44,7 @@ def write_discretization_figure(doc: dict, path: Path) -> Path:
                 ax.loglog(*zip(*pts), MARKERS[i % len(MARKERS)], mfc="none", ms=7 + 2 * i,
                           label=f"{sim} (its linearization)")
         for i, x in enumerate(doc.get("flexible", {}).get("series", [])):
-            pts = [(p["N"], abs(p["relative_error"][k])) for p in x["points"]
-                   if "relative_error" in p and p["relative_error"][k] is not None]
+            pts = mode_points(x, k)
             if pts and not x["unsupported"]:
                 order = x["fitted_order"][k]
                 ax.loglog(*zip(*pts), FLEXIBLE_STYLES[i % len(FLEXIBLE_STYLES)], ms=5,
