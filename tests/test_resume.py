@@ -26,7 +26,7 @@ def test_resumed_run_equals_an_uninterrupted_one(tmp_path):
     killed = tmp_path / "killed"
     shutil.copytree(clean, killed)
     (killed / "results.json").unlink()
-    (killed / "jobs" / "mass_spring_damper.pickle").unlink()
+    (killed / "jobs" / "mass_spring_damper.json").unlink()
     (killed / "jobs" / ".partial.tmp").write_bytes(b"\x80 truncated")  # a write cut short
     res = runner.invoke(app, ARGS + ["--out", str(killed), "--resume"])
     assert res.exit_code == 0, res.output

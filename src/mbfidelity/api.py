@@ -14,6 +14,8 @@ setting) raise ValueError with one line that names the problem.
 """
 from __future__ import annotations
 
+import math
+import os
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Iterable, Mapping
@@ -43,6 +45,47 @@ def _backend(simulator: str):
         raise ValueError(exc.args[0]) from None
 
 
+def checked_output_folder(out: str | Path, option: str = "--out") -> Path:
+    """`out` as a folder results can be written into (it may not exist yet), or a
+    ValueError in one line, before any work: it is not a file, no parent is a file, and
+    the nearest existing folder is writable."""
+    import os
+
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{option} {out}: is a file, not a folder")
+    _checked_parents(out, option)
+    return out
+
+
+def checked_output_file(out: str | Path, option: str = "--out") -> Path:
+    """`out` as a file that can be written (its folder may not exist yet), or a ValueError
+    in one line, before any work."""
+    out = Path(out)
+    if out.is_dir():
+        raise ValueError(f"{option} {out}: is a folder, not a file")
+    if out.exists() and not os.access(out, os.W_OK):
+        raise ValueError(f"{option} {out}: the file is not writable")
+    _checked_parents(out, option)
+    return out
+
+
+def _checked_parents(path: Path, option: str) -> None:
+    for parent in path.absolute().parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{option} {path}: {parent} is a file, not a folder")
+            if not os.access(parent, os.W_OK | os.X_OK):
+                raise ValueError(f"{option} {path}: {parent} is not writable")
+            return
+
+
+def checked_duration(name: str, value: float | None) -> None:
+    """ValueError (one line) unless `value` is None or a finite number > 0."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a finite number > 0, got {value:g}")
+
+
 def _checked_parameters(system, params: Mapping[str, float] | None) -> None:
     """Every parameter set the comparison will use (with each scenario's values)."""
     try:
@@ -52,11 +95,30 @@ def _checked_parameters(system, params: Mapping[str, float] | None) -> None:
         raise ValueError(exc.args[0]) from None
 
 
-def analyze(system_id: str, params: Mapping[str, float] | None = None) -> dict:
+def analyze(system_id: str, params: Mapping[str, float] | None = None, *,
+            timeout: float | None = None) -> dict:
     """What `mbfidelity analyze --json` prints: the equilibria with their stability (and
     modes), the operating point's linearization M, C, K (arrays) and modes, the printed
     formulas against the derivation; a floating mechanism's relative equilibrium, a
-    self-excited one's stability threshold, a driven one's steady state."""
+    self-excited one's stability threshold, a driven one's steady state. With `timeout`
+    (seconds) the analysis runs in a worker process with that budget and the worker
+    memory limit: a worker that dies, runs out of memory or out of time raises
+    RuntimeError (bad input still raises ValueError)."""
+    checked_duration("timeout", timeout)
+    if timeout is None:
+        return _analyze_here(system_id, params)
+    from .comparisons.budget import worker_memory_limit
+    from .comparisons.isolation import isolated
+
+    _system(system_id)
+    try:
+        return isolated(_analyze_here, system_id, params, timeout=timeout)
+    except MemoryError:
+        raise RuntimeError(f"out of memory (the worker limit is {worker_memory_limit():.3g} "
+                           f"bytes; MBFIDELITY_WORKER_MEMORY raises it)") from None
+
+
+def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> dict:
     import numpy as np
 
     from .analytic.errata import errata
@@ -242,10 +304,14 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     from .comparisons.runner import isolated_compare
 
     system = _system(system_id)
-    _backend(simulator)
+    backend = _backend(simulator)
+    ok, why = backend.available()
+    if not ok:
+        raise ValueError(f"{simulator} is not installed: {why}")
     _checked_parameters(system, params)
-    if not dt > 0 or (t_end is not None and not t_end > 0):
-        raise ValueError("dt and t_end must be positive")
+    checked_duration("dt", dt)
+    checked_duration("t_end", t_end)
+    checked_duration("timeout", timeout)
     if timeout is None:
         return compare_here(system.id, simulator, params, dt=dt, t_end=t_end,
                             settings=settings, variant=variant)
@@ -291,21 +357,28 @@ def run(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
         out: str | Path | None = None, *, dt: float = DEFAULT_DT,
         settings: Mapping[str, Mapping] | None = None, variants: bool = False,
         resume: bool = False, report: bool = True,
-        scheduler: str | None = None) -> list[Comparison]:
+        scheduler: str | None = None, progress=None) -> list[Comparison]:
     """The matrix systems x engines (default: all of both). With `out`, the results
     (results.json, results.csv) and, with `report`, the HTML report are written there.
     `settings` maps an engine to its settings; `scheduler`, a Dask scheduler's address,
-    runs the systems on that cluster (same results as the local pool)."""
+    runs the systems on that cluster (same results as the local pool). A failure of one
+    system x engine is an incident of that comparison; the others complete. Two runs into
+    one folder at once are refused (the second one, in one line)."""
     from .comparisons.matrix import run_matrix, write_results
 
+    from .comparisons.results_folder import exclusive
+
     sys_ids, sim_ids = _matrix(systems, sims, installed_only=False)
-    if not dt > 0:
-        raise ValueError("dt must be positive")
+    checked_duration("dt", dt)
     chosen = _validated_settings(settings)
-    out = Path(out) if out is not None else None
-    results = run_matrix(sys_ids, sim_ids, dt=dt, variants=variants, out=out, resume=resume,
-                         settings=chosen, scheduler=scheduler)
-    if out is not None:
+    if out is None:
+        return run_matrix(sys_ids, sim_ids, dt=dt, variants=variants, out=None,
+                          settings=chosen, scheduler=scheduler, progress=progress)
+    out = checked_output_folder(out)
+    with exclusive(out):
+        results = run_matrix(sys_ids, sim_ids, dt=dt, variants=variants, out=out,
+                             resume=resume, settings=chosen, scheduler=scheduler,
+                             progress=progress)
         write_results(results, out)
         if report:
             from .reports.html import write_report
@@ -350,13 +423,13 @@ def check(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
     declared and, with a `baseline` (a results folder or results.json), none got worse
     than there."""
     if baseline is not None:
-        folder = Path(baseline)
-        if not (folder / "results.json" if folder.is_dir() else folder).exists():
-            raise ValueError(f"baseline {baseline}: no results.json there")
+        from .comparisons.diff import load_run
+
+        load_run(Path(baseline))  # a ValueError now, before the work, if it is not one
+    checked_output_folder(out)
     results = run(*_matrix(systems, sims, installed_only=True), out=out, dt=dt,
                   settings=settings, report=report)
-    verdicts = [Verdict(c.system, c.simulator, c.engine_version,
-                        "unsupported" if not c.supported else "pass" if c.passed else "fail",
+    verdicts = [Verdict(c.system, c.simulator, c.engine_version, c.verdict,
                         [m.name for m in c.metrics if not holds(m)], c.reason,
                         [i["outcome"] for i in c.incidents])
                 for c in results]

@@ -44,6 +44,19 @@ def _use_system_paths(paths: Optional[List[Path]]) -> None:
         _fail(str(exc))
 
 
+def _out_folder(value: Optional[Path]) -> Optional[Path]:
+    """An --out folder checked before any work (one line and exit 2 when it cannot be
+    written)."""
+    if value is not None:
+        from .api import checked_output_folder
+
+        try:
+            checked_output_folder(value)
+        except ValueError as exc:
+            _fail(str(exc))
+    return value
+
+
 SYSTEM_PATH_HELP = ("a mechanism module of your own (written like those in "
                     "mbfidelity/systems/), added to the catalog; repeatable")
 
@@ -169,6 +182,8 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             as_json: bool = typer.Option(False, "--json"),
             no_cache: bool = typer.Option(False, "--no-cache", help="recompute the derivations "
                                           "instead of reading the persistent cache"),
+            timeout: float = typer.Option(
+                900.0, "--timeout", help="wall-clock budget of the analysis, s (> 0)"),
             ) -> None:
     """Equilibria with stability, M, K, C, modes, printed-vs-derived comparison."""
     from . import api
@@ -178,9 +193,12 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     params = _parse_params(param)
     values, derived = _values(system, params)
     try:
-        doc = api.analyze(system.id, params)
+        doc = api.analyze(system.id, params, timeout=timeout)
     except ValueError as exc:
         _fail(str(exc))
+    except RuntimeError as exc:  # the worker crashed or ran out of time or memory
+        typer.echo(f"error: analyze {system.id}: {exc}", err=True)
+        raise typer.Exit(1)
     if doc.get("floquet") is not None:
         if as_json:
             _json(doc)
@@ -271,28 +289,21 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                     None, "--variant", help="build the system's named variant (e.g. contact)"),
                 as_json: bool = typer.Option(False, "--json"),
                 timeout: float = typer.Option(
-                    900.0, "--timeout", help="wall-clock budget of the comparison, s"),
+                    900.0, "--timeout", help="wall-clock budget of the comparison, s (> 0)"),
                 no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
                                               "derivations instead of reading the cache"),
                 ) -> None:
     """One comparison: metrics, tolerances, pass/fail (the engine runs in a worker
     process: a crash or a run past --timeout is reported, exit 1)."""
-    from .comparisons.runner import isolated_compare
-    from .simulators import get_backend
+    from . import api
 
     _use_cache(no_cache)
     system = _system(system_id)
     params = _parse_params(param)
     _values(system, params, system.scenarios)
     try:
-        get_backend(sim)
-    except KeyError as exc:
-        _fail(exc.args[0])
-    if not dt > 0 or (t_end is not None and not t_end > 0):
-        _fail("--dt and --t-end must be positive")
-    try:
-        result = isolated_compare(system.id, sim, params, dt=dt, t_end=t_end, timeout=timeout,
-                                  settings=_settings(setting), variant=variant)
+        result = api.compare(system.id, sim, params, dt=dt, t_end=t_end, timeout=timeout,
+                             settings=_settings(setting), variant=variant)
     except ValueError as exc:
         _fail(str(exc))
     doc = result.as_dict()
@@ -301,8 +312,6 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     else:
         shown = f"{result.system}[{result.variant}]" if result.variant else result.system
         typer.echo(f"{shown} on {result.simulator} {result.engine_version}, dt={dt:g}")
-        if not result.supported:
-            typer.echo(f"  unsupported: {result.reason}")
         said = set()
         for m in result.metrics:
             extra = f"  ({m.reason})" if m.reason and m.reason not in said else ""
@@ -310,15 +319,19 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
             typer.echo(f"  {m.name:34s} {m.value:10.3e} <= {m.tolerance:9.3e}  {m.status}{extra}")
         for i in result.incidents:
             at = f" at t = {i['t_reached']:.6g} s" if i.get("t_reached") is not None else ""
-            typer.echo(f"  {i['scenario']}: {i['outcome']}{at}: {i['message']}")
-        typer.echo("PASSED" if result.passed else "FAILED")
-    raise typer.Exit(0 if result.passed else 1)
+            stage = f" ({i['stage']})" if i.get("stage") else ""
+            typer.echo(f"  {i['scenario']}{stage}: {i['outcome']}{at}: {i['message']}")
+        if result.verdict == "unsupported":
+            typer.echo(f"UNSUPPORTED (declared): {result.reason}")
+        else:
+            typer.echo("PASSED" if result.passed else "FAILED")
+    raise typer.Exit(1 if result.verdict == "fail" else 0)
 
 
 @app.command()
 def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
         sims: Optional[List[str]] = typer.Option(None, "--sims", help="simulator ids"),
-        out: Path = typer.Option(Path("results"), "--out", help="output folder"),
+        out: Path = typer.Option(Path("results"), "--out", callback=_out_folder, help="output folder"),
         dt: float = typer.Option(1e-3, "--dt"),
         variants: bool = typer.Option(False, "--variants/--no-variants",
                                       help="also run each system's variants (e.g. rolling by "
@@ -338,8 +351,8 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
     settings = _engine_settings(setting)
     from rich.progress import Progress
 
-    from .comparisons.matrix import reusable_jobs, run_matrix, write_results
-    from .reports.html import write_report
+    from . import api
+    from .comparisons.matrix import reusable_jobs
     from .simulators import all_backends
     from .systems import all_systems
 
@@ -350,6 +363,11 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
     for e in sim_ids:
         if e not in all_backends():
             _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
+    try:
+        api.checked_output_folder(out)
+        api.checked_duration("--dt", dt)
+    except ValueError as exc:
+        _fail(str(exc))
     if resume:
         reused = reusable_jobs(out, sys_ids, sim_ids, dt, variants, settings)
         typer.echo(f"resuming: {len(reused)} of {len(sys_ids)} systems finished in {out}, "
@@ -360,20 +378,24 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
 
         def tick(c):
             progress.update(task, advance=1, description=f"{c.system} / {c.simulator}")
-        results = run_matrix(sys_ids, sim_ids, dt=dt, progress=tick, variants=variants,
-                             out=out, resume=resume, settings=settings, scheduler=scheduler)
-    write_results(results, out)
-    index = write_report(out)
+        try:
+            results = api.run(sys_ids, sim_ids, out, dt=dt, settings=settings,
+                              variants=variants, resume=resume, scheduler=scheduler,
+                              progress=tick)
+        except ValueError as exc:
+            _fail(str(exc))
     elapsed = time.perf_counter() - start
-    failed = [f"{c.system}/{c.simulator}" for c in results if c.supported and not c.passed]
+    verdicts = [c.verdict for c in results]
     typer.echo(f"{len(results)} comparisons in {elapsed:.1f} s; "
-               f"{sum(c.passed for c in results)} passed, {len(failed)} failed")
+               f"{verdicts.count('pass')} passed, {verdicts.count('fail')} failed, "
+               f"{verdicts.count('unsupported')} unsupported (declared)")
     for c in results:
         for i in c.incidents:
-            typer.echo(f"  {c.system}/{c.simulator} {i['scenario']}: {i['outcome']}: "
+            stage = f" ({i['stage']})" if i.get("stage") else ""
+            typer.echo(f"  {c.system}/{c.simulator} {i['scenario']}{stage}: {i['outcome']}: "
                        f"{i['message']}")
     typer.echo(f"results: {out.resolve()}")
-    typer.echo(f"report:  {index.resolve()}")
+    typer.echo(f"report:  {(out / 'index.html').resolve()}")
 
 
 def _split(items):
@@ -408,7 +430,7 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                witnesses: bool = typer.Option(True, "--witnesses/--no-witnesses",
                                               help="run the engines on misprinted equations"),
                out: Optional[Path] = typer.Option(
-                   None, "--out", help="also write errata.html and errata.json there"),
+                   None, "--out", callback=_out_folder, help="also write errata.html and errata.json there"),
                no_cache: bool = typer.Option(False, "--no-cache", help="recompute the "
                                              "derivations instead of reading the cache"),
                ) -> None:
@@ -443,7 +465,7 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                gamma_range: str = typer.Option("0,3", "--gamma", help="A,B"),
                as_json: bool = typer.Option(False, "--json"),
                out: Optional[Path] = typer.Option(
-                   None, "--out", help="also write strutt.json and strutt.png there"),
+                   None, "--out", callback=_out_folder, help="also write strutt.json and strutt.png there"),
                sim: Optional[List[str]] = typer.Option(
                    None, "--sim", help="also classify every point by this engine's runs "
                                        "(repeatable)"),
@@ -522,7 +544,7 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                            None, "--sim", help="also each engine's build of the chain, "
                                                "from its own linearization (repeatable)"),
                        out: Optional[Path] = typer.Option(
-                           None, "--out", help="also write discretization-SYSTEM.json and "
+                           None, "--out", callback=_out_folder, help="also write discretization-SYSTEM.json and "
                                                ".png there"),
                        as_json: bool = typer.Option(False, "--json"),
                        ) -> None:
@@ -615,7 +637,7 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
                                               "fast motion)"),
                     t_end: float = typer.Option(2.0, "--t-end", help="simulated time, s"),
                     out: Optional[Path] = typer.Option(
-                        None, "--out", help="also write convergence.json, convergence.html "
+                        None, "--out", callback=_out_folder, help="also write convergence.json, convergence.html "
                                             "and the figures there"),
                     scheduler: Optional[str] = typer.Option(
                         None, "--scheduler", help="a Dask scheduler's address (default: a "
@@ -686,7 +708,7 @@ def beams_cmd(sim: Optional[List[str]] = typer.Option(
               modes: int = typer.Option(3, "--modes", help="frequencies per point"),
               as_json: bool = typer.Option(False, "--json"),
               out: Optional[Path] = typer.Option(
-                  None, "--out", help="also write beams.json and beams.png there"),
+                  None, "--out", callback=_out_folder, help="also write beams.json and beams.png there"),
               ) -> None:
     """The engines' own flexible elements against the exact beam of §6.1 (Fig. 17): the
     first natural frequencies of the simply supported beam with a point mass, built of N
@@ -757,7 +779,7 @@ def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
               baseline: Optional[Path] = typer.Option(
                   None, "--baseline", help="a results folder (or results.json) to compare "
                                            "with: a gate that got worse fails the check"),
-              out: Path = typer.Option(Path("mbfidelity-check"), "--out",
+              out: Path = typer.Option(Path("mbfidelity-check"), "--out", callback=_out_folder,
                                        help="where the results are written"),
               dt: float = typer.Option(1e-3, "--dt"),
               setting: Optional[List[str]] = typer.Option(
@@ -833,9 +855,12 @@ def diff_cmd(old: Path = typer.Argument(..., metavar="OLD", help="results folder
     """What changed between two runs, per system x engine x metric: engine versions and
     settings, metrics that moved, gates that flipped, new and vanished metrics. Exit 1
     when a gate got worse."""
+    from . import api
     from .comparisons.diff import diff_runs
 
     try:
+        if html_page is not None:
+            api.checked_output_file(html_page, "--html")
         changes = diff_runs(old, new)
     except ValueError as exc:
         _fail(str(exc))
@@ -869,6 +894,7 @@ def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     params = _parse_params(param)
     _values(system, params, system.scenarios)
     try:
+        api.checked_output_file(out)
         text, outside = api.export(system.id, sim, params, settings=_settings(setting), dt=dt)
     except ValueError as exc:
         _fail(str(exc))
@@ -879,8 +905,38 @@ def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         typer.echo(f"  not in the file: {note}")
 
 
+GLOBAL_OPTIONS = ("--system-path",)
+
+
+def global_options_first(argv: list[str]) -> list[str]:
+    """The arguments with every global option (and its value) moved before the command,
+    so that `mbfidelity run --system-path F` means `mbfidelity --system-path F run`. A
+    command's own `--system-path` (check's) stays where it is."""
+    head, rest, i = [], [], 0
+    own = {"check"}
+    command = next((a for a in argv if not a.startswith("-")), None)
+    while i < len(argv):
+        arg = argv[i]
+        name = arg.split("=", 1)[0]
+        if name in GLOBAL_OPTIONS and command not in own:
+            if "=" in arg:
+                head.append(arg)
+            else:
+                head += argv[i:i + 2]
+                i += 1
+        else:
+            rest.append(arg)
+        i += 1
+    return head + rest
+
+
 def main() -> None:
-    app()
+    try:
+        app(args=global_options_first(sys.argv[1:]), prog_name="mbfidelity")
+    except OSError as exc:  # a path given by the user that cannot be read or written
+        where = f": {exc.filename}" if exc.filename else ""
+        typer.echo(f"error: {exc.strerror or exc}{where}", err=True)
+        sys.exit(2)
 
 
 if __name__ == "__main__":

@@ -43,19 +43,13 @@ class GateItem(pytest.Item):
 
     def runtest(self) -> None:
         from .comparisons.runner import compare
+        from .comparisons.verdict import UNSUPPORTED, failure_lines, verdict
 
         result = compare(self.system_id, self.simulator, dt=self.dt)
-        if not result.supported:
-            pytest.skip(f"{self.simulator} cannot express {self.system_id}: {result.reason}")
-        lines = []
-        for m in result.metrics:
-            if m.status == "fail":
-                lines.append(f"{m.name}: {m.value:.3e} > {m.tolerance:.3e}")
-            elif m.status == "xpass":
-                lines.append(f"{m.name}: passed but declared an expected failure ({m.reason})")
-            elif m.status == "unresolved" and not m.expected:
-                lines.append(f"{m.name}: cannot judge ({m.reason})")
-        lines += [f"{i['scenario']}: {i['outcome']}: {i['message']}" for i in result.incidents]
+        if verdict(result) == UNSUPPORTED:  # declared: a visible skip with the reason
+            pytest.skip(f"unsupported (declared): {self.simulator} cannot express "
+                        f"{self.system_id}: {result.reason}")
+        lines = failure_lines(result)
         if lines:
             raise GatesFailed("\n".join(lines))
 

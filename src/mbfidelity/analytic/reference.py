@@ -42,11 +42,22 @@ class Reference:
     actuator_forces: dict | None = None
 
 
+class ReferenceFailed(RuntimeError):
+    """The reference could not be solved over the scenario; `t_reached` is the last time
+    the solver reached."""
+
+    def __init__(self, message: str, t_reached: float | None = None) -> None:
+        super().__init__(message)
+        self.t_reached = t_reached
+
+
 def _dop853(model, y0: np.ndarray, t: np.ndarray, tol: float) -> np.ndarray:
     sol = solve_ivp(model.ode_rhs, (t[0], t[-1]), y0, method="DOP853", rtol=tol, atol=tol,
                     t_eval=t)
     if not sol.success:
-        raise RuntimeError(f"reference solve failed: {sol.message}")
+        reached = float(sol.t[-1]) if len(sol.t) else float(t[0])
+        raise ReferenceFailed(f"reference solve failed at t = {reached:.6g} s: {sol.message}",
+                              reached)
     return sol.y.T
 
 

@@ -232,7 +232,13 @@ def judge_order(study: ConvergenceStudy) -> Metric:
 def _study_item(item: tuple) -> dict:
     """One system x engine (`dts` None: automatic steps)."""
     system_id, simulator, dts, t_end = item
-    study = convergence(system_id, simulator, None, dts, t_end)
+    try:
+        study = convergence(system_id, simulator, None, dts, t_end)
+    except Exception as exc:  # one failed study fails its item only
+        system = get_system(system_id)
+        study = ConvergenceStudy(system.id, system.scenarios[0].name, simulator,
+                                 get_backend(simulator).version(), 0, [], None,
+                                 failure=" ".join(f"{type(exc).__name__}: {exc}".split())[:500])
     return {**study.as_dict(), "metric": judge_order(study).as_dict()}
 
 

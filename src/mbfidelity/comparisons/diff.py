@@ -18,12 +18,7 @@ from .results_folder import RESULTS, comparisons_from_document, row_id
 from .runner import Comparison, Metric
 
 #: metric statuses that do not fail a comparison (an unresolved one only if declared)
-HOLDING = ("pass", "xfail", "measured")
-
-
-def holds(m: Metric) -> bool:
-    """Whether the metric lets its comparison pass (as `Comparison.passed` judges it)."""
-    return m.status in HOLDING or (m.status == "unresolved" and m.expected)
+from .verdict import HOLDING, holds  # noqa: F401  (the one rule, re-exported)
 
 
 @dataclass
@@ -80,14 +75,14 @@ class ResultsDiff:
                               if p.kind == "same"]}
 
 
-def _load(path: Path) -> tuple[dict, list[Comparison]]:
+def load_run(path: Path) -> tuple[dict, list[Comparison]]:
     """A run given as its folder or as a results document (results.json, or a recorded
     baseline under another name)."""
     path = Path(path)
     document = path / RESULTS if path.is_dir() else path
     try:
         doc = json.loads(document.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, ValueError) as exc:
         raise ValueError(f"{path}: no readable {RESULTS} (a results folder of `mbfidelity "
                          f"run` or `check`, or a recorded results.json): {exc}") from exc
     return comparisons_from_document(doc, str(document))
@@ -126,8 +121,8 @@ def _differing(a: dict, b: dict) -> dict:
 
 def diff_runs(old: Path, new: Path) -> ResultsDiff:
     """The differences between two runs (folders or recorded results.json files)."""
-    prov_old, comps_old = _load(old)
-    prov_new, comps_new = _load(new)
+    prov_old, comps_old = load_run(old)
+    prov_new, comps_new = load_run(new)
     before = {(row_id(c), c.simulator): c for c in comps_old}
     after = {(row_id(c), c.simulator): c for c in comps_new}
     pairs = []

@@ -4,7 +4,8 @@ segfault, an abort, a loop that never returns) costs one comparison, not the cal
 `isolated(fn, *args, timeout=..., **kwargs)` calls fn in a forked child and returns its
 result; an exception raised by fn is raised again here (bad input stays bad input);
 a child that dies raises `WorkerCrashed` (with its exit signal or code), one that
-exceeds the wall-clock budget is killed and raises `WorkerTimedOut`.
+exceeds the wall-clock budget is killed and raises `WorkerTimedOut`. The child dies
+with the caller and carries the worker memory limit (`budget.become_worker`).
 """
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ import os
 import signal
 import sys
 from typing import Any, Callable
+
+from .budget import become_worker
 
 
 class WorkerCrashed(RuntimeError):
@@ -23,7 +26,8 @@ class WorkerTimedOut(RuntimeError):
     """The worker process exceeded its wall-clock budget and was killed."""
 
 
-def _child(conn, fn, args, kwargs) -> None:
+def _child(conn, parent, fn, args, kwargs) -> None:
+    become_worker(parent)
     # what engines print from their own code (Exudyn's solver banners) goes to stderr:
     # the caller's stdout may be a JSON document
     sys.stdout.flush()
@@ -50,7 +54,8 @@ def _describe(exitcode: int | None) -> str:
 def isolated(fn: Callable[..., Any], *args, timeout: float | None = None, **kwargs) -> Any:
     context = multiprocessing.get_context("fork")
     receiver, sender = context.Pipe(duplex=False)
-    worker = context.Process(target=_child, args=(sender, fn, args, kwargs), daemon=True)
+    worker = context.Process(target=_child, args=(sender, os.getpid(), fn, args, kwargs),
+                             daemon=True)
     worker.start()
     sender.close()
     try:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import csv
 import json
 import os
-import pickle
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -17,8 +16,10 @@ import numpy as np
 
 from ..systems import get_system
 from . import results_folder
+from .budget import become_worker
 from ..analytic.derivation import cache_key
-from .runner import DEFAULT_DT, Comparison, compare, isolated_compare, provenance
+from .runner import (DEFAULT_DT, Comparison, compare, failed_comparison, isolated_compare,
+                     provenance, record_incident)
 
 #: wall-clock budget of one comparison when a job is re-run engine by engine after its
 #: worker died (see `run_matrix`)
@@ -39,15 +40,25 @@ def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
     comparisons and the job's CPU seconds."""
     system, sims, dt, variants, out, settings = args
     start = time.process_time()
-    found = [run(system, sim, dt=dt, keep_series=True, settings=settings.get(sim))
-             for sim in sims]
+
+    def attempt(sim, **kwargs) -> Comparison:
+        try:
+            return run(system, sim, dt=dt, keep_series=True, **kwargs)
+        except Exception as exc:  # this comparison fails; the others go on
+            return failed_comparison(system, sim, None, dt, kwargs.get("variant") or "",
+                                     "comparison", exc)
+    found = [attempt(sim, settings=settings.get(sim)) for sim in sims]
     if variants:
         for v in get_system(system).variants:
             # engines that do not build the variant give an "unsupported" row, with why
-            found += [run(system, sim, dt=dt, keep_series=True, variant=v.name)
-                      for sim in sims]
+            found += [attempt(sim, variant=v.name) for sim in sims]
     if out is not None:
-        _save_report_files(out, system, found)
+        try:
+            _save_report_files(out, system, found)
+        except Exception as exc:  # the results stand; the report shows the incident
+            for c in found:
+                c.series = {}
+                record_incident(c, "*", "report files", exc)
     return found, time.process_time() - start
 
 
@@ -96,6 +107,11 @@ def _run_on_cluster(scheduler: str, order: list[int], systems: list[str], common
     return crashed
 
 
+def _failed_job(system: str, sims: list[str], dt: float, exc: BaseException
+                ) -> list[Comparison]:
+    return [failed_comparison(system, sim, None, dt, "", "job", exc) for sim in sims]
+
+
 def _isolated_job(args) -> tuple[list[Comparison], float]:
     """A job whose worker died, again, each comparison in a worker of its own with a
     wall-clock budget: the one that kills its worker is recorded as crashed (or
@@ -117,26 +133,38 @@ def _job_request(system: str, sims: list[str], dt: float, variants: bool,
 
 
 def _job_path(out: Path, system: str) -> Path:
-    return out / "jobs" / f"{system}.pickle"
+    return out / "jobs" / f"{system}.json"
 
 
 def _save_job(out: Path, request: tuple, job: tuple[list[Comparison], float]) -> None:
-    """Atomically (temporary file, then rename): a run killed while writing leaves the
-    previous state, never a partial file."""
+    """As plain data (JSON: nothing in an output folder is ever executed), atomically
+    (temporary file, then rename): a run killed while writing leaves the previous state,
+    never a partial file."""
     path = _job_path(out, request[0])
     path.parent.mkdir(parents=True, exist_ok=True)
+    comparisons, cpu = job
+    doc = {"request": list(request), "cpu_seconds": cpu, "provenance": {},
+           "comparisons": [c.as_dict() for c in comparisons]}
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    with os.fdopen(fd, "wb") as fh:
-        pickle.dump((request, job), fh, protocol=pickle.HIGHEST_PROTOCOL)
+    with os.fdopen(fd, "w") as fh:
+        json.dump(doc, fh, default=float)
     os.replace(tmp, path)
 
 
 def _load_job(out: Path, request: tuple) -> tuple[list[Comparison], float] | None:
+    """The saved job answering `request`, or None (missing, damaged, another request, or
+    report files of the system that no longer load: recomputed, never trusted)."""
     try:
-        saved, job = pickle.loads(_job_path(out, request[0]).read_bytes())
-    except Exception:  # missing, partial or from another version: recomputed
+        doc = json.loads(_job_path(out, request[0]).read_text())
+        if doc["request"] != json.loads(json.dumps(list(request))):
+            return None
+        _, comparisons = results_folder.comparisons_from_document(doc, "a saved job")
+        cpu = float(doc["cpu_seconds"])
+    except Exception:  # missing, partial, damaged or from another version
         return None
-    return job if saved == request else None
+    if not results_folder.report_files_intact(out, request[0], comparisons):
+        return None
+    return comparisons, cpu
 
 
 def reusable_jobs(out: Path, systems: Iterable[str], simulators: Iterable[str],
@@ -232,15 +260,20 @@ def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DE
             collect(i, _one_system((systems[i], sims, dt, variants, out, settings)))
     else:
         order = longest_first()
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
+                                 initargs=(os.getpid(),)) as pool:
             futures = {pool.submit(_one_system,
                                    (systems[i], sims, dt, variants, out, settings)): i
                        for i in order}
             for fut in as_completed(futures):
                 try:
-                    collect(futures[fut], fut.result())
+                    job = fut.result()
                 except BrokenProcessPool:
                     crashed.append(futures[fut])
+                    continue
+                except Exception as exc:  # the job could not come back: its rows fail
+                    job = (_failed_job(systems[futures[fut]], sims, dt, exc), 0.0)
+                collect(futures[fut], job)
     for i in sorted(crashed):
         collect(i, _isolated_job((systems[i], sims, dt, variants, out, settings)))
     if out is not None:

@@ -13,14 +13,19 @@ Layout of a folder written by `mbfidelity run --out DIR` (and `mbfidelity errata
                                 (world-frame geometry) and the system's errata entries
     errata.json                 every printed formula, its verdict and the engines'
                                 witnesses (`mbfidelity errata --out`)
+    jobs/<system>.json          each finished system's comparisons, as plain data, for
+                                `run --resume` (reused only when it and the system's
+                                report files load and answer the same request)
+    .mbfidelity.lock            held by the run writing into the folder
 
 A row is the system id, with the variant in brackets for a variant's comparisons.
 """
 from __future__ import annotations
 
 import json
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Iterator
 
 import numpy as np
 import sympy as sp
@@ -230,6 +235,44 @@ def load_system(out: Path, system_id: str) -> dict:
 # --- the metrics -----------------------------------------------------------------------
 
 
+LOCK = ".mbfidelity.lock"
+
+
+@contextmanager
+def exclusive(out: Path) -> Iterator[None]:
+    """Holds `out` for one run: a second run into the same folder while this one works is
+    refused with a ValueError (one line) instead of interleaving its files. The lock is
+    the operating system's (released when the process ends, however it ends)."""
+    out.mkdir(parents=True, exist_ok=True)
+    handle = open(out / LOCK, "a+")
+    try:
+        import fcntl
+    except ImportError:  # not a POSIX system: no lock
+        fcntl = None
+    try:
+        if fcntl is not None:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise ValueError(f"{out}: another run is writing into this folder; wait for "
+                                 f"it to finish or choose another --out") from None
+        yield
+    finally:
+        handle.close()
+
+
+def report_files_intact(out: Path, system_id: str, comparisons: Iterable[Comparison]) -> bool:
+    """Whether what the report shows of a finished system (its drawing and errata, each
+    row's series) is in `out` and loads."""
+    try:
+        load_system(out, system_id)
+        for row in rows_of(comparisons):
+            load_series(out, row)
+    except Exception:  # missing, truncated or damaged: the system is recomputed
+        return False
+    return True
+
+
 def load_results(out: Path) -> tuple[dict, list[Comparison]]:
     """(provenance, comparisons) of results.json, without their series (`load_series`)."""
     return comparisons_from_document(json.loads((out / RESULTS).read_text()), str(out))
@@ -241,6 +284,8 @@ def comparisons_from_document(doc: dict, source: str = "results") -> tuple[dict,
     try:
         comparisons = []
         for c in doc["comparisons"]:
+            for m in c["metrics"]:
+                _check_metric(m)
             metrics = [Metric(name=m["name"], value=m["value"], tolerance=m["tolerance"],
                               passed=m["passed"], status=m["status"],
                               reason=m.get("reason", ""), unit=m["unit"],
@@ -254,9 +299,17 @@ def comparisons_from_document(doc: dict, source: str = "results") -> tuple[dict,
                 simulated_time=c["simulated_time_s"], variant=c["variant"],
                 incidents=c.get("incidents", [])))
         return doc["provenance"], comparisons
-    except (KeyError, TypeError) as exc:
-        raise ValueError(f"{source}: not a results document of mbfidelity (missing "
-                         f"{exc})") from exc
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise ValueError(f"{source}: not a results document of mbfidelity ({exc})") from exc
+
+
+def _check_metric(m: dict) -> None:
+    """TypeError naming the field unless the metric's numbers are numbers."""
+    for key in ("value", "tolerance"):
+        if isinstance(m[key], bool) or not isinstance(m[key], (int, float)):
+            raise TypeError(f"metric {m.get('name')!r}: {key} is not a number: {m[key]!r}")
+    if not isinstance(m["status"], str) or not isinstance(m["name"], str):
+        raise TypeError(f"metric {m.get('name')!r}: name and status must be text")
 
 
 # --- job costs -------------------------------------------------------------------------

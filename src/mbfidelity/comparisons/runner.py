@@ -10,6 +10,7 @@ from contextvars import ContextVar
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -26,8 +27,10 @@ from ..simulators import get_backend
 from ..simulators.base import expected_failures
 from ..systems import Expectation, System, get_system
 from ..systems.model import inertia_matrix
-from . import checks, metrics, tolerances
+from . import budget, checks, metrics, tolerances
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
+from .verdict import PASS
+from .verdict import verdict as verdict_of
 
 DEFAULT_DT = 1e-3
 
@@ -87,9 +90,13 @@ class Comparison:
 
     @property
     def passed(self) -> bool:
-        return self.supported and all(
-            m.status in ("pass", "xfail", "measured") or (m.status == "unresolved" and m.expected)
-            for m in self.metrics)
+        """Supported and every metric holds (`verdict.verdict` is "pass")."""
+        return verdict_of(self) == PASS
+
+    @property
+    def verdict(self) -> str:
+        """pass | fail | unsupported (`comparisons/verdict.py`)."""
+        return verdict_of(self)
 
     def as_dict(self) -> dict:
         return {
@@ -100,6 +107,7 @@ class Comparison:
             "passed": self.passed, "wall_time_s": self.wall_time,
             "simulated_time_s": self.simulated_time, "variant": self.variant,
             "outcome": self.outcome, "incidents": self.incidents,
+            "verdict": self.verdict,
         }
 
 
@@ -226,7 +234,16 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
         merged = backend.resolve_settings(wanted)
         result = Comparison(system.id, simulator, backend.version(), merged, base_values, dt,
                             variant=variant or "")
-        mech = system.numeric_mechanism(base_values, variant)
+        for name in scenarios or ():
+            if name not in {sc.name for sc in system.scenarios} | {
+                    sc.name for sc, _ in _contained_near_equilibrium(system, base_values)}:
+                raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
+                                 f"{', '.join(sc.name for sc in system.scenarios)}")
+        # from here on every stage's failure is an incident of this comparison
+        with contained(result, "*", "description") as stage:
+            mech = system.numeric_mechanism(base_values, variant)
+        if stage.failed:
+            return _finished(system, result, chosen_variant)
         support = backend.support(mech)
         unsupported = expectation_for(system, simulator, "*")
         if not support.ok or (unsupported is not None and unsupported.kind == "unsupported"):
@@ -234,28 +251,41 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
             result.reason = support.reason if not support.ok else unsupported.reason
             return result
         _refuse_unstable_step(system, backend, mech, merged, base_values, dt)
-        every = [(sc, None) for sc in system.scenarios] + near_equilibrium_scenarios(system,
-                                                                                    base_values)
+        budget.refuse_over_budget(comparison_cost(system, base_values, dt, t_end, scenarios))
+        every = [(sc, None) for sc in system.scenarios]
+        with contained(result, "*", "equilibrium"):
+            every += near_equilibrium_scenarios(system, base_values)
         by_name = {sc.name: (sc, eq) for sc, eq in every}
-        for name in scenarios or ():
-            if name not in by_name:
-                raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
-                                 f"{', '.join(by_name)}")
         for name in scenarios or by_name:
             sc, eq = by_name[name]
-            _compare_scenario(system, backend, sc, params, dt, t_end, merged, result, keep_series,
-                              eq, variant)
-        _compare_frequencies(system, backend, base_values, dt, t_end, merged, result, keep_series,
-                             variant)
+            with contained(result, name, "comparison"):
+                _compare_scenario(system, backend, sc, params, dt, t_end, merged, result,
+                                  keep_series, eq, variant)
+        with contained(result, "frequency", "comparison"):
+            _compare_frequencies(system, backend, base_values, dt, t_end, merged, result,
+                                 keep_series, variant)
         if mech.spatial:
-            _compare_stored_inertia(system, backend, mech, merged, result)
-        if chosen_variant is None:
-            _strict_expectations(system, result)
-        else:
-            for m in result.metrics:
-                if m.status != "pass":
-                    m.status, m.reason = "measured", chosen_variant.reason
-        return result
+            with contained(result, "inertia", "engine build"):
+                _compare_stored_inertia(system, backend, mech, merged, result)
+        return _finished(system, result, chosen_variant)
+
+
+def _contained_near_equilibrium(system: System, values: Mapping[str, float]) -> list:
+    try:
+        return near_equilibrium_scenarios(system, values)
+    except Exception:  # recorded as an incident by the comparison itself
+        return []
+
+
+def _finished(system: System, result: Comparison, chosen_variant) -> Comparison:
+    """The strict expectations of the description, or a variant's own measurements."""
+    if chosen_variant is None:
+        _strict_expectations(system, result)
+    else:
+        for m in result.metrics:
+            if m.status != "pass":
+                m.status, m.reason = "measured", chosen_variant.reason
+    return result
 
 
 #: a stored tensor is the description's up to the rounding of one diagonalisation
@@ -287,11 +317,15 @@ def _compare_stored_inertia(system, backend, mech, settings, result) -> None:
 def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) -> None:
     """ValueError (one line) when the engine's scheme cannot be stable at this step on the
     fastest mode of the operating point's linearization (before any reference solve,
-    which a stiff system would make endless)."""
+    which a stiff system would make endless). Where the equilibrium cannot be found the
+    comparison's own stages record why."""
     scheme = backend.scheme(mech, settings)
     if scheme is None or scheme.stability_limit is None:
         return
-    eq = operating_equilibrium(system, values)
+    try:
+        eq = operating_equilibrium(system, values)
+    except Exception:
+        return
     w = float(np.max(np.abs(eq.eigenvalues))) if len(eq.eigenvalues) else 0.0
     refusal = tolerances.stability_refusal(w, dt, f"{backend.id}'s {scheme.name}",
                                            scheme.stability_limit)
@@ -304,20 +338,36 @@ def isolated_compare(system_id: str, simulator: str,
                      **kwargs) -> Comparison:
     """`compare` in a worker process (comparisons/isolation.py): a worker that dies or
     exceeds `timeout` seconds gives a failed comparison with the incident (crashed,
-    timed_out) instead of taking the caller down; a ValueError (bad input) is raised."""
+    timed_out) instead of taking the caller down; a ValueError or KeyError (bad input) is
+    raised; any other exception that escaped the comparison's stages (a memory limit hit
+    outside them) is a failed comparison too."""
     try:
         return isolated(compare, system_id, simulator, params, timeout=timeout, **kwargs)
-    except (WorkerCrashed, WorkerTimedOut) as exc:
-        system, backend = get_system(system_id), get_backend(simulator)
-        result = Comparison(system.id, simulator, backend.version(), {},
-                            system.parameter_values(params), kwargs.get("dt", DEFAULT_DT),
-                            variant=kwargs.get("variant") or "")
-        outcome = "timed_out" if isinstance(exc, WorkerTimedOut) else "crashed"
-        result.incidents.append({"scenario": "*", "outcome": outcome, "t_reached": None,
-                                 "message": str(exc)})
-        result.metrics.append(Metric("run.completed", 0.0, 1.0, False, "fail", str(exc),
-                                     unit="fraction of the run"))
-        return result
+    except (ValueError, KeyError):
+        raise
+    except Exception as exc:
+        outcome = ("timed_out" if isinstance(exc, WorkerTimedOut) else
+                   "crashed" if isinstance(exc, WorkerCrashed) else "failed")
+        return failed_comparison(system_id, simulator, params, kwargs.get("dt", DEFAULT_DT),
+                                 kwargs.get("variant") or "", "worker", exc, outcome)
+
+
+def failed_comparison(system_id: str, simulator: str, params: Mapping[str, float] | None,
+                      dt: float, variant: str, stage: str, exc: BaseException,
+                      outcome: str = "failed") -> Comparison:
+    """A comparison that could not be made at all: its incident (see `record_incident`)
+    and a failed `*.<stage>` metric."""
+    try:
+        version = get_backend(simulator).version()
+    except Exception:  # an engine that cannot even say its version
+        version = ""
+    try:
+        values = get_system(system_id).parameter_values(params)
+    except Exception:
+        values = dict(params or {})
+    result = Comparison(system_id, simulator, version, {}, values, dt, variant=variant)
+    record_incident(result, "*", stage, exc, outcome)
+    return result
 
 
 #: start of the generated checks near the other stable equilibria: this far from the
@@ -374,7 +424,10 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     values = system.parameter_values(params, scenario=sc)
     mech = system.numeric_mechanism(values, variant)
     T = sc.t_end if t_end is None else t_end
-    ref = reference(system, sc, values, dt, T)
+    with contained(result, sc.name, "reference") as stage:
+        ref = reference(system, sc, values, dt, T)
+    if stage.failed:
+        return
     q0, qd0 = ref.q[0], ref.qd[0]
     joints = system.reaction_joints if "reaction" in sc.checks else ()
     contacts = system.contacts(system.symbols) if "constraint_force" in sc.checks else ()
@@ -388,7 +441,10 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
     result.wall_time += run.wall_time
     result.simulated_time += T
     if eq is None:
-        eq = operating_equilibrium(system, values)
+        with contained(result, sc.name, "equilibrium") as stage:
+            eq = operating_equilibrium(system, values)
+        if stage.failed:
+            return
     # a driven system's trajectory is that of its free coordinates (the prescribed ones
     # are judged as the engine's imposed motion, below)
     free = list(numeric_model(system.id, values).independent) if mech.prescribed else list(
@@ -689,6 +745,38 @@ def _compare_growth_rate(system, backend, values, ref, run, n, dt, eq, name, res
     result.metrics.append(metric)
 
 
+def _incident_message(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return f"{type(exc).__name__}: {text}"[:500]
+
+
+def record_incident(result: Comparison, scenario: str, stage: str, exc: BaseException,
+                    outcome: str = "failed", t_reached: float | None = None) -> None:
+    """A stage that raised (description, derivation, equilibrium, reference, engine run,
+    linearization, fit, report files) is data: the incident with its stage, message and
+    the time reached, and a failed `<scenario>.<stage>` metric, so that this comparison
+    fails and nothing else is lost."""
+    if t_reached is None:
+        t_reached = getattr(exc, "t_reached", None)
+    message = _incident_message(exc)
+    result.incidents.append({"scenario": scenario, "stage": stage, "outcome": outcome,
+                             "t_reached": t_reached, "message": message})
+    result.metrics.append(Metric(f"{scenario}.{stage.replace(' ', '_')}", 0.0, 1.0, False,
+                                 "fail", message, unit="stage completed"))
+
+
+@contextmanager
+def contained(result: Comparison, scenario: str, stage: str):
+    """Runs the block; an exception it raises becomes an incident of `result` (see
+    `record_incident`) and the code after the block goes on. `.failed` tells."""
+    state = SimpleNamespace(failed=False)
+    try:
+        yield state
+    except (Exception, SystemExit) as exc:  # a stage's failure is data, not a traceback
+        state.failed = True
+        record_incident(result, scenario, stage, exc)
+
+
 def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
     """`backend.simulate(*args)`, or None when the engine raised: the run is recorded as
     an incident (crashed, with the engine's message) and `<label>.completed` fails. A run
@@ -698,7 +786,8 @@ def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
         run = backend.simulate(*args)
     except Exception as exc:  # an engine's own failure is data, not a traceback
         message = " ".join(str(exc).split()) or type(exc).__name__
-        result.incidents.append({"scenario": label, "outcome": "crashed", "t_reached": None,
+        result.incidents.append({"scenario": label, "stage": "engine run",
+                                 "outcome": "crashed", "t_reached": None,
                                  "message": f"{type(exc).__name__}: {message}"[:500]})
         result.metrics.append(Metric(f"{label}.completed", 0.0, 1.0, False, "fail", message,
                                      unit="fraction of the run"))
@@ -707,8 +796,8 @@ def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
     if not np.all(finite):
         k = int(np.argmin(finite))
         reached = float(run.t[k - 1]) if k > 0 else 0.0
-        result.incidents.append({"scenario": label, "outcome": "diverged",
-                                 "t_reached": reached,
+        result.incidents.append({"scenario": label, "stage": "engine run",
+                                 "outcome": "diverged", "t_reached": reached,
                                  "message": f"non-finite state at t = {run.t[k]:.6g} s"})
         result.metrics.append(Metric(f"{label}.completed", reached / t_end, 1.0, False, "fail",
                                      "the engine's state diverged", unit="fraction of the run"))
@@ -763,20 +852,60 @@ def _kinetic_amplitude(system, values, q, qd) -> float:
     return float(np.max(T))
 
 
+#: a free-vibration fit's release lasts at least FIT_PERIODS periods of its mode (fewer
+#: cannot separate frequency from damping) and at most FIT_PERIODS_MAX, or 10 s between
+FIT_PERIODS = 10
+FIT_PERIODS_MAX = 40
+
+
+def fit_duration(frequency_hz: float, t_end: float | None) -> float:
+    """Simulated seconds of the fit of a mode of `frequency_hz`; never beyond `t_end`."""
+    T = max(min(t_end or 10.0, FIT_PERIODS_MAX / frequency_hz), FIT_PERIODS / frequency_hz)
+    return T if t_end is None else min(T, t_end)
+
+
+def comparison_cost(system: System, values: Mapping[str, float], dt: float,
+                    t_end: float | None, scenarios: Iterable[str] | None = None
+                    ) -> list[budget.PlannedRun]:
+    """The engine runs a comparison will make, from the description (before any work):
+    each scenario at its duration, each generated run near another equilibrium, and each
+    oscillatory mode's free-vibration fit."""
+    chosen = set(scenarios or ())
+    runs = [budget.PlannedRun(sc.name, sc.t_end if t_end is None else t_end, dt)
+            for sc in system.scenarios if not chosen or sc.name in chosen]
+    try:
+        near = near_equilibrium_scenarios(system, values)
+        fit_values = unexcited_values(system, values) if system.mechanism.prescribed else values
+        modes = operating_equilibrium(system, fit_values).modes
+    except Exception:  # the comparison's own stages record why
+        return runs
+    runs += [budget.PlannedRun(sc.name, sc.t_end if t_end is None else t_end, dt)
+             for sc, _ in near if not chosen or sc.name in chosen]
+    runs += [budget.PlannedRun(f"fit of mode {i + 1} ({m.frequency_hz:.3g} Hz)",
+                               fit_duration(m.frequency_hz, t_end), dt)
+             for i, m in enumerate(modes) if m.damped_frequency_hz > 0]
+    return runs
+
+
 def _compare_frequencies(system, backend, values, dt, t_end, settings, result, keep_series,
                          variant=None):
     """Modes of the operating equilibrium: the engine's own linearization, and a
     free-vibration fit of each modal coordinate after a small modal release."""
     if system.mechanism.prescribed:
         values = unexcited_values(system, values)
-    eq = operating_equilibrium(system, values)
+    with contained(result, "frequency", "equilibrium") as stage:
+        eq = operating_equilibrium(system, values)
+    if stage.failed:
+        return
     if not (eq.stable or oscillatory_instability(eq.eigenvalues)):
         return  # a divergent equilibrium: a release departs without oscillating
     # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
     mech = system.numeric_mechanism(values, variant).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
     ref_w = np.array([abs(m.eigenvalue) for m in modes])
-    lin = backend.linearize(mech, eq.q, settings, dt)
+    lin = None
+    with contained(result, "frequency", "linearization"):
+        lin = backend.linearize(mech, eq.q, settings, dt)
     if lin is not None:
         from ..analytic.linear import modes_from_eigenvalues
 
@@ -824,7 +953,15 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
         qd0 = model.velocity_basis(q0) @ (tolerances.FIT_AMPLITUDE * np.real(v[k_dof:]))
         if model.driven:
             q0[model.driven], qd0[model.driven] = model.motion(0.0)[:2]
-        T = max(min(t_end or 10.0, 40 / m.frequency_hz), 10 / m.frequency_hz)
+        T = fit_duration(m.frequency_hz, t_end)
+        if T * m.frequency_hz < FIT_PERIODS * (1 - 1e-9):
+            for kind in ("frequency", "damping"):
+                result.metrics.append(Metric(
+                    f"{kind}.fit_mode{i + 1}", float("nan"), float("nan"), False,
+                    "unresolved", f"not measured: a fit needs {FIT_PERIODS} periods of this "
+                    f"mode ({FIT_PERIODS / m.frequency_hz:.3g} s), longer than --t-end",
+                    expected=True))
+            continue
         run = _guarded_run(backend, result, f"fit_mode{i + 1}", T,
                            mech, q0, qd0, T, dt, settings, ())
         if run is None:

@@ -12,9 +12,12 @@ function and the items must be picklable.
 """
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
+
+from .budget import become_worker
 
 
 def sweep(function: Callable[[Any], Any], items: Iterable[Any], scheduler: str | None = None,
@@ -29,5 +32,6 @@ def sweep(function: Callable[[Any], Any], items: Iterable[Any], scheduler: str |
             return client.gather(client.map(function, items, pure=False))
     if workers == 1:
         return [function(item) for item in items]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
+                             initargs=(os.getpid(),)) as pool:
         return list(pool.map(function, items))

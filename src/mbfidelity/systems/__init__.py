@@ -573,7 +573,7 @@ def _load_module_file(path: Path):
     sys.modules[name] = module  # dataclasses and pickling look modules up by name
     try:
         spec.loader.exec_module(module)
-    except Exception as exc:  # a user's module: any error is reported, in one line
+    except (Exception, SystemExit) as exc:  # a user's module: any error, in one line
         del sys.modules[name]
         raise ValueError(f"{path}: cannot be loaded: {type(exc).__name__}: {exc}") from exc
     return module
