@@ -324,3 +324,26 @@ def threshold_tolerance(w: float, h: float, order: int, slope: float) -> float:
     """Shift of a stability threshold in the parameter's units (module docstring,
     "Stability threshold"): growth-rate error at the neutral mode over |d sigma / dp|."""
     return (w * (w * h) ** max(order, 2) + FIT_RESOLUTION * w) / slope
+
+
+# --- the round-off floor ---------------------------------------------------------------
+#
+# Every step of an engine rounds the state it computes: a few units in the last place of
+# the largest coordinate, |q|max u (u = 2^-53). Over N steps those roundings add up to at
+# most N ROUNDINGS_PER_STEP |q|max u (the linear worst case; a random walk gives sqrt(N)),
+# whatever the scheme's truncation error. Relative to the scale the error is divided by
+# (the motion's amplitude), a gate below that sum would judge round-off: it holds the
+# floor N ROUNDINGS_PER_STEP u |q|max / scale. It matters only where the motion is tiny
+# beside the coordinates' values (a mass of 1e9 kg barely moving, g of 1e-9), and is far
+# below every truncation bound elsewhere (at N = 1e4 steps it is 1e-11 of the amplitude
+# when |q|max = scale).
+
+UNIT_ROUNDOFF = 2.0 ** -53
+#: roundings of a coordinate per step (the update q + h v, and the stages that feed v)
+ROUNDINGS_PER_STEP = 4
+
+
+def roundoff_floor(steps: int, magnitude: float, scale: float) -> float:
+    """The error round-off alone can make after `steps` steps of a state whose largest
+    coordinate is `magnitude`, relative to `scale`."""
+    return steps * ROUNDINGS_PER_STEP * UNIT_ROUNDOFF * magnitude / max(scale, 1e-300)

@@ -82,6 +82,8 @@ zeta (w h) w T (see <code>comparisons/tolerances.py</code>).</p>
 bilateral model pulls from t = {{ "%.3f"|format(w.t_ref) }} s (reference minimum {{ "%.3g"|format(w.min_ref) }} N);
 a real unilateral contact would open there, so from that instant the comparison is of the
 bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} minimum {{ "%.3g"|format(e.min) }} N{% if e.t is not none %} from t = {{ "%.3f"|format(e.t) }} s{% endif %}{% if not loop.last %}; {% endif %}{% endfor %}.</p>{% endfor %}
+{% if incidents[sys] %}<p class="fail">Incidents (stages that did not complete; the rest of the
+run stands):</p><ul>{% for i in incidents[sys] %}<li><b>{{ i.simulator }}</b>, {{ i.scenario }}{% if i.stage %} ({{ i.stage }}){% endif %}: {{ i.outcome }}{% if i.t_reached is not none %} at t = {{ "%.6g"|format(i.t_reached) }} s{% endif %}: {{ i.message }}</li>{% endfor %}</ul>{% endif %}
 {% if expected[sys] %}<p>Declared expected failures:</p><ul>{% for e in expected[sys] %}<li><b>{{ e.simulator }}</b>, {{ e.metric }}: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
 {% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
 {% endfor %}
@@ -220,7 +222,9 @@ def write_report(out: Path, workers: int | None = None) -> Path:
     figures = _render_figures(out, by_system, workers)
     frequencies = frequency_table(results)
     errata = [e for s in dict.fromkeys(map(base_id, systems))
-              for e in load_system(out, s)["errata"]]
+              for e in _saved_errata(out, s, by_system)]
+    incidents = {s: [{"simulator": c.simulator, **i} for c in comps for i in c.incidents]
+                 for s, comps in by_system.items()}
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
     liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
     page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
@@ -228,7 +232,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
                            titles={s: _title(s) for s in systems}, versions=versions,
                            explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
                            expected={s: _expected(s) for s in systems},
-                           liftoff=liftoff,
+                           liftoff=liftoff, incidents=incidents,
                            convergence=(out / "convergence.json").exists(),
                            strutt=(out / "strutt.png").exists(),
                            beams=(out / "beams.png").exists(),
@@ -272,18 +276,47 @@ def _render_figures(out: Path, rows: dict[str, list], workers: int | None) -> di
             drawing = {s: pool.submit(_draw_saved, out, s) for s in drawings}
             plotted = {row: f.result() for row, f in plotting.items()}
             drawn = {s: f.result() for s, f in drawing.items()}
-    return {row: [drawn[base_id(row)]] + plotted[row] for row in rows}
+    figures = {}
+    for row in rows:
+        files = drawn[base_id(row)] + plotted[row]
+        for failure in (f for f in files if f.startswith("!")):
+            _figure_incident(rows, row, RuntimeError(failure[1:]))
+        figures[row] = [f for f in files if not f.startswith("!")]
+    return figures
 
 
-def _draw_saved(out: Path, system_id: str) -> str:
-    return draw_mechanism(load_system(out, system_id)["drawing"], out)
+def _saved_errata(out: Path, system_id: str, rows: dict[str, list]) -> list[dict]:
+    """The system's saved errata entries; a file that does not load is an incident of
+    the system's comparisons (the page says so) instead of the end of the report."""
+    try:
+        return load_system(out, system_id)["errata"]
+    except Exception as exc:
+        _figure_incident(rows, system_id, exc)
+        return []
+
+
+def _figure_incident(rows: dict[str, list], row: str, exc: BaseException) -> None:
+    for c in rows.get(row, []):
+        c.incidents.append({"scenario": "*", "stage": "figure", "outcome": "failed",
+                            "t_reached": None,
+                            "message": f"{type(exc).__name__}: {exc}"[:500]})
+
+
+def _draw_saved(out: Path, system_id: str) -> list[str]:
+    try:
+        return [draw_mechanism(load_system(out, system_id)["drawing"], out)]
+    except Exception as exc:  # shown as an incident by the caller
+        return [f"!{type(exc).__name__}: {exc}"]
 
 
 def _plot_saved(out: Path, row: str, comps) -> list[str]:
-    series = load_series(out, row)
-    for c in comps:
-        c.series = series.get(c.simulator, {})
-    return _figures(row, comps, out)
+    try:
+        series = load_series(out, row)
+        for c in comps:
+            c.series = series.get(c.simulator, {})
+        return _figures(row, comps, out)
+    except Exception as exc:  # one row's figures fail; the report stands
+        return [f"!{type(exc).__name__}: {exc}"]
 
 
 ERRATA_TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">

@@ -66,6 +66,11 @@ COORD = sp.Symbol("_coord", real=True)
 COORD_RATE = sp.Symbol("_coord_rate", real=True)
 GRAVITY = sp.Symbol("g", positive=True)
 STANDARD_GRAVITY = 9.81
+#: the largest number of elements a count parameter admits unless it states its own: the
+#: symbolic derivation of a chain grows at least linearly with it (benchmarks/
+#: count_cost.py), so that a chain of this size is derived, compiled and analysed well
+#: within `analyze`'s default time budget
+MAX_COUNT = 64
 
 
 @dataclass(frozen=True)
@@ -87,6 +92,9 @@ class Parameter:
     #: (the number of elements of a discretized continuum): `build` receives it as a
     #: Python int, never as a symbol (`System.with_structure`)
     domain: str = "positive"
+    #: a count's largest value (default MAX_COUNT): the derivation, the equilibrium
+    #: search and every engine run grow with it (benchmarks/count_cost.py measures how)
+    maximum: int | None = None
 
     def __post_init__(self) -> None:
         if self.domain == "count" and (isinstance(self.default, str)
@@ -126,6 +134,17 @@ class Parameter:
             raise ValueError(f"parameter {self.name} must be >= 0, got {value}")
         if self.domain == "count" and not (value >= 1 and value == int(value)):
             raise ValueError(f"parameter {self.name} must be an integer >= 1, got {value:g}")
+        if self.domain == "count" and value > self.largest:
+            raise ValueError(f"parameter {self.name} must be at most {self.largest} (the cost "
+                             f"of deriving and running the chain grows with it), got "
+                             f"{value:g}")
+
+    @property
+    def largest(self) -> float:
+        """The largest value a count admits (inf for other domains)."""
+        if self.domain != "count":
+            return math.inf
+        return self.maximum if self.maximum is not None else MAX_COUNT
 
 
 # --- drawing / contact geometry (body frame) -------------------------------------------
