@@ -23,7 +23,8 @@ from typing import Iterable, Mapping
 from .comparisons.diff import ResultsDiff, diff_runs, holds
 from .comparisons.runner import DEFAULT_DT, Comparison
 
-__all__ = ["analyze", "compare", "run", "check", "diff", "export", "Verdict", "CheckResult",
+__all__ = ["list_systems", "analyze", "compare", "run", "errata", "strutt", "discretization",
+           "convergence", "beams", "check", "diff", "export", "Verdict", "CheckResult",
            "DEFAULT_DT"]
 
 
@@ -293,6 +294,249 @@ def _relative_equilibrium(system, coords: list, op) -> dict:
     }
 
 
+def checked_simulators(simulators: Iterable[str], installed: bool = False) -> list[str]:
+    """The engine ids, each known (and, with `installed`, installed), or a ValueError in
+    one line naming the valid ones: the one check every command makes."""
+    ids = list(simulators)
+    for e in ids:
+        backend = _backend(e)
+        if installed:
+            ok, why = backend.available()
+            if not ok:
+                raise ValueError(f"{e} is not installed: {why}")
+    return ids
+
+
+def list_systems() -> dict:
+    """What `mbfidelity list --json` prints: every system with its scenarios, variants
+    and, per engine, whether it can express it (and why not)."""
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    backends = all_backends()
+    rows = []
+    for s in all_systems().values():
+        mech = s.numeric_mechanism(s.parameter_values())
+        support = {}
+        for sid, b in backends.items():
+            ok, why = b.available()
+            sup = b.support(mech) if ok else None
+            support[sid] = {"supported": bool(ok and sup.ok),
+                            "reason": why if not ok else (sup.reason if not sup.ok else "")}
+        rows.append({"system": s.id, "title": s.title, "source": s.source,
+                     "coordinates": list(s.coordinates),
+                     "scenarios": [sc.name for sc in s.scenarios], "simulators": support,
+                     "variants": {v.name: {"simulators": list(v.settings),
+                                           "description": v.description}
+                                  for v in s.variants}})
+    return {"systems": rows, "simulators": list(backends)}
+
+
+def errata(witnesses: bool = True, out: str | Path | None = None) -> list[dict]:
+    """Every printed formula the project codes against the derivation, with the engines
+    as witnesses of every misprint (`witnesses`); with `out`, errata.json and errata.html
+    are written there."""
+    from .comparisons.witnesses import witnessed_errata
+    from .systems import all_systems
+
+    if out is not None:
+        out = checked_output_folder(out)
+    entries = witnessed_errata(all_systems().values(), witnesses)
+    if out is not None:
+        from .comparisons.results_folder import save_errata
+        from .reports.html import write_errata_page
+
+        save_errata(entries, out)
+        write_errata_page(out)
+    return entries
+
+
+STRUTT_EQUATION = "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)"
+
+
+def strutt(grid: int = 40, lambda_range: tuple[float, float] = (-1.0, 3.0),
+           gamma_range: tuple[float, float] = (0.0, 3.0), sims: Iterable[str] = (), *,
+           scheduler: str | None = None, steps_per_period: int = 200, periods: int = 10,
+           out: str | Path | None = None) -> dict:
+    """The Strutt chart of eq. 83 from Floquet theory on a grid x grid chart, and with
+    `sims` each engine's classification of every point by simulation; with `out`,
+    strutt.json and strutt.png are written there."""
+    import json
+
+    import numpy as np
+
+    from .analytic.strutt import strutt_chart
+
+    engines = checked_simulators(sims, installed=True)
+    for name, (a, b) in (("lambda", lambda_range), ("gamma", gamma_range)):
+        if not (math.isfinite(a) and math.isfinite(b) and a <= b):
+            raise ValueError(f"the {name} range must be finite A <= B, got {a:g}, {b:g}")
+    if grid < 1:
+        raise ValueError(f"the grid must have at least 1 point per axis, got {grid}")
+    if engines and (steps_per_period < 4 or periods < 1):
+        raise ValueError("steps per period must be at least 4 and periods at least 1")
+    if out is not None:
+        out = checked_output_folder(out)
+    chart = strutt_chart(grid, grid, tuple(lambda_range), tuple(gamma_range))
+    points = chart.points()
+    counts = {v: sum(p["verdict"] == v for p in points)
+              for v in ("stable", "unstable", "marginal")}
+    doc = {"equation": STRUTT_EQUATION, "period": 2 * np.pi, "grid": grid, "counts": counts,
+           "points": points}
+    if engines:
+        from .comparisons.strutt_engines import engine_chart
+
+        doc["simulation"] = engine_chart(points, engines, scheduler=scheduler,
+                                         periods=periods, steps_per_period=steps_per_period)
+    if out is not None:
+        from .reports.strutt_figure import write_strutt_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "strutt.json").write_text(json.dumps(doc, indent=1))
+        write_strutt_figure(points, out / "strutt.png")
+    return doc
+
+
+def discretization(system_id: str, params: Mapping[str, float] | None = None,
+                   counts: Iterable[int] = (2, 4, 8, 16, 32), sims: Iterable[str] = (), *,
+                   out: str | Path | None = None) -> dict:
+    """A discretized continuum against its exact one for each number of elements (the
+    frequencies, their errors, the fitted order, the printed Rayleigh estimates); with
+    `sims`, each engine's build of the chain from its own linearization, and each
+    engine's own flexible elements for a beam. `failed` lists the engine rows that miss
+    their gate. With `out`, discretization-SYSTEM.json and .png are written there."""
+    import json
+
+    from .analytic.continuum import continuum_summary
+    from .analytic.discretization import discretization_study
+
+    system = _system(system_id)
+    try:
+        values, _ = system.resolve_parameters(params)
+    except KeyError as exc:
+        raise ValueError(exc.args[0]) from None
+    engines = checked_simulators(sims)
+    if out is not None:
+        out = checked_output_folder(out)
+    study = discretization_study(system, values, list(counts))
+    doc = study.as_dict()
+    doc["rayleigh"] = [r.as_dict() for r in
+                       continuum_summary(system.continuum, values).rayleigh]
+    if engines:
+        from .comparisons.discretization_engines import engine_discretization
+        from .comparisons.flexible_beams import beam_of, beam_study
+
+        doc["engines"] = engine_discretization(system, values, study, engines)
+        beam = beam_of(system.continuum, values)
+        if beam is not None:
+            # the variants: the same beam of each engine's own flexible elements (no
+            # gravity: modal work about the straight beam)
+            doc["flexible"] = beam_study(beam, engines, list(counts))
+    doc["failed"] = [f"{e}@{study.parameter}={r['N']}"
+                     for e, x in doc.get("engines", {}).items()
+                     for r in x["rows"] if not r["passed"]]
+    if out is not None:
+        from .reports.discretization_figure import figure_name, write_discretization_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / f"discretization-{study.system}.json").write_text(json.dumps(doc, indent=1))
+        write_discretization_figure(doc, out / figure_name(study.system))
+    return doc
+
+
+def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
+                steps: Iterable[float] | None = None, t_end: float = 2.0, *,
+                scheduler: str | None = None, out: str | Path | None = None) -> dict:
+    """Error against the step and work-precision for every system x engine (default:
+    every installed engine), the fitted order against the declared one; `failed` lists
+    the studies whose order gate fails. With `out`, convergence.json, its page and
+    figures are written there."""
+    import json
+
+    import numpy as np
+
+    from .comparisons import convergence as conv
+    from .comparisons.runner import provenance
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = list(systems or all_systems())
+    for s in sys_ids:
+        _system(s)
+    sim_ids = (checked_simulators(sims) if sims else
+               [e for e, b in all_backends().items() if b.available()[0]])
+    dts = None
+    if steps is not None:
+        dts = sorted(set(steps), reverse=True)
+        if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
+            raise ValueError(f"the steps need at least {conv.MIN_FIT_POINTS} positive values; "
+                             f"got {list(steps)}")
+    checked_duration("t_end", t_end)
+    if out is not None:
+        out = checked_output_folder(out)
+    studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
+    doc = {"provenance": provenance(), "steps": dts or "automatic", "t_end": t_end,
+           "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
+           "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
+    doc["failed"] = [f"{s['system']}/{s['simulator']}" for s in studies
+                     if s["metric"]["status"] in ("fail", "xpass")
+                     or (s["metric"]["status"] == "unresolved"
+                         and not s["metric"].get("expected"))]
+    if out is not None:
+        from .reports.convergence_page import CONVERGENCE, write_convergence_page
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=_plain))
+        write_convergence_page(out)
+    return doc
+
+
+def _plain(x):
+    import numpy as np
+
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    raise TypeError(type(x))
+
+
+def beams(sims: Iterable[str] | None = None, elements: Iterable[int] = (2, 4, 8, 16, 32),
+          params: Mapping[str, float] | None = None, modes: int = 3, *,
+          out: str | Path | None = None) -> dict:
+    """The engines' own flexible elements against the exact beam of §6.1 (default: the
+    block of 0 and 1 kg at mid-span): the first `modes` natural frequencies of the beam
+    built of N elements of each kind, their errors and fitted orders. With `out`,
+    beams.json and beams.png are written there."""
+    import json
+
+    from .comparisons.flexible_beams import DEFAULT_CASES, beams_document
+    from .systems._continua import Beam
+
+    engines = checked_simulators(sims or ())
+    sizes = sorted(set(int(n) for n in elements))
+    if not sizes or any(n < 1 for n in sizes):
+        raise ValueError(f"the numbers of elements must be positive integers; got {sizes}")
+    if modes < 1:
+        raise ValueError("modes must be at least 1")
+    given = dict(params or {})
+    cases = [given] if "m" in given else [{**case, **given} for case in DEFAULT_CASES]
+    try:
+        beam_list = [Beam.from_parameters(case) for case in cases]
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
+    if out is not None:
+        out = checked_output_folder(out)
+    doc = beams_document(beam_list, engines or None, sizes, modes)
+    if out is not None:
+        from .reports.beams_figure import BEAMS, FIGURE, write_beams_figure
+
+        out.mkdir(parents=True, exist_ok=True)
+        (out / BEAMS).write_text(json.dumps(doc, indent=1, default=_plain))
+        write_beams_figure(json.loads((out / BEAMS).read_text()), out / FIGURE)
+    return doc
+
+
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None, *,
             dt: float = DEFAULT_DT, t_end: float | None = None,
             settings: Mapping | None = None, variant: str | None = None,
@@ -329,12 +573,7 @@ def _matrix(systems: Iterable[str] | None, sims: Iterable[str] | None,
         _system(s)
     backends = all_backends()
     if sims:
-        sim_ids = list(sims)
-        for e in sim_ids:
-            _backend(e)
-            ok, why = backends[e].available()
-            if not ok:
-                raise ValueError(f"{e} is not installed: {why}")
+        sim_ids = checked_simulators(sims, installed=True)
     else:
         sim_ids = [e for e, b in backends.items() if b.available()[0] or not installed_only]
     return sys_ids, sim_ids

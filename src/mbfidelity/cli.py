@@ -124,27 +124,12 @@ def _jsonable(x):
 @app.command("list")
 def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> None:
     """Systems, engines, and which engine supports which system."""
-    from .simulators import all_backends
-    from .systems import all_systems
+    from . import api
 
-    backends = all_backends()
-    rows = []
-    for s in all_systems().values():
-        mech = s.numeric_mechanism(s.parameter_values())
-        support = {}
-        for sid, b in backends.items():
-            ok, why = b.available()
-            sup = b.support(mech) if ok else None
-            support[sid] = {"supported": bool(ok and sup.ok),
-                            "reason": why if not ok else (sup.reason if not sup.ok else "")}
-        rows.append({"system": s.id, "title": s.title, "source": s.source,
-                     "coordinates": list(s.coordinates),
-                     "scenarios": [sc.name for sc in s.scenarios], "simulators": support,
-                     "variants": {v.name: {"simulators": list(v.settings),
-                                           "description": v.description}
-                                  for v in s.variants}})
+    doc = api.list_systems()
+    rows, backends = doc["systems"], doc["simulators"]
     if as_json:
-        _json({"systems": rows, "simulators": list(backends)})
+        _json(doc)
         return
     typer.echo(f"{'system':26s} " + " ".join(f"{b:9s}" for b in backends) + " source")
     for r in rows:
@@ -357,13 +342,10 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
     from .systems import all_systems
 
     sys_ids = _split(systems) or list(all_systems())
-    sim_ids = _split(sims) or list(all_backends())
     for s in sys_ids:
         _system(s)
-    for e in sim_ids:
-        if e not in all_backends():
-            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     try:
+        sim_ids = api.checked_simulators(_split(sims) or all_backends())
         api.checked_output_folder(out)
         api.checked_duration("--dt", dt)
     except ValueError as exc:
@@ -436,18 +418,11 @@ def errata_cmd(as_json: bool = typer.Option(False, "--json"),
                ) -> None:
     """Every printed formula coded, compared with the derivation; engines as witnesses."""
     _use_cache(no_cache)
-    from .comparisons.witnesses import witnessed_errata
-    from .systems import all_systems
+    from . import api
 
-    entries = witnessed_errata(all_systems().values(), witnesses)
-    if out is not None:
-        from .comparisons.results_folder import save_errata
-        from .reports.html import write_errata_page
-
-        save_errata(entries, out)
-        page = write_errata_page(out)
-        if not as_json:
-            typer.echo(f"errata page: {page.resolve()}")
+    entries = api.errata(witnesses, out)
+    if out is not None and not as_json:
+        typer.echo(f"errata page: {(out / 'errata.html').resolve()}")
     if as_json:
         _json({"errata": entries})
         return
@@ -479,50 +454,24 @@ def strutt_cmd(grid: int = typer.Option(40, "--grid", help="points per axis"),
                ) -> None:
     """The Strutt chart of eq. 83 (Mathieu, period 2 pi) from Floquet theory, and with
     --sim from each engine's simulation of the pendulum that maps to every point."""
-    from .analytic.strutt import strutt_chart
-    from .simulators import all_backends
-
-    engines = _split(sim)
-    for e in engines:
-        if e not in all_backends():
-            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
-        ok, why = all_backends()[e].available()
-        if not ok:
-            _fail(f"{e} is not installed: {why}")
+    from . import api
 
     def bounds(text: str, option: str) -> tuple[float, float]:
         try:
             a, b = (float(x) for x in text.split(","))
         except ValueError:
             _fail(f"{option} expects A,B (two numbers), got {text!r}")
-        if not (np.isfinite(a) and np.isfinite(b) and a <= b):
-            _fail(f"{option} expects finite A <= B, got {text!r}")
         return a, b
 
-    if grid < 1:
-        _fail(f"--grid must be a positive integer, got {grid}")
-    chart = strutt_chart(grid, grid, bounds(lambda_range, "--lambda"),
-                         bounds(gamma_range, "--gamma"))
-    points = chart.points()
-    counts = {v: sum(p["verdict"] == v for p in points) for v in ("stable", "unstable",
-                                                                   "marginal")}
-    doc = {"equation": "phi'' + (lambda + gamma cos t) phi = 0 (eq. 83, omega = 1)",
-           "period": 2 * np.pi, "grid": grid, "counts": counts, "points": points}
-    if engines:
-        from .comparisons.strutt_engines import engine_chart
-
-        if steps_per_period < 4 or periods < 1:
-            _fail("--steps-per-period must be at least 4 and --periods at least 1")
-        doc["simulation"] = engine_chart(points, engines, scheduler=scheduler,
-                                         periods=periods, steps_per_period=steps_per_period)
-    if out is not None:
-        from .reports.strutt_figure import write_strutt_figure
-
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "strutt.json").write_text(json.dumps(doc, indent=1))
-        figure = write_strutt_figure(points, out / "strutt.png")
-        if not as_json:
-            typer.echo(f"Strutt chart: {figure.resolve()}")
+    try:
+        doc = api.strutt(grid, bounds(lambda_range, "--lambda"), bounds(gamma_range, "--gamma"),
+                         _split(sim), scheduler=scheduler, steps_per_period=steps_per_period,
+                         periods=periods, out=out)
+    except ValueError as exc:
+        _fail(str(exc))
+    counts = doc["counts"]
+    if out is not None and not as_json:
+        typer.echo(f"Strutt chart: {(out / 'strutt.png').resolve()}")
     if as_json:
         _json(doc)
         return
@@ -552,46 +501,22 @@ def discretization_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
     frequencies for each number of elements, their errors, the fitted order and the
     leading error derived for the lumping; with --sim, each engine's chain against the
     derived one (exit 1 when an engine misses its linearization gate)."""
-    from .analytic.continuum import continuum_summary
-    from .analytic.discretization import discretization_study
-    from .simulators import all_backends
+    from . import api
+    from .reports.discretization_figure import figure_name
 
     system = _system(system_id)
-    values, _ = _values(system, _parse_params(param))
+    params = _parse_params(param)
+    _values(system, params)
     try:
         chosen = [int(c) for c in counts.split(",") if c.strip()]
     except ValueError:
         _fail(f"--counts expects integers separated by commas, got {counts!r}")
     try:
-        study = discretization_study(system, values, chosen)
+        doc = api.discretization(system.id, params, chosen, _split(sims), out=out)
     except ValueError as exc:
         _fail(str(exc))
-    engines = _split(sims)
-    for e in engines:
-        if e not in all_backends():
-            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
-    doc = study.as_dict()
-    doc["rayleigh"] = [r.as_dict() for r in
-                       continuum_summary(system.continuum, values).rayleigh]
-    if engines:
-        from .comparisons.discretization_engines import engine_discretization
-
-        doc["engines"] = engine_discretization(system, values, study, engines)
-        from .comparisons.flexible_beams import beam_of, beam_study
-
-        beam = beam_of(system.continuum, values)
-        if beam is not None:
-            # the variants: the same beam of each engine's own flexible elements (no
-            # gravity: modal work about the straight beam)
-            doc["flexible"] = beam_study(beam, engines, chosen)
-    failed = [f"{e}@{study.parameter}={r['N']}" for e, x in doc.get("engines", {}).items()
-              for r in x["rows"] if not r["passed"]]
-    if out is not None:
-        from .reports.discretization_figure import figure_name, write_discretization_figure
-
-        out.mkdir(parents=True, exist_ok=True)
-        (out / f"discretization-{study.system}.json").write_text(json.dumps(doc, indent=1))
-        write_discretization_figure(doc, out / figure_name(study.system))
+    failed = doc["failed"]
+    study = SimpleNamespace(**{**doc, "rows": [SimpleNamespace(**r) for r in doc["rows"]]})
     if as_json:
         _json(doc)
         raise typer.Exit(1 if failed else 0)
@@ -647,43 +572,22 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
     """Error against the step and work-precision, per system x engine: the fitted order
     next to the engine's declared order (gate: within 0.5, where the curve still falls).
     Exit 1 when an order gate fails."""
-    from .comparisons import convergence as conv
-    from .comparisons.runner import provenance
-    from .simulators import all_backends
-    from .systems import all_systems
+    from . import api
 
-    sys_ids = _split(systems) or list(all_systems())
-    for s in sys_ids:
-        _system(s)
-    sim_ids = _split(sims) or [e for e, b in all_backends().items() if b.available()[0]]
-    for e in sim_ids:
-        if e not in all_backends():
-            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     dts = None
     if steps is not None:
         try:
-            dts = sorted({float(x) for x in steps.split(",") if x}, reverse=True)
+            dts = [float(x) for x in steps.split(",") if x]
         except ValueError:
             _fail(f"--steps expects numbers A,B,...; got {steps!r}")
-        if len(dts) < conv.MIN_FIT_POINTS or not all(np.isfinite(d) and d > 0 for d in dts):
-            _fail(f"--steps needs at least {conv.MIN_FIT_POINTS} positive steps; got {steps!r}")
-    if not t_end > 0:
-        _fail("--t-end must be positive")
     try:
-        studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
+        doc = api.convergence(_split(systems) or None, _split(sims) or None, dts, t_end,
+                              scheduler=scheduler, out=out)
     except ValueError as exc:
         _fail(str(exc))
-    doc = {"provenance": provenance(), "steps": dts or "automatic", "t_end": t_end,
-           "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
-           "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
-    failed = [s for s in studies if s["metric"]["status"] in ("fail", "xpass")
-              or (s["metric"]["status"] == "unresolved" and not s["metric"].get("expected"))]
+    studies, failed = doc["studies"], doc["failed"]
     if out is not None:
-        from .reports.convergence_page import CONVERGENCE, write_convergence_page
-
-        out.mkdir(parents=True, exist_ok=True)
-        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=_jsonable))
-        page = write_convergence_page(out)
+        page = out / "convergence.html"
     if as_json:
         _json(doc)
     else:
@@ -713,35 +617,18 @@ def beams_cmd(sim: Optional[List[str]] = typer.Option(
     """The engines' own flexible elements against the exact beam of §6.1 (Fig. 17): the
     first natural frequencies of the simply supported beam with a point mass, built of N
     elements of each kind, their relative errors and the fitted convergence order."""
-    from .comparisons.flexible_beams import DEFAULT_CASES, beams_document
-    from .simulators import all_backends
-    from .systems._continua import Beam
+    from . import api
 
-    sims = _split(sim)
-    for e in sims:
-        if e not in all_backends():
-            _fail(f"unknown simulator {e!r}; valid: {', '.join(all_backends())}")
     try:
         sizes = [int(x) for x in elements.split(",") if x]
     except ValueError:
         _fail(f"--elements expects integers A,B,...; got {elements!r}")
-    if not sizes or any(n < 1 for n in sizes):
-        _fail(f"--elements expects positive integers; got {elements!r}")
-    if modes < 1:
-        _fail("--modes must be at least 1")
-    given = _parse_params(param)
-    cases = [given] if "m" in given else [{**case, **given} for case in DEFAULT_CASES]
     try:
-        beams = [Beam.from_parameters(case) for case in cases]
-    except (TypeError, ValueError) as exc:
+        doc = api.beams(_split(sim), sizes, _parse_params(param), modes, out=out)
+    except ValueError as exc:
         _fail(str(exc))
-    doc = beams_document(beams, sims or None, sorted(set(sizes)), modes)
     if out is not None:
-        from .reports.beams_figure import BEAMS, FIGURE, write_beams_figure
-
-        out.mkdir(parents=True, exist_ok=True)
-        (out / BEAMS).write_text(json.dumps(doc, indent=1, default=_jsonable))
-        figure = write_beams_figure(json.loads((out / BEAMS).read_text()), out / FIGURE)
+        figure = out / "beams.png"
     if as_json:
         _json(doc)
         return
