@@ -1668,7 +1668,7 @@ class PyBulletBackend(Backend):
                 # the force f_closure[key] acts on link la, its opposite on link lb
                 in_a = la >= 0 and plan.links[la].body in inside
                 in_b = lb >= 0 and plan.links[lb].body in inside
-                F = np.nan_tonum(f_closure[key])
+                F = np.asarray(f_closure[key], dtype=float)  # NaN where not given
                 if in_a and not in_b:
                     R -= F
                 elif in_b and not in_a:
