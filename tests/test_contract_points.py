@@ -1,0 +1,63 @@
+"""A small check per point of the backend contract (simulators/base.py), run on every
+installed backend in the manner of scikit-learn's common estimator checks: the samples
+start at the initial state (point 6), the reaction is the force the parent exerts on the
+child (point 6), and the scheme a backend declares before stepping (point 10) is the one
+its runs report and the one their errors show (the observed order). The mechanism is the
+compound pendulum of Fig. 7, whose exact motion is Jacobi's elliptic functions."""
+import numpy as np
+import pytest
+
+from mbfidelity.analytic.reference import reference
+from mbfidelity.comparisons import metrics
+from mbfidelity.simulators import all_backends
+from mbfidelity.systems import get_system
+
+INSTALLED = [b for b in all_backends().values() if b.available()[0]]
+SYSTEM = get_system("compound_pendulum")
+
+
+def _pendulum(phi0: float):
+    sc = SYSTEM.scenario("large")
+    values = SYSTEM.parameter_values({"phi0": phi0}, scenario=sc)
+    return sc, values, SYSTEM.numeric_mechanism(values)
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_first_sample_is_the_initial_state(backend):
+    _, _, mech = _pendulum(1.0)
+    q0, qd0 = np.array([1.0]), np.array([-0.5])
+    run = backend.simulate(mech, q0, qd0, 0.01, 1e-3)
+    assert len(run.t) == 11 and run.t[0] == 0.0 and abs(run.t[-1] - 0.01) < 1e-15
+    assert np.allclose(run.q[0], q0, rtol=0, atol=1e-12)
+    assert np.allclose(run.qd[0], qd0, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_reaction_is_the_force_of_the_parent_on_the_child(backend):
+    """Hanging at rest, the pivot carries the bar's weight: the world pushes it up with
+    m g (statics), at every sample the engine can give (the contract allows NaN where it
+    cannot: Pymunk's force comes from the momentum change into a sample, none at t = 0)."""
+    _, values, mech = _pendulum(0.0)
+    run = backend.simulate(mech, np.zeros(1), np.zeros(1), 0.05, 1e-3, None, ("pivot",))
+    weight = values["m"] * values["g"]
+    got = run.reactions["pivot"]
+    given = np.all(np.isfinite(got), axis=1)
+    assert np.all(given[1:])
+    assert np.allclose(got[given], [0.0, weight], rtol=0, atol=1e-9 * weight)
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_declared_order_is_reported_and_observed(backend):
+    """The order `scheme` declares is the order of the run and of its error: halving the
+    step divides the error by about 2^p (within half an order), on a 1 rad swing whose w h
+    stays in every scheme's asymptotic range at these steps."""
+    sc, values, mech = _pendulum(1.0)
+    scheme = backend.scheme(mech)
+    errors = []
+    for dt in (4e-3, 2e-3):
+        ref = reference(SYSTEM, sc, values, dt, 1.0)
+        run = backend.simulate(mech, ref.q[0], ref.qd[0], 1.0, dt)
+        assert run.integrator_order == scheme.order
+        errors.append(metrics.trajectory_errors(run.q, ref.q, np.array([1.0]))[0])
+    observed = np.log2(errors[0] / errors[1])
+    assert abs(observed - scheme.order) <= 0.5, (errors, observed)
