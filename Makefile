@@ -20,8 +20,8 @@ report: install
 	$(BIN)/mbfidelity beams --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity discretization massive_spring --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity discretization beam_with_block --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
-	$(BIN)/mbfidelity run --out $(OUT)
 	$(BIN)/mbfidelity errata --out $(OUT) > /dev/null
+	$(BIN)/mbfidelity run --out $(OUT)
 	@echo "errata:  $(OUT)/errata.html"
 
 test: install

@@ -24,7 +24,9 @@ def test_report_is_rendered_from_the_saved_results_alone(tmp_path):
     assert [p.name for p in figures] == ["compound_pendulum-drawing.png",
                                         "compound_pendulum-large.png",
                                         "compound_pendulum-small.png"]
-    page, summary = (tmp_path / "index.html").read_text(), (tmp_path / "summary.md").read_text()
+    pages = {p.name: p.read_text() for p in tmp_path.glob("*.html")}
+    assert set(pages) == {"index.html", "compound_pendulum.html"}
+    summary = (tmp_path / "summary.md").read_text()
     made = {p.name: _digest(p) for p in figures}
     _, (comparison,) = load_results(tmp_path)
     series = load_series(tmp_path, "compound_pendulum")[comparison.simulator]
@@ -41,7 +43,7 @@ def test_report_is_rendered_from_the_saved_results_alone(tmp_path):
         for p in figures:
             p.unlink()
         write_report(tmp_path, workers=workers)
-        assert (tmp_path / "index.html").read_text() == page
+        assert {p.name: p.read_text() for p in tmp_path.glob("*.html")} == pages
         assert (tmp_path / "summary.md").read_text() == summary
         assert {p.name: _digest(p) for p in sorted(tmp_path.glob("*.png"))} == made
 
@@ -72,7 +74,7 @@ def test_check_series_are_saved_and_drawn(tmp_path):
     errors, gates = checks["stop_events_error"], checks["stop_events_tolerance"]
     assert len(errors) == len(gates) == len(checks["stop_events_reference"]) > 0
     assert (tmp_path / "end_stops-fig2-checks.png").stat().st_size > 0
-    assert "end_stops-fig2-checks.png" in (tmp_path / "index.html").read_text()
+    assert "end_stops-fig2-checks.png" in (tmp_path / "end_stops.html").read_text()
 
 
 def test_every_catalog_mechanism_is_drawn(tmp_path):

@@ -9,8 +9,12 @@ Layout of a folder written by `mbfidelity run --out DIR` (and `mbfidelity errata
     report_data/<row>.npz       the series the figures draw, per scenario: the reference
                                 once (t, q_ref, contact forces), and per engine q, scale,
                                 tolerance, contact forces
+    report_data/<row>.animation.json  the motion drawn: every scenario's frames of the
+                                exact reference and of each engine (`animation`)
     report_data/<system>.json   the mechanism at its operating equilibrium as drawn
-                                (world-frame geometry) and the system's errata entries
+                                (world-frame geometry), its derived model typeset as
+                                MathML (`typeset.model_document`) and the system's errata
+                                entries, typeset beside the derived forms
     errata.json                 every printed formula, its verdict and the engines'
                                 witnesses (`mbfidelity errata --out`)
     jobs/<system>.json          each finished system's comparisons, as plain data, for
@@ -36,6 +40,8 @@ from ..analytic.numeric import numeric_model
 from ..simulators import all_backends
 from ..systems import get_system
 from ..systems.model import WORLD, Circle, Rectangle, Segment
+from . import typeset
+from .animation import animation
 from .runner import Comparison, Metric, provenance
 
 RESULTS = "results.json"
@@ -100,6 +106,30 @@ def save_series(out: Path, row: str, comps: Iterable[Comparison]) -> None:
     path = series_path(out, row)
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, **arrays)
+    save_animation(out, row)
+
+
+def animation_path(out: Path, row: str) -> Path:
+    return out / REPORT_DATA / f"{row}.animation.json"
+
+
+def save_animation(out: Path, row: str) -> None:
+    """The row's motion as drawn frames (`animation.animation`), from its saved series;
+    a mechanism whose drawing cannot follow its coordinates gets the reason instead."""
+    try:
+        doc = animation(base_id(row), load_series(out, row))
+    except (TypeError, ValueError, NameError, KeyError) as exc:
+        doc = {"error": f"{type(exc).__name__}: {exc}"}
+    if doc is None:
+        doc = {"error": "the variant's coordinates are not the mechanism's drawn ones"}
+    # compact: the frames are the page's largest data
+    animation_path(out, row).write_text(json.dumps(doc, separators=(",", ":")))
+
+
+def load_animation(out: Path, row: str) -> dict | None:
+    """The row's frames as `save_animation` saved them (None when none were)."""
+    path = animation_path(out, row)
+    return json.loads(path.read_text()) if path.exists() else None
 
 
 def _reference_arrays(s: dict) -> dict[str, np.ndarray]:
@@ -220,15 +250,17 @@ def _view(mech, items: list[dict]) -> list[int]:
 def save_system(out: Path, system_id: str) -> None:
     """The system's drawing geometry and its errata entries (printed formulas against the
     derivation, without the engines' witnesses)."""
+    system = get_system(system_id)
     doc = {"drawing": mechanism_geometry(system_id),
-           "errata": [e.as_dict() for e in errata(get_system(system_id))]}
+           "model": typeset.model_document(system_id),
+           "errata": with_typeset([e.as_dict() for e in errata(system)])}
     path = out / REPORT_DATA / f"{system_id}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     _write_json(path, doc)
 
 
 def load_system(out: Path, system_id: str) -> dict:
-    """{"drawing": ..., "errata": [...]} as `save_system` saved them."""
+    """{"drawing": ..., "model": ..., "errata": [...]} as `save_system` saved them."""
     return json.loads((out / REPORT_DATA / f"{system_id}.json").read_text())
 
 
@@ -350,8 +382,23 @@ def save_errata(entries: list[dict], out: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     path = out / ERRATA
     _write_json(path, {"provenance": provenance(), "engines": engine_versions(),
-                       "errata": entries})
+                       "errata": with_typeset(entries)})
     return path
+
+
+def with_typeset(entries: list[dict]) -> list[dict]:
+    """The entries with their printed and derived forms typeset ("mathml": printed,
+    derived, difference; `typeset.errata_typeset`), matched by system and label."""
+    typeset_of: dict[str, dict] = {}
+    out = []
+    for e in entries:
+        if e["system"] not in typeset_of:
+            misprints = frozenset(x["label"] for x in entries
+                                  if x["system"] == e["system"] and x["verdict"] != "agrees")
+            typeset_of[e["system"]] = typeset.errata_typeset(get_system(e["system"]),
+                                                             misprints)
+        out.append({**e, "mathml": typeset_of[e["system"]].get(e["label"], {})})
+    return out
 
 
 def load_errata(out: Path) -> dict:

@@ -21,10 +21,11 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Circle as CirclePatch  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
 
-from ..comparisons.results_folder import (base_id, load_errata, load_results,  # noqa: E402
-                                          load_series, load_system, row_id, rows_of,
-                                          series_path)
+from ..comparisons.results_folder import (base_id, load_animation,  # noqa: E402
+                                          load_errata, load_results, load_series,
+                                          load_system, row_id, rows_of, series_path)
 from ..systems import get_system  # noqa: E402
+from . import site  # noqa: E402
 from .check_figures import check_figure  # noqa: E402
 
 #: why an engine deviates, in words a student can follow (SIMULATORS.md)
@@ -44,77 +45,6 @@ EXPLANATIONS = {
               "the velocity level; semi-implicit Euler (first order). Error correction "
               "(error_bias) is off here; its default bleeds energy out of a pendulum.",
 }
-
-TEMPLATE = jinja2.Template("""<!doctype html>
-<html><head><meta charset="utf-8"><title>mbfidelity report</title>
-<style>
-body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;color:#222}
-table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
-th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.xfail{background:#fbeec8}
-.xpass{background:#f8d0d0}.measured{background:#e3ecf8}.unsupported{background:#e6e6e6}img{max-width:100%}
-code{font-size:12px}
-</style></head><body>
-<h1>mbfidelity: simulators against exact models</h1>
-<p>git {{ prov.git_describe }} · {{ prov.date }} · Python {{ prov.python }} · {{ prov.platform }}</p>
-<p>Engines: {% for sim, v in versions.items() %}{{ sim }} {{ v }}{% if not loop.last %}, {% endif %}{% endfor %}.
-Errors are relative to each coordinate's amplitude; each tolerance follows from the integrator's
-order p, the step h, the simulated time T and the fastest frequency w of the motion:
-(w h)^p (1 + w T) for trajectories, and for semi-implicit Euler (w h) + (w h)^2 (1 + w T) +
-zeta (w h) w T (see <code>comparisons/tolerances.py</code>).</p>
-<h2>Summary</h2>
-<table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}</th>{% endfor %}</tr>
-{% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
-{% for sim in sims %}{% set c = cells[sys][sim] %}<td class="{{ c.cls }}">{{ c.text }}</td>{% endfor %}</tr>{% endfor %}
-</table>
-<h2>Why the engines deviate</h2><ul>{% for sim in sims %}<li><b>{{ sim }}</b>: {{ explanations.get(sim, "") }}</li>{% endfor %}</ul>
-{% for sys in systems %}
-<h2 id="{{ sys }}">{{ sys }}</h2><p>{{ titles[sys] }}</p>
-<table><tr><th>metric</th>{% for sim in sims %}<th>{{ sim }}</th>{% endfor %}</tr>
-{% for name in metric_names[sys] %}<tr><td>{{ name }}</td>
-{% for sim in sims %}{% set m = metrics[sys][sim].get(name) %}
-{% if m %}<td class="{{ m.status }}" title="{{ m.reason }}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ unsupported[sys].get(sim, "-") }}</td>{% endif %}
-{% endfor %}</tr>{% endfor %}</table>
-{% if frequencies.get(sys) %}<h3>Frequencies (Hz) at the operating equilibrium</h3>
-<table><tr><th>mode</th><th>reference (linearized M, C, K)</th>{% for sim in sims %}<th>{{ sim }} linearization</th><th>{{ sim }} fit</th>{% endfor %}</tr>
-{% for mode, row in frequencies[sys].items() %}<tr><td>{{ mode }}</td><td>{{ "%.9f"|format(row.reference_hz) }}</td>
-{% for sim in sims %}{% set e = row.engines.get(sim, {}) %}<td>{{ "%.9f"|format(e.get("linearization")) if e.get("linearization") is not none else "-" }}</td><td>{{ "%.9f"|format(e.get("fit")) if e.get("fit") is not none else "-" }}</td>{% endfor %}</tr>{% endfor %}</table>{% endif %}
-{% for w in liftoff[sys] %}<p class="xfail">Contact <b>{{ w.contact }}</b>, scenario {{ w.scenario }}: the
-bilateral model pulls from t = {{ "%.3f"|format(w.t_ref) }} s (reference minimum {{ "%.3g"|format(w.min_ref) }} N);
-a real unilateral contact would open there, so from that instant the comparison is of the
-bilateral model only. Engines: {% for sim, e in w.engines.items() %}{{ sim }} minimum {{ "%.3g"|format(e.min) }} N{% if e.t is not none %} from t = {{ "%.3f"|format(e.t) }} s{% endif %}{% if not loop.last %}; {% endif %}{% endfor %}.</p>{% endfor %}
-{% if incidents[sys] %}<p class="fail">Incidents (stages that did not complete; the rest of the
-run stands):</p><ul>{% for i in incidents[sys] %}<li><b>{{ i.simulator }}</b>, {{ i.scenario }}{% if i.stage %} ({{ i.stage }}){% endif %}: {{ i.outcome }}{% if i.t_reached is not none %} at t = {{ "%.6g"|format(i.t_reached) }} s{% endif %}: {{ i.message }}</li>{% endfor %}</ul>{% endif %}
-{% if expected[sys] %}<p>Declared expected failures:</p><ul>{% for e in expected[sys] %}<li><b>{{ e.simulator }}</b>, {{ e.metric }}: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
-{% for fig in figures[sys] %}<img src="{{ fig }}">{% endfor %}
-{% endfor %}
-{% if strutt %}<h2>The Strutt chart of eq. 83</h2>
-<p>Stability of Mathieu's equation as printed (§8.4, Fig. 28) from Floquet theory{% if strutt_engines %},
-and each engine's classification by simulation ({{ strutt_engines }}){% endif %}
-(written by <code>mbfidelity strutt --out DIR</code>; <code>make report</code> writes it).</p>
-<img src="strutt.png">{% endif %}
-{% if convergence %}<h2>Convergence and work-precision</h2>
-<p>Each engine's error against the step, its fitted order next to the declared one, and its
-error against CPU seconds: <a href="convergence.html">convergence.html</a> (written by
-<code>mbfidelity convergence --out DIR</code>; <code>make report</code> writes it).</p>{% endif %}
-{% if beams %}<h2>Flexible beams: the engines' own elements against the continuum</h2>
-<p>The simply supported beam with a block (§6.1, Fig. 17) in each engine's flexible elements,
-N = 2 to 32, against the exact Euler-Bernoulli frequencies (written by
-<code>mbfidelity beams --out DIR</code>; <code>make report</code> writes it).</p>
-<img src="beams.png">{% endif %}
-{% if discretizations %}<h2>Discretized continua against the exact ones</h2>
-<p>Each chain of N elements as derived, each engine's build of it (its own linearization) and
-the printed Rayleigh estimates, against the exact continuum (§6; written by
-<code>mbfidelity discretization SYSTEM --sim ... --out DIR</code>; <code>make report</code>
-writes them).</p>
-{% for fig in discretizations %}<img src="{{ fig }}">{% endfor %}{% endif %}
-{% if errata %}<h2>Errata: printed formulas against the derivation</h2>
-<p>With the engines as witnesses for every misprint: <a href="errata.html">errata.html</a>
-(written by <code>mbfidelity errata --out DIR</code>; <code>make report</code> writes both).</p>
-<table><tr><th>system</th><th>formula</th><th>verdict</th><th>printed</th><th>derived</th></tr>
-{% for e in errata %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{{ e.system }}</td><td>{{ e.label }}</td><td>{{ e.verdict }}</td>
-<td><code>{{ e.printed }}</code></td><td><code>{{ e.derived }}</code></td></tr>{% endfor %}</table>{% endif %}
-</body></html>""")
-
 
 def _cell(c) -> dict:
     if not c.supported:
@@ -206,43 +136,74 @@ def _figures(system_id: str, comps, out: Path) -> list[str]:
 
 
 def write_report(out: Path, workers: int | None = None) -> Path:
-    """index.html, summary.md and the figures, from the results saved in `out`; the
-    figures are drawn by a pool of `workers` processes (default: up to 2)."""
+    """The site (`reports/site.py`): index.html, one page per mechanism, summary.md and
+    the figures, from the results saved in `out`; the figures are drawn by a pool of
+    `workers` processes (default: up to 2)."""
     prov, results = load_results(out)
     by_system = rows_of(results)
     sims = list(dict.fromkeys(c.simulator for c in results))
-    systems = list(by_system)
-    cells = {s: {c.simulator: _cell(c) for c in comps} for s, comps in by_system.items()}
-    metrics = {s: {c.simulator: {m.name: m for m in c.metrics} for c in comps}
-               for s, comps in by_system.items()}
-    metric_names = {s: list(dict.fromkeys(m.name for c in comps for m in c.metrics))
-                    for s, comps in by_system.items()}
-    unsupported = {s: {c.simulator: "cannot express" for c in comps if not c.supported}
-                   for s, comps in by_system.items()}
+    rows = list(by_system)
     figures = _render_figures(out, by_system, workers)
     frequencies = frequency_table(results)
-    errata = [e for s in dict.fromkeys(map(base_id, systems))
-              for e in _saved_errata(out, s, by_system)]
-    incidents = {s: [{"simulator": c.simulator, **i} for c in comps for i in c.incidents]
-                 for s, comps in by_system.items()}
+    saved = {system: _saved_system(out, system, by_system)
+             for system in dict.fromkeys(map(base_id, rows))}
+    # after the figures and the saved files: their failures are incidents too
+    incidents = {r: [{"simulator": c.simulator, **i} for c in comps for i in c.incidents]
+                 for r, comps in by_system.items()}
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
-    liftoff = {s: contact_warnings(comps) for s, comps in by_system.items()}
-    page = TEMPLATE.render(prov=prov, sims=sims, systems=systems, cells=cells, metrics=metrics,
-                           metric_names=metric_names, unsupported=unsupported, figures=figures,
-                           titles={s: _title(s) for s in systems}, versions=versions,
-                           explanations=EXPLANATIONS, errata=errata, frequencies=frequencies,
-                           expected={s: _expected(s) for s in systems},
-                           liftoff=liftoff, incidents=incidents,
-                           convergence=(out / "convergence.json").exists(),
-                           strutt=(out / "strutt.png").exists(),
-                           beams=(out / "beams.png").exists(),
-                           discretizations=sorted(p.name for p in
-                                                  out.glob("discretization-*.png")),
-                           strutt_engines=_strutt_engines(out))
+    script = site.write_script(out)
+    errata_page = (out / "errata.json").exists()
+    for system, files in saved.items():
+        mine = [row for row in rows if base_id(row) == system]
+        drawing = next((f for row in mine for f in figures[row]
+                        if f == f"{system}-drawing.png"), "")
+        sections = [_section(out, row, by_system[row],
+                             [f for f in figures[row] if f != drawing], frequencies,
+                             incidents[row]) for row in mine]
+        described = get_system(system)
+        convergence = out / f"convergence-{system}.png"
+        (out / site.page_name(system)).write_text(site.MECHANISM.render(
+            style=site.STYLE, system=system, title=described.title, source=described.source,
+            drawing=drawing, model=files.get("model", {}), errata=files.get("errata", []),
+            sections=sections, errata_page=errata_page, script=script,
+            convergence=convergence.name if convergence.exists() else ""))
+    if errata_page:  # (again) now that it can link the mechanism pages
+        write_errata_page(out)
+    others = [(name, title) for name, title in site.OTHER_PAGES if (out / name).exists()]
+    page = site.INDEX.render(
+        style=site.STYLE, prov=prov, versions=versions, sims=sims, rows=rows,
+        cells={r: {c.simulator: _cell(c) for c in comps} for r, comps in by_system.items()},
+        pages={r: site.page_name(base_id(r)) for r in rows},
+        anchors={r: site.anchor(r) for r in rows}, titles={r: _title(r) for r in rows},
+        others=others, explanations=EXPLANATIONS, incidents=incidents,
+        figures=[(name, caption) for name, caption in site.INDEX_FIGURES
+                 if (out / name).exists()],
+        discretizations=sorted(p.name for p in out.glob("discretization-*.png")))
     index = out / "index.html"
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def _section(out: Path, row: str, comps, figures: list[str], frequencies: dict,
+             incidents: list[dict]) -> dict:
+    """A row's part of its mechanism's page: metrics, incidents, frequencies, figures,
+    animation."""
+    sims = [c.simulator for c in comps]
+    try:
+        frames = load_animation(out, row) or {}
+    except Exception as exc:  # a damaged file: the page says so and stands
+        frames = {"error": f"{type(exc).__name__}: {exc}"[:500]}
+    return {"row": row, "anchor": site.anchor(row), "title": _title(row), "sims": sims,
+            "metrics": {c.simulator: {m.name: m for m in c.metrics} for c in comps},
+            "metric_names": list(dict.fromkeys(m.name for c in comps for m in c.metrics)),
+            "unsupported": {c.simulator: "cannot express: " + c.reason for c in comps
+                            if not c.supported},
+            "expected": _expected(row), "liftoff": contact_warnings(comps),
+            "frequencies": frequencies.get(row, {}), "figures": figures,
+            "animation": site.embedded_json(frames) if frames.get("scenarios") else "",
+            "animation_error": frames.get("error", "no saved series"),
+            "scenarios": list(frames.get("scenarios", {})), "incidents": incidents}
 
 
 def _strutt_engines(out: Path) -> str:
@@ -285,14 +246,15 @@ def _render_figures(out: Path, rows: dict[str, list], workers: int | None) -> di
     return figures
 
 
-def _saved_errata(out: Path, system_id: str, rows: dict[str, list]) -> list[dict]:
-    """The system's saved errata entries; a file that does not load is an incident of
-    the system's comparisons (the page says so) instead of the end of the report."""
+def _saved_system(out: Path, system_id: str, rows: dict[str, list]) -> dict:
+    """The system's saved drawing, model and errata entries; a file that does not load is
+    an incident of the system's comparisons (the page says so) instead of the end of the
+    report."""
     try:
-        return load_system(out, system_id)["errata"]
+        return load_system(out, system_id)
     except Exception as exc:
         _figure_incident(rows, system_id, exc)
-        return []
+        return {}
 
 
 def _figure_incident(rows: dict[str, list], row: str, exc: BaseException) -> None:
@@ -319,33 +281,26 @@ def _plot_saved(out: Path, row: str, comps) -> list[str]:
         return [f"!{type(exc).__name__}: {exc}"]
 
 
-ERRATA_TEMPLATE = jinja2.Template("""<!doctype html><html><head><meta charset="utf-8">
-<title>mbfidelity errata</title><style>
-body{font-family:sans-serif;margin:2em;max-width:1400px}
-table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px;vertical-align:top}
-th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}code{font-size:12px}
-</style></head><body>
-<h1>Errata: the monograph's printed formulas against the derivation</h1>
-<p>git {{ prov.git_describe }} · {{ prov.date }} · engines: {% for sim, v in versions.items() %}{{ sim }} {{ v }}{% if not loop.last %}, {% endif %}{% endfor %}.
-A formula agrees when it matches the derivation to 1e-9 relative at two parameter sets.
-For each misprint the engines are witnesses: they run the mechanism, and their motion (or
-their own linearization) is compared with the printed and with the derived model.</p>
-<table><tr><th>system</th><th>formula</th><th>verdict</th><th>difference</th><th>printed</th><th>derived</th><th>engines (witnesses)</th></tr>
-{% for e in entries %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{{ e.system }}</td><td>{{ e.label }}{% if e.note %}<br><small>{{ e.note }}</small>{% endif %}</td>
-<td>{{ e.verdict }}</td><td>{{ "%.2g"|format(e.max_relative_difference) if e.max_relative_difference is not none else "" }}</td>
-<td><code>{{ e.printed }}</code></td><td><code>{{ e.derived }}</code></td>
-<td>{% for sim, w in (e.witnesses or {}).items() %}<b>{{ sim }}</b>: {{ w.verdict }}<br>{% endfor %}</td></tr>{% endfor %}
-</table></body></html>""")
-
-
 def write_errata_page(out: Path) -> Path:
-    """errata.html from the errata.json saved in `out`: every printed formula, its verdict
-    and witnesses."""
+    """errata.html from the errata.json saved in `out`: every printed formula typeset
+    beside the derived one with the differing terms marked, its verdict and witnesses."""
     doc = load_errata(out)
+    systems: dict[str, list] = {}
+    for e in doc["errata"]:
+        systems.setdefault(e["system"], []).append(e)
+    pages = {s: site.page_name(s) for s in systems if (out / site.page_name(s)).exists()}
     page = out / "errata.html"
-    page.write_text(ERRATA_TEMPLATE.render(entries=doc["errata"], prov=doc["provenance"],
-                                           versions=doc["engines"]))
+    page.write_text(site.ERRATA.render(style=site.STYLE, systems=systems, pages=pages,
+                                       prov=doc["provenance"], versions=doc["engines"],
+                                       counts=_verdict_counts(doc["errata"])))
     return page
+
+
+def _verdict_counts(entries: list[dict]) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for e in entries:
+        counts[e["verdict"]] = counts.get(e["verdict"], 0) + 1
+    return counts
 
 
 def _title(shown: str) -> str:
