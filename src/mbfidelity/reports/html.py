@@ -28,7 +28,7 @@ from ..systems import get_system  # noqa: E402
 from . import site  # noqa: E402
 from .check_figures import check_figure  # noqa: E402
 
-#: why an engine deviates, in words a student can follow (SIMULATORS.md)
+#: why an engine deviates, in words a student can follow (docs/engines.md)
 EXPLANATIONS = {
     "mujoco": "Reduced coordinates; RK4 by default here (its Euler is semi-implicit, with an "
               "O(h) phase offset). Massless links are folded into their child body. Loops and "
