@@ -189,7 +189,8 @@ def test_new_rows_serialise_and_render():
     for r in rows:
         systems.setdefault(r["system"], []).append(r)
     page = ERRATA.render(style=STYLE, systems=systems, pages={},
-                         prov={"git_describe": "", "date": ""}, versions={}, counts={})
+                         prov={"git_describe": "", "date": ""}, versions={}, counts={},
+                         section6=[])
     for label in ("Fig. 40, eq. 113", "Fig. 40, eq. 116 (as a system, multipliers fitted)",
                   "Fig. 36, §9.7 (F_enllac = F_act)", "Fig. 34, eq. 99 (P_nc)"):
         assert label in page

@@ -65,3 +65,25 @@ def test_the_motion_is_drawn_rigidly():
         arms.append(far)
     cos = np.dot(arms[0], arms[1]) / (np.linalg.norm(arms[0]) * np.linalg.norm(arms[1]))
     assert abs(cos) < 1e-3
+
+
+def test_section6_formulas_are_derived_and_a_changed_one_is_caught():
+    """§6 (eq. 62-70): every printed Rayleigh reduction equals its derivation identically
+    in c (by hand: eq. 67 at mid-span is 17/35, the spring's third of eq. 70); the same
+    derivation against eq. 67 with 104 for 105 leaves a difference, and every estimate is
+    an upper bound of the exact continuum's first frequency."""
+    from dataclasses import replace
+
+    from mbfidelity.analytic.rayleigh import c, section6_formulas
+    from mbfidelity.comparisons.typeset import section6_entries
+
+    formulas = {f.label: f for f in section6_formulas()}
+    assert all(f.difference() == 0 for f in formulas.values())
+    eq67 = formulas["§6.1, eq. 67 (the beam's reduced mass, per rho l)"]
+    assert eq67.derived.subs(c, sp.Rational(1, 2)) == sp.Rational(17, 35)
+    wrong = replace(eq67, printed=eq67.printed * sp.Rational(105, 104))
+    assert wrong.difference() != 0
+    entries = section6_entries()
+    estimates = [e for e in entries if e["kind"] == "rayleigh_estimate"]
+    assert len(estimates) == 3 and all(e["max_relative_difference"] > 0 for e in estimates)
+    assert all(e["verdict"] == "agrees" and e["mathml"]["printed"] for e in entries)

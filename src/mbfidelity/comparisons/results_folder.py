@@ -16,7 +16,8 @@ Layout of a folder written by `mbfidelity run --out DIR` (and `mbfidelity errata
                                 MathML (`typeset.model_document`) and the system's errata
                                 entries, typeset beside the derived forms
     errata.json                 every printed formula, its verdict and the engines'
-                                witnesses (`mbfidelity errata --out`)
+                                witnesses (`mbfidelity errata --out`), and §6's
+                                Rayleigh formulas and estimates (`typeset.section6_entries`)
     jobs/<system>.json          each finished system's comparisons, as plain data, for
                                 `run --resume` (reused only when it and the system's
                                 report files load and answer the same request)
@@ -253,7 +254,8 @@ def save_system(out: Path, system_id: str) -> None:
     system = get_system(system_id)
     doc = {"drawing": mechanism_geometry(system_id),
            "model": typeset.model_document(system_id),
-           "errata": with_typeset([e.as_dict() for e in errata(system)])}
+           "errata": with_typeset([e.as_dict() for e in errata(system)])
+           + typeset.section6_entries(system_id)}
     path = out / REPORT_DATA / f"{system_id}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     _write_json(path, doc)
@@ -382,7 +384,8 @@ def save_errata(entries: list[dict], out: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     path = out / ERRATA
     _write_json(path, {"provenance": provenance(), "engines": engine_versions(),
-                       "errata": with_typeset(entries)})
+                       "errata": with_typeset(entries),
+                       "section6": typeset.section6_entries()})
     return path
 
 
@@ -402,7 +405,8 @@ def with_typeset(entries: list[dict]) -> list[dict]:
 
 
 def load_errata(out: Path) -> dict:
-    """{"provenance", "engines", "errata"} as `save_errata` saved them."""
+    """{"provenance", "engines", "errata", "section6"} as `save_errata` saved them (a
+    folder written before §6 was saved has no "section6")."""
     return json.loads((out / ERRATA).read_text())
 
 

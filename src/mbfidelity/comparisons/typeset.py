@@ -24,7 +24,9 @@ from ..analytic import cache
 from ..analytic.derivation import cache_key, derivation_of
 from ..analytic.errata import (_equilibrium_at, _one_equation_each, _reduced_cached,
                                _with_relations, nonconservative_power)
+from ..analytic.continuum import continuum_summary
 from ..analytic.linear import find_equilibria, operating_equilibrium
+from ..analytic.rayleigh import section6_formulas
 from ..systems import PrintedFormula, System, coordinate_symbols, get_system
 from ..systems.model import TIME
 
@@ -228,13 +230,15 @@ def sample_points(system: System, d, count: int = 2, seed: int = 20101) -> tuple
 # --- the derived model ------------------------------------------------------------------
 
 
-def _cached(system: System, kind: str, compute: Callable[[], dict], *extra: str) -> dict:
+def _cached(system: System | None, kind: str, compute: Callable[[], dict | list],
+            *extra: str):
     """`compute()`, kept in the persistent cache (`analytic.cache`) under the system's
     content key, named by this module's and the analytic code's digests: typesetting
     simplifies and expands, seconds per mechanism."""
     h = hashlib.sha256(Path(__file__).read_bytes())
     h.update("|".join((cache.analytic_digest(), *extra)).encode())
-    key, name = cache_key(system), f"{kind}-{h.hexdigest()[:16]}.json"
+    key = cache_key(system) if system is not None else kind
+    name = f"{kind}-{h.hexdigest()[:16]}.json"
     blob = cache.load(key, name)
     if blob is not None:
         try:
@@ -477,3 +481,50 @@ def _matching_row(row, reduced: list, d):
             if fewest is None or left < fewest:
                 best, fewest = scaled, left
     return best
+
+
+# --- §6: Rayleigh's method --------------------------------------------------------------
+
+
+def section6_entries(system_id: str | None = None) -> list[dict]:
+    """The printed formulas of §6 (`analytic.rayleigh`) as errata entries, typeset, and
+    each Rayleigh estimate of a catalog continuum against its exact first frequency (an
+    estimate agrees when it is an upper bound, as a Rayleigh quotient must be); all of
+    them, or those of one system. Kept in the persistent cache (`_cached`)."""
+    entries = _cached(None, "section6-mathml", _section6_entries)
+    return [e for e in entries if system_id in (None, e["system"])]
+
+
+def _section6_entries() -> list[dict]:
+    out = []
+    for f in section6_formulas():
+        difference = f.difference()
+        out.append({"system": f.system, "label": f.label, "kind": "rayleigh",
+                    "printed": str(f.printed), "derived": str(f.derived),
+                    "verdict": "agrees" if difference == 0 else "misprint",
+                    "max_relative_difference": None, "note": f.note, "witnesses": {},
+                    "details": {},
+                    "mathml": {"printed": mathml(f.printed), "derived": mathml(f.derived),
+                               "difference": mathml(difference)}})
+    for system_id in ("beam_with_block", "massive_spring"):
+        system = get_system(system_id)
+        summary = continuum_summary(system.continuum, system.parameter_values())
+        exact = summary.frequency_hz[0]
+        for r in summary.rayleigh:
+            bound = r.frequency_hz >= exact * (1 - 1e-12)
+            out.append({
+                "system": system_id, "label": f"{r.label}: Rayleigh's estimate ({r.shape})",
+                "kind": "rayleigh_estimate", "printed": f"{r.frequency_hz:.9g} Hz",
+                "derived": f"{exact:.9g} Hz (the exact continuum's first frequency)",
+                "verdict": "agrees" if bound else "misprint",
+                "max_relative_difference": r.relative_error,
+                "note": (f"an upper bound, {r.relative_error:+.3%} of the exact frequency, at "
+                         "the default parameters" if bound else
+                         "below the exact frequency: not a Rayleigh quotient"),
+                "witnesses": {}, "details": {},
+                "mathml": {"printed": block(f"<mrow><mi>f</mi><mo>=</mo>{number(r.frequency_hz)}"
+                                            "<mtext>&#xA0;Hz</mtext></mrow>"),
+                           "derived": block(f"<mrow><msub><mi>f</mi><mn>1</mn></msub><mo>=</mo>"
+                                            f"{number(exact)}<mtext>&#xA0;Hz</mtext></mrow>"),
+                           "difference": ""}})
+    return out

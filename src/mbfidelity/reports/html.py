@@ -290,9 +290,11 @@ def write_errata_page(out: Path) -> Path:
         systems.setdefault(e["system"], []).append(e)
     pages = {s: site.page_name(s) for s in systems if (out / site.page_name(s)).exists()}
     page = out / "errata.html"
+    section6 = doc.get("section6", [])
     page.write_text(site.ERRATA.render(style=site.STYLE, systems=systems, pages=pages,
                                        prov=doc["provenance"], versions=doc["engines"],
-                                       counts=_verdict_counts(doc["errata"])))
+                                       counts=_verdict_counts(doc["errata"] + section6),
+                                       section6=section6))
     return page
 
 

@@ -164,7 +164,7 @@ compared up to a constant), and the last column is printed &#x2212; derived. Mat
 at the default parameters, their differing entries marked. For each misprint the engines are
 witnesses: they run the mechanism, and their motion (or their own linearization) is compared
 with the printed and with the derived model.</p>
-<p>Mechanisms: {% for s in systems %}<a href="#{{ s }}">{{ s }}</a>{% if not loop.last %} · {% endif %}{% endfor %}</p>
+<p>Mechanisms: {% for s in systems %}<a href="#{{ s }}">{{ s }}</a>{% if not loop.last %} · {% endif %}{% endfor %}{% if section6 %} · <a href="#section6">§6, Rayleigh's method</a>{% endif %}</p>
 {% for s, entries in systems.items() %}
 <h2 id="{{ s }}">{{ s }}{% if s in pages %} <small>(<a href="{{ pages[s]|url }}">its page</a>)</small>{% endif %}</h2>
 <table><tr><th>formula</th><th>verdict</th><th>relative difference</th><th>printed</th><th>derived</th><th>printed &#x2212; derived</th><th>engines (witnesses)</th></tr>
@@ -175,6 +175,18 @@ with the printed and with the derived model.</p>
 <td><div class="formula">{{ t.get("difference", "") }}</div>{% if t.get("note") %}<small>{{ t.note|e }}</small>{% endif %}</td>
 <td>{% for sim, w in (e.witnesses or {}).items() %}<b>{{ sim }}</b>: {{ w.verdict|e }}<br>{% endfor %}</td></tr>{% endfor %}
 </table>{% endfor %}
+{% if section6 %}<h2 id="section6">§6: Rayleigh's method (eq. 62-70)</h2>
+<p>The printed reductions of the beam with a block at a = c l (§6.1, Fig. 17) and of the spring
+with distributed mass (§6.2, Fig. 18), against their derivation identically in c: each static
+shape solved from the beam's equation with pinned ends, the reduced mass the integral of
+rho y<sup>2</sup>, the reduced stiffness the integral of EI y''<sup>2</sup> (a formula agrees when
+printed &#x2212; derived simplifies to zero). Then each Rayleigh estimate against the exact
+continuum's first frequency at the default parameters: a Rayleigh quotient is an upper bound.</p>
+<table><tr><th>mechanism</th><th>formula</th><th>verdict</th><th>printed</th><th>derived</th><th>printed &#x2212; derived</th></tr>
+{% for e in section6 %}{% set t = e.get("mathml", {}) %}<tr class="{{ 'pass' if e.verdict == 'agrees' else 'fail' }}"><td>{% if e.system in pages %}<a href="{{ pages[e.system]|url }}">{{ e.system }}</a>{% else %}{{ e.system }}{% endif %}</td>
+<td>{{ e.label|e }}{% if e.note %}<br><small>{{ e.note|e }}</small>{% endif %}</td><td>{{ e.verdict }}</td>
+<td><div class="formula">{{ t.get("printed", "") }}</div></td><td><div class="formula">{{ t.get("derived", "") }}</div></td>
+<td><div class="formula">{{ t.get("difference", "") }}</div></td></tr>{% endfor %}</table>{% endif %}
 </body></html>""")
 
 SCRIPT = """// The mechanism's motion from frames embedded in the page: the exact reference and every
