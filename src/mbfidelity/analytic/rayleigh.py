@@ -28,9 +28,10 @@ x, l, a, c, EI, F, q, rho = sp.symbols("x l a c EI F q rho", positive=True)
 
 @dataclass(frozen=True)
 class Section6Formula:
-    """A printed formula of §6 and its derivation (SymPy expressions)."""
+    """A printed formula of §6 and its derivation (SymPy expressions), for the continuum
+    model it reduces (`continuum.CONTINUA`; a system names its model, `System.continuum`)."""
 
-    system: str
+    continuum: str
     label: str
     printed: sp.Expr
     derived: sp.Expr
@@ -88,7 +89,7 @@ def section6_formulas() -> tuple[Section6Formula, ...]:
     # the uniform-load shape referred to the block at c l
     u_mass, u_stiffness = _reduced(uniform, uniform, a)
     spring_mass = sp.integrate(rho * (x / l) ** 2, (x, 0, l))
-    beam = "beam_with_block"
+    beam = "beam_with_point_mass"
     return (
         Section6Formula(beam, "§6.1, eq. 64 (deflection z_a under F at a)",
                         F * a**2 * b**2 / (3 * EI * l), z_a),
@@ -110,6 +111,6 @@ def section6_formulas() -> tuple[Section6Formula, ...]:
         Section6Formula(beam, "§6.1, own-weight shape (the reduced stiffness, per EI)",
                         sp.Rational(24, 5) / (s**2 * l**3), u_stiffness,
                         note="the static deflection under the beam's own weight"),
-        Section6Formula("massive_spring", "§6.2, eq. 69-70 (the spring's reduced mass)",
+        Section6Formula("spring_with_end_mass", "§6.2, eq. 69-70 (the spring's reduced mass)",
                         rho * l / 3, spring_mass, note="with the shape z = (x/l) z_a"),
     )

@@ -27,7 +27,7 @@ from ..analytic.errata import (_equilibrium_at, _one_equation_each, _reduced_cac
 from ..analytic.continuum import continuum_summary
 from ..analytic.linear import find_equilibria, operating_equilibrium
 from ..analytic.rayleigh import section6_formulas
-from ..systems import PrintedFormula, System, coordinate_symbols, get_system
+from ..systems import PrintedFormula, System, all_systems, coordinate_symbols, get_system
 from ..systems.model import TIME
 
 #: beyond this many operations an expression is summarised instead of typeset (a long
@@ -497,16 +497,18 @@ def section6_entries(system_id: str | None = None) -> list[dict]:
 
 def _section6_entries() -> list[dict]:
     out = []
+    continua = {s.id: s.continuum for s in all_systems().values() if s.continuum}
     for f in section6_formulas():
         difference = f.difference()
-        out.append({"system": f.system, "label": f.label, "kind": "rayleigh",
+        out += [{"system": system_id, "label": f.label, "kind": "rayleigh",
                     "printed": str(f.printed), "derived": str(f.derived),
                     "verdict": "agrees" if difference == 0 else "misprint",
                     "max_relative_difference": None, "note": f.note, "witnesses": {},
                     "details": {},
                     "mathml": {"printed": mathml(f.printed), "derived": mathml(f.derived),
-                               "difference": mathml(difference)}})
-    for system_id in ("beam_with_block", "massive_spring"):
+                               "difference": mathml(difference)}}
+                for system_id, model in continua.items() if model == f.continuum]
+    for system_id in continua:
         system = get_system(system_id)
         summary = continuum_summary(system.continuum, system.parameter_values())
         exact = summary.frequency_hz[0]
