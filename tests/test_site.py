@@ -87,3 +87,24 @@ def test_section6_formulas_are_derived_and_a_changed_one_is_caught():
     estimates = [e for e in entries if e["kind"] == "rayleigh_estimate"]
     assert len(estimates) == 3 and all(e["max_relative_difference"] > 0 for e in estimates)
     assert all(e["verdict"] == "agrees" and e["mathml"]["printed"] for e in entries)
+
+
+def test_every_catalog_mechanism_can_be_animated():
+    """Every mechanism's drawing follows its coordinates (`make report` animates them
+    all): at the operating point the drawn points are finite, and the joints' anchors are
+    where the saved sketch puts them."""
+    from mbfidelity.comparisons.animation import _drawing
+    from mbfidelity.comparisons.results_folder import mechanism_geometry
+    from mbfidelity.systems import all_systems
+
+    for system_id, system in all_systems().items():
+        items, points, view = _drawing(system_id)
+        geometry = mechanism_geometry(system_id)
+        at = points(np.array(geometry["operating_point"]))
+        assert np.all(np.isfinite(at)), system_id
+        sketched = [j["at"] for j in geometry["items"] if j["kind"] == "joint"]
+        drawn = [at[i["points"][0]] for i in items if i["kind"] == "joint"]
+        assert len(sketched) == len(drawn), system_id
+        for s, d in zip(sketched, drawn):
+            s = np.array(list(s) + [0.0] * (3 - len(s)))
+            assert np.allclose(s, d, atol=1e-9), system_id
