@@ -106,14 +106,14 @@ def _problems(driver, page: Path) -> list[str]:
     return found
 
 
-def test_every_page_opens_clean(site, browser):
+def test_every_page_opens_clean(browser, site):
     pages = sorted(site.glob("*.html"))
     assert {p.name for p in pages} == {"index.html", f"{SYSTEM}.html", "errata.html"}
     for page in pages:
         assert _problems(browser, page) == [], page.name
 
 
-def test_a_broken_page_is_caught(site, browser, tmp_path):
+def test_a_broken_page_is_caught(browser, site, tmp_path):
     """The checks find what they look for: a figure removed, the animation's script
     broken, a mechanism's page gone."""
     broken = tmp_path / "broken"
@@ -128,7 +128,7 @@ def test_a_broken_page_is_caught(site, browser, tmp_path):
     assert any(p.startswith("missing:") for p in _problems(browser, broken / "index.html"))
 
 
-def test_mathml_is_laid_out(site, browser):
+def test_mathml_is_laid_out(browser, site):
     for name in (f"{SYSTEM}.html", "errata.html"):
         _open(browser, site / name)
         boxes = browser.execute_script(
@@ -147,7 +147,7 @@ def test_mathml_is_laid_out(site, browser):
         assert heights and max(heights) > 1.2 * line, name
 
 
-def test_the_animation_advances(site, browser):
+def test_the_animation_advances(browser, site):
     _open(browser, site / f"{SYSTEM}.html")
     boxes = browser.find_elements("css selector", ".animation")
     assert len(boxes) == 2  # the mechanism's two scenarios
