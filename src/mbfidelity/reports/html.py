@@ -5,14 +5,12 @@ saved; from the descriptions it reads only titles, coordinate names and the decl
 expected failures."""
 from __future__ import annotations
 
-import html
 import json
 import os
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from types import SimpleNamespace
 
-import jinja2
 import matplotlib
 
 matplotlib.use("Agg")
@@ -47,14 +45,24 @@ EXPLANATIONS = {
 }
 
 def _cell(c) -> dict:
+    """A matrix cell: its metrics counted by status, coloured by the worst; a comparison
+    whose verdict is a failure without a failing metric (an incident, an unresolved
+    metric) is coloured as failed. The text is plain (the page escapes it)."""
     if not c.supported:
-        return {"cls": "unsupported", "text": "cannot express: " + html.escape(c.reason)}
+        return {"cls": "unsupported", "text": "cannot express: " + c.reason}
     statuses = [m.status for m in c.metrics]
-    worst = next((s for s in ("fail", "xpass", "xfail", "measured") if s in statuses), "pass")
-    counts = ", ".join(f"{statuses.count(s)} {s}" for s in ("pass", "fail", "xfail", "xpass",
-                                                            "measured")
-                       if statuses.count(s))
-    return {"cls": worst, "text": counts}
+    worst = next((s for s in ("fail", "xpass", "unresolved", "xfail", "measured")
+                  if s in statuses), "pass")
+    counts = [f"{statuses.count(s)} {s}" for s in ("pass", "fail", "xfail", "xpass",
+                                                   "measured", "unresolved")
+              if statuses.count(s)]
+    if c.incidents:
+        counts.append(f"{len(c.incidents)} incident" + "s" * (len(c.incidents) > 1))
+    if c.verdict == "fail" and worst in ("pass", "xfail", "measured", "unresolved"):
+        worst = "fail"
+    elif worst == "unresolved":  # declared unresolved: it holds, as an expected failure
+        worst = "xfail"
+    return {"cls": worst, "text": ", ".join(counts)}
 
 
 #: points per line in the figures: a 10 in, 80 dpi axis is 800 pixels wide, so a line of
