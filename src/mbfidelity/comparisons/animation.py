@@ -50,6 +50,10 @@ def _drawing(system_id: str, scenario: str = ""):
             if isinstance(shape, Segment):
                 items.append({"kind": "segment",
                               "points": [point(b.name, shape.a), point(b.name, shape.b)]})
+            elif isinstance(shape, Circle) and not mech.spatial:
+                # planar: its centre moves, its radius stays (one point a frame)
+                items.append({"kind": "circle", "points": [point(b.name, shape.center)],
+                              "radius": float(shape.radius)})
             elif isinstance(shape, Circle):
                 cx, cy = (float(v) for v in shape.center)
                 r = float(shape.radius)

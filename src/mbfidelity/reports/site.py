@@ -209,7 +209,9 @@ SCRIPT = """// The mechanism's motion from frames embedded in the page: the exac
         });
       });
     });
-    var span = Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-9) * 1.1;
+    var rmax = 0;
+    data.items.forEach(function (item) { if (item.radius) { rmax = Math.max(rmax, item.radius); } });
+    var span = (Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-9) + 2 * rmax) * 1.1;
     var mid = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2];
     var size = canvas.width, scale = size / span;
     function px(p) { return [size / 2 + (p[0] - mid[0]) * scale, size / 2 - (p[1] - mid[1]) * scale]; }
@@ -237,6 +239,11 @@ SCRIPT = """// The mechanism's motion from frames embedded in the page: the exac
           if (item.kind === "joint") {
             ctx.arc(pts[0][0], pts[0][1], exact ? 5 : 3, 0, 2 * Math.PI);
             ctx.fill();
+            return;
+          }
+          if (item.kind === "circle") {
+            ctx.arc(pts[0][0], pts[0][1], item.radius * scale, 0, 2 * Math.PI);
+            ctx.stroke();
             return;
           }
           ctx.moveTo(pts[0][0], pts[0][1]);
