@@ -67,10 +67,11 @@ COORD_RATE = sp.Symbol("_coord_rate", real=True)
 GRAVITY = sp.Symbol("g", positive=True)
 STANDARD_GRAVITY = 9.81
 #: the largest number of elements a count parameter admits unless it states its own: the
-#: symbolic derivation of a chain grows at least linearly with it (benchmarks/
-#: count_cost.py), so that a chain of this size is derived, compiled and analysed well
-#: within `analyze`'s default time budget
-MAX_COUNT = 64
+#: symbolic derivation of a chain and its generated code grow with it, and the largest
+#: chain must still derive, compile and be analysed within `analyze`'s default time
+#: budget (benchmarks/count_cost.py measures each size; its record shows where that
+#: stops); the catalog's own studies go to this size
+MAX_COUNT = 32
 
 
 @dataclass(frozen=True)
