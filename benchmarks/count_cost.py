@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 SYSTEM = sys.argv[1] if len(sys.argv) > 1 else "massive_spring"
-COUNTS = [int(n) for n in sys.argv[2:]] or [4, 8, 16, 32, 64]
+COUNTS = [int(n) for n in sys.argv[2:]] or [4, 8, 16, 32, 48, 64]
 MBFIDELITY = Path(sys.executable).with_name("mbfidelity")
 RECORD = Path(__file__).parent / "records" / "count_cost.json"
 
@@ -27,12 +27,15 @@ for n in COUNTS:
                            SYSTEM, "--param", f"N={n}", "--no-cache", "--json"],
                           capture_output=True, text=True)
     wall = time.perf_counter() - start
-    user, system_cpu, peak_kb = done.stderr.strip().splitlines()[-1].split()
+    lines = done.stderr.strip().splitlines()
+    user, system_cpu, peak_kb = lines[-1].split()
     points.append({"N": n, "wall_s": wall, "cpu_s": float(user) + float(system_cpu),
-                   "peak_rss_mb": int(peak_kb) / 1024, "exit": done.returncode})
+                   "peak_rss_mb": int(peak_kb) / 1024, "exit": done.returncode,
+                   "error": lines[-2] if done.returncode and len(lines) > 1 else ""})
     print(points[-1], flush=True)
-ns = np.array([p["N"] for p in points], dtype=float)
-cpu = np.array([p["cpu_s"] for p in points])
+done_points = [p for p in points if p["exit"] == 0]  # the law of the sizes that work
+ns = np.array([p["N"] for p in done_points], dtype=float)
+cpu = np.array([p["cpu_s"] for p in done_points])
 exponent, log_c = np.polyfit(np.log(ns), np.log(cpu), 1)
 doc = {"system": SYSTEM, "command": "mbfidelity analyze SYSTEM --param N=n --no-cache",
        "points": points, "fitted_cpu_s": f"{np.exp(log_c):.3g} * N^{exponent:.2f}",
