@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 SYSTEM = sys.argv[1] if len(sys.argv) > 1 else "massive_spring"
-COUNTS = [int(n) for n in sys.argv[2:]] or [4, 8, 16, 32, 48, 64]
+COUNTS = [int(n) for n in sys.argv[2:]] or [4, 8, 16, 32]
 MBFIDELITY = Path(sys.executable).with_name("mbfidelity")
 RECORD = Path(__file__).parent / "records" / "count_cost.json"
 
