@@ -323,7 +323,7 @@ def list_systems() -> dict:
             sup = b.support(mech) if ok else None
             support[sid] = {"supported": bool(ok and sup.ok),
                             "reason": why if not ok else (sup.reason if not sup.ok else "")}
-        rows.append({"system": s.id, "title": s.title, "source": s.source,
+        rows.append({"system": s.id, "group": s.group, "title": s.title, "source": s.source,
                      "coordinates": list(s.coordinates),
                      "scenarios": [sc.name for sc in s.scenarios], "simulators": support,
                      "variants": {v.name: {"simulators": list(v.settings),

@@ -132,7 +132,11 @@ def list_(as_json: bool = typer.Option(False, "--json", help="print JSON")) -> N
         _json(doc)
         return
     typer.echo(f"{'system':26s} " + " ".join(f"{b:9s}" for b in backends) + " source")
-    for r in rows:
+    group = None
+    for r in sorted(rows, key=lambda r: (r["group"] != "monograph", r["group"])):
+        if r["group"] != group:
+            group = r["group"]
+            typer.echo(f"[{group}]")
         marks = " ".join(f"{'yes' if r['simulators'][b]['supported'] else 'no':9s}"
                          for b in backends)
         typer.echo(f"{r['system']:26s} {marks} {r['source']}")

@@ -67,9 +67,12 @@ def system_key(module_file: str, structure: str = "") -> str:
     h.update(f"{FORMAT}|sympy {sympy.__version__}|python {sys.version_info[:2]}".encode())
     if structure:
         h.update(f"|structure {structure}".encode())
-    # the description machinery: systems/ files that are not mechanism modules
-    shared = sorted(p for p in systems_dir.glob("*.py")
-                    if p.name.startswith("_") or p.name == "model.py")
+    # the description machinery: systems/ files that are not mechanism modules (those of
+    # the package itself too, for a mechanism in one of its groups, systems/<group>/)
+    package = here.parent / "systems"
+    folders = [package, systems_dir] if package in systems_dir.parents else [systems_dir]
+    shared = [p for folder in folders for p in sorted(folder.glob("*.py"))
+              if p.name.startswith("_") or p.name == "model.py"]
     for path in [Path(module_file), *shared, *(here / n for n in _ANALYTIC_SOURCES)]:
         h.update(path.name.encode())
         h.update(_file_digest(str(path)))

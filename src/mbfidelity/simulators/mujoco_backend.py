@@ -5,7 +5,9 @@ Translation (generic over the description, see `to_mjcf`):
 - Every body with mass becomes an MJCF body whose frame is the description's
   centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
   from geom density). The planar inertia goes on z; x and y get the same value so the
-  inertia is valid (they cannot act in planar motion).
+  inertia is valid (they cannot act in planar motion). MuJoCo rejects a moving body of
+  zero inertia, so a point mass (central inertia 0) gets the substitute inertia m r^2
+  (setting ``point_mass_gyration``).
 - MuJoCo rejects massless moving bodies, so a massless body's joints are folded into its
   single child: that MJCF body carries the chain of joints, which MuJoCo applies in order,
   each with its anchor and axis expressed in the body frame at the reference
@@ -230,6 +232,11 @@ class _Closure:
 GYRATION = 0.01
 #: the same for sliders: they turn with the slot body, whose inertia they add to
 SLIDER_GYRATION = 1e-5
+#: radius of gyration (m) of the inertia a point mass is given (setting
+#: point_mass_gyration)
+POINT_MASS_GYRATION = 1e-6
+#: the least substitute inertia of a point mass (kg m^2): ten times MuJoCo's mjMINVAL
+POINT_MASS_INERTIA_FLOOR = 1e-14
 
 
 @dataclass
@@ -338,6 +345,11 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
             key = "massless_mass_ratio" if bd.name in loaded else "link_mass_ratio"
             sub_mass = float(opts.get(key, 3e-4 if bd.name in loaded else 1e-9)) * m_min
             plan.substitutes[bd.name] = (sub_mass, sub_mass * GYRATION**2)
+        elif num(bd.mass) > 0 and num(bd.inertia) == 0:  # a point mass: its substitute
+            radius = float(opts.get("point_mass_gyration", POINT_MASS_GYRATION))
+            # above MuJoCo's mjMINVAL (1e-15) whatever the mass
+            inertia = max(num(bd.mass) * radius**2, POINT_MASS_INERTIA_FLOOR)
+            plan.inertials[bd.name] = (num(bd.mass), (0.0, 0.0), inertia)
     # point-on-line sliders. The slider follows the pin point, so its mass is taken out
     # of the pin body (mass, centre of mass and inertia adjusted so that body + slider
     # have the description's mass, first and second moments: exact while the constraint
@@ -1194,6 +1206,12 @@ class MujocoBackend(Backend):
             "Measured on the slotted link of Fig. 34: 3e-4 and 1e-3 give similar "
             "trajectories (~5e-3), 1e-3 three times the frequency error (6e-4), 1e-2 and "
             "1e-4 2x-8x worse trajectories."),
+        "point_mass_gyration": Setting(
+            POINT_MASS_GYRATION, float,
+            "Radius of gyration (m) of the inertia given to a point mass (central inertia "
+            "0), which MuJoCo rejects below mjMINVAL (1e-15; the substitute is at least "
+            "1e-14 kg m^2). The body's moment about a pivot at d grows by the relative "
+            "(r/d)^2 (1e-12 at d = 1 m): a pendulum's period by (r/d)^2/2."),
         "link_mass_ratio": Setting(
             1e-9, float,
             "Substitute mass of a massless kinematic link that cannot be folded (several "
@@ -1260,8 +1278,15 @@ class MujocoBackend(Backend):
             Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
                               "explicit <inertial> (planar inertia on z, the same on x and y)",
                        when="mass and inertia > 0"),
-            Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass or inertia",
-                       when="mass or inertia 0, not both"),
+            Expression(SUBSTITUTE, "a point mass: an explicit <inertial> of inertia m r^2, "
+                                   "r the setting point_mass_gyration. MuJoCo's compiler "
+                                   "rejects moving bodies whose inertia is below mjMINVAL "
+                                   "(also when a welded child carries the mass); the "
+                                   "substitute changes the body's moment about any point by "
+                                   "m r^2, relative (r/d)^2 at a distance d",
+                       when="mass > 0, inertia 0"),
+            Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass",
+                       when="mass 0, inertia > 0"),
         ),
         MASSLESS_BODY: (
             Expression(EXACT, "folded: its joints become a chain of joints of its single "
@@ -1321,7 +1346,8 @@ class MujocoBackend(Backend):
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
         if kind == BODY:
-            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+            mass, inertia = num(element.mass), num(element.inertia)
+            return cases[0] if mass > 0 and inertia > 0 else cases[1] if mass > 0 else cases[2]
         return cases[0] if element.name in _foldable(mechanism) else cases[1]
 
     SPATIAL_REASON = ""
@@ -1344,6 +1370,7 @@ class MujocoBackend(Backend):
             "slider_mass_ratio": float(settings["slider_mass_ratio"]),
             "massless_mass_ratio": float(settings["massless_mass_ratio"]),
             "link_mass_ratio": float(settings["link_mass_ratio"]),
+            "point_mass_gyration": float(settings["point_mass_gyration"]),
             "substitute_gravcomp": bool(settings["substitute_gravcomp"]),
             "timeconst_steps": steps,
             "dampratio": float(settings["constraint_dampratio"]),

@@ -6,7 +6,8 @@ Translation of the description (conventions of `mbfidelity.systems.model`):
   description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
   substitute is compensated, below); the world is ``space.static_body`` (at the origin,
   angle 0). No shapes are created (except for a RollingContact's circles),
-  so nothing can collide.
+  so nothing can collide. A point mass (central inertia 0) gets the substitute moment
+  m r^2 (setting ``point_mass_gyration``): Chipmunk divides by the moment.
 * ``Revolute`` -> ``PivotJoint`` at the two local anchors.
 * ``Prismatic`` -> ``GrooveJoint`` whose slot is the path of the child's centre of mass
   in the parent's frame (pa - R(offset) ca + q axis, q between the limits, or
@@ -161,6 +162,8 @@ from .plan import (
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
+#: radius of gyration (m) of the moment a point mass is given (setting point_mass_gyration)
+POINT_MASS_GYRATION = 1e-6
 _ELEMENT_FORCE = ("body forces and torques from one compiled function of the body states, "
                   "evaluated at the position-updated state x + h v (element_forces): a "
                   "consistent semi-implicit Euler step")
@@ -555,6 +558,16 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             "belt, rolling: a pivot at the pitch point)")
 
 
+def _moment(body, cfg: Mapping) -> float:
+    """The engine moment of a body: its central inertia, or for a point mass (inertia 0,
+    which Chipmunk inverts to an infinite angular response) m r^2 with r the setting
+    point_mass_gyration."""
+    inertia = num(body.inertia)
+    if inertia > 0:
+        return inertia
+    return num(body.mass) * float(cfg.get("point_mass_gyration", POINT_MASS_GYRATION)) ** 2
+
+
 def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
     """The engine layout (bodies, folded links, pivots, grooves, substitutes), or the
     reason the mechanism cannot be expressed."""
@@ -568,10 +581,10 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
         m, i = num(b.mass), num(b.inertia)
         if m == 0 and i == 0:
             massless.append(b.name)
-        elif m > 0 and i > 0:
+        elif m > 0:  # a point mass (i == 0) gets its substitute moment (_moment)
             dynamic.append(b.name)
         else:
-            return (f"body {b.name}: mass {m} and inertia {i}; Chipmunk needs both > 0 "
+            return (f"body {b.name}: mass 0 and inertia {i}; Chipmunk needs a mass > 0 "
                     "(or both 0 for a massless link that can be eliminated)")
     constraints = mech.constraints
     drives: list[_Drive] = []
@@ -731,7 +744,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
     for name in dynamic:
         b = mech.body(name)
         layout.engine_mass[name] = (num(b.mass),
-                                    math.inf if name in layout.infinite else num(b.inertia))
+                                    math.inf if name in layout.infinite else _moment(b, cfg))
     for car in layout.carriers:
         layout.engine_mass[car.name] = (car.mass, car.moment)
     if layout.carriers and cfg.get("slider_compensation", True):
@@ -757,7 +770,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 if not ok and body in layout.cog:
                     del layout.cog[body]
                     b = mech.body(body)
-                    layout.engine_mass[body] = (num(b.mass), num(b.inertia))
+                    layout.engine_mass[body] = (num(b.mass), _moment(b, cfg))
                     layout.notes.append(f"slider substitutes on {body} not compensated (its "
                                         "centre of gravity must stay on a groove)")
     for g in layout.grooves:
@@ -1213,6 +1226,11 @@ class _Balance:
 class PymunkBackend(Backend):
     id = "pymunk"
     SETTINGS = {
+        "point_mass_gyration": Setting(
+            POINT_MASS_GYRATION, float,
+            "Radius of gyration (m) of the moment given to a point mass (central inertia "
+            "0): Chipmunk needs a moment > 0. The body's moment about a pivot at d grows "
+            "by the relative (r/d)^2 (1e-12 at d = 1 m)."),
         "error_bias": Setting(
             0.0, float,
             "Fraction of a joint's position error left after 1 s, on every constraint. "
@@ -1349,9 +1367,16 @@ class PymunkBackend(Backend):
             Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
                               "(centre of gravity at its origin), no shapes",
                        when="mass and inertia > 0"),
-            Expression(UNSUPPORTED, "Chipmunk needs mass and moment > 0 (or both 0 for a "
-                                    "massless link that can be eliminated)",
-                       when="mass or inertia 0, not both"),
+            Expression(SUBSTITUTE, "a point mass: pymunk.Body(mass, m r^2), r the setting "
+                                   "point_mass_gyration. Chipmunk divides by the moment (a "
+                                   "zero moment makes the body's angular response infinite "
+                                   "and its pivots slip); the substitute changes the "
+                                   "body's moment about any point by m r^2, relative "
+                                   "(r/d)^2 at a distance d",
+                       when="mass > 0, inertia 0"),
+            Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
+                                    "for a massless link that can be eliminated)",
+                       when="mass 0, inertia > 0"),
         ),
         MASSLESS_BODY: (Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
                                           "folded into one GrooveJoint (a revolute and a "
@@ -1415,7 +1440,8 @@ class PymunkBackend(Backend):
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
         if kind == BODY:
-            return cases[0] if num(element.mass) > 0 and num(element.inertia) > 0 else cases[1]
+            mass, inertia = num(element.mass), num(element.inertia)
+            return cases[0] if mass > 0 and inertia > 0 else cases[1] if mass > 0 else cases[2]
         layout = _plan(mechanism, self.default_settings())
         if isinstance(layout, str):  # refused as a whole: see translation_reason
             return cases[0]

@@ -1,7 +1,9 @@
 """The mechanism catalog: one module per mechanism, discovered automatically.
 
 Each module defines ``SYSTEM = System(...)``. Adding a mechanism means adding a module
-here and nothing else (the pattern of dm_control's suite).
+here and nothing else (the pattern of dm_control's suite). The modules here are the
+monograph's mechanisms; a subpackage ``systems/<group>/`` holds a group of its own
+(``benchmarks``: the multibody community's benchmark problems), found the same way.
 
 A user's own mechanisms, written the same way, join the catalog from outside the
 package: module files named in the environment variable ``MBFIDELITY_SYSTEM_PATH``
@@ -163,6 +165,41 @@ class Condition:
     meaning: str
 
 
+PUBLISHED_KINDS = ("state", "period")
+
+
+@dataclass(frozen=True)
+class Published:
+    """A value a source publishes for a scenario's motion (a benchmark's solution), which
+    `analyze` compares with the reference (analytic/published.py).
+
+    kind "state": `expression` (of the coordinate symbols, `coordinate_symbols`, and the
+    parameters) at the instant `time` (s); kind "period": the period of `coordinate`
+    (`time` None). `value`: the published number, which holds at the parameters the
+    source publishes it for (the defaults: under other values it is reported as not
+    applicable), or a function of the parameter values (name -> value) for a closed form,
+    which holds at any. `scenario`: the scenario it belongs to (None: the first)."""
+
+    quantity: str
+    time: float | None
+    value: float | Callable[[Mapping[str, float]], float]
+    source: str
+    kind: str = "state"
+    expression: Expr | None = None
+    coordinate: str | None = None
+    scenario: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in PUBLISHED_KINDS:
+            raise ValueError(f"published {self.quantity}: kind {self.kind!r} is not one of "
+                             f"{', '.join(PUBLISHED_KINDS)}")
+        if (self.kind == "state") != (self.expression is not None and self.time is not None):
+            raise ValueError(f"published {self.quantity}: a state value has an expression "
+                             "and a time, a period neither")
+        if self.kind == "period" and self.coordinate is None:
+            raise ValueError(f"published {self.quantity}: a period names its coordinate")
+
+
 EXPECTATION_KINDS = ("xfail", "unsupported", "unresolved", "judged")
 
 
@@ -262,8 +299,14 @@ class System:
     #: A stiff chain sets a few periods of its first mode: over the default its fast
     #: modes alone cost a minute of reference
     near_equilibrium_t_end: float | None = None
+    #: values the sources publish for the motion (a benchmark's solution), a function of
+    #: the parameter symbols like `printed`: `analyze` compares each with the reference
+    published: Callable[[SimpleNamespace], tuple[Published, ...]] = lambda P: ()
     notes: str = ""
     module_doc: str = field(default="", compare=False)
+    #: the catalog group (set by the discovery): "monograph", a subpackage's name (the
+    #: benchmark problems), or "user"
+    group: str = field(default="", compare=False)
 
     @property
     def driven(self) -> bool:
@@ -282,7 +325,9 @@ class System:
     def all_parameters(self) -> tuple[Parameter, ...]:
         names = {p.name for p in self.parameters}
         extra = () if "g" in names else (
-            Parameter("g", STANDARD_GRAVITY, "m/s^2", "gravitational acceleration (along -y)"),
+            Parameter("g", STANDARD_GRAVITY, "m/s^2", "gravitational acceleration (along "
+                      "-y; any finite value, 0 for a horizontal or a space mechanism)",
+                      domain="real"),
         )
         return tuple(self.parameters) + extra
 
@@ -533,17 +578,39 @@ SYSTEM_PATH_VARIABLE = "MBFIDELITY_SYSTEM_PATH"
 ENTRY_POINT_GROUP = "mbfidelity.systems"
 
 
-def _discover() -> dict[str, System]:
-    found: dict[str, System] = {}
+#: the group of the package's own modules (the monograph's mechanisms); a subpackage
+#: systems/<group>/ holds another group (the community's benchmark problems)
+MONOGRAPH_GROUP = "monograph"
+USER_GROUP = "user"
+
+
+def _catalog_modules():
+    """(group, module name, module) of every mechanism module of the package."""
     for info in pkgutil.iter_modules(__path__):
         if info.name.startswith("_") or info.name == "model":
             continue
-        module = importlib.import_module(f"{__name__}.{info.name}")
+        if not info.ispkg:
+            yield MONOGRAPH_GROUP, info.name, importlib.import_module(f"{__name__}.{info.name}")
+            continue
+        package = importlib.import_module(f"{__name__}.{info.name}")
+        for sub in pkgutil.iter_modules(package.__path__):
+            if not sub.name.startswith("_"):
+                yield info.name, sub.name, importlib.import_module(
+                    f"{package.__name__}.{sub.name}")
+
+
+def _discover() -> dict[str, System]:
+    found: dict[str, System] = {}
+    for group, name, module in _catalog_modules():
         system = getattr(module, "SYSTEM", None)
         if isinstance(system, System):
-            if system.id != info.name:
-                raise ValueError(f"module {info.name} defines system {system.id}")
+            if system.id != name:
+                raise ValueError(f"module {name} defines system {system.id}")
+            if system.id in found:
+                raise ValueError(f"module {module.__name__}: system id {system.id!r} is "
+                                 "already in the catalog")
             object.__setattr__(system, "module_doc", module.__doc__ or "")
+            object.__setattr__(system, "group", group)
             found[system.id] = system
     for source, module in _user_modules():
         _register_user_system(found, source, module)
@@ -591,6 +658,7 @@ def _register_user_system(found: dict[str, System], source: str, module) -> None
         raise ValueError(f"{source}: {system.id}'s build fails: {type(exc).__name__}: "
                          f"{exc}") from exc
     object.__setattr__(system, "module_doc", getattr(module, "__doc__", None) or "")
+    object.__setattr__(system, "group", USER_GROUP)
     found[system.id] = system
 
 

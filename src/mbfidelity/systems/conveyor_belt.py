@@ -97,7 +97,7 @@ def belt_power_function(P, slip):
 def rest_position(P):
     """x_eq = (m g sin(alpha) - Ft(v0)) / k: the spring holds the weight's component less
     the belt's drag at slip v0 (§7.2)."""
-    return (P.m * sp.Symbol("g", positive=True) * sp.sin(P.alpha)
+    return (P.m * P.g * sp.sin(P.alpha)
             - (P.a2 * P.v0**2 - P.a1 * P.v0 + P.a0)) / P.k
 
 
@@ -118,7 +118,7 @@ def build(P) -> Mechanism:
 def printed(P):
     x, x_d, x_dd = coordinate_symbols("x")
     m, k, c, alpha, v0 = P.m, P.k, P.c, P.alpha, P.v0
-    g = sp.Symbol("g", positive=True)
+    g = P.g
 
     def Ft(v):
         # the printed two-branch law, with its coefficients as parameters (printed:

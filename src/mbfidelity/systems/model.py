@@ -9,9 +9,11 @@ Conventions (all backends and the analytic layer honour them):
 
 1. World frame: x to the right, y up, motion in the x-y plane, gravity (0, -g).
 2. Every body has a frame whose origin is its centre of mass; `inertia` is the central
-   moment of inertia about the z axis. A body may be massless (mass 0, inertia 0): it is
-   then a kinematic link only (the arm of Fig. 12); backends that reject massless moving
-   bodies must fold its joints into its child.
+   moment of inertia about the z axis. Mass and inertia are non-negative. A body may be
+   massless (mass 0, inertia 0): it is then a kinematic link only (the arm of Fig. 12);
+   backends that reject massless moving bodies must fold its joints into its child. A
+   body of mass > 0 and central inertia 0 is a point mass (the bob of a simple pendulum
+   on a massless rod); a backend whose engine refuses it declares its substitute.
 3. A body's pose is (x, y, theta); R(theta) rotates body-frame vectors to world axes.
 4. `Revolute(parent, child)`: the anchor points coincide,
    ``p_parent + R(th_parent) parent_anchor = p_child + R(th_child) child_anchor``, and
@@ -64,7 +66,9 @@ LENGTH = sp.Symbol("_length", positive=True)
 LENGTH_RATE = sp.Symbol("_length_rate", real=True)
 COORD = sp.Symbol("_coord", real=True)
 COORD_RATE = sp.Symbol("_coord_rate", real=True)
-GRAVITY = sp.Symbol("g", positive=True)
+#: the gravity parameter: any finite value, zero included (a horizontal or a space
+#: mechanism), negative too (gravity along +up)
+GRAVITY = sp.Symbol("g", real=True)
 STANDARD_GRAVITY = 9.81
 #: the largest number of elements a count parameter admits unless it states its own: the
 #: symbolic derivation of a chain and its generated code grow with it, and the largest
@@ -116,6 +120,10 @@ class Parameter:
 
     @property
     def symbol(self) -> sp.Symbol:
+        if self.name == GRAVITY.name:
+            # one symbol for gravity, whatever domain a module declares for it: the
+            # mechanism's gravity is GRAVITY, and parameters substitute by symbol
+            return GRAVITY
         if self.domain == "count":
             # never in an expression (build gets the integer); a placeholder argument
             # of the compiled functions, like every parameter
@@ -185,6 +193,11 @@ class Body:
 
     def __post_init__(self) -> None:
         tensor = self.inertia_tensor
+        moments = [self.inertia] + ([tensor[i][i] for i in range(3)] if tensor else [])
+        for what, value in [("mass", self.mass)] + [("inertia", v) for v in moments]:
+            value = sp.sympify(value)
+            if value.is_number and value.is_negative:
+                raise ValueError(f"body {self.name}: {what} must be >= 0, got {float(value):g}")
         if tensor is None:
             return
         if len(tensor) != 3 or any(len(row) != 3 for row in tensor):

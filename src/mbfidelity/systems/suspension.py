@@ -43,8 +43,8 @@ import sympy as sp
 
 from ._reasons import coarse_first_order, coarse_second_order
 from . import Condition, PrintedFormula, System, coordinate_symbols
-from .model import (LENGTH, TIME, Body, Mechanism, Parameter, PointToPoint, Prescribed,
-                    Prismatic, Rectangle, Scenario)
+from .model import (GRAVITY, LENGTH, TIME, Body, Mechanism, Parameter, PointToPoint,
+                    Prescribed, Prismatic, Rectangle, Scenario)
 
 #: drawn distance between the chassis' centre and P with the spring relaxed (m)
 SPRING_LENGTH = sp.Rational(1, 2)
@@ -130,7 +130,7 @@ def printed(P):
 
 _L = float(SPRING_LENGTH)
 _P = SimpleNamespace(**{p.name: p.symbol for p in PARAMETERS},
-                     g=sp.Symbol("g", positive=True))
+                     g=GRAVITY)
 
 SYSTEM = System(
     id="suspension",
