@@ -78,28 +78,73 @@ def consistent_initial_state(system: System, scenario: Scenario, values):
     return q, model.velocity_basis(q) @ qd0[model.independent]
 
 
-#: samples between two sequential Newton solves whose results are the starting guesses of
-#: the batched solve of the samples in between (continuity along one assembly branch)
+#: at most this many samples share one anchor (a sequential Newton solve whose result,
+#: with its tangent, is the starting guess of the batched solve of the samples after it)
 ANCHOR_SPACING = 25
+#: the largest change of the independent coordinates (rad or m) between an assembly and
+#: the one solved from it: a sample farther from its anchor becomes an anchor itself,
+#: reached from the last one in steps of at most this size (continuation)
+ANCHOR_REACH = 0.05
+#: halvings of a continuation step whose Newton solve does not converge
+CONTINUATION_HALVINGS = 12
+
+
+def _continue(model, q: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The assembly at the independent coordinates `target`, followed from the assembly
+    `q` along the straight segment between their independent coordinates in steps of at
+    most ANCHOR_REACH, each started from the tangent predictor q + S dq_i (the motion
+    stays on the branch it is on: the segment is the motion's path for one independent
+    coordinate, and a chord of it for several). A step whose Newton solve fails is
+    halved."""
+    ind = model.independent
+    start = q[ind].copy()
+    span = np.asarray(target, dtype=float) - start
+    steps = max(1, int(np.ceil(np.max(np.abs(span)) / ANCHOR_REACH)))
+    done, size, halvings = 0.0, 1.0 / steps, 0
+    while done < 1.0:
+        step = min(size, 1.0 - done)
+        guess = q + model.velocity_basis(q) @ (span * step)
+        guess[ind] = start + span * (done + step)
+        try:
+            q = model.complete(guess)
+        except (RuntimeError, np.linalg.LinAlgError):
+            halvings += 1
+            if halvings > CONTINUATION_HALVINGS:
+                raise RuntimeError("the constraint equations did not converge (assembly "
+                                   "lost) while following the motion between two samples")
+            size /= 2
+            continue
+        done += step
+    return q
 
 
 def _sampled_positions(model, y: np.ndarray, q0: np.ndarray) -> np.ndarray:
     """The coordinates along the independent ones sampled in `y`: in closed form where the
-    constraints solve so, otherwise by Newton's method, sequentially every ANCHOR_SPACING
-    samples (each from the last one: the motion stays on its assembly branch) and for
-    all samples in between at once, each from its anchor."""
+    constraints solve so, otherwise by Newton's method: anchors solved in sequence, each
+    followed from the last one (`_continue`), a new one wherever a sample is more than
+    ANCHOR_REACH from its anchor or ANCHOR_SPACING samples after it, whatever the output
+    step; the samples in between are solved all at once, each started from its anchor
+    and the anchor's tangent."""
     k = len(model.independent)
     if model._explicit is not None:
         return np.array([model._explicit[0](*row[:k]) for row in y], dtype=float)
-    anchors = np.arange(0, len(y), ANCHOR_SPACING)
-    guess, solved = np.array(q0, dtype=float), []
-    for i in anchors:
-        g = guess.copy()
-        g[model.independent] = y[i, :k]
-        guess = model.complete(g)
-        solved.append(guess)
-    guesses = np.array(solved)[np.arange(len(y)) // ANCHOR_SPACING]
-    return model.complete_along(y[:, :k], guesses)
+    qi = y[:, :k]
+    q = np.array(q0, dtype=float)
+    owner = np.zeros(len(y), dtype=int)
+    anchors: list[np.ndarray] = []
+    anchor_rows: list[int] = []
+    for i in range(len(y)):
+        if (not anchor_rows or i - anchor_rows[-1] >= ANCHOR_SPACING
+                or np.max(np.abs(qi[i] - qi[anchor_rows[-1]])) > ANCHOR_REACH):
+            q = _continue(model, q, qi[i])
+            anchors.append(q)
+            anchor_rows.append(i)
+        owner[i] = len(anchors) - 1
+    anchored = np.array(anchors)
+    bases = np.array([model.velocity_basis(a) for a in anchors])
+    shift = qi - qi[anchor_rows][owner]
+    guesses = anchored[owner] + np.einsum("nij,nj->ni", bases[owner], shift)
+    return model.complete_along(qi, guesses)
 
 
 def _full_states(model, y: np.ndarray, q0: np.ndarray, t: np.ndarray):
