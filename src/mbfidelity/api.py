@@ -195,6 +195,11 @@ def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> 
             doc["steady_state_note"] = response.reason
         else:
             doc["steady_state_harmonic_residual"] = response.harmonic_residual
+    if system.published(system.symbols):
+        from .analytic.published import compare_published
+
+        # what the sources publish (a benchmark's solution) against the reference
+        doc["published"] = compare_published(system, values)
     return doc
 
 

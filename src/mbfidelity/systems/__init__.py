@@ -188,6 +188,9 @@ class Published:
     expression: Expr | None = None
     coordinate: str | None = None
     scenario: str | None = None
+    #: how the source obtained the value (a closed form, a numerical solution and its
+    #: tolerances): why it may differ from the reference beyond the reference's error
+    note: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in PUBLISHED_KINDS:

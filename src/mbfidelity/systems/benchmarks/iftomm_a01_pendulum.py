@@ -36,6 +36,8 @@ from ..model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 SOURCE = ("IFToMM benchmark A01 (González et al., Multibody System Dynamics 16, 2006); "
           "closed form: Jacobi's elliptic functions")
 
+CLOSED_FORM = "exact (Jacobi's elliptic functions, SciPy's ellipk and ellipj to round-off)"
+
 PARAMETERS = (
     Parameter("m", 1.0, "kg", "mass of the point P1", "IFToMM A01"),
     Parameter("L", 1.0, "m", "length of the massless bar", "IFToMM A01"),
@@ -71,11 +73,12 @@ def _period(values) -> float:
 def published(P):
     phi = sp.Symbol("phi", real=True)
     return (
-        Published("period", None, _period, SOURCE, kind="period", coordinate="phi"),
+        Published("period", None, _period, SOURCE, kind="period", coordinate="phi",
+                  note=CLOSED_FORM),
         Published("P1.x", 10.0, lambda v: v["L"] * math.sin(_closed_form_phi(v, 10.0)),
-                  SOURCE, expression=P.L * sp.sin(phi)),
+                  SOURCE, expression=P.L * sp.sin(phi), note=CLOSED_FORM),
         Published("P1.y", 10.0, lambda v: -v["L"] * math.cos(_closed_form_phi(v, 10.0)),
-                  SOURCE, expression=-P.L * sp.cos(phi)),
+                  SOURCE, expression=-P.L * sp.cos(phi), note=CLOSED_FORM),
     )
 
 

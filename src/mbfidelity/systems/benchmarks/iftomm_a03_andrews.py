@@ -138,14 +138,29 @@ def build(P) -> Mechanism:
     )
 
 
+#: how the test set obtained its solution (why it may differ from the reference beyond
+#: the reference's own error estimate)
+NOTE = ("a numerical solution of the index-3 formulation (PSIDE, rtol = atol = 1e-14, "
+        "Cray C90 double precision), not a closed form: its own error may exceed the "
+        "reference's estimate; the reference's value is stable under tighter tolerances")
+
+
 def published(P):
     out = []
     for name, (angle, rate) in SOLUTION.items():
         q, qd, _ = coordinate_symbols(name)
-        out.append(Published(name, 0.03, angle, SOURCE, expression=q))
-        out.append(Published(f"{name}_dot", 0.03, rate, SOURCE, expression=qd))
+        out.append(Published(name, 0.03, angle, SOURCE, expression=q, note=NOTE))
+        out.append(Published(f"{name}_dot", 0.03, rate, SOURCE, expression=qd, note=NOTE))
     return tuple(out)
 
+
+#: why no gate can judge the engines at the default step (1 ms)
+_UNRESOLVED = (
+    "At the default step the published run is thirty steps long while the crank turns "
+    "two and a half times, and the stiff spring's mode about the equilibrium has w h "
+    "near 0.4: no error bound of a fixed-step scheme says anything there (the benchmark "
+    "asks for steps well below a millisecond); the engines are judged at the steps of "
+    "the convergence study")
 
 SYSTEM = System(
     id="iftomm_a03_andrews",
@@ -153,10 +168,22 @@ SYSTEM = System(
     source="IFToMM benchmark A03; Hairer & Wanner II §VII.7; Test Set for IVP Solvers, andrews",
     parameters=PARAMETERS,
     build=build,
-    operating_point=lambda P: dict(INITIAL),
+    # the stable equilibrium on the published state's assembly branch: the spring holds
+    # the drive torque (the crank turned back about 3 rad from the published start)
+    operating_point=lambda P: {"beta": -3.0, "Theta": 3.04, "gamma": 0.041, "delta": 0.524,
+                               "Phi": -0.534, "epsilon": 1.048, "Omega": 0.534},
     scenarios=(
         Scenario("published", dict(INITIAL), t_end=0.03, checks=("trajectory",),
                  description="the test set's consistent initial state at rest, 0.03 s"),
     ),
     published=published,
+    expectations=(  # the first match declares a metric
+        Expectation("exudyn", "published.completed", "xfail",
+                    "Exudyn's implicit scheme solves each step by Newton's method, which "
+                    "does not converge when the crank turns about a radian within one "
+                    "step: the solver stops (a step well below a millisecond runs)"),
+        Expectation("*", "*", "unresolved", _UNRESOLVED),
+    ),
+    # releases near the other stable equilibria last as long as the published run
+    near_equilibrium_t_end=0.03,
 )
