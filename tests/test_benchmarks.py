@@ -167,3 +167,16 @@ def test_a03_reference_sampling_keeps_the_assembly_at_any_step(dt):
     assert ref.t[-1] == pytest.approx(0.03)
     for name, value in TEST_SET_ANGLES.items():
         assert last[name] == pytest.approx(value, rel=1e-9), name
+
+
+def test_analyze_reports_the_published_values():
+    """`analyze --json` gains `published`; a published number holds at the published
+    parameters only (a closed form at any)."""
+    from mbfidelity.api import analyze
+
+    doc = analyze(A01, {"phi0": 1.0})
+    assert {p["quantity"] for p in doc["published"]} == {"period", "P1.x", "P1.y"}
+    assert all(p["applies"] and p["relative_difference"] < 1e-9 for p in doc["published"])
+    s = get_system(A03)
+    moved = compare_published(s, s.parameter_values({"mom": 0.04}))
+    assert moved and not any(p["applies"] for p in moved)

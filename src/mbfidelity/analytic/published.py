@@ -61,16 +61,21 @@ def _state_at(system: System, scenario, values, time: float, tol: float):
     return model.state_from_independent(y[:k], y[k:])
 
 
-def _state(system: System, item: Published, values, scenario) -> tuple[float, float]:
+def _state(system: System, item: Published, values, scenario,
+           solved: dict) -> tuple[float, float]:
     """The expression at the instant, and its error estimate: its change from the
-    reference's tolerance to a 10x looser one (as the reference's own estimate)."""
+    reference's tolerance to a 10x looser one (as the reference's own estimate). `solved`
+    keeps the states already integrated (one solve per instant and tolerance)."""
     names = list(system.coordinates)
     symbols = [s for c in names for s in coordinate_symbols(c)[:2]]
     expr = sp.sympify(item.expression).xreplace(system.subs(values))
     law = sp.lambdify(symbols, expr, modules="math")
     out = []
     for tol in (TIGHT, LOOSE):
-        q, qd = _state_at(system, scenario, values, item.time, tol)
+        key = (scenario.name, item.time, tol)
+        if key not in solved:
+            solved[key] = _state_at(system, scenario, values, item.time, tol)
+        q, qd = solved[key]
         out.append(float(law(*[x for pair in zip(q, qd) for x in pair])))
     return out[0], abs(out[1] - out[0])
 
@@ -98,7 +103,7 @@ def compare_published(system: System, values: Mapping[str, float]) -> list[dict]
     quantity), beyond_reference_error (the difference exceeds it: the published value's
     own error, or a different model; `note` gives the source's account), source, and
     whether the published value applies at these parameters."""
-    out = []
+    out, solved = [], {}
     for item in system.published(system.symbols):
         scenario = (system.scenario(item.scenario) if item.scenario
                     else system.scenarios[0])
@@ -115,7 +120,7 @@ def compare_published(system: System, values: Mapping[str, float]) -> list[dict]
             ref = reference(system, scenario, values, scenario.t_end / SAMPLES)
             got, error = _period(system, item, ref)
         else:
-            got, error = _state(system, item, values, scenario)
+            got, error = _state(system, item, values, scenario, solved)
         entry.update(applies=True, published_value=published, reference_value=got,
                      relative_difference=abs(got - published) / abs(published)
                      if published else abs(got),
