@@ -1368,11 +1368,11 @@ class PymunkBackend(Backend):
                               "(centre of gravity at its origin), no shapes",
                        when="mass and inertia > 0"),
             Expression(SUBSTITUTE, "a point mass: pymunk.Body(mass, m r^2), r the setting "
-                                   "point_mass_gyration. Chipmunk divides by the moment (a "
-                                   "zero moment makes the body's angular response infinite "
-                                   "and its pivots slip); the substitute changes the "
-                                   "body's moment about any point by m r^2, relative "
-                                   "(r/d)^2 at a distance d",
+                                   "point_mass_gyration. Chipmunk divides by the moment "
+                                   "(its constraint solver uses the inverse moment, "
+                                   "infinite at zero); the substitute changes the body's "
+                                   "moment about any point by m r^2, relative (r/d)^2 at "
+                                   "a distance d",
                        when="mass > 0, inertia 0"),
             Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
                                     "for a massless link that can be eliminated)",
