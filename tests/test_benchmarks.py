@@ -180,3 +180,7 @@ def test_analyze_reports_the_published_values():
     s = get_system(A03)
     moved = compare_published(s, s.parameter_values({"mom": 0.04}))
     assert moved and not any(p["applies"] for p in moved)
+    # g = 0: no swing, the closed form says so instead of dividing by zero
+    level = analyze(A01, {"g": 0.0})["published"]
+    assert level and not any(p["applies"] for p in level)
+    assert all("g > 0" in p["note"] for p in level)

@@ -115,7 +115,14 @@ def compare_published(system: System, values: Mapping[str, float]) -> list[dict]
                          note="published for the source's parameters, not these")
             out.append(entry)
             continue
-        published = float(item.value(values)) if callable(item.value) else float(item.value)
+        try:
+            published = (float(item.value(values)) if callable(item.value)
+                         else float(item.value))
+        except (ValueError, ArithmeticError) as exc:  # a closed form outside its domain
+            entry.update(applies=False, published_value=None, reference_value=None,
+                         relative_difference=None, reference_error=None, note=str(exc))
+            out.append(entry)
+            continue
         if item.kind == "period":
             ref = reference(system, scenario, values, scenario.t_end / SAMPLES)
             got, error = _period(system, item, ref)

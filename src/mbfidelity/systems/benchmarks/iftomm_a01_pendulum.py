@@ -53,10 +53,17 @@ def build(P) -> Mechanism:
     return Mechanism(bodies=(bob,), joints=(pivot,))
 
 
+def _swings(values) -> None:
+    """The closed form is that of a swing: gravity down and a start below the top."""
+    if not (values["g"] > 0 and abs(values["phi0"]) < math.pi):
+        raise ValueError("the closed form holds for g > 0 and |phi0| < pi (a swing)")
+
+
 def _closed_form_phi(values, t: float) -> float:
     """phi(t) from rest at phi0 (sin(phi/2) = k sn(K - w t | k^2))."""
     from scipy.special import ellipj, ellipk
 
+    _swings(values)
     k = math.sin(values["phi0"] / 2)
     w = math.sqrt(values["g"] / values["L"])
     sn, _, _, _ = ellipj(ellipk(k * k) - w * t, k * k)
@@ -66,6 +73,7 @@ def _closed_form_phi(values, t: float) -> float:
 def _period(values) -> float:
     from scipy.special import ellipk
 
+    _swings(values)
     k = math.sin(values["phi0"] / 2)
     return 4 * math.sqrt(values["L"] / values["g"]) * float(ellipk(k * k))
 
