@@ -30,7 +30,7 @@ from ..analytic.reference import LOOSE, TIGHT, reference
 from ..simulators import get_backend
 from ..systems import get_system
 from . import metrics, tolerances
-from .runner import Metric, _judge
+from .runner import Metric, _judge, expectation_for
 
 #: the steps of a study (s): halvings, each an integer multiple of the finest; scaled down
 #: where the motion is too fast for them (`automatic_steps`)
@@ -216,6 +216,10 @@ def judge_order(study: ConvergenceStudy) -> Metric:
         return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "unsupported",
                       study.unsupported, "order")
     if study.failure:
+        exp = expectation_for(system, study.simulator, ORDER_METRIC)
+        if exp is not None and exp.kind == "xfail":  # a declared failure of the run
+            return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "xfail",
+                          f"{exp.reason} ({study.failure})", "order")
         return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "fail",
                       study.failure, "order")
     if study.observed_order is None:

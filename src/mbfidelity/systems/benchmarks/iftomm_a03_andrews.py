@@ -178,6 +178,19 @@ SYSTEM = System(
     ),
     published=published,
     expectations=(  # the first match declares a metric
+        Expectation("exudyn", "convergence.order", "xfail",
+                    "Exudyn's implicit scheme does not converge its Newton iteration at the "
+                    "study's coarsest step, where the crank turns about a radian per step: "
+                    "the study stops there"),
+        Expectation("mujoco", "convergence.order", "xfail",
+                    "MuJoCo's equality constraints are soft, with a reference time constant "
+                    "that follows the step: their error falls as dt^2 beside RK4's dt^4, "
+                    "and over the study's steps the mix gives an order between the two"),
+        *(Expectation(engine, "convergence.order", "xfail",
+                      "the study's steps for this short, fast run are few per turn of the "
+                      "crank and lie outside the first-order scheme's asymptotic range: the "
+                      "error falls faster than first order over them")
+          for engine in ("pybullet", "pymunk")),
         Expectation("exudyn", "published.completed", "xfail",
                     "Exudyn's implicit scheme solves each step by Newton's method, which "
                     "does not converge when the crank turns about a radian within one "
