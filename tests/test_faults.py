@@ -120,6 +120,10 @@ def test_convergence_item_that_fails_fails_alone(user_modules):
     # ten periods of a 5e-5 Hz mode at 1 ms: beyond the step budget, refused before work
     (["compare", "mass_spring_damper", "--sim", "mujoco", "--param", "m=1e9"], "budget"),
     (["--system-path", FAULTS / "exits_on_import.py", "list"], "SystemExit"),
+    (["--system-path", FAULTS / "negative_mass.py", "analyze", "user_negative_mass"],
+     "mass must be >= 0"),
+    (["--system-path", FAULTS / "negative_mass.py", "compare", "user_negative_mass",
+      "--sim", "mujoco", "--param", "m=1", "--param", "l=-1"], "l must be > 0"),
 ])
 def test_bad_input_is_one_line(args, says):
     assert says in _one_line_refusal(_mbfidelity(*args))

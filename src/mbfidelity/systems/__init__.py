@@ -469,6 +469,23 @@ class System:
             if not _RELATIONS[op](a, b):
                 raise ValueError(f"{self.id}: the parameters violate {condition.relation} "
                                  f"({a:.6g} {op} {b:.6g} is false): {condition.meaning}")
+        for body, what, f in self._body_quantities:
+            value = float(f(*(values[n] for n in f.names)))
+            if not value >= 0:
+                raise ValueError(f"{self.id}: body {body}'s {what} must be >= 0 (a point mass "
+                                 f"has zero inertia), got {value:g} at these parameters")
+
+    @cached_property
+    def _body_quantities(self):
+        """(body, "mass" | "inertia", compiled expression) of every body of the
+        description, whatever parameters they depend on: each must stay non-negative."""
+        out = []
+        for b in self.mechanism.bodies:
+            tensor = b.inertia_tensor
+            moments = [b.inertia] + ([tensor[i][i] for i in range(3)] if tensor else [])
+            for what, expr in [("mass", b.mass)] + [("inertia", m) for m in moments]:
+                out.append((b.name, what, _compiled(sp.sympify(expr), self.symbols)))
+        return tuple(out)
 
     def is_valid(self, values: Mapping[str, float]) -> bool:
         try:
