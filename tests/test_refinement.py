@@ -46,8 +46,9 @@ def test_pymunk_unbalanced_rotor_gets_a_verdict_on_every_metric_and_passes():
     result = compare("unbalanced_rotor", "pymunk", scenarios=["ratio_1"])
     scenario = [m for m in result.metrics if m.name.startswith("ratio_1.")]
     assert scenario and all(m.rule == "refinement" for m in scenario)
-    assert all(m.status == "pass" for m in result.metrics), [m.as_dict() for m in
-                                                               result.metrics]
+    # every gate passes (a declaration about other scenarios may flag a pass of this
+    # one as unexpected: the comparison of one scenario is not the declared one)
+    assert all(m.passed for m in result.metrics), [m.as_dict() for m in result.metrics]
     trajectory = next(m for m in scenario if m.name.endswith("trajectory_max")).as_dict()
     numbers = trajectory["refinement"]
     assert numbers["observed_order"] >= 1 - tolerances.REFINEMENT_ORDER_MARGIN
@@ -64,8 +65,9 @@ def test_pybullet_out_of_the_box_damping_fails_the_refinement_gate():
     assert torque.rule == "refinement" and torque.status == "fail"
     assert not damped.passed
     correct = compare("unbalanced_rotor", "pybullet", scenarios=["ratio_0_5"])
-    assert correct.passed and next(
-        m for m in correct.metrics if m.name == "ratio_0_5.actuator_motor").status == "pass"
+    assert all(m.passed for m in correct.metrics)
+    assert next(m for m in correct.metrics if m.name == "ratio_0_5.actuator_motor").rule == \
+        "refinement"
 
 
 def test_the_fit_refinement_rejects_a_damping_left_on():
