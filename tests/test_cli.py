@@ -156,7 +156,9 @@ def test_coarse_step_cannot_pass():
                               "--t-end", "4", "--json"])
     assert res.exit_code == 1, res.output
     doc = json.loads(res.stdout)
-    statuses = {m["status"] for m in doc["metrics"]}
+    # the engine's own refinement predicts an error above what a trajectory can tell
+    # apart: no trajectory passes (a slow mode's fit, w h small, may be judged)
+    statuses = {m["status"] for m in doc["metrics"] if ".trajectory_" in m["name"]}
     assert "pass" not in statuses and "unresolved" in statuses
 
 

@@ -41,12 +41,12 @@ def mean_period(t: np.ndarray, x: np.ndarray) -> float | None:
 
 def relative_vector_error(f: np.ndarray, f_ref: np.ndarray, scale: float = 0.0) -> float:
     """max |f - f_ref| / max(max |f_ref|, scale) over samples (Euclidean norms), NaN
-    samples ignored."""
-    ok = ~np.any(np.isnan(f), axis=1)
+    samples (of either) ignored."""
+    ok = ~np.any(np.isnan(f), axis=1) & ~np.any(np.isnan(f_ref), axis=1)
     if not np.any(ok):
         return float("nan")
     num = np.max(np.linalg.norm(f[ok] - f_ref[ok], axis=1))
-    return float(num / max(np.max(np.linalg.norm(f_ref, axis=1)), scale, 1e-300))
+    return float(num / max(np.nanmax(np.linalg.norm(f_ref, axis=1)), scale, 1e-300))
 
 
 def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess: float):

@@ -323,7 +323,9 @@ def comparisons_from_document(doc: dict, source: str = "results") -> tuple[dict,
             metrics = [Metric(name=m["name"], value=m["value"], tolerance=m["tolerance"],
                               passed=m["passed"], status=m["status"],
                               reason=m.get("reason", ""), unit=m["unit"],
-                              detail=m.get("detail", {}), expected=m.get("expected", False))
+                              detail=m.get("detail", {}), expected=m.get("expected", False),
+                              rule=m.get("rule", "a_priori"),
+                              refinement=m.get("refinement", {}))
                        for m in c["metrics"]]
             comparisons.append(Comparison(
                 system=c["system"], simulator=c["simulator"],
@@ -331,7 +333,8 @@ def comparisons_from_document(doc: dict, source: str = "results") -> tuple[dict,
                 parameters=c["parameters"], dt=c["dt"], metrics=metrics,
                 supported=c["supported"], reason=c["reason"], wall_time=c["wall_time_s"],
                 simulated_time=c["simulated_time_s"], variant=c["variant"],
-                incidents=c.get("incidents", [])))
+                incidents=c.get("incidents", []),
+                refinement_wall_time=c.get("refinement_wall_time_s", 0.0)))
         return doc["provenance"], comparisons
     except (KeyError, TypeError, AttributeError) as exc:
         raise ValueError(f"{source}: not a results document of mbfidelity ({exc})") from exc

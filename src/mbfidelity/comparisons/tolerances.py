@@ -145,6 +145,58 @@ faster forcing).
   error of MAX_TRAJECTORY_TOLERANCE = 0.1 of the amplitude: the motion is then no longer
   the reference's; a frequency error of MAX_FREQUENCY_TOLERANCE = 0.05) is unresolved too:
   a pass would mean nothing.
+* A posteriori, by the engine's own refinement (where the bound above does not resolve a
+  metric: outside its range of w h, or above the ceiling). The metric is a distance
+  v = |Q_h - Q_ref| between a quantity the engine computes at step h (a trajectory, a
+  force history, a fitted amplitude, an energy history) and the reference's, in a norm
+  |.| (max or rms over the samples, or an absolute value) relative to the reference's
+  scale. The same comparison is made between the engine's own runs at h, h/2, h/4, each
+  pair on the samples of its coarser run: d_k = |Q_(h/2^(k-1)) - Q_(h/2^k)|, and the
+  observed order is log2(d1 / d2). (A max over the samples of h is at most the max over
+  the finer samples, so the sum below holds on the samples of h; and an error every run
+  makes once, at its first step, shows in every d_k instead of in d1 alone.) In the asymptotic regime of an order-p scheme Q_h = Q* + C h^p + ..., Q*
+  the engine's limit, so d1 = |C| h^p (1 - 2^-p) and Richardson's estimate of the engine's
+  own error at h is e(h) = d1 / (1 - 2^-p). The engine's distance to its limit is a
+  telescoping sum (the triangle inequality, in any of the norms above),
+  |Q_h - Q*| <= d1 + d2 + d3 + ..., and while each halving shrinks the difference by
+  r <= 2^-(p - REFINEMENT_ORDER_MARGIN) (what the observed order checks: d2/d1 <= r) the
+  tail is at most d2 / (1 - r), so |Q_h - Q*| <= d1 + d2 / (1 - r) <= d1 / (1 - r)
+  = S e(h), with S = (1 - 2^-p) / (1 - r) the safety factor (1.71 for p = 1, 1.16 for
+  p = 2, 1.03 for p = 4, at the margin 0.5). An engine whose limit is the exact motion,
+  Q* = Q_exact, is then within d1 + d2 / (1 - r) + eps_ref of the reference (eps_ref the
+  reference's own error, as for the a-priori gates); one whose limit is another motion (a
+  mass off, a damping left on) is off by |Q* - Q_exact| however fine its step, which its
+  own refinement does not predict. Gate: the observed order agrees with the scheme's,
+  p - REFINEMENT_ORDER_MARGIN <= observed <= p_top + REFINEMENT_ORDER_MARGIN, and
+  v <= d1 + d2 / (1 - r) + eps_ref. p_top is the fastest order the scheme's error terms
+  have (`highest_order`): p, except semi-implicit Euler's 2 (its phase drift is second
+  order on a conservative motion, its offset first order); r from the declared p is the
+  conservative ratio in between. An order outside that range says the pair is not in
+  the asymptotic regime (a difference that does not shrink: a floor; one that collapses:
+  an error of the coarse run alone, e.g. its first step, that the finer runs do not
+  share on the samples of h). Then the engine is run at h/8 too and the last pair
+  confirms the order instead: the bound is d1 + d2 + d3 / (1 - r), the same sum with the
+  unconfirmed difference taken as it is, and e(h) = d1 + d2 / (1 - 2^-p). A pass also
+  needs the bound below the ceiling the metric can discriminate (as for the a-priori
+  gates, 0.1 of the amplitude, 0.05 of a frequency): a wider bound says the engine's own
+  error at h leaves no room to tell its limit from the reference (a model error that
+  large would pass), and the metric stays unresolved; a value above the bound fails
+  whatever its width. Differences at or below STEP_INDEPENDENT of the scale
+  are round-off: the quantity does not depend on the step (an imposed motion sampled
+  exactly), and the order is not asked for. A free-vibration fit is refined alike (the
+  same release at h/2, h/4, fitted alike: d_k the differences of successive fitted
+  frequencies relative to the mode's, or of damping ratios); its resolution
+  FIT_RESOLUTION is then the floor, and eps_ref (the fit on the exact motion is off by as
+  much). Growth rates (judged against an eigenvalue, or by the Floquet check) and the
+  other checks' metrics (comparisons/checks) are not refined. Where the bound holds: in the engine's
+  asymptotic regime, which the observed order confirms on the last pair of halvings (the
+  next terms of the expansion shrink faster; a cancellation exactly at the finest pair
+  would overstate the order, which the max norm over a run makes unlikely). Where the
+  order falls short down to h/8 (the differences stop shrinking with the step: a
+  constraint's compliance, an event located to the step, a motion too fast), the metric
+  stays `unresolved`, the observed order stated. The refinement runs cost six times the
+  engine's run at h (h/2 and h/4; fourteen with h/8), only on the scenarios that have an
+  unresolved metric.
 * Stability. An explicit scheme diverges on a mode with w h above its stability limit on
   the imaginary axis (RK4: 2 sqrt 2; semi-implicit Euler: 2; each backend names its
   scheme and limit, simulators/base.py point 10); a comparison refuses such a step
@@ -153,6 +205,7 @@ faster forcing).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Sequence
 
 FD_FREQUENCY = 1e-6
 FIT_RESOLUTION = 1e-5
@@ -165,6 +218,15 @@ ASYMPTOTIC_LIMIT = {1: 0.2}
 ASYMPTOTIC_LIMIT_HIGHER_ORDER = 0.5
 MAX_TRAJECTORY_TOLERANCE = 0.1
 MAX_FREQUENCY_TOLERANCE = 0.05
+
+
+#: largest shortfall of the observed order below the declared one in the refinement rule
+REFINEMENT_ORDER_MARGIN = 0.5
+#: differences between the engine's runs at or below this (relative to the metric's scale)
+#: are round-off: eps = 2.2e-16 per step over up to 1e5 steps (h/4 over the longest runs)
+#: is 2e-11 of the state's magnitude, which is at most about 100 times the amplitude (a
+#: coordinate far from its origin moving little)
+STEP_INDEPENDENT = 1e-9
 
 
 @dataclass(frozen=True)
@@ -347,3 +409,66 @@ def roundoff_floor(steps: int, magnitude: float, scale: float) -> float:
     """The error round-off alone can make after `steps` steps of a state whose largest
     coordinate is `magnitude`, relative to `scale`."""
     return steps * ROUNDINGS_PER_STEP * UNIT_ROUNDOFF * magnitude / max(scale, 1e-300)
+
+
+@dataclass(frozen=True)
+class RefinementGate:
+    """The a-posteriori gate of a metric from the engine's own refinement (see "A
+    posteriori" above): `tolerance` = the telescoping bound + `reference_error`, with
+    Richardson's `predicted_error`, or `unresolved` with why."""
+
+    tolerance: float
+    observed_order: float | None
+    declared_order: int
+    predicted_error: float
+    differences: tuple[float, ...]
+    reference_error: float
+    unresolved: str = ""
+
+    def as_dict(self) -> dict:
+        return {"observed_order": self.observed_order, "declared_order": self.declared_order,
+                "predicted_error": self.predicted_error, "differences": list(self.differences),
+                "reference_error": self.reference_error}
+
+
+def highest_order(order: int) -> int:
+    """The fastest order at which an order-`order` scheme's error can fall: semi-implicit
+    Euler's phase drift is second order (its offset first), the other schemes' error is
+    of their order."""
+    return 2 if order == 1 else order
+
+
+def refinement_safety(order: int) -> float:
+    """S = (1 - 2^-p) / (1 - 2^-(p - margin)): the telescoping bound over e(h)."""
+    return (1.0 - 2.0 ** -order) / (1.0 - 2.0 ** -(order - REFINEMENT_ORDER_MARGIN))
+
+
+def refinement_gate(differences: Sequence[float], order: int, reference_error: float,
+                    floor: float = STEP_INDEPENDENT) -> RefinementGate:
+    """The gate from the differences d_k = |Q_(h/2^(k-1)) - Q_(h/2^k)| (at least two) of an
+    order-`order` scheme (module docstring, "A posteriori"): the last pair confirms the
+    order, the earlier differences add as they are. Differences at or below `floor` are
+    the quantity's own resolution (round-off; a fit's FIT_RESOLUTION)."""
+    import math
+
+    d = [float(x) for x in differences]
+    shrink = 2.0 ** -(order - REFINEMENT_ORDER_MARGIN)
+    head, (last, tail) = sum(d[:-2]), d[-2:]
+    predicted = head + last / (1.0 - 2.0 ** -order)
+    bound = head + last + tail / (1.0 - shrink)
+    if not all(math.isfinite(x) for x in d):
+        return RefinementGate(math.inf, None, order, math.inf, tuple(d), reference_error,
+                              "the refined runs give no finite difference")
+    if max(last, tail) <= floor:
+        return RefinementGate(head + floor / (1.0 - shrink) + reference_error, None,
+                              order, head + floor, tuple(d), reference_error)
+    observed = (math.log2(last / tail) if last > 0 and tail > 0
+                else math.inf if tail <= 0 else -math.inf)
+    lowest, highest = order - REFINEMENT_ORDER_MARGIN, (
+        highest_order(order) + REFINEMENT_ORDER_MARGIN)
+    unresolved = "" if lowest <= observed <= highest else (
+        f"no asymptotic regime down to h/{2 ** len(d)}: the engine's own differences "
+        f"between its last halvings fall at order {observed:.2f}, outside the scheme's "
+        f"{lowest:g} to {highest:g}")
+    return RefinementGate(bound + reference_error, observed, order, predicted, tuple(d),
+                          reference_error, unresolved)

@@ -124,7 +124,7 @@ at two parameter sets{% if errata_page %} (see <a href="errata.html">the errata<
 <h2 id="{{ r.anchor }}">{{ r.row|e }}: the engines against the exact motion</h2><p>{{ r.title|e }}</p>
 <table><tr><th>metric</th>{% for sim in r.sims %}<th>{{ sim }}</th>{% endfor %}</tr>
 {% for name in r.metric_names %}<tr><td>{{ name|e }}</td>
-{% for sim in r.sims %}{% set m = r.metrics[sim].get(name) %}{% if m %}<td class="{{ m.status }}" title="{{ m.reason|e }}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ r.unsupported.get(sim, "-")|e }}</td>{% endif %}{% endfor %}</tr>{% endfor %}</table>
+{% for sim in r.sims %}{% set m = r.metrics[sim].get(name) %}{% if m %}<td class="{{ m.status }}" title="judged {{ (m.rule or 'a_priori')|replace('_', '-') }}{% if m.reason %}: {{ m.reason|e }}{% endif %}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ r.unsupported.get(sim, "-")|e }}</td>{% endif %}{% endfor %}</tr>{% endfor %}</table>
 {% if r.incidents %}<p class="fail">Incidents (stages that did not complete; the rest of the
 run stands):</p><ul>{% for i in r.incidents %}<li><b>{{ i.simulator|e }}</b>, {{ i.scenario|e }}{% if i.stage %} ({{ i.stage|e }}){% endif %}: {{ i.outcome|e }}{% if i.get("t_reached") is not none %} at t = {{ "%.6g"|format(i.t_reached) }} s{% endif %}: {{ i.message|e }}</li>{% endfor %}</ul>{% endif %}
 {% if r.expected %}<p>Declared expected failures:</p><ul>{% for e in r.expected %}<li><b>{{ e.simulator|e }}</b>, {{ e.metric|e }}: {{ e.reason|e }}</li>{% endfor %}</ul>{% endif %}

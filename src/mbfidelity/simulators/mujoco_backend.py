@@ -72,7 +72,7 @@ stepping, outside the timed loop); ``cfrc_int[body, 3:6]`` is the force the pare
 on the body (world axes). Forces MuJoCo books as joint-space passive forces (joint
 springs/dampers, the callback) are inside that number, so those acting on the child's
 subtree from outside are subtracted to give the description's joint reaction; native
-tendon forces are already outside it (MuJoCo 4.0 puts them in ``cfrc_ext``, measured).
+tendon forces are already outside it (MuJoCo puts them in ``cfrc_ext``).
 """
 from __future__ import annotations
 
@@ -143,14 +143,13 @@ from .plan import (
 #: what MuJoCo's soft equalities cost (SIMULATORS.md; each measured, the numbers per
 #: mechanism are in the results)
 SOFT_EQUALITY = (
-    "MuJoCo's equality constraints are soft: the impedance is capped at 0.9999 (solimp) and "
-    "the reference time constant at 2 dt, so each constraint force falls about 1e-4 of "
-    "itself short and a small violation (1e-9 to 1e-7 m) makes up the rest; constraint "
-    "forces are then off by 1e-4 to 2e-3 and trajectories by 1e-6 to 1e-5, against RK4 "
-    "gates near 1e-7. No solref/solimp choice removes the floor (measured). The time "
-    "constant follows the step, so the violation, and the trajectory error with it, falls "
-    "as dt^2: the observed order of convergence is 2, not RK4's 4 (mbfidelity "
-    "convergence).")
+    "MuJoCo's equality constraints are soft: the impedance is capped below 1 (solimp) and "
+    "the reference time constant is tied to the step (2 dt), so each constraint force "
+    "falls short of the exact one by the impedance's shortfall and a small violation makes "
+    "up the rest; the constraint forces and the trajectories then carry a floor of their "
+    "own, above RK4's gates, which no solref/solimp choice removes. The time constant "
+    "follows the step, so the violation, and the trajectory error with it, falls as dt^2: "
+    "the observed order of convergence is 2, not RK4's 4 (mbfidelity convergence).")
 #: the metrics a soft closure is expected to push beyond the RK4 gates: its own force and
 #: the contact forces read from it, the motion and the energy the motion carries, and the
 #: order of convergence of the motion
@@ -1629,7 +1628,7 @@ class MujocoBackend(Backend):
                     r += ext[:, i]
             # callback forces are joint-space forces, so cfrc_int counts them as
             # transmitted by the joint: take those from outside the subtree out. Native
-            # tendon forces are already external (MuJoCo 4.0 puts them in cfrc_ext).
+            # tendon forces are already external (MuJoCo puts them in cfrc_ext).
             for i, e in enumerate(plan.p2p):
                 f = e.element
                 in_a, in_b = f.body_a in inside, f.body_b in inside

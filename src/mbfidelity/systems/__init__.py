@@ -212,10 +212,11 @@ class Expectation:
 
     kind "xfail": the metric is expected to fail its gate (strict: a pass is reported);
     kind "unsupported": the engine cannot express the mechanism (or scenario) at all;
-    kind "unresolved": at the default step the metric's error bound says nothing (outside
-    its range of w h, or above the ceiling a gate can discriminate: comparisons/
-    tolerances.py), so it is measured and shown, not judged (strict too: a declaration
-    whose metrics all resolve is reported, and their passes become unexpected);
+    kind "unresolved": at the default step neither the metric's a-priori error bound nor
+    the engine's own refinement says anything (comparisons/tolerances.py: no asymptotic
+    regime down to h/8, or a bound above the ceiling a gate can discriminate), so it is
+    measured and shown, not judged (strict too: a declaration whose metrics all resolve
+    is reported, and their passes become unexpected);
     kind "judged": the metric is judged by its gate (a failure fails) although a
     backend-wide declaration (simulators/base.py `expected_failures`) expects it to fail:
     the reason says why that backend's floor lies below this system's gate.

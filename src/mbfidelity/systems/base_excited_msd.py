@@ -22,7 +22,6 @@ massless); the description gives it a mass, so they are not compared.
 """
 import sympy as sp
 
-from ._reasons import coarse_first_order
 from . import PrintedFormula, System, coordinate_symbols
 from .model import (LENGTH, LENGTH_RATE, TIME, Body, CoordinateForce, Mechanism, Parameter,
                     PointToPoint,
@@ -134,5 +133,4 @@ SYSTEM = System(
     notes="Transmissibility: |X/Y| = sqrt(k^2 + (c Omega)^2) / |k - m Omega^2 + i c Omega| "
           "(absolute x = y + z) and |Z/Y| = m Omega^2 / |k - m Omega^2 + i c Omega| "
           "(relative z).",
-    expectations=coarse_first_order("omega_1wn.*"),
 )

@@ -128,52 +128,30 @@ def released(P) -> dict:
     return {f"th{i}": -sp.asin((nodes[i] - nodes[i - 1]) / h) for i in range(1, P.N)}
 
 
-#: measured with `mbfidelity compare beam_with_block --sim ENGINE` (N = 4, dt = 1e-3 s;
-#: modes 54.6, 391.9 and 536.1 rad/s): the chain's fast modes, which the beam's continuum
-#: also has (its higher bending modes), are where each scheme's bound runs out
 MIRROR_RELEASE_EXCITES_THE_FAST_MODES = (
     "The generic release near the mirrored equilibrium (the chain along -x, the same beam "
-    "reflected: same modes) turns every independent angle by 0.05 rad "
-    "(comparisons/runner.py), which bends the hinges by up to 0.15 rad and puts as much "
-    "motion in the fast modes (392 and 536 rad/s, w h = 0.39 and 0.54 at dt = 1e-3 s) as "
-    "in the first. Within its 0.5 s the reference departs from its own linear prediction "
-    "by 1.4 of the amplitude (the fast modes' frequencies depend on their amplitude), so "
-    "neither the fastest-mode nor the mode-by-mode bound says anything (the latter 4.4 to "
-    "16). Measured maximum errors: 0.091 (MuJoCo), 1.17 (Exudyn), 1.11 (PyBullet), 1.10 "
-    "(Pymunk); the roller's force 0.092 to 1.38. The operating release ('released') and "
-    "the frequencies are judged.")
-
-FAST_MODE_FITS = (
-    "The chain's second and third modes (391.9 and 536.1 rad/s at N = 4) leave the range "
-    "where a scheme's fit bound holds at dt = 1e-3 s (w h = 0.39 and 0.54: RK4 up to 0.5, "
-    "semi-implicit Euler up to 0.2) or its bound exceeds 0.05 (the trapezoidal rule's "
-    "(w h)^2 = 0.15). The measured errors are each scheme's own frequency shift: Exudyn "
-    "1.27e-2 and 2.3e-2 ((w h)^2/12), PyBullet and Pymunk 6.5e-3 and 1.24e-2 "
-    "((w h)^2/24), MuJoCo 2.0e-4 and 6.2e-4; the first mode's fit is judged, and every "
-    "mode of the engines' linearizations (MuJoCo, Exudyn) within 1e-7.")
+    "reflected: same modes) turns every independent angle by the same offset "
+    "(comparisons/runner.py), which bends the hinges by up to three times as much and puts "
+    "as much motion in the chain's fast modes, beyond the range of w h where a scheme's "
+    "bound holds at the default step, as in the first; the reference departs from its own "
+    "linear prediction by more than the amplitude (the fast modes' frequencies depend on "
+    "their amplitude), so neither the fastest-mode nor the mode-by-mode bound says "
+    "anything. The engine's own refinement converges, but bounds its error at the default "
+    "step above what a gate can tell apart (MuJoCo's RK4 excepted, judged). The operating "
+    "release ('released') and the frequencies are judged.")
 
 SOFT_ROLLER_BELOW_THE_GATE = (
-    "MuJoCo's roller is a slider body held by a soft equality (SOFT_EQUALITY: 1e-6 to 1e-5 "
-    "of a trajectory's amplitude), far below this release's mode-by-mode gate (9.0e-3, "
-    "from the fast modes' share of the release): the metrics are judged. Measured: 9.3e-4 "
-    "at dt = 1e-3 s, RK4's phase error on the fastest mode (w h = 0.54), and 2.4e-6 at "
-    "dt = 1e-4 s.")
-
-FIRST_ORDER_RELEASE_BOUND = (
-    "Semi-implicit Euler's bound on the first mode alone, w h + (w h)^2 (1 + w T) at "
-    "w = 54.6 rad/s over the 0.5 s release, is 0.14 of the amplitude at dt = 1e-3 s, "
-    "beyond what a gate can tell apart (0.1). Measured maximum errors: 3.9e-2 (PyBullet), "
-    "3.2e-2 (Pymunk); at dt = 5e-4 s the bound is 0.048.")
-
+    "MuJoCo's roller is a slider body held by a soft equality (SOFT_EQUALITY), whose floor "
+    "lies far below this release's mode-by-mode gate (set by the fast modes' share of the "
+    "release): the metrics are judged. The error is RK4's phase error on the fastest mode, "
+    "falling with the step.")
 
 SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK = (
-    "With a lighter block the first mode is faster (15.7 Hz without it, against 8.7 Hz "
-    "with m = 1) and the release from the block-load deflection smaller, so Exudyn's "
-    "second-order bound, (w h)^2 (1 + w T) mode by mode, passes 0.1 of the amplitude over "
-    "the 0.5 s release below m = 0.95 (0.101 at m = 0.94, 0.096 at m = 0.95, 0.51 at "
-    "m = 0), where a pass would mean nothing. Measured maximum errors: 1.98e-2 (m = 0.94), "
-    "9.1e-2 (m = 0); the bound's leading coefficient is 1 where the trapezoidal rule's "
-    "phase error is 1/12 of it.")
+    "With a lighter block the first mode is faster and the release from the block-load "
+    "deflection smaller, so Exudyn's second-order bound, (w h)^2 (1 + w T) mode by mode, "
+    "passes 0.1 of the amplitude over the release, where a pass would mean nothing; the "
+    "bound's leading coefficient is 1 where the trapezoidal rule's phase error is 1/12 of "
+    "it.")
 
 
 SYSTEM = System(
@@ -193,15 +171,9 @@ SYSTEM = System(
     near_equilibrium_t_end=0.5,
     expectations=(
         *(Expectation(engine, "eq*_small.*", "unresolved", MIRROR_RELEASE_EXCITES_THE_FAST_MODES)
-          for engine in ("mujoco", "exudyn", "pybullet", "pymunk")),
-        *(Expectation(engine, f"{kind}.fit_mode*", "unresolved", FAST_MODE_FITS,
-                      when="N >= 4")
-          for engine in ("mujoco", "exudyn", "pybullet", "pymunk")
-          for kind in ("frequency", "damping")),
+          for engine in ("exudyn", "pybullet", "pymunk")),
         Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
         Expectation("exudyn", "released.*", "unresolved", SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK,
                     when="m < 0.95"),
-        *(Expectation(engine, "released.*", "unresolved", FIRST_ORDER_RELEASE_BOUND)
-          for engine in ("pybullet", "pymunk")),
     ),
 )

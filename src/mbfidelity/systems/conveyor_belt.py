@@ -56,22 +56,24 @@ PARAMETERS = (
 )
 
 STICK_SLIP_DRIFT = (
-    "Over 40 s the stick-slip cycles add up timing errors: no engine locates the jump of "
-    "the belt force at zero slip, and the phase drift this allows (comparisons/"
-    "tolerances.py, 'Stick-slip') exceeds a tenth of the amplitude at dt = 1e-3 s, where "
-    "a pass would mean nothing; at dt = 2.5e-4 s the bound resolves (compare --dt 2.5e-4). "
+    "Over the long run the stick-slip cycles add up timing errors: no engine locates the "
+    "jump of the belt force at zero slip, and the phase drift this allows (comparisons/"
+    "tolerances.py, 'Stick-slip') exceeds a tenth of the amplitude at the default step, "
+    "where a pass would mean nothing. Each crossing of the jump leaves an error of first "
+    "order in the step, so an RK4 engine's own refinement falls at first order, not at "
+    "its scheme's fourth, and cannot judge either; a first-order engine's can. "
     "The limit cycle's amplitude, set anew every cycle, is judged at the default step.")
 FIRST_ORDER_NEUTRAL = (
-    "At the threshold the motion neither grows nor decays for 40 s: semi-implicit Euler's "
-    "first-order trajectory bound (w h) + (w h)^2 (1 + w T) (comparisons/tolerances.py) "
-    "exceeds a tenth of the amplitude at dt = 1e-3 s; at dt = 2.5e-4 s it resolves.")
+    "At the threshold the motion neither grows nor decays over the long run: semi-implicit "
+    "Euler's first-order trajectory bound (w h) + (w h)^2 (1 + w T) (comparisons/"
+    "tolerances.py) exceeds a tenth of the amplitude at the default step; a step a few "
+    "times smaller resolves it.")
 
 FIRST_ORDER_MIXED = (
     "Semi-implicit Euler on this weakly (negatively) damped oscillation: its O(h) "
     "distortion of the orbit and its O(h^2 w T) phase drift are of one size at the studied "
     "steps and partly cancel in the error's maximum, so the error falls irregularly with "
-    "the step (by 1.4 to 2.5 per halving) and no single order fits (mbfidelity "
-    "convergence).")
+    "the step and no single order fits (mbfidelity convergence).")
 
 #: the belt speeds of Fig. 22: unstable, critical and stable rest state
 BELT_SPEEDS = (0.29, 0.30, 0.31)
@@ -169,11 +171,12 @@ SYSTEM = System(
     scenarios=tuple(_scenario(v) for v in BELT_SPEEDS),
     stability_parameter="v0",
     expectations=(
-        Expectation("*", "v0_0_29.trajectory_*", "unresolved", STICK_SLIP_DRIFT),
+        *(Expectation(engine, "v0_0_29.trajectory_*", "unresolved", STICK_SLIP_DRIFT)
+          for engine in ("mujoco", "exudyn")),
         *(Expectation(engine, "convergence.order", "unresolved", FIRST_ORDER_MIXED)
           for engine in ("pybullet", "pymunk")),
         *(Expectation(engine, metric, "unresolved", FIRST_ORDER_NEUTRAL)
           for engine in ("pybullet", "pymunk")
-          for metric in ("v0_0_30.trajectory_*", "v0_0_30.final_amplitude")),
+          for metric in ("v0_0_30.final_amplitude",)),
     ),
 )

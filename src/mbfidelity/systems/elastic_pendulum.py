@@ -59,9 +59,8 @@ _PYBULLET_REASON = (
     "PyBullet integrates reduced coordinates with semi-implicit Euler; here the mass "
     "matrix depends on the configuration (m s^2 + I_G and Coriolis terms), so the scheme "
     "is not symplectic and the phase drifts at first order, (w h) w T, beyond the semi-"
-    "implicit-Euler gate (measured 2.2e-1 against a 2.7e-2 gate at dt = 1e-3, converging "
-    "at first order). Pymunk's maximal coordinates have a constant mass matrix and stay "
-    "within it."
+    "implicit-Euler gate, converging at first order in the step. Pymunk's maximal "
+    "coordinates have a constant mass matrix and stay within it."
 )
 
 SYSTEM = System(

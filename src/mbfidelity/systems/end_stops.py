@@ -36,9 +36,9 @@ from .model import (COORD, Body, CoordinateForce, Mechanism, Parameter, Prismati
                     Scenario, coordinate_spring_damper)
 
 GRAZING_CONTACT = (
-    "The last contact with a stop is a graze of about 18 ms: a first-order scheme's timing "
-    "bound at the default step (about 0.03 s, comparisons/tolerances.py 'Switching "
-    "instants') exceeds half the interval between its hit and its release, so the engine's "
+    "The last contact with a stop is a short graze: a first-order scheme's timing bound at "
+    "the default step (comparisons/tolerances.py 'Switching instants') exceeds half the "
+    "interval between its hit and its release, so the engine's "
     "crossings cannot be paired with the reference's there; the earlier hits and releases "
     "are judged and pass.")
 

@@ -14,7 +14,6 @@ the catalog) sets the actuator torque only; gravity acts across the guide.
 """
 import sympy as sp
 
-from ._reasons import coarse_first_order, coarse_second_order
 from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, Prescribed,
                     Prismatic, Rectangle, Revolute, Scenario, coordinate_spring_damper)
@@ -35,11 +34,24 @@ PARAMETERS = (
               "catalog: it changes the actuator torque only)", "chosen here"),
 )
 
-RESONANT_STEADY_STATE = (
-    "Near resonance (0.9-1.1 times the natural frequency) the steady response is "
-    "1/zeta ~ 42 times as sensitive to the scheme's frequency error as the forcing is: "
-    "a second-order scheme's bound (w h)^2 (1 + 2 |K| |D^-1|) exceeds 0.1 at the default "
-    "step (comparisons/tolerances.py), so the amplitude there is measured, not judged.")
+PYMUNK_MOTOR_STARTUP = (
+    "Pymunk imposes the rotor's spin through a motor constraint solved at the velocity "
+    "level: its torque carries a start-up transient over the first steps, of first order "
+    "in the step and growing with the rotor's speed, which at the default step is beyond "
+    "what the torque's gate can tell apart (the engine's own refinement converges, at "
+    "first order); the motion it drives is judged and passes.")
+
+STEADY_AMPLITUDE_FLOOR = (
+    "The steady amplitude is fitted over the periods after the transient has fallen below "
+    "a hundredth of the response; what remains of the transient in that window differs "
+    "between the engine's runs at successive halvings by an amount that no longer shrinks "
+    "with the step, so its refinement shows no asymptotic regime for this amplitude; the "
+    "error is far below the a-priori bound and is shown, not judged.")
+
+FORCED_MOTION_AT_TWICE_RESONANCE = (
+    "At twice the natural frequency the frame's forced motion is fast for semi-implicit "
+    "Euler: the engine's own refinement converges at first order, and its error bound at "
+    "the default step reaches the tenth of the amplitude where a pass would mean nothing.")
 
 #: speeds of the amplitude curve, as ratios to the natural frequency sqrt(k/(M + m))
 SPEED_RATIOS = (0.5, 0.75, 0.9, 1.0, 1.1, 1.5, 2.0)
@@ -91,9 +103,11 @@ SYSTEM = System(
     unexcited={"e": 0.0},
     exact_solution="unbalanced_rotor_eq86",
     excitation_frequencies=lambda P: (P.omega,),
-    expectations=(coarse_first_order("ratio_*")
-                  + coarse_second_order("ratio_*.trajectory_*", "ratio_*.imposed_*",
-                                        "ratio_*.actuator_*")
-                  + (Expectation("exudyn", "ratio_*.steady_state_*", "unresolved",
-                                 RESONANT_STEADY_STATE),)),
+    expectations=(
+        Expectation("pymunk", "ratio_*.actuator_*", "unresolved", PYMUNK_MOTOR_STARTUP),
+        *(Expectation(engine, "ratio_*.steady_state_*", "unresolved", STEADY_AMPLITUDE_FLOOR)
+          for engine in ("pybullet", "pymunk")),
+        Expectation("pybullet", "ratio_2.trajectory_*", "unresolved",
+                    FORCED_MOTION_AT_TWICE_RESONANCE),
+    ),
 )

@@ -33,9 +33,8 @@ from .model import (TIME, Body, Circle, Mechanism, Parameter, Prescribed, Prisma
 
 PYBULLET_TIME_VARYING_INERTIA = (
     "PyBullet's semi-implicit Euler on the time-varying inertia m l(t)^2 of the swing is not "
-    "symplectic: the pumped swing's phase drifts at first order, just beyond the gate "
-    "(measured: 7.65e-3 against 7.08e-3 at dt = 1e-3 s, 3.82e-3 against 3.34e-3 at "
-    "dt = 5e-4 s; the error halves with the step).")
+    "symplectic: the pumped swing's phase drifts at first order, just beyond the gate at "
+    "every step (the error and the gate both halve with the step).")
 
 PARAMETERS = (
     Parameter("m", 1.0, "kg", "mass of the particle", "MECHANISMS.md A; Fig. 11"),
@@ -111,10 +110,10 @@ SYSTEM = System(
     expectations=(Expectation("pybullet", "pumped.trajectory_max", "xfail",
                               PYBULLET_TIME_VARYING_INERTIA),
                   Expectation("mujoco", "convergence.order", "unresolved",
-                              "At 4-0.5 ms RK4's error meets the reference's own (about 5e-11 "
-                              "of the amplitude) after one halving, too few points above it "
-                              "for a fit; at 20, 10, 5 and 2.5 ms the order is 3.99 "
-                              "(measured, mbfidelity convergence --steps)."),),
+                              "At the study's default steps RK4's error meets the "
+                              "reference's own after one halving, too few points above it "
+                              "for a fit; at coarser steps (mbfidelity convergence --steps) "
+                              "the fit shows RK4's fourth order."),),
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Parametric resonance at Omega = 2 sqrt(g/l0): the swing grows at the Floquet rate "
           "ln|mu|max / T about phi = 0.",
