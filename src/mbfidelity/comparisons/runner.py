@@ -509,7 +509,12 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
                                              scale_free[k]) for k, c in enumerate(free))
     tol = tolerances.gate(bound + ref_err + roundoff, w, dt, order,
                           tolerances.MAX_TRAJECTORY_TOLERANCE)
-    if not system.driven:
+    control = run.error_control
+    if control is not None:  # the engine chose its steps: the gate follows its accuracy
+        tol = tolerances.error_controlled_gate(tolerances.error_controlled_trajectory_tolerance(
+            control.accuracy, control.steps, w, T_eff, float(np.min(scale_free)))
+            + allowances + ref_err + roundoff)
+    elif not system.driven:
         modal = _modal_trajectory_gate(system, values, eq, ref, free, scale_free, dt, order,
                                        T_eff, allowances + ref_err + roundoff)
         if modal is not None and (tol.unresolved or modal.tolerance < tol.tolerance):

@@ -134,6 +134,24 @@ faster forcing).
   |p - p*| / p*: that over |d sigma / dp| p*, plus the bracket's final half-width. It
   holds while the perturbation stays in the linear range (the test's amplitude is a
   thirtieth of the belt speed, far from sticking).
+* Trajectory of an error-controlled integrator (its steps chosen by the engine between
+  the samples, e.g. Drake's Runge-Kutta 5 at a target accuracy eps). The step does not
+  set the error: the controller accepts a step only when its local error estimate, in
+  the engine's norm of the state change (an infinity norm with unit weights here: rad, m,
+  rad/s, m/s), is below eps. Each step's local error is therefore at most eps (with
+  local extrapolation, as in Dormand-Prince 5(4), the propagated solution's is smaller
+  still, by a power of the step), and the global error is the sum of the N local errors
+  the run took (the engine reports N), each carried forward by the motion: a position
+  error stays a phase error, at most growing like (1 + w T) on a motion whose frequency
+  depends on its amplitude (as above), and a velocity error dv becomes a position error
+  of at most dv min(T, 1/w) (an oscillation at w, or a free drift over T). Relative to
+  the smallest amplitude a of the coordinates: N eps (1 + min(T, 1/w)) (1 + w T) / a.
+  The number of steps reflects both the accuracy (a tighter eps takes more, smaller
+  steps, N ~ w T eps^(-1/(p+1)) for an estimate of order p) and the sampling (no step
+  crosses a sample, N >= T/dt), so the bound follows the run without a fitted constant.
+  It holds while the error estimate is asymptotic (the accepted steps are small against
+  1/w; tight eps) and the motion is not chaotic (the same proviso as above); the range
+  w h of the fixed-step bounds does not apply, the ceiling MAX_TRAJECTORY_TOLERANCE does.
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -269,6 +287,24 @@ def trajectory_tolerance(w: float, h: float, order: int, t_end: float, zeta: flo
     if order == 1:
         return w * h + (w * h) ** 2 * (1.0 + w * t_end) + zeta * w * h * w * t_end
     return (w * h) ** order * (1.0 + w * t_end)
+
+
+def error_controlled_trajectory_tolerance(accuracy: float, steps: int, w: float,
+                                          t_end: float, amplitude: float) -> float:
+    """N eps (1 + min(T, 1/w)) (1 + w T) / a: the trajectory bound of an error-controlled
+    integrator (module docstring), relative to the amplitude a."""
+    carry = t_end if w <= 0 else min(t_end, 1.0 / w)
+    return steps * accuracy * (1.0 + carry) * (1.0 + w * t_end) / amplitude
+
+
+def error_controlled_gate(tolerance: float) -> Gate:
+    """An error-controlled bound as a Gate: no range of w h applies (the engine picks its
+    steps), the ceiling of a trajectory metric does."""
+    if not tolerance <= MAX_TRAJECTORY_TOLERANCE:
+        return Gate(tolerance, f"the error bound {tolerance:.3g} exceeds "
+                               f"{MAX_TRAJECTORY_TOLERANCE:g} of the amplitude: at this "
+                               f"accuracy and duration a pass would mean nothing")
+    return Gate(tolerance)
 
 
 def modal_trajectory_tolerance(amplitudes: "np.ndarray", omegas: "np.ndarray",

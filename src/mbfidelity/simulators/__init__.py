@@ -7,7 +7,7 @@ import pkgutil
 
 from .base import Backend, Linearization, RunResult, Support
 
-SIMULATOR_IDS = ("mujoco", "pybullet", "exudyn", "pymunk")
+SIMULATOR_IDS = ("mujoco", "pybullet", "exudyn", "pymunk", "drake")
 
 
 def all_backends() -> dict[str, Backend]:

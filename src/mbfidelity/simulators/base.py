@@ -5,7 +5,7 @@ conventions 1-8) into one engine and runs it. The contract:
 
 1. A backend is one module ``mbfidelity.simulators.<engine>_backend`` that defines
    ``BACKEND``, an instance of a `Backend` subclass whose `id` is the engine's id
-   (``mujoco``, ``pybullet``, ``exudyn``, ``pymunk``). Importing the module must not
+   (``mujoco``, ``pybullet``, ``exudyn``, ``pymunk``, ``drake``). Importing the module must not
    import the engine; `available()` does.
 2. `available()` returns ``(True, "")`` or ``(False, reason)``; a missing engine is a
    visible skip, never an error.
@@ -50,7 +50,10 @@ conventions 1-8) into one engine and runs it. The contract:
      moved them, so that the error of the engine's route to impose q(t) is measured;
    - ``wall_time``: seconds spent stepping only (build excluded), and ``cpu_time``: the
      CPU seconds (``time.process_time``) of the same stepping, comparable with point 9;
-   - ``integrator_order``: the order of the scheme actually used (tolerances use it).
+   - ``integrator_order``: the order of the scheme actually used (tolerances use it);
+   - ``error_control``: for an error-controlled integrator (its steps chosen by the engine
+     between the samples), the target accuracy in use and the steps it took (the
+     trajectory gate follows from them, comparisons/tolerances.py); None for a fixed step.
    Applied loads that depend on time are evaluated at the time of each integrator stage
    where the engine allows it, and so are prescribed motions (`plan.Motion`): the engine
    imposes q(t) by its most exact route, named in its settings with its order.
@@ -199,6 +202,16 @@ class Scheme:
     stability_limit: float | None
 
 
+@dataclass(frozen=True)
+class ErrorControl:
+    """How an error-controlled integrator ran (contract point 6): the `accuracy` it kept
+    every step's local error estimate below (the engine's own measure, in the state's
+    units), and the number of `steps` it took. Fixed-step runs have none."""
+
+    accuracy: float
+    steps: int
+
+
 @dataclass
 class RunResult:
     t: np.ndarray
@@ -212,6 +225,7 @@ class RunResult:
     constraint_forces: dict[str, np.ndarray] = field(default_factory=dict)
     cpu_time: float = 0.0
     actuator_forces: dict[str, np.ndarray] = field(default_factory=dict)
+    error_control: ErrorControl | None = None
 
     def __post_init__(self) -> None:
         if self.q.shape != self.qd.shape or self.q.shape[0] != len(self.t):

@@ -1,0 +1,583 @@
+"""Drake backend (pydrake): the continuous-time `MultibodyPlant` integrated by the
+`Simulator` with an error-controlled scheme.
+
+Translation (generic over the description, conventions 1-8 of `systems.model`):
+
+- every description body becomes a rigid body whose frame is the description's
+  centre-of-mass frame, with its mass and central inertia (the planar moment on z, a
+  lamina's half of it on x and y so that the tensor is physical; they cannot act in planar
+  motion). Drake accepts zero central inertia, so point masses are exact; a massless body
+  is a zero-mass body, regular while a massive descendant carries its coordinates;
+- `Revolute` -> ``RevoluteJoint`` about z between a frame on the parent (at the parent
+  anchor, turned by the angle offset) and a frame on the child (at the child anchor);
+  `Prismatic` -> ``PrismaticJoint`` along the unit axis, the child's joint frame turned by
+  minus the angle offset. The joint values are the engine values of `plan.CoordinateMap`
+  (relative angles, slides along the unit axis), so q = T v + c maps them back;
+- gravity is the plant's gravity field;
+- a `CoordinateForce` whose law is affine (no TIME) on one engine joint value, with a
+  non-negative stiffness and damping, is Drake's own ``RevoluteSpring`` /
+  ``PrismaticSpring`` plus the joint's viscous damping; a `PointToPoint` element whose
+  law is a spring of positive free length and stiffness with a non-negative damper is
+  Drake's ``LinearSpringDamper``. Every other law (custom, time loads e(t), springs
+  Drake's elements cannot hold) is evaluated by one Python ``LeafSystem`` from the plan's
+  compiled laws at every integrator stage (the stage's time and state): coordinate laws
+  as the plant's applied generalized force (tau = T^T Q), point-to-point laws as
+  externally applied spatial forces on the two bodies (so that they are not booked as
+  forces through the joints);
+- the run is sampled at t = k dt by ``Simulator.AdvanceTo`` (the integrator's own steps
+  are error-controlled between samples and end on them);
+- reactions: the plant's reaction forces output (the force on the child at its joint
+  frame, in that frame) turned to world axes. Drake counts the generalized forces on a
+  joint's own coordinate (springs, damping, applied generalized force) as transmitted
+  through the joint; along a prismatic joint's slide they are the coordinate's force
+  elements, which the contract's reaction excludes, so they are subtracted;
+- linearization: Drake's ``Linearize`` (automatic differentiation) of the plant when no
+  Python force system is needed, otherwise central differences of the diagram's own time
+  derivatives; the eigenvalues of the 2n x 2n state matrix.
+
+A continuous-time plant refuses constraints, so closure constraints, rolling couplings and
+prescribed motions are not built (declared in `EXPRESSIONS`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from ..systems.model import WORLD, CoordinateForce, Mechanism, PointToPoint, Prismatic, Revolute
+from .base import (
+    EXACT,
+    RK3_STABILITY,
+    UNSUPPORTED,
+    Backend,
+    ErrorControl,
+    Expression,
+    Linearization,
+    RunResult,
+    Scheme,
+    Setting,
+)
+from .plan import (
+    BODY,
+    COORDINATE_FORCE_CUSTOM,
+    COORDINATE_FORCE_LINEAR,
+    LINEAR_COUPLING,
+    MASSLESS_BODY,
+    POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    POINT_TO_POINT_LINEAR,
+    PRESCRIBED,
+    PRISMATIC,
+    REVOLUTE,
+    ROLLING_CONTACT,
+    TIME_LOAD,
+    CoordinateMap,
+    ForceLaw,
+    body_states,
+    coordinate_map,
+    num,
+    point_state,
+)
+
+#: order of the solution each integrator propagates (Drake's documentation of each class)
+_ORDER = {"runge_kutta5": 5, "runge_kutta3": 3, "bogacki_shampine3": 3, "radau3": 3,
+          "implicit_euler": 1}
+#: integrators whose fixed-step mode has a known stability limit on the imaginary axis
+#: (explicit: the 3-stage third-order scheme, R = the cubic Taylor polynomial) or none
+#: (implicit); Drake's runge_kutta5 is meant for error control and is not offered fixed
+_FIXED_STABILITY = {"runge_kutta3": RK3_STABILITY, "radau3": None, "implicit_euler": None}
+_CLOSURE_REASON = ("Drake's continuous-time plant refuses constraints; its discrete plant "
+                   "(SAP) holds them compliantly, which this backend does not build")
+
+
+@dataclass
+class _Built:
+    """A diagram built from a mechanism, with what the read-out needs."""
+
+    diagram: object
+    plant: object
+    joints: list                      # Drake joints, in description joint order
+    positions: np.ndarray             # plant position index of each joint
+    velocities: np.ndarray            # plant velocity index of each joint
+    cmap: CoordinateMap
+    python_forces: bool               # whether a Python LeafSystem computes forces
+    slide_laws: dict = field(default_factory=dict)  # prismatic joint -> its coordinate laws
+
+
+class DrakeBackend(Backend):
+    id = "drake"
+    SETTINGS = {
+        "integrator": Setting(
+            "runge_kutta5", tuple(_ORDER),
+            "Drake's Simulator defaults to runge_kutta3 at accuracy 1e-2 (a few significant "
+            "digits); runge_kutta5 (Dormand-Prince, fifth order with a fourth-order error "
+            "estimate) is its most accurate explicit scheme. Also offered: runge_kutta3, "
+            "bogacki_shampine3, radau3, implicit_euler (integrator_order reports the order "
+            "of the one used)."),
+        "target_accuracy": Setting(
+            1e-10, float,
+            "Drake's default target accuracy (1e-2 in the Simulator's flags) replaced by "
+            "1e-10: the local error the integrator keeps each step below (unit weights: "
+            "rad, m, rad/s, m/s); tight enough that Drake is the most accurate engine on "
+            "smooth trees. Drake quietly clamps a value outside the integrator's range; the "
+            "run records the accuracy in use."),
+        "max_step": Setting(
+            None, (float, type(None)),
+            "Drake's largest step (the Simulator's default 0.1 s) capped at the sampling "
+            "step dt (null); a number caps it further."),
+        "fixed_step": Setting(
+            False, bool,
+            "Drake default (error control) kept; True runs the integrator at the fixed "
+            "step dt (the convergence study's knob), for runge_kutta3, radau3 and "
+            "implicit_euler."),
+        "native_elements": Setting(
+            True, bool,
+            "Backend choice: springs and dampers that Drake's own elements express exactly "
+            "(LinearSpringDamper, RevoluteSpring, PrismaticSpring, joint damping) use them; "
+            "False sends every law through the Python force system (same model, slower)."),
+        "linearization_step": Setting(
+            1e-6, float,
+            "linearize() with a Python force system: step of the central differences of "
+            "the diagram's time derivatives (truncation ~1e-12, round-off ~1e-10); without "
+            "one Drake's Linearize differentiates automatically and this is unused."),
+    }
+
+    # --- identity --------------------------------------------------------------------------
+    def available(self) -> tuple[bool, str]:
+        try:
+            import pydrake.multibody.plant  # noqa: F401
+            import pydrake.systems.analysis  # noqa: F401
+        except Exception as exc:  # noqa: BLE001 - any import failure is a visible skip
+            return False, f"pydrake not importable: {exc}"
+        return True, ""
+
+    def version(self) -> str:
+        from importlib.metadata import version
+
+        return version("drake")
+
+    # --- support ---------------------------------------------------------------------------
+    EXPRESSIONS = {
+        BODY: (Expression(EXACT, "a rigid body with its mass and central inertia (zero "
+                                 "central inertia accepted: point masses are exact)"),),
+        MASSLESS_BODY: (
+            Expression(EXACT, "a zero-mass body: the articulated inertia stays regular "
+                              "while a massive descendant carries its coordinates",
+                       when="a massive body below it"),
+            Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the "
+                                    "plant's mass matrix would be singular",
+                       when="only massless bodies below it"),
+        ),
+        REVOLUTE: (Expression(EXACT, "RevoluteJoint about z between frames at the anchors "
+                                     "(the parent's turned by the angle offset)"),),
+        PRISMATIC: (Expression(EXACT, "PrismaticJoint along the unit axis"),),
+        POINT_TO_POINT_LINEAR: (Expression(EXACT, "LinearSpringDamper where the law is a "
+                                                  "spring of positive free length with a "
+                                                  "non-negative damper, otherwise the law as "
+                                                  "externally applied spatial forces from a "
+                                                  "LeafSystem at every integrator stage"),),
+        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "externally applied spatial forces on both "
+                                                  "bodies from a LeafSystem, evaluated at "
+                                                  "every integrator stage"),),
+        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
+                                                    "the joint's damping where the law acts "
+                                                    "on one joint value with non-negative "
+                                                    "stiffness and damping, otherwise the "
+                                                    "plant's applied generalized force"),),
+        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "the plant's applied generalized force "
+                                                    "from a LeafSystem, evaluated at every "
+                                                    "integrator stage"),),
+        TIME_LOAD: (Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
+                                      "the stage time"),),
+        POINT_ON_POINT: (Expression(UNSUPPORTED, _CLOSURE_REASON),),
+        POINT_ON_LINE: (Expression(UNSUPPORTED, _CLOSURE_REASON),),
+        LINEAR_COUPLING: (Expression(UNSUPPORTED, "a rolling or gear coupling is a constraint, "
+                                                  "which the continuous-time plant refuses; "
+                                                  "the discrete plant's coupler constraint is "
+                                                  "compliant and not built here"),),
+        ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact geometry is built: the "
+                                                  "continuous plant's point contact is a "
+                                                  "penalty (compliant) model"),),
+        PRESCRIBED: (Expression(UNSUPPORTED, "imposing q(t) on a continuous-time plant needs "
+                                             "a time-dependent constraint, which it refuses; "
+                                             "a feedback actuator would only track q(t)"),),
+    }
+
+    def choose(self, mechanism: Mechanism, kind: str, element,
+               cases: tuple[Expression, ...]) -> Expression:
+        massive = any(not mechanism.body(b).massless for b in mechanism.subtree(element.name))
+        return cases[0] if massive else cases[1]
+
+    # --- the scheme --------------------------------------------------------------------------
+    def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
+        cfg = self.resolve_settings(settings)
+        name = str(cfg["integrator"])
+        if cfg["fixed_step"]:
+            if name not in _FIXED_STABILITY:
+                raise ValueError(f"drake fixed_step runs {', '.join(_FIXED_STABILITY)}; "
+                                 f"got {name!r}")
+            return Scheme(f"{name} (fixed step)", _ORDER[name], _FIXED_STABILITY[name])
+        # an error-controlled scheme shrinks its step until the error estimate, and with
+        # it the growth of every mode, is small: no stability limit at the sampling step
+        return Scheme(f"{name} (error-controlled, accuracy {cfg['target_accuracy']:g})",
+                      _ORDER[name], None)
+
+    # --- building ----------------------------------------------------------------------------
+    def _build(self, mech: Mechanism, cfg: dict) -> _Built:
+        from pydrake.math import RigidTransform, RotationMatrix
+        from pydrake.multibody.plant import MultibodyPlant
+        from pydrake.multibody.tree import (LinearSpringDamper, PrismaticJoint, PrismaticSpring,
+                                            RevoluteJoint, RevoluteSpring, RotationalInertia,
+                                            SpatialInertia)
+        from pydrake.systems.framework import DiagramBuilder
+
+        support = self.support(mech)
+        if not support.ok:
+            raise ValueError(f"drake cannot express this mechanism: {support.reason}")
+        builder = DiagramBuilder()
+        plant = builder.AddSystem(MultibodyPlant(time_step=0.0))
+        plant.mutable_gravity_field().set_gravity_vector([0.0, -num(mech.gravity), 0.0])
+        bodies = {WORLD: plant.world_body()}
+        for b in mech.bodies:
+            izz = num(b.inertia)
+            bodies[b.name] = plant.AddRigidBody(b.name, SpatialInertia.MakeFromCentralInertia(
+                num(b.mass), np.zeros(3), RotationalInertia(izz / 2, izz / 2, izz)))
+        cmap = coordinate_map(mech)
+        native = bool(cfg["native_elements"])
+        springs, damping, python_laws = self._coordinate_laws(mech, cmap, native)
+
+        def frame(body: str, name: str, anchor, angle: float):
+            point = [num(anchor[0]), num(anchor[1]), 0.0]
+            pose = RigidTransform(RotationMatrix.MakeZRotation(angle), point)
+            return plant.AddFrame(_fixed_frame(name, bodies[body].body_frame(), pose))
+
+        joints = []
+        for i, j in enumerate(mech.joints):
+            off = num(j.angle_offset)
+            if isinstance(j, Revolute):
+                jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, off)
+                jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, 0.0)
+                joint = plant.AddJoint(RevoluteJoint(j.name, jp, jc, [0.0, 0.0, 1.0],
+                                                     damping=damping[i]))
+            else:
+                axis = np.array([num(j.axis[0]), num(j.axis[1]), 0.0])
+                jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, 0.0)
+                jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, -off)
+                joint = plant.AddJoint(PrismaticJoint(j.name, jp, jc, axis / np.linalg.norm(axis),
+                                                      damping=damping[i]))
+            joints.append(joint)
+        for i, k, nominal in springs:
+            spring = RevoluteSpring if isinstance(mech.joints[i], Revolute) else PrismaticSpring
+            plant.AddForceElement(spring(joints[i], nominal, k))
+        python_p2p = []
+        for f in mech.forces:
+            if not isinstance(f, PointToPoint) or f.body_a == f.body_b:
+                continue
+            spring = _native_spring(ForceLaw.of(f)) if native else None
+            if spring is None:
+                python_p2p.append(f)
+                continue
+            free_length, stiffness, damper = spring
+            plant.AddForceElement(LinearSpringDamper(
+                bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
+                bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
+                free_length, stiffness, damper))
+        plant.Finalize()
+        python_forces = bool(python_laws or python_p2p)
+        positions = np.array([j.position_start() for j in joints], dtype=int)
+        velocities = np.array([j.velocity_start() for j in joints], dtype=int)
+        if python_forces:
+            forces = builder.AddSystem(_force_system(mech, plant, bodies, cmap, positions,
+                                                     velocities, python_laws, python_p2p))
+            builder.Connect(plant.get_state_output_port(), forces.get_input_port(0))
+            builder.Connect(forces.get_output_port(0),
+                            plant.get_applied_generalized_force_input_port())
+            builder.Connect(forces.get_output_port(1), plant.get_applied_spatial_force_input_port())
+        slide_laws = {i: [(f.weights(mech.coordinates), ForceLaw.of(f)) for f in mech.forces
+                          if isinstance(f, CoordinateForce) and i in f.weights(mech.coordinates)]
+                      for i, j in enumerate(mech.joints) if isinstance(j, Prismatic)}
+        return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
+                      python_forces, slide_laws)
+
+    @staticmethod
+    def _coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool):
+        """(springs [(joint, stiffness, nominal value)], damping per joint, laws left to the
+        Python force system [(weights, law)]). A law goes to Drake's own elements when its
+        coordinate is r v_j, one engine joint value (COORD = sum sign q_i = (sum sign T_i) v
+        + sum sign c_i): then tau_j = r F(r v_j, r v_j') = r a + r^2 b v_j + r^2 c v_j', a
+        spring of stiffness k = -r^2 b >= 0 and nominal value r a / k, and a damper
+        -r^2 c >= 0."""
+        n = len(mech.joints)
+        springs, damping, python_laws = [], [0.0] * n, []
+        for f in mech.forces:
+            if not isinstance(f, CoordinateForce):
+                continue
+            weights = f.weights(mech.coordinates)
+            law = ForceLaw.of(f)
+            row = sum(sign * cmap.T[i] for i, sign in weights.items())
+            row = np.where(np.abs(row) < 1e-12, 0.0, row)
+            shift = sum(sign * cmap.c[i] for i, sign in weights.items())
+            target = np.flatnonzero(row)
+            linear = law.linear if native else None
+            if linear is not None and len(target) == 1 and shift == 0:
+                j = int(target[0])
+                r = float(row[j])
+                a, b, c = linear
+                k, d = -r * r * b, -r * r * c
+                if k >= 0 and d >= 0 and (k > 0 or a == 0):
+                    if k > 0:
+                        springs.append((j, k, r * a / k))
+                    damping[j] += d
+                    continue
+            python_laws.append((weights, law))
+        return springs, damping, python_laws
+
+    # --- running -----------------------------------------------------------------------------
+    def _simulator(self, built: _Built, q0: np.ndarray, qd0: np.ndarray, dt: float, cfg: dict):
+        from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator
+
+        simulator = Simulator(built.diagram)
+        context = simulator.get_mutable_context()
+        plant_context = built.plant.GetMyMutableContextFromRoot(context)
+        v0 = np.zeros(built.plant.num_positions())
+        vd0 = np.zeros(built.plant.num_velocities())
+        v0[built.positions] = built.cmap.engine_values(q0)
+        vd0[built.velocities] = built.cmap.A @ np.asarray(qd0, dtype=float)
+        built.plant.SetPositions(plant_context, v0)
+        built.plant.SetVelocities(plant_context, vd0)
+        max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
+        integrator = ResetIntegratorFromFlags(simulator, str(cfg["integrator"]), max_step)
+        if cfg["fixed_step"]:
+            if str(cfg["integrator"]) not in _FIXED_STABILITY:
+                raise ValueError(f"drake fixed_step runs {', '.join(_FIXED_STABILITY)}")
+            integrator.set_fixed_step_mode(True)
+        else:
+            integrator.set_target_accuracy(float(cfg["target_accuracy"]))
+        simulator.Initialize()
+        return simulator, integrator, plant_context
+
+    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                 dt: float, settings: Mapping | None = None,
+                 reaction_joints: Sequence[str] = ()) -> RunResult:
+        cfg = self.resolve_settings(settings)
+        steps = int(round(t_end / dt))
+        built = self._build(mechanism, cfg)
+        simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
+        plant = built.plant
+        n = len(mechanism.joints)
+        state = np.empty((steps + 1, 2 * n))
+        index = np.concatenate([built.positions, plant.num_positions() + built.velocities])
+        vector = plant_context.get_continuous_state_vector()
+        wanted = [(name, mechanism.joints.index(mechanism.joint(name))) for name in reaction_joints]
+        forces = {name: np.empty((steps + 1, 2)) for name, _ in wanted}
+
+        def read(k: int) -> None:
+            state[k] = vector.CopyToVector()[index]
+            if wanted:
+                reaction = plant.get_reaction_forces_output_port().Eval(plant_context)
+                for name, i in wanted:
+                    joint = built.joints[i]
+                    turn = joint.frame_on_child().CalcRotationMatrixInWorld(plant_context)
+                    forces[name][k] = (turn.matrix() @ reaction[int(joint.index())].translational())[:2]
+
+        read(0)
+        if wanted:  # reactions need the accelerations at every sample: read while stepping
+            start, cpu_start = time.perf_counter(), time.process_time()
+            for k in range(1, steps + 1):
+                simulator.AdvanceTo(k * dt)
+                read(k)
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+        else:
+            start, cpu_start = time.perf_counter(), time.process_time()
+            for k in range(1, steps + 1):
+                simulator.AdvanceTo(k * dt)
+                state[k] = vector.CopyToVector()[index]
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+        t = np.arange(steps + 1) * dt
+        q = built.cmap.coordinates(state[:, :n])
+        qd = built.cmap.rates(state[:, n:])
+        reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd)
+                     for name, i in wanted}
+        scheme = self.scheme(mechanism, cfg)
+        control = None if cfg["fixed_step"] else ErrorControl(
+            float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
+        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
+                         integrator_order=scheme.order, settings=cfg, steps=steps, cpu_time=cpu,
+                         error_control=control)
+
+    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
+                  dt: float, settings: Mapping | None = None) -> float:
+        """The diagram of `simulate`, advanced to the same sample times, nothing read."""
+        cfg = self.resolve_settings(settings)
+        steps = int(round(t_end / dt))
+        built = self._build(mechanism, cfg)
+        simulator, _, _ = self._simulator(built, q0, qd0, dt, cfg)
+        cpu_start = time.process_time()
+        for k in range(1, steps + 1):
+            simulator.AdvanceTo(k * dt)
+        return time.process_time() - cpu_start
+
+    @staticmethod
+    def _slide_force(mech: Mechanism, built: _Built, i: int, t: np.ndarray, q: np.ndarray,
+                     qd: np.ndarray) -> np.ndarray:
+        """World force on the child of prismatic joint i from the coordinate's force
+        elements (Drake books them as transmitted through the joint; the contract's
+        reaction excludes them): Q axis / |axis|^2, the axis turned with the parent."""
+        out = np.zeros((len(t), 2))
+        if i not in built.slide_laws:
+            return out
+        joint = mech.joints[i]
+        Q = np.zeros(len(t))
+        for weights, law in built.slide_laws[i]:
+            x = sum(sign * q[:, k] for k, sign in weights.items())
+            xd = sum(sign * qd[:, k] for k, sign in weights.items())
+            Q += weights[i] * law.vector_law(x, xd, t)
+        axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
+        axis = axis / float(axis @ axis)
+        th = built.cmap.angle(joint.parent, q)
+        world = np.stack([np.cos(th) * axis[0] - np.sin(th) * axis[1],
+                          np.sin(th) * axis[0] + np.cos(th) * axis[1]], axis=1)
+        return Q[:, None] * world
+
+    # --- linearization -------------------------------------------------------------------------
+    def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
+                  settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
+        if not self.support(mechanism).ok:
+            return None
+        cfg = self.resolve_settings(settings)
+        # the autonomous system: the excitation e(t) does not belong to the equilibrium
+        mech = mechanism.without_time_loads()
+        built = self._build(mech, cfg)
+        context = built.diagram.CreateDefaultContext()
+        plant_context = built.plant.GetMyMutableContextFromRoot(context)
+        v_eq = np.zeros(built.plant.num_positions())
+        v_eq[built.positions] = built.cmap.engine_values(q_eq)
+        built.plant.SetPositions(plant_context, v_eq)
+        built.plant.SetVelocities(plant_context, np.zeros(built.plant.num_velocities()))
+        if not built.python_forces:
+            from pydrake.systems.primitives import Linearize
+
+            from pydrake.systems.framework import InputPortSelection, OutputPortSelection
+
+            linear = Linearize(built.plant, plant_context,
+                               input_port_index=InputPortSelection.kNoInput,
+                               output_port_index=OutputPortSelection.kNoOutput)
+            A = np.asarray(linear.A())
+            how = "drake Linearize of the MultibodyPlant (automatic differentiation)"
+        else:
+            step = float(cfg["linearization_step"])
+            x0 = context.get_continuous_state_vector().CopyToVector()
+            derivatives = built.diagram.AllocateTimeDerivatives()
+            A = np.zeros((len(x0), len(x0)))
+            for k in range(len(x0)):
+                columns = []
+                for sign in (1.0, -1.0):
+                    x = x0.copy()
+                    x[k] += sign * step
+                    context.SetContinuousState(x)
+                    built.diagram.CalcTimeDerivatives(context, derivatives)
+                    columns.append(derivatives.CopyToVector())
+                A[:, k] = (columns[0] - columns[1]) / (2 * step)
+            context.SetContinuousState(x0)
+            how = ("central differences of the Drake diagram's time derivatives "
+                   "(CalcTimeDerivatives; a Python force system has no automatic "
+                   "differentiation)")
+        eig = np.linalg.eigvals(A)
+        return Linearization(eigenvalues=eig[np.argsort(eig.imag)], method=how,
+                             extra={"coordinates": "the plant's joint values and rates "
+                                                   "(eigenvalues are invariant)"})
+
+
+def _fixed_frame(name: str, parent_frame, pose):
+    from pydrake.multibody.tree import FixedOffsetFrame
+
+    return FixedOffsetFrame(name, parent_frame, pose)
+
+
+def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
+    """(free length, stiffness, damping) of a point-to-point law that Drake's
+    LinearSpringDamper expresses exactly (tension = k (L - L0) + c L' with k > 0, L0 > 0,
+    c >= 0), or None."""
+    if law.linear is None:
+        return None
+    a, b, c = law.linear
+    if not (b > 0 and c >= 0 and -a / b > 0):
+        return None
+    return -a / b, b, c
+
+
+def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
+                  positions: np.ndarray, velocities: np.ndarray, coordinate_laws: list,
+                  point_laws: list):
+    """A LeafSystem that reads the plant's state and outputs (0) the applied generalized
+    force tau = T^T Q of the coordinate laws and (1) the externally applied spatial forces
+    of the point-to-point laws, both at the stage's time (contract point 6)."""
+    from pydrake.common.value import Value
+    from pydrake.multibody.math import SpatialForce
+    from pydrake.multibody.plant import ExternallyAppliedSpatialForce
+    from pydrake.systems.framework import BasicVector, LeafSystem
+
+    nq, nv = plant.num_positions(), plant.num_velocities()
+    n = len(mech.joints)
+    laws = [(tuple(w.items()), law.law) for w, law in coordinate_laws]
+    points = [(f, ForceLaw.of(f).law, [num(v) for v in f.point_a], [num(v) for v in f.point_b])
+              for f in point_laws]
+    T, c = cmap.T, cmap.c
+
+    class _Forces(LeafSystem):
+        def __init__(self) -> None:
+            super().__init__()
+            self.DeclareVectorInputPort("state", nq + nv)
+            self.DeclareVectorOutputPort("generalized_force", nv, self._generalized)
+            self.DeclareAbstractOutputPort(
+                "spatial_forces", lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
+                self._spatial)
+
+        def _state(self, context):
+            x = self.get_input_port(0).Eval(context)
+            return T @ x[positions] + c, T @ x[nq + velocities]
+
+        def _generalized(self, context, output: BasicVector) -> None:
+            tau = np.zeros(nv)
+            if laws:
+                q, qd = self._state(context)
+                t = context.get_time()
+                Q = np.zeros(n)
+                for w, law in laws:
+                    F = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
+                    for i, s in w:
+                        Q[i] += s * F
+                tau[velocities] = T.T @ Q
+            output.SetFromVector(tau)
+
+        def _spatial(self, context, output) -> None:
+            forces = []
+            if points:
+                q, qd = self._state(context)
+                t = context.get_time()
+                states = body_states(mech, q, qd)
+                for f, law, pa, pb in points:
+                    xa, ya, vxa, vya = point_state(states[f.body_a], pa)
+                    xb, yb, vxb, vyb = point_state(states[f.body_b], pb)
+                    d = np.array([xb - xa, yb - ya])
+                    length = math.hypot(*d)
+                    rate = float(d @ np.array([vxb - vxa, vyb - vya])) / length
+                    on_a = law(length, rate, t) * d / length  # tension pulls a towards b
+                    for body, point, force in ((f.body_a, pa, on_a), (f.body_b, pb, -on_a)):
+                        if body == WORLD:
+                            continue
+                        applied = ExternallyAppliedSpatialForce()
+                        applied.body_index = bodies[body].index()
+                        applied.p_BoBq_B = [point[0], point[1], 0.0]
+                        applied.F_Bq_W = SpatialForce([0.0, 0.0, 0.0], [force[0], force[1], 0.0])
+                        forces.append(applied)
+            output.set_value(forces)
+
+    return _Forces()
+
+
+BACKEND = DrakeBackend()
