@@ -77,10 +77,8 @@ from .plan import (
     TIME_LOAD,
     CoordinateMap,
     ForceLaw,
-    body_states,
     coordinate_map,
     num,
-    point_state,
 )
 
 #: order of the solution each integrator propagates (Drake's documentation of each class)
@@ -92,6 +90,36 @@ _ORDER = {"runge_kutta5": 5, "runge_kutta3": 3, "bogacki_shampine3": 3, "radau3"
 _FIXED_STABILITY = {"runge_kutta3": RK3_STABILITY, "radau3": None, "implicit_euler": None}
 _CLOSURE_REASON = ("Drake's continuous-time plant refuses constraints; its discrete plant "
                    "(SAP) holds them compliantly, which this backend does not build")
+_JUMP_REASON = ("the law jumps (a force discontinuous in the state): Drake's error "
+                "control has no event location, so it shrinks the step toward zero at every "
+                "crossing of the jump, and a sticking motion crosses it at every step")
+
+
+def _jumps(expr) -> bool:
+    """Whether a law is discontinuous: a sign or step function, or a Piecewise whose
+    pieces differ across one of its boundaries (checked on either side of each root of
+    the conditions, the law's other arguments at zero)."""
+    import sympy as sp
+
+    if expr.atoms(sp.sign, sp.Heaviside):
+        return True
+    for piecewise in expr.atoms(sp.Piecewise):
+        for _, condition in piecewise.args:
+            relations = [condition] if condition.is_Relational else list(
+                condition.atoms(sp.core.relational.Relational))
+            for relation in relations:
+                boundary = relation.lhs - relation.rhs
+                for x in boundary.free_symbols:
+                    others = {y: 0 for y in expr.free_symbols - {x}}
+                    f = sp.lambdify(x, expr.xreplace(others))
+                    for root in sp.solve(boundary.xreplace(others), x):
+                        if not root.is_real:
+                            continue
+                        d = 1e-7 * max(1.0, abs(float(root)))
+                        left, right = float(f(float(root) - d)), float(f(float(root) + d))
+                        if abs(left - right) > 1e-4 * max(1.0, abs(left), abs(right)):
+                            return True
+    return False
 
 
 @dataclass
@@ -180,17 +208,21 @@ class DrakeBackend(Backend):
                                                   "non-negative damper, otherwise the law as "
                                                   "externally applied spatial forces from a "
                                                   "LeafSystem at every integrator stage"),),
-        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "externally applied spatial forces on both "
-                                                  "bodies from a LeafSystem, evaluated at "
-                                                  "every integrator stage"),),
+        POINT_TO_POINT_CUSTOM: (
+            Expression(EXACT, "externally applied spatial forces on both bodies from a "
+                              "LeafSystem, evaluated at every integrator stage",
+                       when="the law is continuous"),
+            Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
         COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
                                                     "the joint's damping where the law acts "
                                                     "on one joint value with non-negative "
                                                     "stiffness and damping, otherwise the "
                                                     "plant's applied generalized force"),),
-        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "the plant's applied generalized force "
-                                                    "from a LeafSystem, evaluated at every "
-                                                    "integrator stage"),),
+        COORDINATE_FORCE_CUSTOM: (
+            Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
+                              "evaluated at every integrator stage",
+                       when="the law is continuous"),
+            Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
         TIME_LOAD: (Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
                                       "the stage time"),),
         POINT_ON_POINT: (Expression(UNSUPPORTED, _CLOSURE_REASON),),
@@ -209,6 +241,8 @@ class DrakeBackend(Backend):
 
     def choose(self, mechanism: Mechanism, kind: str, element,
                cases: tuple[Expression, ...]) -> Expression:
+        if kind in (COORDINATE_FORCE_CUSTOM, POINT_TO_POINT_CUSTOM):
+            return cases[1] if _jumps(ForceLaw.of(element).expr) else cases[0]
         massive = any(not mechanism.body(b).massless for b in mechanism.subtree(element.name))
         return cases[0] if massive else cases[1]
 
@@ -231,8 +265,8 @@ class DrakeBackend(Backend):
         from pydrake.math import RigidTransform, RotationMatrix
         from pydrake.multibody.plant import MultibodyPlant
         from pydrake.multibody.tree import (LinearSpringDamper, PrismaticJoint, PrismaticSpring,
-                                            RevoluteJoint, RevoluteSpring, RotationalInertia,
-                                            SpatialInertia)
+                                            RevoluteJoint, RevoluteSpring, SpatialInertia,
+                                            UnitInertia)
         from pydrake.systems.framework import DiagramBuilder
 
         support = self.support(mech)
@@ -243,9 +277,11 @@ class DrakeBackend(Backend):
         plant.mutable_gravity_field().set_gravity_vector([0.0, -num(mech.gravity), 0.0])
         bodies = {WORLD: plant.world_body()}
         for b in mech.bodies:
-            izz = num(b.inertia)
-            bodies[b.name] = plant.AddRigidBody(b.name, SpatialInertia.MakeFromCentralInertia(
-                num(b.mass), np.zeros(3), RotationalInertia(izz / 2, izz / 2, izz)))
+            mass, izz = num(b.mass), num(b.inertia)
+            # Drake stores the inertia per unit mass; a massless body has none at all
+            unit = UnitInertia(izz / mass / 2, izz / mass / 2, izz / mass) if mass else UnitInertia(
+                0.0, 0.0, 0.0)
+            bodies[b.name] = plant.AddRigidBody(b.name, SpatialInertia(mass, np.zeros(3), unit))
         cmap = coordinate_map(mech)
         native = bool(cfg["native_elements"])
         springs, damping, python_laws = self._coordinate_laws(mech, cmap, native)
@@ -524,8 +560,9 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
     nq, nv = plant.num_positions(), plant.num_velocities()
     n = len(mech.joints)
     laws = [(tuple(w.items()), law.law) for w, law in coordinate_laws]
-    points = [(f, ForceLaw.of(f).law, [num(v) for v in f.point_a], [num(v) for v in f.point_b])
-              for f in point_laws]
+    points = [(f, ForceLaw.of(f).law, np.array([num(f.point_a[0]), num(f.point_a[1]), 0.0]),
+               np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in point_laws]
+    kinematics = plant.CreateDefaultContext()
     T, c = cmap.T, cmap.c
 
     class _Forces(LeafSystem):
@@ -557,27 +594,38 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
         def _spatial(self, context, output) -> None:
             forces = []
             if points:
-                q, qd = self._state(context)
+                # the plant's own kinematics, in a context of this system's
+                plant.SetPositionsAndVelocities(kinematics, self.get_input_port(0).Eval(context))
                 t = context.get_time()
-                states = body_states(mech, q, qd)
                 for f, law, pa, pb in points:
-                    xa, ya, vxa, vya = point_state(states[f.body_a], pa)
-                    xb, yb, vxb, vyb = point_state(states[f.body_b], pb)
-                    d = np.array([xb - xa, yb - ya])
-                    length = math.hypot(*d)
-                    rate = float(d @ np.array([vxb - vxa, vyb - vya])) / length
+                    ends = [_point_motion(bodies[body], point, kinematics)
+                            for body, point in ((f.body_a, pa), (f.body_b, pb))]
+                    d = ends[1][0] - ends[0][0]
+                    length = float(np.linalg.norm(d))
+                    rate = float(d @ (ends[1][1] - ends[0][1])) / length
                     on_a = law(length, rate, t) * d / length  # tension pulls a towards b
                     for body, point, force in ((f.body_a, pa, on_a), (f.body_b, pb, -on_a)):
                         if body == WORLD:
                             continue
                         applied = ExternallyAppliedSpatialForce()
                         applied.body_index = bodies[body].index()
-                        applied.p_BoBq_B = [point[0], point[1], 0.0]
-                        applied.F_Bq_W = SpatialForce([0.0, 0.0, 0.0], [force[0], force[1], 0.0])
+                        applied.p_BoBq_B = point
+                        applied.F_Bq_W = SpatialForce(np.zeros(3), force)
                         forces.append(applied)
             output.set_value(forces)
 
     return _Forces()
+
+
+def _point_motion(body, point: np.ndarray, context) -> tuple[np.ndarray, np.ndarray]:
+    """World position and velocity of a body point (body frame coordinates; planar: the
+    angular velocity is about z)."""
+    pose = body.EvalPoseInWorld(context)
+    velocity = body.EvalSpatialVelocityInWorld(context)
+    arm = pose.rotation().matrix() @ point
+    w = velocity.rotational()[2]
+    v = velocity.translational()
+    return pose.translation() + arm, np.array([v[0] - w * arm[1], v[1] + w * arm[0], 0.0])
 
 
 BACKEND = DrakeBackend()
