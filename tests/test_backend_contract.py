@@ -136,7 +136,7 @@ def test_variant_is_description_data():
     assert not support.ok and support.reason.startswith("RollingContact rolling:")
 
 
-@pytest.mark.parametrize("engine", ["mujoco", "pybullet", "exudyn", "pymunk"])
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet", "exudyn", "pymunk", "drake"])
 def test_bare_loop_runs_the_model_of_simulate(engine):
     """Contract point 9 on the compound pendulum: the bare loop steps the same model and
     returns its CPU seconds."""

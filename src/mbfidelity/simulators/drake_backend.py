@@ -18,7 +18,8 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   non-negative stiffness and damping, is Drake's own ``RevoluteSpring`` /
   ``PrismaticSpring`` plus the joint's viscous damping; a `PointToPoint` element whose
   law is a spring of positive free length and stiffness with a non-negative damper is
-  Drake's ``LinearSpringDamper``. Every other law (custom, time loads e(t), springs
+  Drake's ``LinearSpringDamper``, a spring of zero free length without damper an
+  isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time loads e(t), springs
   Drake's elements cannot hold) is evaluated by one Python ``LeafSystem`` from the plan's
   compiled laws at every integrator stage (the stage's time and state): coordinate laws
   as the plant's applied generalized force (tau = T^T Q), point-to-point laws as
@@ -205,9 +206,12 @@ class DrakeBackend(Backend):
         PRISMATIC: (Expression(EXACT, "PrismaticJoint along the unit axis"),),
         POINT_TO_POINT_LINEAR: (Expression(EXACT, "LinearSpringDamper where the law is a "
                                                   "spring of positive free length with a "
-                                                  "non-negative damper, otherwise the law as "
-                                                  "externally applied spatial forces from a "
-                                                  "LeafSystem at every integrator stage"),),
+                                                  "non-negative damper, an isotropic "
+                                                  "LinearBushingRollPitchYaw without torque "
+                                                  "for a spring of zero free length, "
+                                                  "otherwise the law as externally applied "
+                                                  "spatial forces from a LeafSystem at every "
+                                                  "integrator stage"),),
         POINT_TO_POINT_CUSTOM: (
             Expression(EXACT, "externally applied spatial forces on both bodies from a "
                               "LeafSystem, evaluated at every integrator stage",
@@ -264,7 +268,8 @@ class DrakeBackend(Backend):
     def _build(self, mech: Mechanism, cfg: dict) -> _Built:
         from pydrake.math import RigidTransform, RotationMatrix
         from pydrake.multibody.plant import MultibodyPlant
-        from pydrake.multibody.tree import (LinearSpringDamper, PrismaticJoint, PrismaticSpring,
+        from pydrake.multibody.tree import (LinearBushingRollPitchYaw, LinearSpringDamper,
+                                            PrismaticJoint, PrismaticSpring,
                                             RevoluteJoint, RevoluteSpring, SpatialInertia,
                                             UnitInertia)
         from pydrake.systems.framework import DiagramBuilder
@@ -318,6 +323,15 @@ class DrakeBackend(Backend):
                 python_p2p.append(f)
                 continue
             free_length, stiffness, damper = spring
+            if free_length == 0:
+                # a spring of zero free length pulls each point towards the other with
+                # k times their separation: a bushing with isotropic force stiffness and
+                # no torque, whose force acts on the line between its frames' origins
+                plant.AddForceElement(LinearBushingRollPitchYaw(
+                    frame(f.body_a, f"{f.name}_a", f.point_a, 0.0),
+                    frame(f.body_b, f"{f.name}_b", f.point_b, 0.0),
+                    np.zeros(3), np.zeros(3), np.full(3, stiffness), np.zeros(3)))
+                continue
             plant.AddForceElement(LinearSpringDamper(
                 bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
                 bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
@@ -535,12 +549,14 @@ def _fixed_frame(name: str, parent_frame, pose):
 
 
 def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
-    """(free length, stiffness, damping) of a point-to-point law that Drake's
-    LinearSpringDamper expresses exactly (tension = k (L - L0) + c L' with k > 0, L0 > 0,
-    c >= 0), or None."""
+    """(free length, stiffness, damping) of a point-to-point law that Drake's own elements
+    express exactly: tension = k (L - L0) + c L' with k > 0, L0 > 0, c >= 0
+    (LinearSpringDamper), or k L (L0 = 0, c = 0: LinearBushingRollPitchYaw); else None."""
     if law.linear is None:
         return None
     a, b, c = law.linear
+    if b > 0 and a == 0 and c == 0:
+        return 0.0, b, 0.0
     if not (b > 0 and c >= 0 and -a / b > 0):
         return None
     return -a / b, b, c

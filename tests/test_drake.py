@@ -1,0 +1,95 @@
+"""The Drake backend (simulators/drake_backend.py): an optional engine that is a visible
+skip when pydrake is absent, and the trajectory gate of its error-controlled integrator
+(comparisons/tolerances.py), which must reject a model error."""
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from mbfidelity.comparisons import tolerances
+from mbfidelity.comparisons.runner import compare
+from mbfidelity.simulators import all_backends, get_backend
+from mbfidelity.systems import get_system
+
+
+def _drake():
+    backend = get_backend("drake")
+    ok, why = backend.available()
+    if not ok:
+        pytest.skip(f"drake not installed: {why}")
+    return backend
+
+
+def test_a_missing_pydrake_is_reported_not_raised():
+    """Importing the backends never imports pydrake; with pydrake unimportable the engine
+    says so through `available()` and every other engine is still listed."""
+    script = (
+        "import sys\n"
+        "from mbfidelity.simulators import all_backends\n"
+        "backends = all_backends()\n"
+        "assert 'pydrake' not in sys.modules, 'discovery imported pydrake'\n"
+        "sys.modules['pydrake'] = None  # as if it were not installed\n"
+        "ok, why = backends['drake'].available()\n"
+        "assert not ok and 'pydrake' in why, why\n"
+        "assert {'mujoco', 'pybullet', 'exudyn', 'pymunk'} <= set(backends)\n"
+        "print('ok')\n")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def test_the_error_controlled_bound_is_the_sum_of_the_local_errors():
+    """N eps (1 + min(T, 1/w)) / a, by hand: a velocity error is carried for 1/w on an
+    oscillation and for the whole run on a free drift."""
+    assert tolerances.error_controlled_trajectory_tolerance(1e-10, 2000, 4.0, 10.0, 0.5) == \
+        pytest.approx(2000 * 1e-10 * 1.25 / 0.5, rel=1e-15)
+    assert tolerances.error_controlled_trajectory_tolerance(1e-10, 2000, 0.0, 3.0, 1.0) == \
+        pytest.approx(2000 * 1e-10 * 4.0, rel=1e-15)
+    assert tolerances.error_controlled_gate(0.2).unresolved
+    assert not tolerances.error_controlled_gate(1e-6).unresolved
+
+
+def test_the_gate_rejects_a_drake_build_one_percent_heavier(monkeypatch):
+    """The double pendulum's moderate swing (reference: the exact model) on a Drake
+    build whose lower link is 1 % heavier: its motion departs from the reference far
+    beyond the error-controlled gate, so the gate fails it; the true build passes the
+    same gate."""
+    backend = _drake()
+    truthful = compare("double_pendulum", "drake", scenarios=["moderate"], t_end=2.0)
+    good = {m.name: m for m in truthful.metrics}["moderate.trajectory_max"]
+    assert good.status == "pass"
+    simulate = type(backend).simulate
+
+    def heavier(self, mechanism, *args, **kwargs):
+        bodies = tuple(replace(b, mass=1.01 * float(b.mass)) if b.name == mechanism.bodies[-1].name
+                       else b for b in mechanism.bodies)
+        return simulate(self, replace(mechanism, bodies=bodies), *args, **kwargs)
+
+    monkeypatch.setattr(type(backend), "simulate", heavier)
+    wrong = compare("double_pendulum", "drake", scenarios=["moderate"], t_end=2.0)
+    bad = {m.name: m for m in wrong.metrics}["moderate.trajectory_max"]
+    assert bad.status == "fail" and bad.value > 10 * bad.tolerance
+    assert bad.tolerance == pytest.approx(good.tolerance, rel=0.5)  # the same gate
+
+
+def test_fixed_step_mode_converges_at_the_declared_order():
+    """runge_kutta3 at a fixed step (the convergence study's knob): the compound
+    pendulum's error against its own run at a quarter of the step falls by 2^3 per
+    halving, within half an order."""
+    backend = _drake()
+    system = get_system("compound_pendulum")
+    mech = system.numeric_mechanism(system.parameter_values())
+    settings = {"integrator": "runge_kutta3", "fixed_step": True}
+    assert backend.scheme(mech, settings).order == 3
+    finals = [backend.simulate(mech, np.array([1.0]), np.array([0.0]), 1.0, dt, settings).q[-1, 0]
+              for dt in (0.02, 0.01, 0.0025)]
+    order = np.log2(abs(finals[0] - finals[2]) / abs(finals[1] - finals[2]))
+    # e(h) - e(h/4) over e(h/2) - e(h/4) = (1 - 4^-p) / (2^-p - 4^-p): 9 for p = 3
+    assert order == pytest.approx(np.log2(9.0), abs=0.5)
+
+
+def test_drake_is_discovered_like_the_other_engines():
+    assert "drake" in all_backends()
+    assert all_backends()["drake"].id == "drake"
