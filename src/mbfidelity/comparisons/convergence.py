@@ -142,6 +142,7 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     sc = system.scenario(scenario) if scenario else system.scenarios[0]
     values = system.parameter_values(scenario=sc)
     backend = get_backend(simulator)
+    settings = {**backend.CONVERGENCE_SETTINGS, **(settings or {})}
     mech = system.numeric_mechanism(values)
     eq = operating_equilibrium(system, values)
     T = sc.t_end if t_end is None else min(t_end, sc.t_end)

@@ -275,6 +275,9 @@ class Backend(ABC):
     #: per element kind, the cases the backend can build (contract point 5); a kind that
     #: is missing is unsupported
     EXPRESSIONS: ClassVar[Mapping[str, tuple[Expression, ...]]] = {}
+    #: the settings under which the step is a convergence study's knob (an engine that
+    #: chooses its own steps runs at a fixed step there); empty: its defaults
+    CONVERGENCE_SETTINGS: ClassVar[Mapping[str, object]] = {}
     #: why the backend does not build spatial mechanisms (model convention 10); empty
     #: when it does
     SPATIAL_REASON: ClassVar[str] = (

@@ -175,6 +175,9 @@ class DrakeBackend(Backend):
             "one Drake's Linearize differentiates automatically and this is unused."),
     }
 
+    #: the convergence study's knob is the step: Runge-Kutta 3 at a fixed step dt
+    CONVERGENCE_SETTINGS = {"integrator": "runge_kutta3", "fixed_step": True}
+
     # --- identity --------------------------------------------------------------------------
     def available(self) -> tuple[bool, str]:
         try:
