@@ -52,7 +52,7 @@ conventions 1-8) into one engine and runs it. The contract:
      CPU seconds (``time.process_time``) of the same stepping, comparable with point 9;
    - ``integrator_order``: the order of the scheme actually used (tolerances use it);
    - ``error_control``: for an error-controlled integrator (its steps chosen by the engine
-     between the samples), the target accuracy in use and the steps it took (the
+     between the samples), its target accuracy and the steps it took (the
      trajectory gate follows from them, comparisons/tolerances.py); None for a fixed step.
    Applied loads that depend on time are evaluated at the time of each integrator stage
    where the engine allows it, and so are prescribed motions (`plan.Motion`): the engine

@@ -151,8 +151,8 @@ class DrakeBackend(Backend):
             "Drake's default target accuracy (1e-2 in the Simulator's flags) replaced by "
             "1e-10: the local error the integrator keeps each step below (unit weights: "
             "rad, m, rad/s, m/s); tight enough that Drake is the most accurate engine on "
-            "smooth trees. Drake quietly clamps a value outside the integrator's range; the "
-            "run records the accuracy in use."),
+            "smooth trees. The run records it with the number of steps taken (the "
+            "error-controlled trajectory gate follows from both)."),
         "max_step": Setting(
             None, (float, type(None)),
             "Drake's largest step (the Simulator's default 0.1 s) capped at the sampling "
