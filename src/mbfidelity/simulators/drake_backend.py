@@ -37,7 +37,9 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   derivatives; the eigenvalues of the 2n x 2n state matrix.
 
 A continuous-time plant refuses constraints, so closure constraints, rolling couplings and
-prescribed motions are not built (declared in `EXPRESSIONS`).
+prescribed motions are not built (declared in `EXPRESSIONS`), and neither is a law that
+jumps (dry friction): the error control has no event location. The convergence study
+runs Runge-Kutta 3 at a fixed step (`CONVERGENCE_SETTINGS`), so that the step is its knob.
 """
 from __future__ import annotations
 
