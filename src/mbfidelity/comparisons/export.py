@@ -2,8 +2,8 @@
 for MuJoCo the MJCF (loadable by ``mujoco.MjModel.from_xml_path``) with a keyframe per
 scenario's initial state and the coordinate map (simulators/mujoco_backend.py, `export`);
 for an engine built through its Python API, a standalone script of the recorded build
-calls (PyBullet), of the system's item dictionaries (Exudyn) or of the space read back
-(Pymunk), see simulators/script_export.py. A backend without `export` has none."""
+calls (PyBullet, Drake's plant calls), of the system's item dictionaries (Exudyn) or of
+the space read back (Pymunk), see simulators/script_export.py. A backend without `export` has none."""
 from __future__ import annotations
 
 from typing import Mapping

@@ -36,6 +36,9 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   Python force system is needed, otherwise central differences of the diagram's own time
   derivatives; the eigenvalues of the 2n x 2n state matrix.
 
+`export` writes the plant calls of the build, recorded as they are made, as a standalone
+pydrake script.
+
 A continuous-time plant refuses constraints, so closure constraints, rolling couplings and
 prescribed motions are not built (declared in `EXPRESSIONS`), and neither is a law that
 jumps (dry friction): the error control has no event location. The convergence study
@@ -269,36 +272,46 @@ class DrakeBackend(Backend):
                       _ORDER[name], None)
 
     # --- building ----------------------------------------------------------------------------
-    def _build(self, mech: Mechanism, cfg: dict) -> _Built:
+    def _build(self, mech: Mechanism, cfg: dict, recorder: "_Recorder | None" = None) -> _Built:
+        """The diagram; every plant call goes through `recorder` (`export` writes them)."""
         from pydrake.math import RigidTransform, RotationMatrix
         from pydrake.multibody.plant import MultibodyPlant
-        from pydrake.multibody.tree import (LinearBushingRollPitchYaw, LinearSpringDamper,
-                                            PrismaticJoint, PrismaticSpring,
-                                            RevoluteJoint, RevoluteSpring, SpatialInertia,
-                                            UnitInertia)
+        from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
+                                            LinearSpringDamper, PrismaticJoint,
+                                            PrismaticSpring, RevoluteJoint, RevoluteSpring,
+                                            SpatialInertia, UnitInertia)
         from pydrake.systems.framework import DiagramBuilder
 
         support = self.support(mech)
         if not support.ok:
             raise ValueError(f"drake cannot express this mechanism: {support.reason}")
+        rec = recorder or _Recorder()
         builder = DiagramBuilder()
-        plant = builder.AddSystem(MultibodyPlant(time_step=0.0))
-        plant.mutable_gravity_field().set_gravity_vector([0.0, -num(mech.gravity), 0.0])
-        bodies = {WORLD: plant.world_body()}
+        plant = rec("plant", builder.AddSystem, "builder.AddSystem",
+                    rec(None, MultibodyPlant, "MultibodyPlant", time_step=0.0))
+        rec("", plant.mutable_gravity_field().set_gravity_vector,
+            "plant.mutable_gravity_field().set_gravity_vector", [0.0, -num(mech.gravity), 0.0])
+        bodies = {WORLD: rec("world", plant.world_body, "plant.world_body")}
         for b in mech.bodies:
             mass, izz = num(b.mass), num(b.inertia)
             # Drake stores the inertia per unit mass; a massless body has none at all
-            unit = UnitInertia(izz / mass / 2, izz / mass / 2, izz / mass) if mass else UnitInertia(
-                0.0, 0.0, 0.0)
-            bodies[b.name] = plant.AddRigidBody(b.name, SpatialInertia(mass, np.zeros(3), unit))
+            unit = (izz / mass / 2, izz / mass / 2, izz / mass) if mass else (0.0, 0.0, 0.0)
+            bodies[b.name] = rec(f"body_{len(bodies)}", plant.AddRigidBody, "plant.AddRigidBody",
+                                 b.name, rec(None, SpatialInertia, "SpatialInertia", mass,
+                                             [0.0, 0.0, 0.0],
+                                             rec(None, UnitInertia, "UnitInertia", *unit)))
         cmap = coordinate_map(mech)
         native = bool(cfg["native_elements"])
         springs, damping, python_laws = self._coordinate_laws(mech, cmap, native)
 
         def frame(body: str, name: str, anchor, angle: float):
             point = [num(anchor[0]), num(anchor[1]), 0.0]
-            pose = RigidTransform(RotationMatrix.MakeZRotation(angle), point)
-            return plant.AddFrame(_fixed_frame(name, bodies[body].body_frame(), pose))
+            pose = rec(None, RigidTransform, "RigidTransform",
+                       rec(None, RotationMatrix.MakeZRotation, "RotationMatrix.MakeZRotation",
+                           angle), point)
+            parent = rec(None, bodies[body].body_frame, f"{rec.code(bodies[body])}.body_frame")
+            return rec(f"frame_{name}", plant.AddFrame, "plant.AddFrame",
+                       rec(None, FixedOffsetFrame, "FixedOffsetFrame", name, parent, pose))
 
         joints = []
         for i, j in enumerate(mech.joints):
@@ -306,18 +319,19 @@ class DrakeBackend(Backend):
             if isinstance(j, Revolute):
                 jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, off)
                 jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, 0.0)
-                joint = plant.AddJoint(RevoluteJoint(j.name, jp, jc, [0.0, 0.0, 1.0],
-                                                     damping=damping[i]))
+                made = rec(None, RevoluteJoint, "RevoluteJoint", j.name, jp, jc, [0.0, 0.0, 1.0],
+                           damping=damping[i])
             else:
                 axis = np.array([num(j.axis[0]), num(j.axis[1]), 0.0])
                 jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, 0.0)
                 jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, -off)
-                joint = plant.AddJoint(PrismaticJoint(j.name, jp, jc, axis / np.linalg.norm(axis),
-                                                      damping=damping[i]))
-            joints.append(joint)
+                made = rec(None, PrismaticJoint, "PrismaticJoint", j.name, jp, jc,
+                           axis / np.linalg.norm(axis), damping=damping[i])
+            joints.append(rec(f"joint_{i}", plant.AddJoint, "plant.AddJoint", made))
         for i, k, nominal in springs:
             spring = RevoluteSpring if isinstance(mech.joints[i], Revolute) else PrismaticSpring
-            plant.AddForceElement(spring(joints[i], nominal, k))
+            rec("", plant.AddForceElement, "plant.AddForceElement",
+                rec(None, spring, spring.__name__, joints[i], nominal, k))
         python_p2p = []
         for f in mech.forces:
             if not isinstance(f, PointToPoint) or f.body_a == f.body_b:
@@ -331,15 +345,19 @@ class DrakeBackend(Backend):
                 # a spring of zero free length pulls each point towards the other with
                 # k times their separation: a bushing with isotropic force stiffness and
                 # no torque, whose force acts on the line between its frames' origins
-                plant.AddForceElement(LinearBushingRollPitchYaw(
-                    frame(f.body_a, f"{f.name}_a", f.point_a, 0.0),
-                    frame(f.body_b, f"{f.name}_b", f.point_b, 0.0),
-                    np.zeros(3), np.zeros(3), np.full(3, stiffness), np.zeros(3)))
-                continue
-            plant.AddForceElement(LinearSpringDamper(
-                bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
-                bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
-                free_length, stiffness, damper))
+                element = rec(None, LinearBushingRollPitchYaw, "LinearBushingRollPitchYaw",
+                              frame(f.body_a, f"{f.name}_a", f.point_a, 0.0),
+                              frame(f.body_b, f"{f.name}_b", f.point_b, 0.0),
+                              [0.0] * 3, [0.0] * 3, [stiffness] * 3, [0.0] * 3)
+            else:
+                element = rec(None, LinearSpringDamper, "LinearSpringDamper",
+                              bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
+                              bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
+                              free_length, stiffness, damper)
+            rec("", plant.AddForceElement, "plant.AddForceElement", element)
+        rec.python_forces = [f.name for f in mech.forces
+                             if any(f is w for w in python_p2p)
+                             or any(law.element is f for _, law in python_laws)]
         plant.Finalize()
         python_forces = bool(python_laws or python_p2p)
         positions = np.array([j.position_start() for j in joints], dtype=int)
@@ -356,6 +374,72 @@ class DrakeBackend(Backend):
                       for i, j in enumerate(mech.joints) if isinstance(j, Prismatic)}
         return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
                       python_forces, slide_laws)
+
+    def export(self, mechanism: Mechanism, coordinates: Sequence[str],
+               initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
+               settings: Mapping | None = None, dt: float = 1e-3) -> tuple[str, list[str]]:
+        """(a standalone pydrake script, what it does not reproduce): the plant calls of
+        `simulate`'s build as recorded, the first scenario's initial state, the same
+        integrator, one second advanced sample by sample, and the description's
+        coordinates at the end. The Python force system (laws Drake's own elements do not
+        hold) cannot be written out: its laws are listed."""
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        cfg = self.resolve_settings(settings)
+        recorder = _Recorder()
+        built = self._build(mechanism, cfg, recorder)
+        cmap = built.cmap
+        accuracy = ("integrator.set_fixed_step_mode(True)" if cfg["fixed_step"] else
+                    f"integrator.set_target_accuracy({float(cfg['target_accuracy'])!r})")
+        max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
+        text = "\n".join([
+            f'"""The mechanism as mbfidelity builds it in Drake {self.version()}, from the',
+            f"initial state of scenario {name!r}; backend settings:",
+            *[f"  {k} = {v!r}" for k, v in cfg.items()],
+            '"""',
+            "import numpy as np",
+            "from pydrake.math import RigidTransform, RotationMatrix",
+            "from pydrake.multibody.plant import MultibodyPlant",
+            "from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw, "
+            "LinearSpringDamper,",
+            "                                    PrismaticJoint, PrismaticSpring, RevoluteJoint, "
+            "RevoluteSpring,",
+            "                                    SpatialInertia, UnitInertia)",
+            "from pydrake.systems.analysis import ResetIntegratorFromFlags, Simulator",
+            "from pydrake.systems.framework import DiagramBuilder",
+            "",
+            "builder = DiagramBuilder()",
+            *recorder.lines,
+            "plant.Finalize()",
+            "diagram = builder.Build()",
+            "simulator = Simulator(diagram)",
+            "context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())",
+            "joints = [" + ", ".join(f"joint_{i}" for i in range(len(built.joints))) + "]",
+            f"v0 = {[float(v) for v in cmap.engine_values(q0)]!r}",
+            f"vd0 = {[float(v) for v in cmap.A @ np.asarray(qd0, dtype=float)]!r}",
+            "positions, velocities = np.zeros(plant.num_positions()), "
+            "np.zeros(plant.num_velocities())",
+            "for joint, value, rate in zip(joints, v0, vd0):  # the engine's joint values",
+            "    positions[joint.position_start()] = value",
+            "    velocities[joint.velocity_start()] = rate",
+            "plant.SetPositions(context, positions)",
+            "plant.SetVelocities(context, velocities)",
+            f"integrator = ResetIntegratorFromFlags(simulator, {cfg['integrator']!r}, "
+            f"{max_step!r})",
+            accuracy,
+            "simulator.Initialize()",
+            f"dt = {dt!r}",
+            "for k in range(1, int(round(1.0 / dt)) + 1):",
+            "    simulator.AdvanceTo(k * dt)",
+            "v = np.array([plant.GetPositions(context)[j.position_start()] for j in joints])",
+            f"T = np.array({cmap.T.tolist()!r})",
+            f"c = np.array({cmap.c.tolist()!r})",
+            f"print(dict(zip({list(coordinates)!r}, (T @ v + c).tolist())))",
+            ""])
+        outside = ([f"the force laws computed by the Python force system: "
+                    f"{', '.join(recorder.python_forces)}"] if recorder.python_forces else [])
+        return text, outside
 
     @staticmethod
     def _coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool):
@@ -541,10 +625,38 @@ class DrakeBackend(Backend):
                                                    "(eigenvalues are invariant)"})
 
 
-def _fixed_frame(name: str, parent_frame, pose):
-    from pydrake.multibody.tree import FixedOffsetFrame
+class _Recorder:
+    """Calls into pydrake, each also written as a line of Python (`export`): a call given
+    a variable name becomes ``name = text(args)``, one given "" a statement, one given
+    None an expression that later lines inline. The objects are kept, so that their ids
+    stay theirs."""
 
-    return FixedOffsetFrame(name, parent_frame, pose)
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.names: dict[int, str] = {}
+        self.kept: list = []
+        self.python_forces: list[str] = []
+
+    def code(self, value) -> str:
+        if id(value) in self.names:
+            return self.names[id(value)]
+        if isinstance(value, np.ndarray):
+            return repr([float(v) for v in value])
+        if isinstance(value, (list, tuple)):
+            return "[" + ", ".join(self.code(v) for v in value) + "]"
+        return repr(float(value)) if isinstance(value, (float, np.floating)) else repr(value)
+
+    def __call__(self, var: str | None, fn, text: str, *args, **kwargs):
+        out = fn(*args, **kwargs)
+        call = f"{text}({', '.join([self.code(a) for a in args] + [f'{k}={self.code(v)}' for k, v in kwargs.items()])})"
+        self.kept.append(out)
+        if var is None:
+            self.names[id(out)] = call
+        else:
+            self.lines.append(f"{var} = {call}" if var else call)
+            if var:
+                self.names[id(out)] = var
+        return out
 
 
 def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
