@@ -51,9 +51,17 @@ def _belongs(metric_name: str, check: str) -> bool:
         CHECKS["frequency"])
 
 
+def _marks(system_id: str, simulator: str) -> list:
+    """Its system's worker group; Drake's driven rows are long (the actuator's inverse
+    dynamics runs in Python at every integrator stage): in `make test-slow`."""
+    marks = [pytest.mark.xdist_group(system_id)]
+    if simulator == "drake" and all_systems()[system_id].mechanism.prescribed:
+        marks.append(pytest.mark.slow)
+    return marks
+
+
 @pytest.mark.parametrize("system_id,simulator,check", [
-    pytest.param(a, b, c, id=f"{a}-{b}-{c}", marks=pytest.mark.xdist_group(a))
-    for a, b, c in CASES])
+    pytest.param(a, b, c, id=f"{a}-{b}-{c}", marks=_marks(a, b)) for a, b, c in CASES])
 def test_conformance(system_id, simulator, check):
     backend = all_backends().get(simulator)
     if backend is None:

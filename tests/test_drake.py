@@ -41,12 +41,15 @@ def test_a_missing_pydrake_is_reported_not_raised():
 
 
 def test_the_error_controlled_bound_is_the_sum_of_the_local_errors():
-    """N eps (1 + min(T, 1/w)) / a, by hand: a velocity error is carried for 1/w on an
-    oscillation and for the whole run on a free drift."""
+    """N eps G (1 + min(T, 1/w)) / a, by hand: a velocity error is carried for 1/w on an
+    oscillation and for the whole run on a free drift; an unstable motion multiplies every
+    local error by at most its growth factor G."""
     assert tolerances.error_controlled_trajectory_tolerance(1e-10, 2000, 4.0, 10.0, 0.5) == \
         pytest.approx(2000 * 1e-10 * 1.25 / 0.5, rel=1e-15)
     assert tolerances.error_controlled_trajectory_tolerance(1e-10, 2000, 0.0, 3.0, 1.0) == \
         pytest.approx(2000 * 1e-10 * 4.0, rel=1e-15)
+    assert tolerances.error_controlled_trajectory_tolerance(1e-10, 2000, 4.0, 10.0, 0.5, 30.0) \
+        == pytest.approx(30 * 2000 * 1e-10 * 1.25 / 0.5, rel=1e-15)
     assert tolerances.error_controlled_gate(0.2).unresolved
     assert not tolerances.error_controlled_gate(1e-6).unresolved
 

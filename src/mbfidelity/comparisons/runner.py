@@ -20,7 +20,7 @@ from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria
                                operating_equilibrium, oscillatory_instability,
                                unexcited_values, wrap_angles)
 from ..analytic.numeric import contact_forces, numeric_model
-from ..analytic.reference import reference
+from ..analytic.reference import reference, sensitivity
 from ..analytic.steady_state import (excitation_frequencies, observable_functions,
                                      steady_state)
 from ..simulators import get_backend
@@ -512,8 +512,8 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
     control = run.error_control
     if control is not None:  # the engine chose its steps: the gate follows its accuracy
         tol = tolerances.error_controlled_gate(tolerances.error_controlled_trajectory_tolerance(
-            control.accuracy, control.steps, w, T_eff, float(np.min(scale_free)))
-            + allowances + ref_err + roundoff)
+            control.accuracy, control.steps, w, T_eff, float(np.min(scale_free)),
+            max(1.0, sensitivity(system, sc, values))) + allowances + ref_err + roundoff)
     elif not system.driven:
         modal = _modal_trajectory_gate(system, values, eq, ref, free, scale_free, dt, order,
                                        T_eff, allowances + ref_err + roundoff)

@@ -141,11 +141,13 @@ faster forcing).
   rad/s, m/s), is below eps. Each step's local error is therefore at most eps (with
   local extrapolation, as in Dormand-Prince 5(4), the propagated solution's is smaller
   still, by a power of the step), and the global error is the sum of the N local errors
-  the run took (the engine reports N), each carried forward by the motion as the
-  fixed-step bound carries its per-step errors (summed, a phase drift that does not grow
-  exponentially: the same proviso of no chaos). A velocity error dv becomes a position
-  error of at most dv min(T, 1/w) (an oscillation at w, or a free drift over T).
-  Relative to the smallest amplitude a of the coordinates: N eps (1 + min(T, 1/w)) / a.
+  the run took (the engine reports N), each carried forward by the motion: at most
+  multiplied by the growth factor G of a perturbation over the run (analytic/reference.py
+  `sensitivity`: of order one on a regular motion, which makes the sum a phase drift as
+  in the fixed-step bound; exp(sigma T) on an unstable one). A velocity error dv becomes
+  a position error of at most dv min(T, 1/w) (an oscillation at w, or a free drift over
+  T). Relative to the smallest amplitude a of the coordinates:
+  N eps G (1 + min(T, 1/w)) / a, with G at least 1.
   The number of steps reflects both the accuracy (a tighter eps takes more, smaller
   steps, N ~ w T eps^(-1/(p+1)) for an estimate of order p) and the sampling (no step
   crosses a sample, N >= T/dt), so the bound follows the run without a fitted constant.
@@ -290,11 +292,12 @@ def trajectory_tolerance(w: float, h: float, order: int, t_end: float, zeta: flo
 
 
 def error_controlled_trajectory_tolerance(accuracy: float, steps: int, w: float,
-                                          t_end: float, amplitude: float) -> float:
-    """N eps (1 + min(T, 1/w)) / a: the trajectory bound of an error-controlled
+                                          t_end: float, amplitude: float,
+                                          growth: float = 1.0) -> float:
+    """N eps G (1 + min(T, 1/w)) / a: the trajectory bound of an error-controlled
     integrator (module docstring), relative to the amplitude a."""
     carry = t_end if w <= 0 else min(t_end, 1.0 / w)
-    return steps * accuracy * (1.0 + carry) / amplitude
+    return steps * accuracy * growth * (1.0 + carry) / amplitude
 
 
 def error_controlled_gate(tolerance: float) -> Gate:

@@ -39,9 +39,15 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
 `export` writes the plant calls of the build, recorded as they are made, as a standalone
 pydrake script.
 
-A continuous-time plant refuses constraints, so closure constraints, rolling couplings and
-prescribed motions are not built (declared in `EXPRESSIONS`), and neither is a law that
-jumps (dry friction): the error control has no event location. The convergence study
+Prescribed motions (convention 9) start on q(0), q'(0) and are imposed through their
+acceleration by the same LeafSystem, at every integrator stage: from the plant's mass
+matrix and its other generalized forces (force elements, gravity, bias, the Python laws)
+it solves for the generalized force that gives q''(t), the actuator force; the
+coordinates then follow q(t) to the integrator's accuracy.
+
+A continuous-time plant refuses constraints, so closure constraints and rolling couplings
+are not built (declared in `EXPRESSIONS`), and neither is a law that jumps (dry
+friction): the error control has no event location. The convergence study
 runs Runge-Kutta 3 at a fixed step (`CONVERGENCE_SETTINGS`), so that the step is its knob.
 """
 from __future__ import annotations
@@ -83,6 +89,7 @@ from .plan import (
     CoordinateMap,
     ForceLaw,
     coordinate_map,
+    motions,
     num,
 )
 
@@ -139,6 +146,7 @@ class _Built:
     cmap: CoordinateMap
     python_forces: bool               # whether a Python LeafSystem computes forces
     slide_laws: dict = field(default_factory=dict)  # prismatic joint -> its coordinate laws
+    forces: object = None             # the Python force system, when there is one
 
 
 class DrakeBackend(Backend):
@@ -245,9 +253,11 @@ class DrakeBackend(Backend):
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact geometry is built: the "
                                                   "continuous plant's point contact is a "
                                                   "penalty (compliant) model"),),
-        PRESCRIBED: (Expression(UNSUPPORTED, "imposing q(t) on a continuous-time plant needs "
-                                             "a time-dependent constraint, which it refuses; "
-                                             "a feedback actuator would only track q(t)"),),
+        PRESCRIBED: (Expression(EXACT, "the acceleration imposed by the LeafSystem's applied "
+                                       "generalized force at every integrator stage (from the "
+                                       "plant's mass matrix and its other generalized forces "
+                                       "at the stage's state and time); that force is the "
+                                       "actuator force"),),
     }
 
     def choose(self, mechanism: Mechanism, kind: str, element,
@@ -359,9 +369,10 @@ class DrakeBackend(Backend):
                              if any(f is w for w in python_p2p)
                              or any(law.element is f for _, law in python_laws)]
         plant.Finalize()
-        python_forces = bool(python_laws or python_p2p)
+        python_forces = bool(python_laws or python_p2p or mech.prescribed)
         positions = np.array([j.position_start() for j in joints], dtype=int)
         velocities = np.array([j.velocity_start() for j in joints], dtype=int)
+        forces = None
         if python_forces:
             forces = builder.AddSystem(_force_system(mech, plant, bodies, cmap, positions,
                                                      velocities, python_laws, python_p2p))
@@ -373,7 +384,7 @@ class DrakeBackend(Backend):
                           if isinstance(f, CoordinateForce) and i in f.weights(mech.coordinates)]
                       for i, j in enumerate(mech.joints) if isinstance(j, Prismatic)}
         return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
-                      python_forces, slide_laws)
+                      python_forces, slide_laws, forces)
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -504,6 +515,7 @@ class DrakeBackend(Backend):
         cfg = self.resolve_settings(settings)
         steps = int(round(t_end / dt))
         built = self._build(mechanism, cfg)
+        q0, qd0 = _driven_state(mechanism, q0, qd0)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
         n = len(mechanism.joints)
@@ -512,9 +524,14 @@ class DrakeBackend(Backend):
         vector = plant_context.get_continuous_state_vector()
         wanted = [(name, mechanism.joints.index(mechanism.joint(name))) for name in reaction_joints]
         forces = {name: np.empty((steps + 1, 2)) for name, _ in wanted}
+        driven = [p.name for p in mechanism.prescribed]
+        actuators = np.empty((steps + 1, len(driven)))
 
         def read(k: int) -> None:
             state[k] = vector.CopyToVector()[index]
+            if driven:
+                x = vector.CopyToVector()
+                actuators[k] = built.forces.actuators(x, k * dt, built.forces._laws(x, k * dt))
             if wanted:
                 reaction = plant.get_reaction_forces_output_port().Eval(plant_context)
                 for name, i in wanted:
@@ -533,14 +550,16 @@ class DrakeBackend(Backend):
         t = np.arange(steps + 1) * dt
         q = built.cmap.coordinates(state[:, :n])
         qd = built.cmap.rates(state[:, n:])
-        reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd)
+        actuator_forces = {name: actuators[:, k] for k, name in enumerate(driven)}
+        reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd,
+                                                            actuator_forces)
                      for name, i in wanted}
         scheme = self.scheme(mechanism, cfg)
         control = None if cfg["fixed_step"] else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
         return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
                          integrator_order=scheme.order, settings=cfg, steps=steps, cpu_time=cpu,
-                         error_control=control)
+                         error_control=control, actuator_forces=actuator_forces)
 
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
@@ -548,6 +567,7 @@ class DrakeBackend(Backend):
         cfg = self.resolve_settings(settings)
         steps = int(round(t_end / dt))
         built = self._build(mechanism, cfg)
+        q0, qd0 = _driven_state(mechanism, q0, qd0)
         simulator, _, _ = self._simulator(built, q0, qd0, dt, cfg)
         cpu_start = time.process_time()
         for k in range(1, steps + 1):
@@ -556,7 +576,7 @@ class DrakeBackend(Backend):
 
     @staticmethod
     def _slide_force(mech: Mechanism, built: _Built, i: int, t: np.ndarray, q: np.ndarray,
-                     qd: np.ndarray) -> np.ndarray:
+                     qd: np.ndarray, actuator_forces: Mapping[str, np.ndarray]) -> np.ndarray:
         """World force on the child of prismatic joint i from the coordinate's force
         elements (Drake books them as transmitted through the joint; the contract's
         reaction excludes them): Q axis / |axis|^2, the axis turned with the parent."""
@@ -564,7 +584,9 @@ class DrakeBackend(Backend):
         if i not in built.slide_laws:
             return out
         joint = mech.joints[i]
-        Q = np.zeros(len(t))
+        # an actuator on the joint's own slide acts between parent and child like a law
+        Q = sum((actuator_forces[p.name] for p in mech.prescribed
+                 if p.coordinate == joint.coordinate), np.zeros(len(t)))
         for weights, law in built.slide_laws[i]:
             x = sum(sign * q[:, k] for k, sign in weights.items())
             xd = sum(sign * qd[:, k] for k, sign in weights.items())
@@ -579,7 +601,8 @@ class DrakeBackend(Backend):
     # --- linearization -------------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        if not self.support(mechanism).ok:
+        # a driven mechanism moves about a motion, not an equilibrium
+        if not self.support(mechanism).ok or mechanism.prescribed:
             return None
         cfg = self.resolve_settings(settings)
         # the autonomous system: the excitation e(t) does not belong to the equilibrium
@@ -623,6 +646,16 @@ class DrakeBackend(Backend):
         return Linearization(eigenvalues=eig[np.argsort(eig.imag)], method=how,
                              extra={"coordinates": "the plant's joint values and rates "
                                                    "(eigenvalues are invariant)"})
+
+
+def _driven_state(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The initial state with each prescribed coordinate on its motion at t = 0
+    (convention 9); an undriven mechanism's state unchanged."""
+    q0, qd0 = np.array(q0, dtype=float), np.array(qd0, dtype=float)
+    for motion in motions(mech):
+        q0[motion.index], qd0[motion.index] = motion.position(0.0), motion.rate(0.0)
+    return q0, qd0
 
 
 class _Recorder:
@@ -677,11 +710,20 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
                   positions: np.ndarray, velocities: np.ndarray, coordinate_laws: list,
                   point_laws: list):
     """A LeafSystem that reads the plant's state and outputs (0) the applied generalized
-    force tau = T^T Q of the coordinate laws and (1) the externally applied spatial forces
-    of the point-to-point laws, both at the stage's time (contract point 6)."""
+    force: tau = T^T Q of the coordinate laws plus the prescribed motions' actuators, and
+    (1) the externally applied spatial forces of the point-to-point laws, all at the
+    stage's time (contract point 6).
+
+    The actuators (convention 9) impose each prescribed coordinate's acceleration: with
+    the plant's mass matrix M and its generalized forces f without them (force elements,
+    gravity, bias, the Python laws), and G the rows of q = T v + c that give the prescribed
+    coordinates (in the plant's velocity order), G M^-1 (f + G^T Q_p) = q_p''(t), so
+    Q_p = (G M^-1 G^T)^-1 (q_p''(t) - G M^-1 f): the actuator forces in the description's
+    coordinates."""
     from pydrake.common.value import Value
     from pydrake.multibody.math import SpatialForce
     from pydrake.multibody.plant import ExternallyAppliedSpatialForce
+    from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
     from pydrake.systems.framework import BasicVector, LeafSystem
 
     nq, nv = plant.num_positions(), plant.num_velocities()
@@ -691,6 +733,10 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
                np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in point_laws]
     kinematics = plant.CreateDefaultContext()
     T, c = cmap.T, cmap.c
+    driven = motions(mech)
+    select = np.zeros((n, nv))  # joint values' rates from the plant's velocities
+    select[np.arange(n), velocities] = 1.0
+    G = T[[m.index for m in driven]] @ select
 
     class _Forces(LeafSystem):
         def __init__(self) -> None:
@@ -701,44 +747,69 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
                 "spatial_forces", lambda: Value[list[ExternallyAppliedSpatialForce]]([]),
                 self._spatial)
 
-        def _state(self, context):
-            x = self.get_input_port(0).Eval(context)
-            return T @ x[positions] + c, T @ x[nq + velocities]
-
-        def _generalized(self, context, output: BasicVector) -> None:
+        def _laws(self, x: np.ndarray, t: float) -> np.ndarray:
+            """The coordinate laws' generalized force, in the plant's velocity order."""
             tau = np.zeros(nv)
             if laws:
-                q, qd = self._state(context)
-                t = context.get_time()
+                q, qd = T @ x[positions] + c, T @ x[nq + velocities]
                 Q = np.zeros(n)
                 for w, law in laws:
                     F = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
                     for i, s in w:
                         Q[i] += s * F
                 tau[velocities] = T.T @ Q
+            return tau
+
+        def actuators(self, x: np.ndarray, t: float, tau_laws: np.ndarray) -> np.ndarray:
+            """Q_p, the prescribed coordinates' actuator forces at state x and time t."""
+            plant.SetPositionsAndVelocities(kinematics, x)
+            elements = MultibodyForces(plant)
+            plant.CalcForceElementsContribution(kinematics, elements)
+            f = (plant.CalcGeneralizedForces(kinematics, elements)
+                 - plant.CalcBiasTerm(kinematics) + tau_laws)
+            for body, point, force in self._point_forces(t):
+                J = plant.CalcJacobianTranslationalVelocity(
+                    kinematics, JacobianWrtVariable.kV, bodies[body].body_frame(), point,
+                    plant.world_frame(), plant.world_frame())
+                f += J.T @ force
+            M = plant.CalcMassMatrix(kinematics)
+            wanted = np.array([m.acceleration(t) for m in driven])
+            MG = np.linalg.solve(M, G.T)
+            return np.linalg.solve(G @ MG, wanted - MG.T @ f)
+
+        def _generalized(self, context, output: BasicVector) -> None:
+            x = self.get_input_port(0).Eval(context)
+            tau = self._laws(x, context.get_time())
+            if driven:
+                tau = tau + G.T @ self.actuators(x, context.get_time(), tau)
             output.SetFromVector(tau)
+
+        def _point_forces(self, t: float) -> list:
+            """(body, point in its frame, world force) of the point-to-point laws at the
+            state already set in the kinematics context."""
+            out = []
+            for f, law, pa, pb in points:
+                ends = [_point_motion(bodies[body], point, kinematics)
+                        for body, point in ((f.body_a, pa), (f.body_b, pb))]
+                d = ends[1][0] - ends[0][0]
+                length = float(np.linalg.norm(d))
+                rate = float(d @ (ends[1][1] - ends[0][1])) / length
+                on_a = law(length, rate, t) * d / length  # tension pulls a towards b
+                out += [(body, point, force) for body, point, force in
+                        ((f.body_a, pa, on_a), (f.body_b, pb, -on_a)) if body != WORLD]
+            return out
 
         def _spatial(self, context, output) -> None:
             forces = []
             if points:
                 # the plant's own kinematics, in a context of this system's
                 plant.SetPositionsAndVelocities(kinematics, self.get_input_port(0).Eval(context))
-                t = context.get_time()
-                for f, law, pa, pb in points:
-                    ends = [_point_motion(bodies[body], point, kinematics)
-                            for body, point in ((f.body_a, pa), (f.body_b, pb))]
-                    d = ends[1][0] - ends[0][0]
-                    length = float(np.linalg.norm(d))
-                    rate = float(d @ (ends[1][1] - ends[0][1])) / length
-                    on_a = law(length, rate, t) * d / length  # tension pulls a towards b
-                    for body, point, force in ((f.body_a, pa, on_a), (f.body_b, pb, -on_a)):
-                        if body == WORLD:
-                            continue
-                        applied = ExternallyAppliedSpatialForce()
-                        applied.body_index = bodies[body].index()
-                        applied.p_BoBq_B = point
-                        applied.F_Bq_W = SpatialForce(np.zeros(3), force)
-                        forces.append(applied)
+                for body, point, force in self._point_forces(context.get_time()):
+                    applied = ExternallyAppliedSpatialForce()
+                    applied.body_index = bodies[body].index()
+                    applied.p_BoBq_B = point
+                    applied.F_Bq_W = SpatialForce(np.zeros(3), force)
+                    forces.append(applied)
             output.set_value(forces)
 
     return _Forces()

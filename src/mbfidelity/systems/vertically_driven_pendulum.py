@@ -139,7 +139,14 @@ SYSTEM = System(
                    "shaking; mbfidelity convergence), faster than the first order its "
                    "semi-implicit Euler declares, while Pymunk's same scheme shows first "
                    "order: the cause (the velocity-motor route that imposes the "
-                   "pivot, or the first step's start term) is not established."),),
+                   "pivot, or the first step's start term) is not established."),
+       Expectation("drake", "convergence.order", "xfail",
+                   "Drake's fixed-step Runge-Kutta 3 error here falls faster than the third "
+                   "order it declares (within the asymptotic range of the fast shaking; "
+                   "mbfidelity convergence), while it shows third order on every other "
+                   "mechanism it runs: the cause (a cancellation of the scheme's leading "
+                   "term on the parametrically shaken pendulum, or the route of its "
+                   "actuator) is not established.")),
     excitation_frequencies=lambda P: (P.Omega,),
     notes="Inverted position Floquet-stable for Y^2 Omega^2 > 2 g L_e to leading order "
           "(L_e = (I_G + m l^2)/(m l)); parametric resonance about hanging near "
