@@ -13,7 +13,9 @@ conventions 1-8) into one engine and runs it. The contract:
 4. Settings are declared once, in the backend's `SETTINGS` table: per key a `Setting`
    with its default (a JSON value, the engine's distorting defaults neutralised,
    SIMULATORS.md), the values or the type it admits, and a note saying which engine
-   default it replaces and why. `default_settings()` and `setting_notes()` derive from
+   default it replaces and why; where it replaces one, `engine_default` holds the engine's
+   out-of-the-box value (cited in the note), which the power and out-of-the-box studies
+   switch back on. `default_settings()` and `setting_notes()` derive from
    the table. Users may override any key; `resolve_settings` checks every override
    centrally: an unknown key, a value of the wrong type or outside the admitted values
    raises `ValueError` naming the valid ones.
@@ -150,6 +152,19 @@ class Setting:
     default: object
     allowed: object
     note: str
+    #: where `default` neutralises a distorting engine default: the value the engine uses
+    #: out of the box, in this setting's terms (the note cites the engine's documentation
+    #: for it); None where the default is the engine's own or has no engine counterpart
+    engine_default: object = None
+    #: the setting counts time steps while the engine's default is a duration:
+    #: `engine_default` is then in seconds (see `out_of_the_box`)
+    engine_default_in_seconds: bool = False
+
+    def out_of_the_box(self, dt: float) -> object:
+        """The engine's own value at step `dt` (None: nothing neutralised)."""
+        if self.engine_default is not None and self.engine_default_in_seconds:
+            return float(self.engine_default) / dt
+        return copy.deepcopy(self.engine_default)
 
     def check(self, engine: str, key: str, value: object) -> None:
         """Raise `ValueError` when `value` is not admitted."""

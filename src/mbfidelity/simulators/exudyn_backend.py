@@ -318,7 +318,9 @@ class ExudynBackend(Backend):
             "also offered: RK44, RK67, RK33, ExplicitMidpoint, ExplicitEuler, "
             "GeneralizedAlpha, TrapezoidalIndex2 (integrator_order reports the order of "
             "the one used). Mechanisms with closure constraints run constrained_solver, "
-            "with prescribed motion driven_solver."),
+            "with prescribed motion driven_solver. Engine default: Exudyn documentation, "
+            "SolveDynamic(..., solverType=exudyn.DynamicSolverType.GeneralizedAlpha).",
+            engine_default="GeneralizedAlpha"),
         "constrained_solver": Setting(
             "GeneralizedAlpha", _CONSTRAINT_SOLVERS,
             "Mechanisms with closure constraints (exact index-3 constraints: Exudyn's "
@@ -349,27 +351,43 @@ class ExudynBackend(Backend):
         "automatic_step_size": Setting(
             False, bool,
             "Exudyn default True lets error-controlled explicit solvers change the step; "
-            "False keeps the fixed step dt the contract asks for."),
+            "False keeps the fixed step dt the contract asks for. Engine default: Exudyn "
+            "documentation, SimulationSettings timeIntegration.automaticStepSize = True.",
+            engine_default=True),
         "ga_spectral_radius": Setting(
             1.0, float,
             "GeneralizedAlpha as 'solver' (unconstrained mechanisms). Exudyn default 0.9 "
             "adds numerical damping (energy decays); 1.0 removes it (no constraints, so "
-            "rho = 1 is stable). Constrained: constrained_spectral_radius."),
+            "rho = 1 is stable). Constrained: constrained_spectral_radius. Engine default: "
+            "Exudyn documentation, SimulationSettings "
+            "timeIntegration.generalizedAlpha.spectralRadius = 0.9.",
+            engine_default=0.9),
         "ga_adaptive_step": Setting(
             False, bool,
             "Implicit solvers only. Exudyn default True silently reduces the step after a "
-            "failed Newton solve; False keeps dt fixed (a failure is raised instead)."),
+            "failed Newton solve; False keeps dt fixed (a failure is raised instead). "
+            "Engine default: Exudyn documentation, SimulationSettings "
+            "timeIntegration.adaptiveStep = True.",
+            engine_default=True),
         "newton_relative_tolerance": Setting(
             1e-13, float,
             "Implicit solvers only. Exudyn default 1e-8 limits the accuracy of small "
-            "motions; tightened."),
+            "motions; tightened. Engine default: Exudyn documentation, SimulationSettings "
+            "timeIntegration.newton.relativeTolerance = 1e-8.",
+            engine_default=1e-8),
         "newton_absolute_tolerance": Setting(
             1e-14, float,
-            "Implicit solvers only. Exudyn default 1e-10; tightened for small amplitudes."),
+            "Implicit solvers only. Exudyn default 1e-10; tightened for small amplitudes. "
+            "Engine default: Exudyn documentation, SimulationSettings "
+            "timeIntegration.newton.absoluteTolerance = 1e-10.",
+            engine_default=1e-10),
         "modified_newton": Setting(
             False, bool,
             "Implicit solvers only. Exudyn default True reuses an old Jacobian; full "
-            "Newton converges to the tight tolerances."),
+            "Newton converges to the tight tolerances. Engine default: Exudyn "
+            "documentation, SimulationSettings timeIntegration.newton.useModifiedNewton = "
+            "True.",
+            engine_default=True),
         "end_of_step_accelerations": Setting(
             True, bool,
             "Exudyn default True (kept): explicit solvers recompute the accelerations at "

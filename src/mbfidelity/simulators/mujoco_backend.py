@@ -1137,7 +1137,10 @@ class MujocoBackend(Backend):
             "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
             "every custom and time-dependent force, is evaluated at each stage at the "
             "stage time). Also accepted: Euler, implicit, implicitfast (order 1). With "
-            "Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp)."),
+            "Euler, MuJoCo integrates joint/tendon damping implicitly (eulerdamp). Engine "
+            "default: MuJoCo XML reference, option/integrator: '[Euler, RK4, implicit, "
+            "implicitfast], \"Euler\"'.",
+            engine_default="Euler"),
         "native_springs": Setting(
             True, bool,
             "true: force laws linear in length/coordinate and rate (no time) use MuJoCo's "
@@ -1161,14 +1164,18 @@ class MujocoBackend(Backend):
             False, bool,
             "false replaces MuJoCo's default (autoreset on), which silently resets the "
             "state to qpos0 when an acceleration is NaN or huge and would show a "
-            "divergence as a jump back to the start; off, it shows as NaN/inf."),
+            "divergence as a jump back to the start; off, it shows as NaN/inf. Engine "
+            "default: MuJoCo XML reference, option/flag/autoreset '\"enable\"'.",
+            engine_default=True),
         "constraint_timeconst_steps": Setting(
             2.0, float,
             "Closure equalities: solref time constant in time steps (solref[0] = steps * "
             "dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. MuJoCo clamps "
             "it to 2 dt unless refsafe is off; measured on the scotch yoke with RK4: 2 is "
             "best (1: same trajectory, 20x the force error; 0.5: 15x worse; 0.3: "
-            "unstable)."),
+            "unstable). Engine default: MuJoCo XML reference, equality/solref "
+            "'\"0.02 1\"' (0.02 s, i.e. 0.02/dt steps).",
+            engine_default=0.02, engine_default_in_seconds=True),
         "constraint_dampratio": Setting(
             1.0, float,
             "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
@@ -1178,7 +1185,9 @@ class MujocoBackend(Backend):
             "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
             "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
             "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
-            "trajectory error 10x larger."),
+            "trajectory error 10x larger. Engine default: MuJoCo XML reference, "
+            "equality/solimp '\"0.9 0.95 0.001 0.5 2\"'.",
+            engine_default=[0.9, 0.95, 0.001, 0.5, 2.0]),
         "refsafe": Setting(
             True, bool,
             "MuJoCo's default (on): solref time constants below 2 dt are raised to 2 dt. "
@@ -1188,7 +1197,9 @@ class MujocoBackend(Backend):
             "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint regularisation "
             "uses the exact diagonal of J M^-1 J^T instead of the body_invweight0 "
             "estimate; with the estimate the scotch yoke's slot force was 6 % low at t = "
-            "0 and its violation 3e-6 m (5e-9 m exact)."),
+            "0 and its violation 3e-6 m (5e-9 m exact). Engine default: MuJoCo XML "
+            "reference, option/flag/diagexact '\"disable\"'.",
+            engine_default=False),
         "slider_mass_ratio": Setting(
             0.3, float,
             "Mass of each point-on-line slider as a fraction of the largest point mass "
@@ -1223,14 +1234,18 @@ class MujocoBackend(Backend):
             "of the description (MuJoCo body gravcomp=1)."),
         "contact_timeconst_steps": Setting(
             2.0, float,
-            "RollingContact: solref[0] of the contacts in steps."),
+            "RollingContact: solref[0] of the contacts in steps. Engine default: MuJoCo "
+            "XML reference, geom/solref '\"0.02 1\"' (0.02 s, i.e. 0.02/dt steps).",
+            engine_default=0.02, engine_default_in_seconds=True),
         "contact_dampratio": Setting(
             1.0, float,
             "RollingContact: solref[1] of the contacts."),
         "contact_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
             "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
-            "energy: 0.215 rad error in SIMULATORS.md)."),
+            "energy: 0.215 rad error in SIMULATORS.md). Engine default: MuJoCo XML "
+            "reference, geom/solimp '\"0.9 0.95 0.001 0.5 2\"'.",
+            engine_default=[0.9, 0.95, 0.001, 0.5, 2.0]),
         "contact_friction": Setting(
             1.0, float,
             "RollingContact: sliding friction coefficient of the disc."),

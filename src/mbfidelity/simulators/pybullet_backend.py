@@ -556,7 +556,10 @@ class PyBulletBackend(Backend):
             False, bool,
             "False: every joint's default velocity motor (target 0) is switched off with "
             "VELOCITY_CONTROL force=0. PyBullet's default (True here) locks the joints "
-            "(bullet3 #2463)."),
+            "(bullet3 #2463). Engine default: PyBullet Quickstart Guide, "
+            "setJointMotorControl2: 'by default, each revolute joint and prismatic joint "
+            "is motorized using a velocity motor'.",
+            engine_default=True),
         "linear_damping": Setting(
             0.0, float,
             "Replaces the engine default 0.04 (a velocity-proportional plus quadratic "
@@ -564,19 +567,31 @@ class PyBulletBackend(Backend):
             "changeDynamics call: PyBullet's body-level setters (linearDamping, "
             "angularDamping, maxJointVelocity) reset the link index to -1, so "
             "mass/inertia passed in the same call land on the base (it becomes a floating "
-            "base)."),
+            "base). Engine default: PyBullet Quickstart Guide, changeDynamics: "
+            "linearDamping 'linear damping of the link (0.04 by default)'.",
+            engine_default=0.04),
         "angular_damping": Setting(
             0.0, float,
-            "Replaces the engine default 0.04 (see linear_damping)."),
+            "Replaces the engine default 0.04 (see linear_damping). Engine default: "
+            "PyBullet Quickstart Guide, changeDynamics: angularDamping 'angular damping of "
+            "the link (0.04 by default)'.",
+            engine_default=0.04),
         "max_joint_velocity": Setting(
             1.0e6, float,
-            "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate."),
+            "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate. Engine "
+            "default: PyBullet Quickstart Guide, changeDynamics: maxJointVelocity, "
+            "'default maximum joint velocity is 100 units'.",
+            engine_default=100.0),
         "explicit_inertia": Setting(
             True, bool,
             "True: the description's mass and central inertia are set on every link with "
             "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
             "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
-            "No collision shapes are created, so there are no contacts between links."),
+            "No collision shapes are created, so there are no contacts between links. "
+            "Engine default (False): PyBullet Quickstart Guide, loadURDF flags: without "
+            "URDF_USE_INERTIA_FROM_FILE 'Bullet recomputed the inertia tensor based on "
+            "mass and volume of the collision shape'; createMultiBody does the same.",
+            engine_default=False),
         "sleeping": Setting(
             False, bool,
             "False: deactivation disabled. PyBullet multibodies created without "
@@ -617,7 +632,10 @@ class PyBulletBackend(Backend):
         "constraint_max_force": Setting(
             1.0e12, float,
             "maxForce of every constraint; the engine default 500 N would clip the "
-            "constraint forces (e.g. the start of a fast run)."),
+            "constraint forces (e.g. the start of a fast run). Engine default: bullet3 "
+            "examples/SharedMemory/SharedMemoryPublic.h, b3UserConstraint: "
+            "m_maxAppliedForce = 500.",
+            engine_default=500.0),
         "solver_iterations": Setting(
             50, int,
             "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
@@ -627,7 +645,10 @@ class PyBulletBackend(Backend):
             "solverResidualThreshold; the engine default 1e-7 ends the sweeps early (that "
             "is why the iteration count 'had no effect'): it left a 1e-5 m drift of the "
             "rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep (belt "
-            "and rolling couplings then hold to 1e-15; same wall time)."),
+            "and rolling couplings then hold to 1e-15; same wall time). Engine default: "
+            "PyBullet Quickstart Guide, setPhysicsEngineParameter: solverResidualThreshold "
+            "'default value is 1e-7'.",
+            engine_default=1e-7),
         "point_on_line": Setting(
             "prismatic", _POINT_ON_LINE,
             "'prismatic' (default): a rotor link (revolute, no mass, inertia "

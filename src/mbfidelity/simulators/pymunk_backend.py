@@ -1238,7 +1238,10 @@ class PymunkBackend(Backend):
             "and its correction velocity enters the real velocity: measured on the 2 rad "
             "compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory error and "
             "5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error in the next "
-            "step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad."),
+            "step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad. Engine "
+            "default: Pymunk API reference, Constraint.error_bias 'Defaults to "
+            "pow(1.0 - 0.1, 60.0)'.",
+            engine_default=0.9 ** 60),
         "iterations": Setting(
             50, int,
             "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk default "
@@ -1247,7 +1250,9 @@ class PymunkBackend(Backend):
             "1.4e-4 with 20 or more (20, 30, 50, 100 identical; trajectories identical "
             "from 10 on, reactions 65 % off with 1). 50 keeps a margin at negligible "
             "cost. Closed loops with slider substitutes need it: the scotch yoke diverged "
-            "with 10 at slider_mass_fraction 0.1."),
+            "with 10 at slider_mass_fraction 0.1. Engine default: Pymunk API reference, "
+            "Space.iterations 'Defaults to 10'.",
+            engine_default=10),
         "start_iterations": Setting(
             1000, int,
             "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
