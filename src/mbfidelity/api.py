@@ -699,3 +699,36 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
     if not dt > 0:
         raise ValueError("dt must be positive")
     return export_model(system.id, simulator, params, settings, dt)
+
+
+# --- gate power (comparisons/power.py) ---------------------------------------------------
+
+POWER = "power.json"
+OUT_OF_THE_BOX = "out_of_the_box.json"
+
+
+def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
+          out: str | Path | None = None, *, dt: float = DEFAULT_DT, progress=None):
+    """The power study (comparisons/power.py) of systems x engines (default: all systems,
+    every installed engine): per injected model error the smallest relative error the
+    gates reject, per neutralised default whether they reject it. With `out`, power.json
+    and out_of_the_box.json and their pages (power.html, out_of_the_box.html) are written
+    there. Returns the `PowerStudy`."""
+    import json
+
+    from .comparisons.power import power_study
+
+    sys_ids, sim_ids = _matrix(systems, sims, installed_only=True)
+    if not dt > 0:
+        raise ValueError("dt must be positive")
+    study = power_study(sys_ids, sim_ids, dt, progress=progress)
+    if out is not None:
+        from .reports.power_page import write_power_pages
+
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / POWER).write_text(json.dumps(study.as_dict(), indent=1, default=str))
+        (folder / OUT_OF_THE_BOX).write_text(json.dumps(study.out_of_the_box(), indent=1,
+                                                        default=str))
+        write_power_pages(folder)
+    return study

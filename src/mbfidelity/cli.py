@@ -821,6 +821,49 @@ def global_options_first(argv: list[str]) -> list[str]:
     return head + rest
 
 
+# --- gate power (comparisons/power.py) ---------------------------------------------------
+
+
+@app.command("power")
+def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
+              sims: Optional[List[str]] = typer.Option(
+                  None, "--sims", help="simulator ids (default: every installed one)"),
+              dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+              out: Optional[Path] = typer.Option(
+                  None, "--out", help="also write power.json, out_of_the_box.json and their "
+                                      "pages there"),
+              as_json: bool = typer.Option(False, "--json"),
+              ) -> None:
+    """What the gates catch: per system x engine, the smallest relative error of a mass,
+    an inertia, a length, g, a stiffness and a damping coefficient injected into the
+    engine's build (decade grid 1e-6..1e-1) that the gates reject, and each neutralised
+    engine default switched back on: rejected or not, and its effect."""
+    from . import api
+
+    def progress(entry) -> None:
+        if not as_json:
+            found = ", ".join(f"{p.kind} {p.smallest_rejected:g}" if p.smallest_rejected
+                              else f"{p.kind} {'not rejected' if p.applicable else 'n/a'}"
+                              for p in entry.errors)
+            typer.echo(f"{entry.system:28s} {entry.simulator:9s} "
+                       + (found if entry.supported else f"unsupported: {entry.reason}"))
+            for d in entry.defaults:
+                verdict = ("rejected by " + ", ".join(d.rejected_by[:3]) if d.rejected
+                           else "passes" if d.acts else "does not act here")
+                typer.echo(f"    default {d.setting} = {d.engine_value}: {verdict}")
+
+    try:
+        study = api.power(_split(systems) or None, _split(sims) or None, out, dt=dt,
+                          progress=progress)
+    except ValueError as exc:
+        _fail(str(exc))
+    if as_json:
+        _json(study.as_dict())
+    elif out is not None:
+        typer.echo(f"pages: {(out / 'power.html').resolve()}, "
+                   f"{(out / 'out_of_the_box.html').resolve()}")
+
+
 def main() -> None:
     try:
         app(args=global_options_first(sys.argv[1:]), prog_name="mbfidelity")

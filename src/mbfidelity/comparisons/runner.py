@@ -128,6 +128,26 @@ _COMPARED_VALUES: ContextVar[Mapping[str, float] | None] = ContextVar("compared_
                                                                       default=None)
 
 
+#: per parameter, the factor applied to its value in the engine's build only (a model error
+#: injected by the power study, comparisons/power.py); the reference keeps the true values
+_ENGINE_SCALE: ContextVar[Mapping[str, float]] = ContextVar("engine_scale", default={})
+
+
+@contextmanager
+def _engine_scaled(scale: Mapping[str, float]):
+    token = _ENGINE_SCALE.set(dict(scale))
+    try:
+        yield
+    finally:
+        _ENGINE_SCALE.reset(token)
+
+
+def _engine_mechanism(system: System, values: Mapping[str, float], variant=None):
+    scale = _ENGINE_SCALE.get()
+    return system.numeric_mechanism(
+        {k: v * scale.get(k, 1.0) for k, v in values.items()} if scale else values, variant)
+
+
 @contextmanager
 def _declarations_judged_at(values: Mapping[str, float]):
     token = _COMPARED_VALUES.set(values)
@@ -230,15 +250,18 @@ def _coordinate_scales(system: System, q_eq: np.ndarray) -> np.ndarray:
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None,
             dt: float = DEFAULT_DT, t_end: float | None = None,
             settings: Mapping | None = None, scenarios: Iterable[str] | None = None,
-            keep_series: bool = False, variant: str | None = None) -> Comparison:
+            keep_series: bool = False, variant: str | None = None,
+            engine_scale: Mapping[str, float] | None = None) -> Comparison:
     """One system on one engine, every scenario and the frequency checks. With `variant`
     the engine builds the system's named variant (its settings first, then `settings`);
     the metrics are then measurements of the variant's own error (status "measured"
-    where the description's gate is not met)."""
+    where the description's gate is not met). `engine_scale` multiplies parameters in the
+    engine's build only (an injected model error; the reference and gates keep the true
+    values)."""
     system = get_system(system_id)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
-    with _declarations_judged_at(base_values):
+    with _declarations_judged_at(base_values), _engine_scaled(engine_scale or {}):
         backend = get_backend(simulator)
         system = system.with_structure(base_values)  # built for the user's number of elements
         ok, why = backend.available()
@@ -264,7 +287,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
         strict = t_end is None and dt == DEFAULT_DT
         # from here on every stage's failure is an incident of this comparison
         with contained(result, "*", "description") as stage:
-            mech = system.numeric_mechanism(base_values, variant)
+            mech = _engine_mechanism(system, base_values, variant)
         if stage.failed:
             return _finished(system, result, chosen_variant, strict)
         support = backend.support(mech)
@@ -445,7 +468,7 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
 def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, keep_series,
                       eq=None, variant=None):
     values = system.parameter_values(params, scenario=sc)
-    mech = system.numeric_mechanism(values, variant)
+    mech = _engine_mechanism(system, values, variant)
     T = sc.t_end if t_end is None else t_end
     with contained(result, sc.name, "reference") as stage:
         ref = reference(system, sc, values, dt, T)
@@ -971,7 +994,7 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     if not (eq.stable or oscillatory_instability(eq.eigenvalues)):
         return  # a divergent equilibrium: a release departs without oscillating
     # free vibration: the excitation e(t) is off, as for the equilibrium (eq. 78)
-    mech = system.numeric_mechanism(values, variant).without_time_loads()
+    mech = _engine_mechanism(system, values, variant).without_time_loads()
     modes = [m for m in eq.modes if m.frequency_hz > 0]
     ref_w = np.array([abs(m.eigenvalue) for m in modes])
     lin = None

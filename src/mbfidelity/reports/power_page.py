@@ -1,0 +1,91 @@
+"""The power pages, rendered from the saved power.json and out_of_the_box.json only
+(`mbfidelity power --out DIR`): power.html, the smallest injected model error the gates
+reject per system x engine and error kind, and whether they reject each neutralised engine
+default switched back on; out_of_the_box.html, what each of those defaults does to the
+motion against the neutralised run."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jinja2
+
+POWER = "power.json"
+OUT_OF_THE_BOX = "out_of_the_box.json"
+
+STYLE = """body{font-family:sans-serif;margin:2em;max-width:1400px}
+table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px}
+th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.weak{background:#fbeec8}
+.na{background:#e6e6e6;color:#666}small{color:#555}"""
+
+_ENV = jinja2.Environment(autoescape=True)
+_ENV.filters["eps"] = lambda x: "-" if x is None else (x if isinstance(x, str) else f"{x:.0e}")
+_ENV.filters["num"] = lambda x: "-" if x is None else (x if isinstance(x, str) else f"{x:.3g}")
+
+POWER_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="utf-8">
+<title>mbfidelity gate power</title><style>{{ style }}</style></head><body>
+<h1>Gate power: the smallest model error each engine's gates reject</h1>
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. One parameter of each kind is
+multiplied by (1 + eps) in the engine's build only (the reference keeps the true value);
+eps on the decade grid {{ doc.epsilons|map("eps")|join(", ") }}, searched by bisection
+assuming a larger error is rejected whenever a smaller one is. Each run is the system's
+first scenario and the frequency checks. A cell gives the smallest rejected eps and the
+parameter; "not rejected" means not even eps = {{ doc.epsilons[-1]|eps }}; its colour is
+yellow where a {{ doc.probe|eps }} error moves the exact motion beyond the gate (a blind
+spot), grey where it does not (the error is below what the gates can see).</p>
+<h2>Summary: median smallest rejected eps</h2>
+<table><tr><th>engine</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults that act: rejected</th></tr>
+{% for sim, row in doc.summary.items() %}<tr><td>{{ sim }}</td>
+{% for k in kinds %}<td>{{ row[k].median_smallest_rejected|eps }} <small>({{ row[k].systems }} systems{% if row[k].not_rejected_at_largest %}, {{ row[k].not_rejected_at_largest }} not rejected{% endif %})</small></td>{% endfor %}
+<td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}</td></tr>{% endfor %}</table>
+<h2>Per system and engine</h2>
+<table><tr><th>system</th><th>engine</th><th>baseline</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults switched on</th></tr>
+{% for e in doc.entries %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td>
+{% if not e.supported %}<td class="na" colspan="{{ kinds|length + 2 }}">unsupported: {{ e.reason }}</td>
+{% else %}<td class="{{ 'pass' if e.baseline_passed else 'fail' }}" title="{{ e.baseline_not_holding|join(', ') }}">{{ 'passes' if e.baseline_passed else 'fails' }}</td>
+{% for p in e.errors %}{% if not p.applicable %}<td class="na" title="{{ p.reason }}">n/a</td>
+{% elif p.smallest_rejected is not none %}<td class="pass" title="{{ p.trials|map(attribute='rejected_by')|map('join', ', ')|join(' | ') }}">{{ p.smallest_rejected|eps }} <small>{{ p.parameter }}</small></td>
+{% else %}<td class="{{ 'weak' if p.motion_change.beyond_gate else 'na' }}" title="1 %: trajectory change {{ p.motion_change.trajectory|num }} (gate {{ p.motion_change.trajectory_gate|num }}), frequency change {{ p.motion_change.frequency|num }} (gate {{ p.motion_change.frequency_gate|num }})">not rejected <small>{{ p.parameter }}</small></td>{% endif %}{% endfor %}
+<td>{% for d in e.defaults %}<span class="{{ 'pass' if d.rejected else ('weak' if d.acts else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ d.setting }}: {{ 'rejected' if d.rejected else ('passes' if d.acts else 'no effect') }}</span>{% if not loop.last %}; {% endif %}{% endfor %}</td>{% endif %}</tr>{% endfor %}
+</table>
+<h2>Motion change of a {{ doc.probe|eps }} error against the gates</h2>
+<table><tr><th>system</th><th>engine</th><th>kind</th><th>parameter</th><th>trajectory change</th><th>trajectory gate</th><th>frequency change</th><th>frequency gate</th><th>beyond a gate</th><th>smallest rejected</th></tr>
+{% for e in doc.entries if e.supported %}{% for p in e.errors if p.applicable %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td><td>{{ p.kind }}</td><td>{{ p.parameter }}</td>
+<td>{{ p.motion_change.trajectory|num }}</td><td>{{ p.motion_change.trajectory_gate|num }} {{ p.motion_change.trajectory_gate_status }}</td><td>{{ p.motion_change.frequency|num }}</td><td>{{ p.motion_change.frequency_gate|num }}</td>
+<td>{{ 'yes' if p.motion_change.beyond_gate else 'no' }}</td><td class="{{ 'pass' if p.smallest_rejected is not none else ('weak' if p.motion_change.beyond_gate else 'na') }}">{{ p.smallest_rejected|eps if p.smallest_rejected is not none else 'not rejected' }}</td></tr>{% endfor %}{% endfor %}
+</table>
+<p><a href="out_of_the_box.html">What each engine default does out of the box</a></p>
+</body></html>""")
+
+OUT_OF_THE_BOX_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="utf-8">
+<title>mbfidelity out of the box</title><style>{{ style }}</style></head><body>
+<h1>Out of the box: what each engine default the harness neutralises does</h1>
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. Each default (the engine's
+documented value, cited in its note) is switched back on alone, then all together, on the
+system's first scenario and its frequency checks; each cell gives the metric with the harness's
+setting → with the default (relative to the amplitude for trajectories, to the largest kinetic
+energy for the energy drift, absolute for a damping ratio). "no effect": no metric moved (the
+setting does not act on this mechanism's build). Rejected: a gate that holds with the harness's
+setting fails with the default.</p>
+{% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{{ e.system }} · {{ e.simulator }} {{ e.engine_version }}</h2>
+{% if not e.supported %}<p>unsupported: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default.</p>{% else %}
+<table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>trajectory error</th><th>energy drift</th><th>damping ratio (mode 1)</th><th>frequency (mode 1)</th></tr>
+{% for d in e.defaults %}{% set traj = d.effect.get(e.scenario ~ '.trajectory_max') %}{% set drift = d.effect.get(e.scenario ~ '.energy_drift') %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
+<tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
+<td class="{{ 'pass' if d.rejected else ('weak' if d.acts else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ 'rejected' if d.rejected else ('passes the gates' if d.acts else 'no effect') }}</td>
+{% for m in (traj, drift, damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
+</table>{% endif %}{% endfor %}
+<p><a href="power.html">Gate power</a></p>
+</body></html>""")
+
+
+def write_power_pages(out: Path) -> tuple[Path, Path]:
+    """power.html and out_of_the_box.html in `out`, from the JSON saved there."""
+    power = json.loads((out / POWER).read_text())
+    box = json.loads((out / OUT_OF_THE_BOX).read_text())
+    kinds = list(power["error_kinds"])
+    power_page = out / "power.html"
+    power_page.write_text(POWER_TEMPLATE.render(doc=power, kinds=kinds, style=STYLE))
+    box_page = out / "out_of_the_box.html"
+    box_page.write_text(OUT_OF_THE_BOX_TEMPLATE.render(doc=box, style=STYLE))
+    return power_page, box_page

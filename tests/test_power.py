@@ -1,0 +1,128 @@
+"""The power study (comparisons/power.py): injected model errors reach the engine's build
+only and are rejected where their closed-form effect exceeds the gates; a neutralised
+engine default switched back on is rejected; the neutralised defaults are data."""
+import math
+
+import numpy as np
+import pytest
+
+from mbfidelity.comparisons import power
+from mbfidelity.comparisons.runner import compare
+from mbfidelity.simulators import all_backends, get_backend
+from mbfidelity.systems import get_system
+
+
+def _installed(engine: str) -> None:
+    ok, why = get_backend(engine).available()
+    if not ok:
+        pytest.skip(why)
+
+
+def test_engine_defaults_are_admitted_and_differ():
+    """Every neutralised default's engine value is a value the setting admits (so the
+    studies can switch it on) and is not the harness's own; its note cites where it comes
+    from."""
+    found = 0
+    for engine, backend in all_backends().items():
+        for key, setting in backend.SETTINGS.items():
+            value = setting.out_of_the_box(1e-3)
+            if value is None:
+                continue
+            found += 1
+            setting.check(engine, key, value)
+            assert value != setting.default, (engine, key)
+            assert "default" in setting.note.lower(), (engine, key)
+    assert found >= 4  # at least one per engine
+    for engine in ("pybullet", "mujoco", "pymunk", "exudyn"):
+        assert any(s.engine_default is not None
+                   for s in get_backend(engine).SETTINGS.values()), engine
+
+
+def test_mutated_parameter_per_kind():
+    """The compound pendulum has a mass, an inertia about the pivot, a length that moves
+    the centre of mass (L alone only draws the bar) and g, and no spring or damper."""
+    system = get_system("compound_pendulum")
+    values = system.parameter_values(None, scenario=system.scenarios[0])
+    chosen = {k: power.mutated_parameter(system, k, values) for k in power.ERROR_KINDS}
+    assert chosen == {"mass": "m", "inertia": "I_O", "length": "l", "gravity": "g",
+                      "stiffness": None, "damping": None}
+
+
+#: the compound pendulum's small-oscillation frequency is sqrt(m g l / I_O): a length l
+#: (I_O about the pivot held) changed by eps changes it by sqrt(1 + eps) - 1
+LENGTH_ERROR = 0.1
+
+
+def test_length_error_reaches_the_engine_only_and_is_rejected():
+    """The engine's free-vibration frequency moves by the closed form sqrt(1.1) - 1 while
+    the reference keeps the true one: the fit measures that shift to within the gate that
+    the unmutated engine meets (its own error), and the comparison is rejected by it."""
+    _installed("mujoco")
+    baseline = compare("compound_pendulum", "mujoco", scenarios=["small"])
+    mutated = compare("compound_pendulum", "mujoco", scenarios=["small"],
+                      engine_scale={"l": 1 + LENGTH_ERROR})
+    expected = math.sqrt(1 + LENGTH_ERROR) - 1
+    for name in ("frequency.fit_mode1", "frequency.linearization_mode1"):
+        before = next(m for m in baseline.metrics if m.name == name)
+        after = next(m for m in mutated.metrics if m.name == name)
+        assert before.status == "pass"
+        # the engine's own error is below the gate (baseline); the shift adds to it
+        assert abs(after.value - expected) <= before.tolerance + before.value, name
+        assert after.detail["reference_hz"] == before.detail["reference_hz"]
+    assert not mutated.passed
+    assert "frequency.fit_mode1" in power.rejecting_metrics(baseline, mutated)
+
+
+def _phase_drift(w: float, eps: float, t_end: float) -> float:
+    """max over [0, t_end] of |cos(w' t) - cos(w t)|, w' = w sqrt(1 + eps): the linear
+    trajectory change of a release from rest, relative to its amplitude."""
+    t = np.linspace(0.0, t_end, 200001)
+    return float(np.max(np.abs(np.cos(w * math.sqrt(1 + eps) * t) - np.cos(w * t))))
+
+
+def test_smallest_rejected_length_error_matches_the_gates():
+    """PyBullet (first order) on the compound pendulum's small release (near-linear: the
+    closed form cos(w t) holds to the amplitude squared, which the true and the mutated
+    runs share): the smallest rejected eps of a length error lies between the first decade
+    at which the closed-form effect may exceed a gate (the linear phase drift against the
+    trajectory gate, the frequency shift sqrt(1 + eps) - 1 against each frequency gate,
+    the engine's own error, the baseline's value, taken as adding) and the first at which
+    it must (that error taken as subtracting)."""
+    _installed("pybullet")
+    system = get_system("compound_pendulum")
+    entry = power.power_entry("compound_pendulum", "pybullet", kinds=("length",),
+                              defaults=False)
+    found = entry.errors[0]
+    assert found.parameter == "l" and found.smallest_rejected is not None
+    baseline = compare("compound_pendulum", "pybullet", scenarios=["small"])
+    trajectory = next(m for m in baseline.metrics if m.name == "small.trajectory_max")
+    frequency = [m for m in baseline.metrics if m.name.startswith("frequency.")]
+    assert trajectory.status == "pass" and frequency
+    values = system.parameter_values(None, scenario=system.scenarios[0])
+    w = math.sqrt(values["m"] * values["g"] * values["l"] / values["I_O"])
+    t_end = system.scenarios[0].t_end
+
+    def exceeds(eps: float, sign: float) -> bool:
+        shift = math.sqrt(1 + eps) - 1
+        return (_phase_drift(w, eps, t_end) + sign * trajectory.value > trajectory.tolerance
+                or any(shift + sign * m.value > m.tolerance for m in frequency))
+
+    may = min(e for e in power.EPSILONS if exceeds(e, +1.0))
+    must = min(e for e in power.EPSILONS if exceeds(e, -1.0))
+    assert may <= found.smallest_rejected <= must, (may, found.smallest_rejected, must)
+
+
+def test_pybullet_default_damping_is_rejected_on_a_pendulum():
+    """PyBullet's link damping 0.04 (its out-of-the-box value), switched back on, drains
+    the compound pendulum's energy: a gate that holds without it fails with it."""
+    _installed("pybullet")
+    backend = get_backend("pybullet")
+    on = {k: backend.SETTINGS[k].out_of_the_box(1e-3)
+          for k in ("linear_damping", "angular_damping")}
+    assert on == {"linear_damping": 0.04, "angular_damping": 0.04}
+    baseline = compare("compound_pendulum", "pybullet", scenarios=["small"])
+    damped = compare("compound_pendulum", "pybullet", scenarios=["small"], settings=on)
+    rejected_by = power.rejecting_metrics(baseline, damped)
+    assert rejected_by
+    assert any(name.startswith("damping.") or name.endswith(".energy_drift")
+               for name in rejected_by), rejected_by
