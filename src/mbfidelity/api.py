@@ -703,9 +703,6 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
 
 # --- gate power (comparisons/power.py) ---------------------------------------------------
 
-POWER = "power.json"
-OUT_OF_THE_BOX = "out_of_the_box.json"
-
 
 def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
           out: str | Path | None = None, *, dt: float = DEFAULT_DT, progress=None):
@@ -723,7 +720,7 @@ def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
         raise ValueError("dt must be positive")
     study = power_study(sys_ids, sim_ids, dt, progress=progress)
     if out is not None:
-        from .reports.power_page import write_power_pages
+        from .reports.power_page import OUT_OF_THE_BOX, POWER, write_power_pages
 
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)

@@ -451,16 +451,21 @@ class PowerStudy:
                 "summary": self.summary(), "entries": [e.as_dict() for e in self.entries]}
 
     def out_of_the_box(self) -> dict:
-        """The out-of-the-box reading: per system x engine, each default switched on and
-        its effect against the neutralised run."""
-        return {"provenance": self.provenance, "entries": [
-            {"system": e.system, "simulator": e.simulator, "engine_version": e.engine_version,
-             "scenario": e.scenario, "dt": e.dt, "supported": e.supported, "reason": e.reason,
-             "defaults": [{"setting": d.setting, "engine_value": d.engine_value,
-                           "harness_value": d.harness_value, "acts": d.acts,
-                           "rejected": d.rejected, "rejected_by": d.rejected_by,
-                           "effect": d.effect, "note": d.note} for d in e.defaults]}
-            for e in self.entries]}
+        """The out-of-the-box reading (see `out_of_the_box_document`)."""
+        return out_of_the_box_document(self.as_dict())
+
+
+def out_of_the_box_document(power: dict) -> dict:
+    """The out-of-the-box reading of a power study (its saved document): per system x
+    engine, each default switched on, its verdict and its effect against the neutralised
+    run."""
+    keep = ("setting", "engine_value", "harness_value", "acts", "rejected", "rejected_by",
+            "effect", "motion", "incidents", "note")
+    return {"provenance": power["provenance"], "entries": [
+        {**{k: e[k] for k in ("system", "simulator", "engine_version", "scenario", "dt",
+                              "supported", "reason")},
+         "defaults": [{k: d[k] for k in keep} for d in e["defaults"]]}
+        for e in power["entries"]]}
 
 
 def power_study(systems: Iterable[str], sims: Iterable[str], dt: float = DEFAULT_DT,

@@ -61,19 +61,23 @@ OUT_OF_THE_BOX_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta c
 <title>mbfidelity out of the box</title><style>{{ style }}</style></head><body>
 <h1>Out of the box: what each engine default the harness neutralises does</h1>
 <p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. Each default (the engine's
-documented value, cited in its note) is switched back on alone, then all together, on the
-system's first scenario and its frequency checks; each cell gives the metric with the harness's
-setting → with the default (relative to the amplitude for trajectories, to the largest kinetic
-energy for the energy drift, absolute for a damping ratio). "no effect": no metric moved (the
-setting does not act on this mechanism's build). Rejected: a gate that holds with the harness's
-setting fails with the default.</p>
+documented value, cited in its note: hover the setting) is switched back on alone, then all
+together ("all": the engine as it comes), on the system's first scenario. "Motion change": the
+largest difference between the run with the default and the same run with the harness's
+setting, relative to the amplitude, against the trajectory gate. Energy drift: the largest
+change of the exact model's energy along the run, relative to the largest kinetic energy.
+Damping ratio: what the free-vibration fit of mode 1 finds added to the exact one. Verdict:
+rejected when a gate that holds with the harness's setting fails with the default (a run that
+does not complete counts as rejected: timed out, crashed); "no effect" when no metric moved.</p>
 {% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{{ e.system }} · {{ e.simulator }} {{ e.engine_version }}</h2>
 {% if not e.supported %}<p>unsupported: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default.</p>{% else %}
-<table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>trajectory error</th><th>energy drift</th><th>damping ratio (mode 1)</th><th>frequency (mode 1)</th></tr>
-{% for d in e.defaults %}{% set traj = d.effect.get(e.scenario ~ '.trajectory_max') %}{% set drift = d.effect.get(e.scenario ~ '.energy_drift') %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
-<tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
-<td class="{{ 'pass' if d.rejected else ('weak' if d.acts else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ 'rejected' if d.rejected else ('passes the gates' if d.acts else 'no effect') }}</td>
-{% for m in (traj, drift, damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
+<table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate)</th><th>energy drift: harness → default</th><th>damping ratio added (mode 1)</th><th>frequency error (mode 1)</th></tr>
+{% for d in e.defaults %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
+<tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ 'each above' if d.setting == 'all' else d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
+<td class="{{ 'pass' if d.rejected else ('weak' if d.motion.beyond_gate else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ 'rejected' if d.rejected else ('passes the gates' if d.acts else 'no effect') }}{% for i in d.incidents %} ({{ i.outcome }}){% endfor %}</td>
+<td>{% if d.motion.error %}{{ d.motion.error }}{% else %}{{ d.motion.trajectory_change|num }} <small>({{ d.motion.trajectory_gate|num }})</small>{% endif %}</td>
+<td>{% if d.motion.energy_drift_switched_on is not none and not d.motion.error %}{{ d.motion.energy_drift_neutralised|num }} → {{ d.motion.energy_drift_switched_on|num }}{% else %}-{% endif %}</td>
+{% for m in (damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
 </table>{% endif %}{% endfor %}
 <p><a href="power.html">Gate power</a></p>
 </body></html>""")
