@@ -126,3 +126,35 @@ def test_pybullet_default_damping_is_rejected_on_a_pendulum():
     assert rejected_by
     assert any(name.startswith("damping.") or name.endswith(".energy_drift")
                for name in rejected_by), rejected_by
+
+
+def test_power_command_writes_both_documents_and_pages(tmp_path):
+    """`mbfidelity power --json --out DIR`: the smallest rejected eps per injected error
+    (on the grid, or None), the kinds without a parameter marked not applicable, each
+    neutralised default with its verdict, and both pages rendered from the saved JSON.
+    Pymunk (two neutralised defaults) keeps it short."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from mbfidelity.cli import app
+
+    _installed("pymunk")
+    res = CliRunner().invoke(app, ["power", "--systems", "compound_pendulum", "--sims",
+                                   "pymunk", "--json", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(res.stdout)
+    (entry,) = doc["entries"]
+    kinds = {p["kind"]: p for p in entry["errors"]}
+    assert set(kinds) == set(power.ERROR_KINDS)
+    assert not kinds["stiffness"]["applicable"] and not kinds["damping"]["applicable"]
+    for kind in ("mass", "inertia", "length", "gravity"):
+        assert kinds[kind]["smallest_rejected"] in power.EPSILONS
+        # a 1 % error of any of them moves the pendulum beyond its gates
+        assert kinds[kind]["motion_change"]["beyond_gate"]
+    assert {d["setting"] for d in entry["defaults"]} == {"error_bias", "iterations", "all"}
+    assert json.loads((tmp_path / "power.json").read_text())["summary"] == doc["summary"]
+    box = json.loads((tmp_path / "out_of_the_box.json").read_text())
+    assert box["entries"][0]["defaults"][0]["setting"] == "error_bias"
+    for page in ("power.html", "out_of_the_box.html"):
+        assert "compound_pendulum" in (tmp_path / page).read_text()
