@@ -21,12 +21,15 @@ apart from a blind gate.
 Each neutralised default (`Setting.engine_default`) is switched back on alone, and all
 together (the engine as a user gets it); the gates' verdict and the effect against the
 neutralised run are recorded: the trajectory error, the energy drift and the damping
-ratio each default leaves (the metrics of both runs).
+ratio each default leaves (the metrics of both runs), and the motion change.
 
-Cost: every run is the system's first scenario plus the frequency checks (free-vibration
-fits and the engine's linearization; `runner.compare(scenarios=[first])`); the other
-scenarios, the near-equilibrium checks and the checks that build their own mechanisms
-(a stability threshold's trials) are not run. The unmutated run is made in the calling
+Cost: a model error's run is the system's first scenario plus the frequency checks
+(free-vibration fits and the engine's linearization; `runner.compare(scenarios=[first])`):
+a small relative error acts linearly at any amplitude. A default's run takes every
+declared scenario and the frequency checks, since a default's effect depends on the
+amplitude (an error-correction bias that is invisible on a small swing acts on a large
+one). The near-equilibrium checks and the checks that build their own mechanisms (a
+stability threshold's trials) are not run. The unmutated run is made in the calling
 process (its solves are shared); every other run is a worker process
 (comparisons/isolation.py), so an engine that crashes on a mutated model costs that run.
 """
@@ -121,10 +124,12 @@ class DefaultPower:
     #: a run that did not complete (crashed, timed_out, diverged), with its message
     incidents: list = field(default_factory=list)
     wall_time_s: float = 0.0
-    #: the first scenario run with the default against the same run without it (one
-    #: engine run each, whatever the comparison's fate): `trajectory_change`, the largest
-    #: |q_on - q_off| relative to the reference's amplitude; `energy_drift` of each run
-    #: (conservative mechanisms), relative to the largest kinetic energy
+    #: each declared scenario run with the default against the same run without it (one
+    #: engine run each, whatever the comparison's fate), under "scenarios":
+    #: `trajectory_change`, the largest |q_on - q_off| relative to the reference's
+    #: amplitude, against the scenario's trajectory gate; `energy_drift` of each run
+    #: (conservative mechanisms), relative to the largest kinetic energy. At the top
+    #: level, the scenario where the change is largest against its gate
     motion: dict = field(default_factory=dict)
 
 
@@ -136,6 +141,8 @@ class PowerEntry:
     supported: bool = True
     reason: str = ""
     scenario: str = ""
+    #: the scenarios the defaults are switched on in (every declared one)
+    defaults_scenarios: list[str] = field(default_factory=list)
     dt: float = DEFAULT_DT
     #: the unmutated run: passed, and the metrics that do not hold in it (they cannot
     #: reject anything)
@@ -291,8 +298,21 @@ def power_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     for kind in kinds:
         entry.errors.append(_error_power(system, kind, values, scenario, baseline, dt, run))
     if defaults:
-        entry.defaults = _defaults_power(system, backend, scenario, values, baseline, dt,
-                                         run, budget)
+        declared = [sc.name for sc in system.scenarios]
+        entry.defaults_scenarios = declared
+        whole = (baseline if len(declared) == 1
+                 else compare(system.id, simulator, dt=dt, scenarios=declared))
+        entry.comparisons += len(declared) > 1
+
+        def run_declared(**kwargs) -> Comparison:
+            entry.comparisons += 1
+            c = isolated_compare(system.id, simulator, dt=dt, scenarios=declared,
+                                 timeout=budget * len(declared), **kwargs)
+            entry.engine_time_s += c.wall_time
+            return c
+
+        entry.defaults = _defaults_power(system, backend, whole, dt, run_declared,
+                                         budget)
     entry.wall_time_s = time.perf_counter() - started
     return entry
 
@@ -331,11 +351,10 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
     return power
 
 
-def _defaults_power(system, backend, scenario, values, baseline: Comparison, dt: float, run,
+def _defaults_power(system, backend, baseline: Comparison, dt: float, run,
                     budget: float) -> list[DefaultPower]:
     out = []
     switched = {}
-    neutral = _scenario_run(system, backend, scenario, values, dt, {}, budget)
     for key, setting in backend.SETTINGS.items():
         value = setting.out_of_the_box(dt)
         if value is None or value == setting.default:
@@ -347,14 +366,26 @@ def _defaults_power(system, backend, scenario, values, baseline: Comparison, dt:
         out.append(_default_power("all", switched, None, baseline, run,
                                   "every neutralised default switched back on together: "
                                   "the engine as it comes"))
-    gate = _metric(baseline, f"{scenario.name}.trajectory_max")
+    for scenario in system.scenarios:
+        values = system.parameter_values(None, scenario=scenario)
+        neutral = _scenario_run(system, backend, scenario, values, dt, {}, budget)
+        gate = _metric(baseline, f"{scenario.name}.trajectory_max")
+        for d in out:
+            chosen = switched if d.setting == "all" else {d.setting: switched[d.setting]}
+            motion = _motion_against(neutral, _scenario_run(system, backend, scenario, values,
+                                                            dt, chosen, budget))
+            if gate is not None and "trajectory_change" in motion:
+                motion["trajectory_gate"] = gate.tolerance
+                motion["beyond_gate"] = bool(motion["trajectory_change"] > gate.tolerance)
+            d.motion.setdefault("scenarios", {})[scenario.name] = motion
     for d in out:
-        chosen = switched if d.setting == "all" else {d.setting: switched[d.setting]}
-        d.motion = _motion_against(neutral, _scenario_run(system, backend, scenario, values,
-                                                          dt, chosen, budget))
-        if gate is not None and "trajectory_change" in d.motion:
-            d.motion["trajectory_gate"] = gate.tolerance
-            d.motion["beyond_gate"] = bool(d.motion["trajectory_change"] > gate.tolerance)
+        # the scenario where the default moves the motion most, against its gate
+        worst = max(d.motion["scenarios"].items(), key=lambda item: (
+            item[1].get("trajectory_change", math.inf)
+            / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
+        d.motion.update(worst[1], scenario=worst[0],
+                        beyond_gate=any(m.get("beyond_gate", False)
+                                        for m in d.motion["scenarios"].values()))
     return out
 
 
@@ -369,7 +400,7 @@ def _default_power(key, settings, harness, baseline, run, note) -> DefaultPower:
 
 
 def _simulate_scenario(system, backend, scenario, values, dt, settings) -> dict:
-    """The first scenario on the engine with `settings` (a worker's task): the free
+    """One scenario on the engine with `settings` (a worker's task): the free
     coordinates relative to the reference's amplitude, and the energy drift."""
     ref = reference(system, scenario, values, dt)
     mech = system.numeric_mechanism(values)
@@ -462,8 +493,8 @@ def out_of_the_box_document(power: dict) -> dict:
     keep = ("setting", "engine_value", "harness_value", "acts", "rejected", "rejected_by",
             "effect", "motion", "incidents", "note")
     return {"provenance": power["provenance"], "entries": [
-        {**{k: e[k] for k in ("system", "simulator", "engine_version", "scenario", "dt",
-                              "supported", "reason")},
+        {**{k: e[k] for k in ("system", "simulator", "engine_version", "scenario",
+                              "defaults_scenarios", "dt", "supported", "reason")},
          "defaults": [{k: d[k] for k in keep} for d in e["defaults"]]}
         for e in power["entries"]]}
 

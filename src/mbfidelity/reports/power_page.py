@@ -29,7 +29,7 @@ POWER_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="u
 multiplied by (1 + eps) in the engine's build only (the reference keeps the true value);
 eps on the decade grid {{ doc.epsilons|map("eps")|join(", ") }}, searched by bisection
 assuming a larger error is rejected whenever a smaller one is. Each run is the system's
-first scenario and the frequency checks. A cell gives the smallest rejected eps and the
+first scenario and the frequency checks (a default's: every declared scenario). A cell gives the smallest rejected eps and the
 parameter; "not rejected" means not even eps = {{ doc.epsilons[-1]|eps }}; its colour is
 yellow where a {{ doc.probe|eps }} error moves the exact motion beyond the gate (a blind
 spot), grey where it does not (the error is below what the gates can see).</p>
@@ -62,9 +62,10 @@ OUT_OF_THE_BOX_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta c
 <h1>Out of the box: what each engine default the harness neutralises does</h1>
 <p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. Each default (the engine's
 documented value, cited in its note: hover the setting) is switched back on alone, then all
-together ("all": the engine as it comes), on the system's first scenario. "Motion change": the
-largest difference between the run with the default and the same run with the harness's
-setting, relative to the amplitude, against the trajectory gate. Energy drift: the largest
+together ("all": the engine as it comes), on every scenario the system declares. "Motion
+change": the largest difference between the run with the default and the same run with the
+harness's setting, relative to the amplitude, against that scenario's trajectory gate, in the
+scenario where it is largest against its gate (named). Energy drift: the largest
 change of the exact model's energy along the run, relative to the largest kinetic energy.
 Damping ratio: what the free-vibration fit of mode 1 finds added to the exact one. Verdict:
 rejected when a gate that holds with the harness's setting fails with the default (a run that
@@ -75,7 +76,7 @@ does not complete counts as rejected: timed out, crashed); "no effect" when no m
 {% for d in e.defaults %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
 <tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ 'each above' if d.setting == 'all' else d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
 <td class="{{ 'pass' if d.rejected else ('weak' if d.motion.beyond_gate else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ 'rejected' if d.rejected else ('passes the gates' if d.acts else 'no effect') }}{% for i in d.incidents %} ({{ i.outcome }}){% endfor %}</td>
-<td>{% if d.motion.error %}{{ d.motion.error }}{% else %}{{ d.motion.trajectory_change|num }} <small>({{ d.motion.trajectory_gate|num }})</small>{% endif %}</td>
+<td>{% if d.motion.error %}{{ d.motion.error }}{% else %}{{ d.motion.trajectory_change|num }} <small>(gate {{ d.motion.trajectory_gate|num }}, {{ d.motion.scenario }})</small>{% endif %}</td>
 <td>{% if d.motion.energy_drift_switched_on is not none and not d.motion.error %}{{ d.motion.energy_drift_neutralised|num }} → {{ d.motion.energy_drift_switched_on|num }}{% else %}-{% endif %}</td>
 {% for m in (damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
 </table>{% endif %}{% endfor %}
