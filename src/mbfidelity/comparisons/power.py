@@ -218,6 +218,13 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
     if gate is not None:
         out["trajectory_gate"] = gate.tolerance
         out["trajectory_gate_status"] = gate.status
+    # a driven mechanism: the actuator force the motion takes (judged on the same gate)
+    forces = [float(np.max(np.abs(other.actuator_forces[a][:n] - f[:n])))
+              / max(float(np.max(np.abs(f))), 1e-300)
+              for a, f in (ref.actuator_forces or {}).items()
+              if a in (other.actuator_forces or {})]
+    if forces:
+        out["actuator_force"] = max(forces)
     unexcited = unexcited_values(system, values) if system.mechanism.prescribed else values
     try:
         before = [m.frequency_hz for m in operating_equilibrium(system, unexcited).modes]
@@ -231,8 +238,10 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
              and m.status != "unresolved"]
     if gates:
         out["frequency_gate"] = min(m.tolerance for m in gates)
+    judged = gate is not None and gate.status != "unresolved"
     out["beyond_gate"] = bool(
-        (gate is not None and gate.status != "unresolved" and trajectory > gate.tolerance)
+        (judged and trajectory > gate.tolerance)
+        or (judged and forces and out["actuator_force"] > gate.tolerance)
         or (out.get("frequency") is not None and gates
             and out["frequency"] > out["frequency_gate"]))
     return out
