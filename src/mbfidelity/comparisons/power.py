@@ -455,34 +455,8 @@ class PowerStudy:
     provenance: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
-        """Per engine and error kind: the median smallest rejected eps over the systems
-        where the kind applies (None where the gates rejected not even the largest eps
-        counts as above the grid), and how many such systems there are; per engine, how
-        many switched-on defaults that act were rejected."""
-        out: dict = {}
-        for sim in dict.fromkeys(e.simulator for e in self.entries):
-            mine = [e for e in self.entries if e.simulator == sim and e.supported]
-            row = {}
-            for kind in ERROR_KINDS:
-                found = [p.smallest_rejected for e in mine for p in e.errors
-                         if p.kind == kind and p.applicable]
-                ranked = sorted(found, key=lambda x: math.inf if x is None else x)
-                row[kind] = {
-                    "median_smallest_rejected": (statistics.median_low(
-                        [math.inf if x is None else x for x in ranked]) if ranked else None),
-                    "systems": len(found),
-                    "not_rejected_at_largest": sum(x is None for x in found)}
-                if row[kind]["median_smallest_rejected"] == math.inf:
-                    row[kind]["median_smallest_rejected"] = "above grid"
-            acting = [d for e in mine for d in e.defaults if d.acts and d.setting != "all"]
-            row["defaults"] = {"acting": len(acting),
-                               "rejected": sum(d.rejected for d in acting),
-                               "not_rejected": sorted(f"{e.system}:{d.setting}"
-                                                      for e in mine for d in e.defaults
-                                                      if d.acts and not d.rejected
-                                                      and d.setting != "all")}
-            out[sim] = row
-        return out
+        """See `summary_of`."""
+        return summary_of([e.as_dict() for e in self.entries])
 
     def as_dict(self) -> dict:
         return {"provenance": self.provenance, "epsilons": list(EPSILONS), "probe": PROBE,
@@ -493,6 +467,35 @@ class PowerStudy:
     def out_of_the_box(self) -> dict:
         """The out-of-the-box reading (see `out_of_the_box_document`)."""
         return out_of_the_box_document(self.as_dict())
+
+
+def summary_of(entries: list[dict]) -> dict:
+    """Per engine and error kind, over the saved entries where the kind applies: the median
+    (the lower one of an even count) smallest rejected eps, where an error the gates
+    rejected not even at the largest eps counts as above the grid; how many systems, and
+    how many of them rejected nothing. Per engine, how many switched-on defaults that act
+    (alone) were rejected, and those that were not."""
+    out: dict = {}
+    for sim in dict.fromkeys(e["simulator"] for e in entries):
+        mine = [e for e in entries if e["simulator"] == sim and e["supported"]]
+        row = {}
+        for kind in ERROR_KINDS:
+            found = [p["smallest_rejected"] for e in mine for p in e["errors"]
+                     if p["kind"] == kind and p["applicable"]]
+            ranked = [math.inf if x is None else x for x in found]
+            median = statistics.median_low(ranked) if ranked else None
+            row[kind] = {"median_smallest_rejected": "above grid" if median == math.inf
+                         else median,
+                         "systems": len(found),
+                         "not_rejected_at_largest": sum(x is None for x in found)}
+        acting = [(e["system"], d) for e in mine for d in e["defaults"]
+                  if d["acts"] and d["setting"] != "all"]
+        row["defaults"] = {"acting": len(acting),
+                           "rejected": sum(d["rejected"] for _, d in acting),
+                           "not_rejected": [f"{system}:{d['setting']}"
+                                            for system, d in acting if not d["rejected"]]}
+        out[sim] = row
+    return out
 
 
 def out_of_the_box_document(power: dict) -> dict:
