@@ -1,9 +1,10 @@
-"""§6.1, Fig. 17: the simply supported beam with the block at mid-span, as the chain of N
+"""§6.1, Fig. 17: the simply supported beam with the block at a = c l, as the chain of N
 rigid segments of the description, by hand (a second derivation, from energies written
 here, not from the code under test).
 
 Segment b (length h = l/N, mass m_b, centre of mass c_b from its left node, central moment
-I_b; the block m is folded into segment N/2 at its right end). With absolute angles th_i
+I_b; the block m is folded into segment k = c N at its right end, the node x = c l: the
+chain has such a node only when c N is an integer between 1 and N - 1, `block_node`). With absolute angles th_i
 and e(th) = (cos th, sin th), its centre of mass is sum_{k<b} h e(th_k) + c_b e(th_b), so
 d/dth_i of it is a_bi e'(th_i), a_bi = h (i < b), c_b (i = b), 0 (i > b), and
 
@@ -40,12 +41,20 @@ EQUILIBRIA = (None, 2)
 MISPRINTS = set()
 
 
+def block_node(v) -> int:
+    """The node k = c N that carries the block (x = k h = c l)."""
+    k = round(v["c"] * v["N"])
+    assert 1 <= k <= v["N"] - 1 and math.isclose(k, v["c"] * v["N"]), "no node at c l"
+    return k
+
+
 def _segments(v):
     N, l, rho, m = int(v["N"]), v["l"], v["rho"], v["m"]
     h = l / N
+    k = block_node(v)
     out = []
     for b in range(1, N + 1):
-        if b == N // 2:
+        if b == k:
             mass = rho * h + m
             c = (rho * h * h / 2 + m * h) / mass
             inertia = rho * h**3 / 12 + rho * h * (h / 2 - c) ** 2 + m * (h - c) ** 2

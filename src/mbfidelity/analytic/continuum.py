@@ -226,9 +226,9 @@ def rayleigh_beam_own_weight_shape(EI: float, rho: float, l: float, m: float, c:
 
 def beam_with_point_mass(values: Mapping[str, float], count: int = 3) -> ContinuumSummary:
     """The simply supported beam of length l, stiffness EI, mass rho per length with a
-    block m at mid-span (§6.1, Fig. 17, the catalog's c = 1/2): parameters l, EI, rho, m.
-    The leading error of the rigid-segment chain is not derived (None)."""
-    EI, rho, l, m, c = values["EI"], values["rho"], values["l"], values["m"], 0.5
+    block m at a = c l (§6.1, Fig. 17; the catalog's c = 1/2): parameters l, EI, rho, m,
+    c. The leading error of the rigid-segment chain is not derived (None)."""
+    EI, rho, l, m, c = values["EI"], values["rho"], values["l"], values["m"], values["c"]
     exact = [w / (2 * math.pi)
              for w in beam_with_point_mass_frequencies(EI, rho, l, m, c * l, count)]
     estimates = [
@@ -238,7 +238,7 @@ def beam_with_point_mass(values: Mapping[str, float], count: int = 3) -> Continu
                          rayleigh_beam_own_weight_shape(EI, rho, l, m, c) / (2 * math.pi), 0.0)]
     return ContinuumSummary(
         model="beam_with_point_mass",
-        description="Euler-Bernoulli beam, simply supported, with a point mass at mid-span: "
+        description="Euler-Bernoulli beam, simply supported, with a point mass at a = c l: "
                     "the 4 x 4 matching determinant of the mode shapes on both sides",
         frequency_hz=exact,
         rayleigh=[replace(r, relative_error=(r.frequency_hz - exact[0]) / exact[0])

@@ -1,5 +1,5 @@
 """Convergence of a discretized continuum (monograph §6) toward the exact one, in the
-number of elements N: the system's structural parameter (`System.with_structure`).
+number of elements N: the system's count parameter (`System.with_structure`).
 
 For each N the chain is derived like any mechanism and linearized at its operating
 point; its first frequencies are compared with the continuum's exact ones
@@ -58,11 +58,13 @@ class DiscretizationStudy:
 
 
 def structural_parameter(system: System) -> str:
-    """The one structural parameter of a discretized system (its number of elements)."""
-    if len(system.structure) != 1:
+    """The one count parameter of a discretized system (its number of elements; another
+    structural parameter, a load's place along the chain, stays as given)."""
+    counts = [p.name for p in system.all_parameters if p.domain == "count"]
+    if len(counts) != 1:
         raise ValueError(f"{system.id}: a discretization study needs exactly one "
-                         f"structural parameter, not {sorted(system.structure) or 'none'}")
-    return next(iter(system.structure))
+                         f"count parameter, not {sorted(counts) or 'none'}")
+    return counts[0]
 
 
 def chain_frequencies(system: System, values: Mapping[str, float], N: int,

@@ -147,10 +147,10 @@ def beam_study(beam: Beam, simulators: Sequence[str] | None = None,
 def beam_of(continuum: str | None, values: Mapping[str, float]) -> Beam | None:
     """The `Beam` that a system's continuum model describes (its flexible-element variants:
     the same beam built of each engine's own elements), or None for another continuum.
-    The catalog's beam (§6.1) has its block at mid-span."""
+    The block sits at a = c l (the catalog's c = 1/2, mid-span)."""
     if continuum != "beam_with_point_mass":
         return None
-    return Beam.from_parameters({name: values[name] for name in ("l", "EI", "rho", "m")})
+    return Beam.from_parameters({name: values[name] for name in ("l", "EI", "rho", "m", "c")})
 
 
 def beams_document(cases: Sequence[Beam], simulators: Sequence[str] | None = None,

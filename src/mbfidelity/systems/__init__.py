@@ -236,7 +236,7 @@ class Expectation:
             raise ValueError(f"expectation kind {self.kind!r} is not one of "
                              f"{', '.join(EXPECTATION_KINDS)}")
 
-    def applies(self, structure: Mapping[str, int],
+    def applies(self, structure: Mapping[str, int | float],
                 values: Mapping[str, float] | None = None) -> bool:
         """Whether the declaration holds for a system built with `structure`, compared at
         the parameter `values` (a `when` may name any parameter: a bound that resolves
@@ -244,7 +244,7 @@ class Expectation:
         if self.when is None:
             return True
         names = {k: sp.Float(v) for k, v in (values or {}).items()}
-        names.update({k: sp.Integer(v) for k, v in structure.items()})
+        names.update({k: sp.sympify(v) for k, v in structure.items()})
         verdict = sp.sympify(self.when, locals=names)
         if verdict not in (sp.true, sp.false):
             raise ValueError(f"expectation condition {self.when!r} must be a relation of the "
@@ -296,7 +296,7 @@ class System:
     #: a discretized continuum (monograph §6): the name of its exact continuum model in
     #: mbfidelity.analytic.continuum (`CONTINUA`), whose frequencies and Rayleigh
     #: estimates `analyze` reports next to the chain's modes; the number of elements is
-    #: the system's structural parameter
+    #: the system's count parameter (domain "count")
     continuum: str | None = None
     #: duration (s) of the generated releases near the other stable equilibria
     #: (comparisons/runner.py `near_equilibrium_scenarios`); None: the runner's default.
@@ -338,24 +338,34 @@ class System:
     @cached_property
     def symbols(self) -> SimpleNamespace:
         """The parameters as SymPy symbols, for `build` and the other description
-        functions; a structural parameter is its integer instead (it shapes the
+        functions; a structural parameter is its value instead (it shapes the
         mechanism: `with_structure`)."""
-        return SimpleNamespace(**{p.name: int(p.default) if p.structural else p.symbol
-                                  for p in self.all_parameters})
+        return SimpleNamespace(**{p.name: p.structural_value(p.default) if p.structural
+                                  else p.symbol for p in self.all_parameters})
+
+    @cached_property
+    def parameter_symbols(self) -> SimpleNamespace:
+        """Every parameter as its SymPy symbol, structural ones too: what a relation
+        between parameters (a validity condition) is written in."""
+        return SimpleNamespace(**{p.name: p.symbol for p in self.all_parameters})
 
     # --- structural parameters -----------------------------------------------------------
     # A parameter of domain "count" (the number of elements of a discretized continuum)
-    # shapes the mechanism: its coordinates, bodies and derivation. A System is built for
-    # one value of each (its defaults); `with_structure` gives the System built for other
-    # values: the same description with those defaults and the id
-    # "<catalog id>@<name>=<value>,...", so that everything keyed by the id (the
-    # in-process caches, the persistent cache through `structure_tag`, results rows)
-    # tells the structures apart, and `get_system` resolves such an id.
+    # shapes the mechanism: its coordinates, bodies and derivation; so does a real one
+    # marked `shapes` (which element of the chain carries a load placed at a fraction of
+    # its length). A System is built for one value of each (its defaults);
+    # `with_structure` gives the System built for other values: the same description with
+    # those defaults and the id "<catalog id>@<name>=<value>,...", so that everything
+    # keyed by the id (the in-process caches, the persistent cache through
+    # `structure_tag`, results rows) tells the structures apart, and `get_system`
+    # resolves such an id.
 
     @cached_property
-    def structure(self) -> dict[str, int]:
-        """The structural parameters this System is built for (name -> integer)."""
-        return {p.name: int(p.default) for p in self.all_parameters if p.structural}
+    def structure(self) -> dict[str, int | float]:
+        """The structural parameters this System is built for (name -> a count's integer,
+        a `shapes` parameter's float)."""
+        return {p.name: p.structural_value(p.default) for p in self.all_parameters
+                if p.structural}
 
     @property
     def structure_tag(self) -> str:
@@ -370,8 +380,8 @@ class System:
     def with_structure(self, values: Mapping[str, float]) -> "System":
         """The System built for the structural parameters in `values` (others ignored;
         absent ones keep this System's): itself when they are its own. Each value is
-        validated (an integer >= 1, ValueError otherwise). The specialisations of a
-        catalog system are kept, one object per structure."""
+        validated (a count an integer >= 1, ValueError otherwise). The specialisations of
+        a catalog system are kept, one object per structure."""
         current = self.structure
         if not current:
             return self
@@ -381,7 +391,7 @@ class System:
             if name in values:
                 value = float(values[name])
                 known[name].validate(value)
-                wanted[name] = int(value)
+                wanted[name] = known[name].structural_value(value)
         if wanted == current:
             return self
         base = self.__dict__.get("_catalog_system", self)
@@ -515,16 +525,18 @@ class System:
     @cached_property
     def _conditions(self):
         out = []
+        # in the parameters' symbols, structural ones too: a condition on them (a load on
+        # a node of the chain) holds for the values checked, not for this System's own
         for c in self.validity:
-            rel = sp.sympify(c.relation, locals=vars(self.symbols), evaluate=False)
+            rel = sp.sympify(c.relation, locals=vars(self.parameter_symbols), evaluate=False)
             if not isinstance(rel, sp.core.relational.Relational):
                 raise ValueError(f"{self.id}: validity condition {c.relation!r} is not a "
                                  f"relation")
             if rel.rel_op not in _RELATIONS:
                 raise ValueError(f"{self.id}: validity condition {c.relation!r} must be an "
                                  f"inequality")
-            out.append((c, _compiled(rel.lhs, self.symbols), _compiled(rel.rhs, self.symbols),
-                        rel.rel_op))
+            out.append((c, _compiled(rel.lhs, self.parameter_symbols),
+                        _compiled(rel.rhs, self.parameter_symbols), rel.rel_op))
         return tuple(out)
 
     def subs(self, values: Mapping[str, float]) -> dict[sp.Symbol, float]:
@@ -712,7 +724,7 @@ def get_system(system_id: str) -> System:
         try:
             values[name] = float(value)
         except ValueError:
-            raise KeyError(f"unknown system {system_id!r}: {name} must be an integer") from None
+            raise KeyError(f"unknown system {system_id!r}: {name} must be a number") from None
     try:
         return system.with_structure(values)
     except ValueError as exc:

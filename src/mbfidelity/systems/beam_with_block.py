@@ -1,4 +1,4 @@
-"""A simply supported beam carrying a block at mid-span (monograph §6.1, Fig. 17,
+"""A simply supported beam carrying a block at a = c l (monograph §6.1, Fig. 17,
 eq. 62-68), as a chain of N rigid segments with hinge springs.
 
 The monograph's system: an Euler-Bernoulli beam of length l, bending stiffness EI and
@@ -6,14 +6,27 @@ mass rho per length, pinned at x = 0 and on a roller at x = l, with a block m at
 a = c l. Rayleigh's method with two static shapes (the deflection under the block's
 weight, eq. 66-68, and under the beam's own weight) estimates its first frequency; the
 exact continuum comes from the mode shapes on both sides of the block
-(`analytic/continuum.py`, model "beam_with_point_mass"). The catalog's block sits at
-mid-span, c = 1/2, the only position this chain takes (`c` is not a parameter here).
+(`analytic/continuum.py`, model "beam_with_point_mass"); both follow c. The catalog's
+block sits at mid-span, c = 1/2 (the default; `--param c=0.25` puts it at a quarter span).
 
-The discretized model (N elements, even, a structural parameter: `--param N=16`)::
+The discretized model (N elements, a structural parameter: `--param N=16`), here with
+N = 4 and c = 1/2::
 
-     pin O                 block m at the node x = l/2               roller
+     pin O                 block m at the node k = c N               roller
       o----seg1----o----seg2----[m]----seg3----o----seg4----o  ->  slides on y = 0
       th1          th2          ...                         thN (dependent)
+
+The block sits on the node k = c N of the chain, which must exist: c N is an integer
+with 1 <= c N <= N - 1 (the system's validity condition refuses any other c for that N,
+before any work: c = 0.25 needs N = 4, 8, ...). Which segment carries the block shapes
+the mechanism, as N does, so c is a structural parameter too (`Parameter.shapes`): the
+chain is built, derived and cached for each pair (N, c) (`System.with_structure`; the id
+of a specialisation reads "beam_with_block@N=8,c=0.25"), each derivation the same size
+as at mid-span. The alternatives cost more: a symbolic c would put the block's mass on
+every node behind an indicator of c, every segment's mass, centre of mass and moment an
+expression, a larger derivation for every position; a count naming the node would make
+the user give the node instead of the monograph's c. Everything that is no chain (the
+continuum, Rayleigh's estimates, the declarations' `when`) reads c as a number.
 
 Each segment is a rigid bar of length h = l/N, mass rho h and central moment
 rho h^3 / 12; consecutive segments are hinged, with a rotational spring EI / h on their
@@ -24,8 +37,8 @@ segments i, j through cos(th_i - th_j) alone, and the derivation grows as N^3, n
 exponentially as with nested relative angles (`Mechanism.simplify` is off: SymPy's
 simplify does not finish on the chain beyond N = 4). The springs are couples between
 consecutive angles (`CoordinateForce.relative_to`): in every engine, the hinge's own
-joint spring. The block is a point mass at the end of segment N/2 (a point mass at a
-hinge belongs to either body: the kinetic energy is the same), so that segment's centre
+joint spring. The block is a point mass at the end of segment k = c N (a point mass at
+a hinge belongs to either body: the kinetic energy is the same), so that segment's centre
 of mass and central moment include it. The roller holds the end of segment N on the line
 y = 0 (one constraint): thN is dependent, th1 ... th(N-1) independent. Gravity (0, -g)
 sags the chain under the block's and its own weight: the operating point is that static
@@ -39,14 +52,14 @@ its supports) or along -x (the same beam mirrored, the roller at x = -l): two eq
 both stable. (The search also finds folded chains held by the roller's force: unstable.)
 
 The trajectory check ('released') starts the chain at rest on the static deflection under
-the block's weight alone (eq. 66's shape), so the beam's own weight moves it: about the
-full sag, mostly in the first mode. Its fast modes are the beam's higher bending modes,
+the block's weight alone (eq. 66's shape, the load at the block's node), so the beam's own
+weight moves it: about the full sag, mostly in the first mode. Its fast modes are the beam's higher bending modes,
 barely excited; the trajectory gate counts each mode's share with its own bound
 (comparisons/tolerances.py).
 """
 import sympy as sp
 
-from . import Expectation, System
+from . import Condition, Expectation, System
 from .model import (Body, Circle, CoordinateForce, Mechanism, Parameter, PointOnLine,
                     Revolute, Scenario, Segment, coordinate_spring_damper)
 
@@ -54,21 +67,40 @@ PARAMETERS = (
     Parameter("l", 1.0, "m", "span between the supports", "MECHANISMS.md B; Fig. 17"),
     Parameter("EI", 100.0, "N m^2", "bending stiffness", "MECHANISMS.md B; Fig. 17"),
     Parameter("rho", 1.0, "kg/m", "mass per length of the beam", "MECHANISMS.md B; Fig. 17"),
-    Parameter("m", 1.0, "kg", "mass of the block at mid-span (the catalog also runs m = 0)",
+    Parameter("m", 1.0, "kg", "mass of the block (the catalog also runs m = 0)",
               "MECHANISMS.md B", domain="nonnegative"),
-    Parameter("N", 4, "1", "number of rigid segments (even: the block sits on the middle "
-              "node; structural: it sets the coordinates; 4 keeps the checks fast)",
-              "chosen here", domain="count"),
+    Parameter("c", 0.5, "1", "position of the block, a = c l from the pin (structural: the "
+              "block sits on the node c N of the chain)", "MECHANISMS.md B; Fig. 17",
+              shapes=True),
+    Parameter("N", 4, "1", "number of rigid segments (structural: it sets the coordinates; "
+              "4 keeps the checks fast)", "chosen here", domain="count"),
 )
+
+#: the block on an interior node of the chain: c N at zero distance (to round-off) from
+#: the nearest of the nodes 1 ... N - 1
+BLOCK_ON_A_NODE = Condition(
+    "Abs(c*N - Min(Max(floor(c*N + 1/2), 1), N - 1)) <= 1e-9",
+    "the block sits on a node of the chain between the supports: c N must be an integer "
+    "with 1 <= c N <= N - 1")
 
 #: radius of the drawn block (m): drawing only
 BLOCK = 0.03
 
 
+def block_node(P) -> int:
+    """The node k = c N that carries the block (the build's own guard: the validity
+    condition refuses such a c before any work; a study over N may still reach here)."""
+    k = round(P.c * P.N)
+    if not (1 <= k <= P.N - 1 and abs(P.c * P.N - k) <= 1e-9):
+        raise ValueError(f"beam_with_block: c = {P.c:g} with N = {P.N} elements: "
+                         f"{BLOCK_ON_A_NODE.meaning}")
+    return k
+
+
 def _segment(P, i: int):
     """(mass, central moment, centre of mass from the segment's left end) of segment i."""
     h = P.l / P.N
-    if i != P.N // 2:
+    if i != block_node(P):
         return P.rho * h, P.rho * h**3 / 12, h / 2
     mass = P.rho * h + P.m
     x_c = (P.rho * h * h / 2 + P.m * h) / mass
@@ -77,17 +109,14 @@ def _segment(P, i: int):
 
 
 def build(P) -> Mechanism:
-    N = P.N
-    if N % 2:
-        raise ValueError(f"beam_with_block: N = {N} elements leave no node at mid-span for "
-                         f"the block; N must be even")
+    N, k = P.N, block_node(P)
     h = P.l / N
     bodies, joints, forces = [], [], []
     previous_end = None
     for i in range(1, N + 1):
         mass, inertia, x_c = _segment(P, i)
         shapes = [Segment((-x_c, 0), (h - x_c, 0), 0.01)]
-        if i == N // 2:
+        if i == k:
             shapes.append(Circle((h - x_c, 0), BLOCK))
         bodies.append(Body(f"seg{i}", mass, inertia, tuple(shapes)))
         if i == 1:
@@ -111,12 +140,16 @@ def operating_point(P) -> dict:
     return {}
 
 
-def block_load_deflection(P, fraction: float):
+def block_load_deflection(P, fraction):
     """Deflection (downward) at x = fraction l of the continuum beam under the block's
-    weight m g at mid-span (eq. 66's static shape): m g x (3 l^2 - 4 x^2) / (48 EI) for
-    x <= l/2, symmetric about mid-span."""
-    x = min(fraction, 1 - fraction) * P.l
-    return P.m * P.g * x * (3 * P.l**2 - 4 * x**2) / (48 * P.EI)
+    weight F = m g at its node, a = (k / N) l, b = l - a (eq. 64-66's static shape):
+    F b x (l^2 - b^2 - x^2) / (6 EI l) for x <= a, and the same with a for b and l - x
+    for x on the other side; m g x (3 l^2 - 4 x^2) / (48 EI) at mid-span."""
+    at = sp.Rational(block_node(P), P.N)
+    if fraction > at:  # the mirror image: the roller's side seen from the roller
+        at, fraction = 1 - at, 1 - fraction
+    x, b = fraction * P.l, (1 - at) * P.l
+    return P.m * P.g * b * x * (P.l**2 - b**2 - x**2) / (6 * P.EI * P.l)
 
 
 def released(P) -> dict:
@@ -156,11 +189,12 @@ SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK = (
 
 SYSTEM = System(
     id="beam_with_block",
-    title="Simply supported beam with a block at mid-span, as a chain of N rigid segments",
+    title="Simply supported beam with a block at a = c l, as a chain of N rigid segments",
     source="monograph §6.1, Fig. 17, eq. 62-68",
     parameters=PARAMETERS,
     build=build,
     operating_point=operating_point,
+    validity=(BLOCK_ON_A_NODE,),
     scenarios=(
         Scenario("released", released, t_end=0.5,
                  description="from rest in the static deflection under the block's weight "

@@ -100,6 +100,11 @@ class Parameter:
     #: a count's largest value (default MAX_COUNT): the derivation, the equilibrium
     #: search and every engine run grow with it (benchmarks/count_cost.py measures how)
     maximum: int | None = None
+    #: a real parameter that shapes the mechanism too, like a count: which element of a
+    #: chain carries a load placed at a fraction of its length. `build` receives its
+    #: value (a float), never a symbol, and the System is built for each value it takes
+    #: (`System.with_structure`); a validity condition keeps it where the chain has a node
+    shapes: bool = False
 
     def __post_init__(self) -> None:
         if self.domain == "count" and (isinstance(self.default, str)
@@ -107,6 +112,9 @@ class Parameter:
                                        or self.default < 1):
             raise ValueError(f"parameter {self.name}: a count's default must be an integer "
                              f">= 1, not {self.default!r}")
+        if self.shapes and isinstance(self.default, str):
+            raise ValueError(f"parameter {self.name}: a parameter that shapes the mechanism "
+                             f"has a number for its default, not {self.default!r}")
 
     @property
     def derived(self) -> bool:
@@ -115,8 +123,12 @@ class Parameter:
 
     @property
     def structural(self) -> bool:
-        """Whether the value shapes the mechanism (domain "count")."""
-        return self.domain == "count"
+        """Whether the value shapes the mechanism (domain "count", or `shapes`)."""
+        return self.domain == "count" or self.shapes
+
+    def structural_value(self, value: float) -> int | float:
+        """A structural value as `build` receives it: a count's integer, a float else."""
+        return int(value) if self.domain == "count" else float(value)
 
     @property
     def symbol(self) -> sp.Symbol:
