@@ -186,6 +186,16 @@ SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK = (
     "bound's leading coefficient is 1 where the trapezoidal rule's phase error is 1/12 of "
     "it.")
 
+OFF_CENTRE_RELEASE_EXCITES_THE_FAST_MODES = (
+    "Off mid-span the release from the block-load deflection loses the beam's symmetry: it "
+    "puts in the chain's faster modes (the antisymmetric one among them, which a symmetric "
+    "release leaves at rest) a far larger share of the motion, and at the default step "
+    "those modes lie beyond the range of w h where the scheme's bound holds, each counted "
+    "at twice its amplitude; with the first mode faster (the beam is stiffer under an "
+    "off-centre load) the mode-by-mode bound passes 0.1 of the amplitude, where a pass "
+    "would mean nothing, and the engine's own refinement bounds its error above what a "
+    "gate can tell apart. The frequencies are judged.")
+
 
 SYSTEM = System(
     id="beam_with_block",
@@ -209,5 +219,8 @@ SYSTEM = System(
         Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
         Expectation("exudyn", "released.*", "unresolved", SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK,
                     when="m < 0.95"),
+        *(Expectation(engine, "released.*", "unresolved",
+                      OFF_CENTRE_RELEASE_EXCITES_THE_FAST_MODES, when="Abs(c - 1/2) > 0.01")
+          for engine in ("exudyn", "pybullet", "pymunk")),
     ),
 )
