@@ -303,3 +303,17 @@ def test_the_off_centre_release_is_declared_off_mid_span_only(system, engine):
     for c, off in ((0.5, False), (0.25, True), (0.75, True), (7 / 16, True)):
         values = system.parameter_values({"c": c, "N": 16 if c == 7 / 16 else 4})
         assert declared.applies(system.with_structure(values).structure, values) is off
+
+
+def test_mujocos_block_near_the_roller_declarations_hold_there_only(system):
+    """MuJoCo's mirrored release is judged, and its soft roller's floor on the fastest
+    mode's fit declared, with the block nearer the roller (c > 1/2) only: at c = 1/4 and
+    1/2 the backend-wide declarations stand."""
+    mine = [e for e in system.expectations if e.simulator == "mujoco" and e.reason in (
+        beam_with_block.MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER,
+        beam_with_block.SOFT_ROLLER_FLOOR_FASTEST_MODE_FIT)]
+    assert len(mine) == 2
+    for c, near in ((0.25, False), (0.5, False), (0.75, True)):
+        values = system.parameter_values({"c": c})
+        structure = system.with_structure(values).structure
+        assert all(e.applies(structure, values) is near for e in mine)

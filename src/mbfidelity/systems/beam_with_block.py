@@ -196,6 +196,22 @@ OFF_CENTRE_RELEASE_EXCITES_THE_FAST_MODES = (
     "would mean nothing, and the engine's own refinement bounds its error above what a "
     "gate can tell apart. The frequencies are judged.")
 
+MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER = (
+    "With the block nearer the roller than the pin, the generic release near the mirrored "
+    "equilibrium (every independent angle turned by the same offset, the roller's segment "
+    "following) puts a smaller share of the motion in the fast modes: MuJoCo's RK4 "
+    "refinement then judges it, and the soft roller's floor (SOFT_EQUALITY) lies below that "
+    "gate: the metrics are judged.")
+
+SOFT_ROLLER_FLOOR_FASTEST_MODE_FIT = (
+    "With the block nearer the roller than the pin the fastest mode moves the roller's end "
+    "more, and MuJoCo's soft roller (SOFT_EQUALITY) adds to its fitted frequency and "
+    "damping a floor that refining the step does not show as RK4's order (the impedance's "
+    "cap does not depend on the step, the violation falls as dt^2): at the default step "
+    "that mode lies beyond the range of w h where RK4's bound holds, so only the engine's "
+    "own refinement can judge it, and the floor passes that gate or leaves the refined "
+    "differences off RK4's order.")
+
 
 SYSTEM = System(
     id="beam_with_block",
@@ -217,6 +233,10 @@ SYSTEM = System(
         *(Expectation(engine, "eq*_small.*", "unresolved", MIRROR_RELEASE_EXCITES_THE_FAST_MODES)
           for engine in ("exudyn", "pybullet", "pymunk")),
         Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
+        Expectation("mujoco", "eq*_small.*", "judged", MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER,
+                    when="c > 0.55"),
+        Expectation("mujoco", "*.fit_mode3", "xfail", SOFT_ROLLER_FLOOR_FASTEST_MODE_FIT,
+                    when="c > 0.55"),
         Expectation("exudyn", "released.*", "unresolved", SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK,
                     when="m < 0.95"),
         *(Expectation(engine, "released.*", "unresolved",
