@@ -136,7 +136,8 @@ def test_analyze_at_a_quarter_span_gives_that_continuum_and_rayleighs_estimates(
         lambda x: (b * x * (l**2 - b**2 - x**2) if x <= a
                    else a * (l - x) * (l**2 - a**2 - (l - x) ** 2)) / (6 * v["EI"] * l))
     own_weight = _rayleigh_quotient(
-        v, lambda x: x * (l - x) / 2, lambda x: x * (l**3 - 2 * l * x**2 + x**3) / (24 * v["EI"]))
+        v, lambda x: x * (l - x) / 2,
+        lambda x: x * (l**3 - 2 * l * x**2 + x**3) / (24 * v["EI"]))
     estimates = [r["frequency_hz"] * 2 * math.pi for r in doc["rayleigh"]]
     assert estimates == pytest.approx([point_load, own_weight], rel=1e-9)
     assert all(r["relative_error"] > 0 for r in doc["rayleigh"])  # upper bounds

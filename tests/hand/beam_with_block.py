@@ -3,10 +3,11 @@ rigid segments of the description, by hand (a second derivation, from energies w
 here, not from the code under test).
 
 Segment b (length h = l/N, mass m_b, centre of mass c_b from its left node, central moment
-I_b; the block m is folded into segment k = c N at its right end, the node x = c l: the
-chain has such a node only when c N is an integer between 1 and N - 1, `block_node`). With absolute angles th_i
-and e(th) = (cos th, sin th), its centre of mass is sum_{k<b} h e(th_k) + c_b e(th_b), so
-d/dth_i of it is a_bi e'(th_i), a_bi = h (i < b), c_b (i = b), 0 (i > b), and
+I_b; the block m is folded into segment c N at its right end, the node x = c l: the chain
+has such a node only when c N is an integer between 1 and N - 1, `block_node`). With
+absolute angles th_i and e(th) = (cos th, sin th), its centre of mass is
+sum_{k<b} h e(th_k) + c_b e(th_b), so d/dth_i of it is a_bi e'(th_i), a_bi = h (i < b),
+c_b (i = b), 0 (i > b), and
 
     M_ij = cos(th_i - th_j) sum_b m_b a_bi a_bj + delta_ij I_i,
     V = sum_{i>1} (EI/h)(th_i - th_(i-1))^2 / 2 + g sum_b m_b y_b,
