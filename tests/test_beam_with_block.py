@@ -15,6 +15,7 @@ from mbfidelity.analytic.discretization import discretization_study
 from mbfidelity.analytic.reference import consistent_initial_state
 from mbfidelity.cli import app
 from mbfidelity.systems import beam_with_block, get_system
+from mbfidelity.systems.model import Parameter
 
 from hand import facts
 
@@ -51,6 +52,8 @@ def test_c_moves_the_block_to_its_node(system):
     masses = [float(quarter.evaluate(b.mass, v)) for b in quarter.mechanism.bodies]
     h = v["l"] / 4
     assert masses == pytest.approx([v["rho"] * h + v["m"]] + [v["rho"] * h] * 3, rel=1e-15)
+    with pytest.raises(ValueError, match="number for its default"):
+        Parameter("c", "l/2", "1", "a structural position given by a formula", shapes=True)
 
 
 def test_analyze_gives_the_continuum_both_rayleigh_estimates_and_the_chains_modes():
