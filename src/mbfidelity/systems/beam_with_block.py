@@ -199,20 +199,19 @@ OFF_CENTRE_RELEASE_EXCITES_THE_FAST_MODES = (
 
 MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER = (
     "With the block nearer the roller than the pin, the generic release near the mirrored "
-    "equilibrium (every independent angle turned by the same offset, the roller's segment "
-    "following) puts a smaller share of the motion in the fast modes: MuJoCo's RK4 "
-    "refinement then judges it, and the soft roller's floor (SOFT_EQUALITY) lies below that "
-    "gate: the metrics are judged.")
+    "equilibrium is judged by MuJoCo's own RK4 refinement (the a-priori bound cannot: the "
+    "fast modes lie beyond the range of w h where it holds at the default step), whose "
+    "bound stays within what a gate can tell apart, and the soft roller's floor "
+    "(SOFT_EQUALITY) lies below that gate: the metrics are judged.")
 
 SOFT_ROLLER_FLOOR_FASTEST_MODE_FIT = (
-    "With the block nearer the roller than the pin the fastest mode moves the roller's end "
-    "more, and MuJoCo's soft roller (SOFT_EQUALITY) adds to its fitted frequency and "
-    "damping a floor that refining the step does not show as RK4's order (the impedance's "
-    "cap does not depend on the step, the violation falls as dt^2): at the default step "
-    "that mode lies beyond the range of w h where RK4's bound holds, so only the engine's "
-    "own refinement can judge it, and the floor passes that gate or leaves the refined "
-    "differences off RK4's order.")
-
+    "With the block nearer the roller than the pin, MuJoCo's fit of the fastest mode is "
+    "judged by the engine's own refinement alone (that mode lies beyond the range of w h "
+    "where RK4's bound holds at the default step), which extrapolates at RK4's order; the "
+    "soft roller (SOFT_EQUALITY), whose violation falls as dt^2 and whose impedance's cap "
+    "does not depend on the step, adds a floor that this extrapolation does not see: the "
+    "fitted frequency passes its gate and the refined damping differences leave RK4's "
+    "order.")
 
 SYSTEM = System(
     id="beam_with_block",
