@@ -12,7 +12,7 @@ conventions 1-8) into one engine and runs it. The contract:
 3. `version()` is the engine's version string; it is recorded in every result.
 4. Settings are declared once, in the backend's `SETTINGS` table: per key a `Setting`
    with its default (a JSON value, the engine's distorting defaults neutralised,
-   SIMULATORS.md), the values or the type it admits, and a note saying which engine
+   docs/engines.md), the values or the type it admits, and a note saying which engine
    default it replaces and why; where it replaces one, `engine_default` holds the engine's
    out-of-the-box value (cited in the note), which the power and out-of-the-box studies
    switch back on. `default_settings()` and `setting_notes()` derive from

@@ -140,8 +140,8 @@ from .plan import (
     rot,
 )
 
-#: what MuJoCo's soft equalities cost (SIMULATORS.md; each measured, the numbers per
-#: mechanism are in the results)
+#: what MuJoCo's soft equalities cost (docs/engines.md; the numbers per mechanism are
+#: measured in the results)
 SOFT_EQUALITY = (
     "MuJoCo's equality constraints are soft: the impedance is capped below 1 (solimp) and "
     "the reference time constant is tied to the step (2 dt), so each constraint force "
@@ -1242,8 +1242,8 @@ class MujocoBackend(Backend):
             "RollingContact: solref[1] of the contacts."),
         "contact_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
-            "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lost "
-            "energy: 0.215 rad error in SIMULATORS.md). Engine default: MuJoCo XML "
+            "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lets the "
+            "rolling contact slip and lose energy). Engine default: MuJoCo XML "
             "reference, geom/solimp '\"0.9 0.95 0.001 0.5 2\"'.",
             engine_default=[0.9, 0.95, 0.001, 0.5, 2.0]),
         "contact_friction": Setting(

@@ -1269,7 +1269,7 @@ class PymunkBackend(Backend):
         "sleep_time_threshold": Setting(
             None, (float, type(None)),
             "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
-            "Sleeping froze a small oscillation when enabled (SIMULATORS.md)."),
+            "Sleeping freezes a small oscillation (a body below the sleep threshold stops)."),
         "element_forces": Setting(
             "position_updated", _FORCE_MODES,
             "When force elements are evaluated in a step. Chipmunk moves positions (x += "
@@ -2025,7 +2025,7 @@ class PymunkBackend(Backend):
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        # Chipmunk has no linearization facility (SIMULATORS.md)
+        # Chipmunk has no linearization facility: frequencies come from the fits
         return None
 
 
