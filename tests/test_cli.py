@@ -21,7 +21,7 @@ def test_list_json_names_every_system_and_engine():
     ids = {s["system"] for s in doc["systems"]}
     assert {"compound_pendulum", "double_pendulum", "elastic_pendulum",
             "pendulum_sliding_block", "mass_spring_damper"} <= ids
-    assert set(doc["simulators"]) <= {"mujoco", "pybullet", "exudyn", "pymunk"}
+    assert set(doc["simulators"]) <= {"mujoco", "pybullet", "exudyn", "pymunk", "drake"}
 
 
 def test_analyze_json_contract_and_param_override():

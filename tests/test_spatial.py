@@ -7,9 +7,10 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from mbfidelity.analytic.derivation import Derivation
+from mbfidelity.systems.model import GRAVITY as g
 from mbfidelity.systems.model import Body, Mechanism, Revolute, rotation3
 
-m, L, l, I_O, I_xx, I_yy, I_xy, g = sp.symbols("m L l I_O I_xx I_yy I_xy g", positive=True)
+m, L, l, I_O, I_xx, I_yy, I_xy = sp.symbols("m L l I_O I_xx I_yy I_xy", positive=True)
 
 
 def planar_pendulum() -> Mechanism:
