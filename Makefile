@@ -14,12 +14,13 @@ $(BIN)/.installed: pyproject.toml
 
 install: $(BIN)/.installed
 
+# a study whose gate fails (exit 1) is still drawn: the report shows the failure
 report: install
-	$(BIN)/mbfidelity convergence --out $(OUT) > /dev/null
+	-$(BIN)/mbfidelity convergence --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity strutt --grid 100 --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity beams --out $(OUT) > /dev/null
-	$(BIN)/mbfidelity discretization massive_spring --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
-	$(BIN)/mbfidelity discretization beam_with_block --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
+	-$(BIN)/mbfidelity discretization massive_spring --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
+	-$(BIN)/mbfidelity discretization beam_with_block --sim mujoco --sim pybullet --sim exudyn --sim pymunk --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity errata --out $(OUT) > /dev/null
 	$(BIN)/mbfidelity run --out $(OUT)
 	@echo "errata:  $(OUT)/errata.html"
