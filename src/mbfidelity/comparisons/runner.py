@@ -1100,16 +1100,6 @@ REFINEMENT_DIVISORS = (2, 4, 8)
 NOT_REFINED = ("growth_rate",)
 
 
-def _declared_beyond_refinement(system: System, simulator: str, name: str) -> bool:
-    """Whether the system declares the metric `unresolved` for this engine: its
-    declaration says the engine's own refinement cannot judge it (no asymptotic regime
-    down to h/8, or a bound above the ceiling), so the up to fourteen runs' worth of
-    refinement are not spent on it; it stays unresolved, as declared. (Such a declaration
-    is strict only a priori: the refinement is what would resolve it.)"""
-    exp = expectation_for(system, simulator, name)
-    return exp is not None and exp.kind == "unresolved"
-
-
 def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, settings,
                      result, eq, measured_here: list) -> None:
     """Judge the scenario's unresolved metrics (of `measured_here`) by the engine's own
@@ -1118,8 +1108,7 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     (`_measure_scenario` with the finer run in the reference's place), and each metric
     judged by `tolerances.refinement_gate`. The a-priori verdicts stay as they are."""
     pending = [m for m in measured_here if m.status == "unresolved"
-               and np.isfinite(m.value) and not m.name.endswith(NOT_REFINED)
-               and not _declared_beyond_refinement(system, backend.id, m.name)]
+               and np.isfinite(m.value) and not m.name.endswith(NOT_REFINED)]
     if not pending:
         return
     joints = system.reaction_joints if "reaction" in sc.checks else ()
@@ -1173,8 +1162,7 @@ def _refine_fit(system, backend, mech, q0, qd0, t_end, dt, settings, result, fit
     a priori, judged by the engine's own refinement: the same release at h/2, h/4 (h/8
     where needed) fitted alike; d_k are the differences of successive fits, relative to
     the mode's frequency (the damping ratio's, absolute), tolerances.refinement_gate."""
-    pending = [m for m in fitted if m.status == "unresolved" and np.isfinite(m.value)
-               and not _declared_beyond_refinement(system, backend.id, m.name)]
+    pending = [m for m in fitted if m.status == "unresolved" and np.isfinite(m.value)]
     if not pending or not np.all(np.isfinite(first_fit)):
         return
     w_ref = abs(mode.eigenvalue)
