@@ -7,8 +7,8 @@ conventions 1-8) into one engine and runs it. The contract:
    ``BACKEND``, an instance of a `Backend` subclass whose `id` is the engine's id
    (``mujoco``, ``pybullet``, ``exudyn``, ``pymunk``, ``drake``). Importing the module must not
    import the engine; `available()` does.
-2. `available()` returns ``(True, "")`` or ``(False, reason)``; a missing engine is a
-   visible skip, never an error.
+2. `available()` (the base imports the backend's `ENGINE_MODULES`) returns ``(True, "")``
+   or ``(False, reason)``; a missing engine is a visible skip, never an error.
 3. `version()` is the engine's version string; it is recorded in every result.
 4. Settings are declared once, in the backend's `SETTINGS` table: per key a `Setting`
    with its default (a JSON value, the engine's distorting defaults neutralised,
@@ -299,9 +299,20 @@ class Backend(ABC):
         "its translation is planar: a spatial mechanism (full inertia tensor, hinges "
         "about any axis) has no build in this backend")
 
-    @abstractmethod
+    #: the engine's Python modules, imported by `available` (never at import time)
+    ENGINE_MODULES: ClassVar[tuple[str, ...]] = ()
+
     def available(self) -> tuple[bool, str]:
-        """See the contract in the module docstring."""
+        """(True, "") when every module of `ENGINE_MODULES` imports; otherwise (False,
+        why): a missing or broken engine is a visible skip, never an error."""
+        import importlib
+
+        for name in self.ENGINE_MODULES:
+            try:
+                importlib.import_module(name)
+            except Exception as exc:  # noqa: BLE001 - any import failure is data
+                return False, f"{name} is not importable: {exc}"
+        return True, ""
 
     @abstractmethod
     def version(self) -> str:

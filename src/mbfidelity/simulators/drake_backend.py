@@ -191,13 +191,7 @@ class DrakeBackend(Backend):
     CONVERGENCE_SETTINGS = {"integrator": "runge_kutta3", "fixed_step": True}
 
     # --- identity --------------------------------------------------------------------------
-    def available(self) -> tuple[bool, str]:
-        try:
-            import pydrake.multibody.plant  # noqa: F401
-            import pydrake.systems.analysis  # noqa: F401
-        except Exception as exc:  # noqa: BLE001 - any import failure is a visible skip
-            return False, f"pydrake not importable: {exc}"
-        return True, ""
+    ENGINE_MODULES = ('pydrake.multibody.plant', 'pydrake.systems.analysis')
 
     def version(self) -> str:
         from importlib.metadata import version

@@ -424,13 +424,7 @@ class ExudynBackend(Backend):
     }
 
     # --- identity --------------------------------------------------------------------------
-    def available(self) -> tuple[bool, str]:
-        try:
-            import exudyn  # noqa: F401
-            import exudyn.utilities  # noqa: F401
-        except Exception as exc:  # noqa: BLE001 - any import failure is a visible skip
-            return False, f"exudyn not importable: {exc}"
-        return True, ""
+    ENGINE_MODULES = ('exudyn', 'exudyn.utilities')
 
     def version(self) -> str:
         import exudyn

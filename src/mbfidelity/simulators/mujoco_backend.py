@@ -1275,12 +1275,7 @@ class MujocoBackend(Backend):
             "lag."),
     }
 
-    def available(self) -> tuple[bool, str]:
-        try:
-            import mujoco  # noqa: F401
-        except ImportError as exc:  # pragma: no cover - depends on the environment
-            return False, f"mujoco is not importable: {exc}"
-        return True, ""
+    ENGINE_MODULES = ('mujoco',)
 
     def version(self) -> str:
         import mujoco

@@ -714,12 +714,7 @@ class PyBulletBackend(Backend):
     }
 
     # --- contract points 1-5 ---------------------------------------------------------
-    def available(self) -> tuple[bool, str]:
-        try:
-            import pybullet  # noqa: F401
-        except Exception as exc:  # pragma: no cover - depends on the environment
-            return False, f"pybullet not importable: {exc}"
-        return True, ""
+    ENGINE_MODULES = ('pybullet',)
 
     def version(self) -> str:
         try:

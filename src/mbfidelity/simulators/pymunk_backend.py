@@ -1355,12 +1355,7 @@ class PymunkBackend(Backend):
     #: and notes on substitutes that could not be compensated
     diagnostics: dict = {}
 
-    def available(self) -> tuple[bool, str]:
-        try:
-            import pymunk  # noqa: F401
-        except Exception as exc:  # a missing or broken engine is a visible skip
-            return False, f"pymunk not importable: {exc}"
-        return True, ""
+    ENGINE_MODULES = ('pymunk',)
 
     def version(self) -> str:
         import pymunk
