@@ -67,6 +67,7 @@ def _save_report_files(out: Path, system: str, found: list[Comparison]) -> None:
     dropped from it), the mechanism's drawing and the errata entries."""
     for row, comps in results_folder.rows_of(found).items():
         results_folder.save_series(out, row, comps)
+        results_folder.save_deviations(out, row, comps)
     for c in found:
         c.series = {}
     results_folder.save_system(out, system)

@@ -248,6 +248,51 @@ def _view(mech, items: list[dict]) -> list[int]:
     return sorted(int(k) for k in np.argsort(-spread, kind="stable")[:2])
 
 
+def deviations(comps: Iterable[Comparison]) -> dict[str, dict]:
+    """Why each engine deviates on this row, from this run: per engine the scheme it ran
+    (name, order, step), its largest error against its gate (the metric with the
+    largest value / tolerance), and each element of the mechanism it does not express
+    exactly (the element kind, the level: soft or substitute, how)."""
+    from ..simulators import get_backend
+    from ..simulators.plan import elements
+
+    out: dict[str, dict] = {}
+    for c in comps:
+        if not c.supported:
+            continue
+        backend = get_backend(c.simulator)
+        system = get_system(c.system)
+        mech = system.numeric_mechanism(c.parameters, c.variant or None)
+        scheme = backend.scheme(mech, c.settings)
+        judged = [m for m in c.metrics if m.tolerance and m.tolerance == m.tolerance
+                  and m.value == m.value and m.unit != "stage completed"]
+        worst = max(judged, key=lambda m: m.value / m.tolerance, default=None)
+        inexact = {}
+        for kind, element in elements(mech):
+            e = backend.expression(mech, element)
+            if e.level != "exact":
+                inexact[(kind, e.level, e.how)] = None
+        out[c.simulator] = {
+            "scheme": scheme.name if scheme else "", "order": scheme.order if scheme else None,
+            "dt": c.dt,
+            "worst": ({"metric": worst.name, "value": worst.value,
+                       "tolerance": worst.tolerance, "status": worst.status}
+                      if worst is not None else None),
+            "elements": [{"kind": k, "level": lvl, "how": how} for k, lvl, how in inexact]}
+    return out
+
+
+def save_deviations(out: Path, row: str, comps: Iterable[Comparison]) -> None:
+    path = out / REPORT_DATA / f"{row}.deviations.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _write_json(path, deviations(comps))
+
+
+def load_deviations(out: Path, row: str) -> dict:
+    path = out / REPORT_DATA / f"{row}.deviations.json"
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
 def save_system(out: Path, system_id: str) -> None:
     """The system's drawing geometry and its errata entries (printed formulas against the
     derivation, without the engines' witnesses)."""

@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Circle as CirclePatch  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
 
-from ..comparisons.results_folder import (base_id, load_animation,  # noqa: E402
+from ..comparisons.results_folder import (base_id, load_animation, load_deviations,  # noqa: E402
                                           load_errata, load_results, load_series,
                                           load_system, row_id, rows_of, series_path)
 from ..systems import get_system  # noqa: E402
@@ -202,6 +202,10 @@ def _section(out: Path, row: str, comps, figures: list[str], frequencies: dict,
         frames = load_animation(out, row) or {}
     except Exception as exc:  # a damaged file: the page says so and stands
         frames = {"error": f"{type(exc).__name__}: {exc}"[:500]}
+    try:
+        deviating = load_deviations(out, row)
+    except Exception:  # a damaged file: the section is left out
+        deviating = {}
     return {"row": row, "anchor": site.anchor(row), "title": _title(row), "sims": sims,
             "metrics": {c.simulator: {m.name: m for m in c.metrics} for c in comps},
             "metric_names": list(dict.fromkeys(m.name for c in comps for m in c.metrics)),
@@ -211,7 +215,8 @@ def _section(out: Path, row: str, comps, figures: list[str], frequencies: dict,
             "frequencies": frequencies.get(row, {}), "figures": figures,
             "animation": site.embedded_json(frames) if frames.get("scenarios") else "",
             "animation_error": frames.get("error", "no saved series"),
-            "scenarios": list(frames.get("scenarios", {})), "incidents": incidents}
+            "scenarios": list(frames.get("scenarios", {})), "incidents": incidents,
+            "deviations": deviating}
 
 
 def _strutt_engines(out: Path) -> str:

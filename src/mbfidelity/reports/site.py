@@ -92,6 +92,8 @@ MECHANISM = ENV.from_string("""<!doctype html>
 <nav><a href="index.html">index</a>{% if errata_page %}<a href="errata.html">errata</a>{% endif %}</nav>
 <h1>{{ system|e }}</h1><p>{{ title|e }}{% if source %} ({{ source|e }}){% endif %}</p>
 {% if drawing %}<h2>Sketch</h2><img src="{{ drawing|url }}" alt="{{ system|e }} at its operating equilibrium">{% endif %}
+{% if not model %}<p class="fail">The derived model of this mechanism could not be saved (see
+its incidents below).</p>{% else %}
 <h2>Parameters</h2>
 <table><tr><th>symbol</th><th>value</th><th>unit</th><th>meaning</th><th>default</th><th>source</th></tr>
 {% for p in model.parameters %}<tr><td>{{ p.symbol }}</td><td>{{ "%.6g"|format(p.value) }}</td><td>{{ p.unit|e }}</td><td>{{ p.meaning|e }}</td><td><code>{{ p.default|e }}</code></td><td>{{ p.source|e }}</td></tr>{% endfor %}
@@ -110,7 +112,7 @@ MECHANISM = ENV.from_string("""<!doctype html>
 {% for m in op.modes %}<tr><td>{{ loop.index }}</td><td>{{ "%.9g"|format(m.frequency_hz) }}</td><td>{{ "%.4g"|format(m.damping_ratio) }}</td><td>{{ "%.9g"|format(m.damped_frequency_hz) }}</td><td>{{ "%.6g"|format(m.eigenvalue[0]) }} {{ "%+.6g"|format(m.eigenvalue[1]) }} i</td></tr>{% endfor %}</table>
 {% else %}<p>{{ model.get("operating_point_note", "")|e }}</p>{% endif %}
 {% if model.get("equilibria") %}<h3>Equilibria found</h3><table><tr><th>equilibrium</th><th>stable</th><th>frequencies (Hz)</th></tr>
-{% for e in model.equilibria %}<tr><td>{{ e.q }}</td><td>{{ "yes" if e.stable else "no" }}</td><td>{{ e.frequencies_hz|map("round", 6)|join(", ") }}</td></tr>{% endfor %}</table>{% endif %}
+{% for e in model.equilibria %}<tr><td>{{ e.q }}</td><td>{{ "yes" if e.stable else "no" }}</td><td>{{ e.frequencies_hz|map("round", 6)|join(", ") }}</td></tr>{% endfor %}</table>{% endif %}{% endif %}
 {% if errata %}<h2>The printed formulas beside the derived ones</h2>
 <p>Terms found on one side only are marked; printed equations of motion are first scaled to the
 derived row's normalisation. A formula agrees when it matches the derivation to 1e-9 relative
@@ -127,6 +129,7 @@ at two parameter sets{% if errata_page %} (see <a href="errata.html">the errata<
 {% for sim in r.sims %}{% set m = r.metrics[sim].get(name) %}{% if m %}<td class="{{ m.status }}" title="judged {{ (m.rule or 'a_priori')|replace('_', '-') }}{% if m.reason %}: {{ m.reason|e }}{% endif %}">{{ "%.2e"|format(m.value) }} / {{ "%.1e"|format(m.tolerance) }} {{ m.status }}</td>{% else %}<td class="unsupported">{{ r.unsupported.get(sim, "-")|e }}</td>{% endif %}{% endfor %}</tr>{% endfor %}</table>
 {% if r.incidents %}<p class="fail">Incidents (stages that did not complete; the rest of the
 run stands):</p><ul>{% for i in r.incidents %}<li><b>{{ i.simulator|e }}</b>, {{ i.scenario|e }}{% if i.stage %} ({{ i.stage|e }}){% endif %}: {{ i.outcome|e }}{% if i.get("t_reached") is not none %} at t = {{ "%.6g"|format(i.t_reached) }} s{% endif %}: {{ i.message|e }}</li>{% endfor %}</ul>{% endif %}
+{% if r.deviations %}<h3>Why each engine deviates here</h3><ul>{% for sim, d in r.deviations.items() %}<li><b>{{ sim|e }}</b>: {{ d.scheme|e }}{% if d.order %} (order {{ d.order }}){% endif %} at dt = {{ "%g"|format(d.dt) }} s: its error falls as dt^{{ d.order or "?" }}{% if d.worst %}; its largest error here, {{ d.worst.metric|e }}, is {{ "%.2e"|format(d.worst.value) }} against a gate of {{ "%.2e"|format(d.worst.tolerance) }} ({{ d.worst.status }}){% endif %}{% if d.elements %}; not exact here: {% for e in d.elements %}{{ e.kind|e }} ({{ e.level }}: {{ e.how|e }}){% if not loop.last %}; {% endif %}{% endfor %}{% else %}; every element of the mechanism is built exactly{% endif %}.</li>{% endfor %}</ul>{% endif %}
 {% if r.expected %}<p>Declared expected failures:</p><ul>{% for e in r.expected %}<li><b>{{ e.simulator|e }}</b>, {{ e.metric|e }}: {{ e.reason|e }}</li>{% endfor %}</ul>{% endif %}
 {% for w in r.liftoff %}<p class="xfail">Contact <b>{{ w.contact|e }}</b>, scenario {{ w.scenario|e }}: the
 bilateral model pulls from t = {{ "%.3f"|format(w.t_ref) }} s (reference minimum {{ "%.3g"|format(w.min_ref) }} N);
