@@ -50,8 +50,6 @@ def checked_output_folder(out: str | Path, option: str = "--out") -> Path:
     """`out` as a folder results can be written into (it may not exist yet), or a
     ValueError in one line, before any work: it is not a file, no parent is a file, and
     the nearest existing folder is writable."""
-    import os
-
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"{option} {out}: is a file, not a folder")
@@ -491,18 +489,22 @@ def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None
         from .reports.convergence_page import CONVERGENCE, write_convergence_page
 
         out.mkdir(parents=True, exist_ok=True)
-        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=_plain))
+        (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=jsonable))
         write_convergence_page(out)
     return doc
 
 
-def _plain(x):
+def jsonable(x):
+    """A JSON encoder's `default` for the NumPy values and complex numbers of the
+    documents the API returns."""
     import numpy as np
 
     if isinstance(x, np.ndarray):
         return x.tolist()
     if isinstance(x, (np.floating, np.integer)):
         return x.item()
+    if isinstance(x, complex):
+        return [x.real, x.imag]
     raise TypeError(type(x))
 
 
@@ -537,7 +539,7 @@ def beams(sims: Iterable[str] | None = None, elements: Iterable[int] = (2, 4, 8,
         from .reports.beams_figure import BEAMS, FIGURE, write_beams_figure
 
         out.mkdir(parents=True, exist_ok=True)
-        (out / BEAMS).write_text(json.dumps(doc, indent=1, default=_plain))
+        (out / BEAMS).write_text(json.dumps(doc, indent=1, default=jsonable))
         write_beams_figure(json.loads((out / BEAMS).read_text()), out / FIGURE)
     return doc
 

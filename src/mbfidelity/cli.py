@@ -108,17 +108,9 @@ def _values(system, params, scenarios=()):
 
 
 def _json(doc) -> None:
-    typer.echo(json.dumps(doc, indent=1, default=_jsonable))
+    from .api import jsonable
 
-
-def _jsonable(x):
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, (np.floating, np.integer)):
-        return x.item()
-    if isinstance(x, complex):
-        return [x.real, x.imag]
-    raise TypeError(type(x))
+    typer.echo(json.dumps(doc, indent=1, default=jsonable))
 
 
 @app.command("list")
@@ -350,7 +342,6 @@ def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="sys
         _system(s)
     try:
         sim_ids = api.checked_simulators(_split(sims) or all_backends())
-        api.checked_output_folder(out)
         api.checked_duration("--dt", dt)
     except ValueError as exc:
         _fail(str(exc))

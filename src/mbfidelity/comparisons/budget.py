@@ -16,7 +16,6 @@ processes carry.
 """
 from __future__ import annotations
 
-import math
 import os
 import signal
 import sys
@@ -132,8 +131,3 @@ def become_worker(parent: int) -> None:
     _die_with_parent(parent)
     _limit_memory()
 
-
-def check_finite_positive(name: str, value: float | None) -> None:
-    """ValueError (one line) unless `value` is None or a finite number > 0."""
-    if value is not None and not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be a finite number > 0, got {value:g}")

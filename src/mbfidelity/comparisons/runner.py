@@ -871,7 +871,7 @@ def _guarded_run(backend, result: Comparison, label: str, t_end: float, *args):
         message = " ".join(str(exc).split()) or type(exc).__name__
         result.incidents.append({"scenario": label, "stage": "engine run",
                                  "outcome": "crashed", "t_reached": None,
-                                 "message": f"{type(exc).__name__}: {message}"[:500]})
+                                 "message": _incident_message(exc)})
         result.metrics.append(_incomplete(result, backend, label, 0.0, message))
         return None
     finite = np.all(np.isfinite(run.q), axis=1) & np.all(np.isfinite(run.qd), axis=1)

@@ -27,12 +27,6 @@ def verdict(comparison) -> str:
     return PASS if all(holds(m) for m in comparison.metrics) else FAIL
 
 
-def acceptable(comparison) -> bool:
-    """Whether the comparison lets a gate pass: it passed, or it is unsupported
-    (declared)."""
-    return verdict(comparison) != FAIL
-
-
 def failure_lines(comparison) -> list[str]:
     """Why the comparison failed, one line per metric or incident (empty when it did
     not)."""

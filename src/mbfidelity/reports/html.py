@@ -185,7 +185,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
         anchors={r: site.anchor(r) for r in rows}, titles={r: _title(r) for r in rows},
         others=others, explanations=EXPLANATIONS, incidents=incidents,
         figures=[(name, caption) for name, caption in site.INDEX_FIGURES
-                 if (out / name).exists()],
+                 if (out / name).exists()], strutt_engines=_strutt_engines(out),
         discretizations=sorted(p.name for p in out.glob("discretization-*.png")))
     index = out / "index.html"
     index.write_text(page)

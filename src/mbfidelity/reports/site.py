@@ -76,7 +76,7 @@ gated, fail).</p>
 {% for row, found in incidents.items() %}{% for i in found %}<li><a href="{{ pages[row]|url }}#{{ anchors[row] }}">{{ row|e }}</a>, <b>{{ i.simulator|e }}</b>, {{ i.scenario|e }}{% if i.stage %} ({{ i.stage|e }}){% endif %}: {{ i.outcome|e }}{% if i.get("t_reached") is not none %} at t = {{ "%.6g"|format(i.t_reached) }} s{% endif %}: {{ i.message|e }}</li>{% endfor %}{% endfor %}</ul>{% endif %}
 {% if others %}<h2>Other pages</h2><ul>{% for name, title in others %}<li><a href="{{ name|url }}">{{ title }}</a></li>{% endfor %}
 </ul>{% endif %}
-{% for name, caption in figures %}<h2>{{ caption.split(":")[0] }}</h2><p>{{ caption }}</p>
+{% for name, caption in figures %}<h2>{{ caption.split(":")[0] }}</h2><p>{{ caption }}{% if name == "strutt.png" and strutt_engines %} Engines: {{ strutt_engines|e }}.{% endif %}</p>
 <img src="{{ name }}">{% endfor %}
 {% if discretizations %}<h2>Discretized continua against the exact ones</h2>
 <p>Each chain of N elements as derived, each engine's build of it (its own linearization) and
