@@ -1,4 +1,4 @@
-"""The command line as a user meets it (DESIGN.md): JSON contracts and clear errors."""
+"""The command line as a user meets it (docs/user-guide.md): JSON contracts and clear errors."""
 import json
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Command line (DESIGN.md): list, analyze, compare, run, errata, strutt, convergence,
+"""Command line (docs/user-guide.md): list, analyze, compare, run, errata, strutt, convergence,
 beams (the engines' flexible elements against the exact beam of §6.1); and the users'
 gates: check (the gates against the installed engines, optionally against a baseline) and
 diff (what changed between two runs)."""

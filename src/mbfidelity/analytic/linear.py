@@ -1,4 +1,4 @@
-"""Equilibria, their stability, the linearized M, C, K and the modes (DESIGN.md):
+"""Equilibria, their stability, the linearized M, C, K and the modes (docs/user-guide.md):
 
 eigenvalues s of M s^2 + C s + K = 0;
 frequency_hz = |s|/(2 pi), damping_ratio = -Re(s)/|s|, damped_frequency_hz = |Im s|/(2 pi).
