@@ -140,24 +140,6 @@ def test_variant_is_description_data():
     assert not support.ok and support.reason.startswith("RollingContact rolling:")
 
 
-@pytest.mark.parametrize("engine", ["mujoco", "pybullet", "exudyn", "pymunk", "drake"])
-def test_bare_loop_runs_the_model_of_simulate(engine):
-    """Contract point 9 on the compound pendulum: the bare loop steps the same model and
-    returns its CPU seconds."""
-    import numpy as np
-
-    from mbfidelity.simulators import get_backend
-    from mbfidelity.systems import get_system
-
-    backend = get_backend(engine)
-    if not backend.available()[0]:
-        pytest.skip(f"{engine} not installed")
-    system = get_system("compound_pendulum")
-    mech = system.numeric_mechanism(system.parameter_values())
-    seconds = backend.bare_loop(mech, np.array([0.5]), np.array([0.0]), 0.2, 1e-3)
-    assert isinstance(seconds, float) and seconds >= 0.0
-
-
 # --- flexible elements (contract point 12) ---------------------------------------------
 
 from mbfidelity.simulators.base import NO_BEAM_ELEMENT, UNSUPPORTED, BeamElement  # noqa: E402

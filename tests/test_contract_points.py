@@ -61,3 +61,78 @@ def test_declared_order_is_reported_and_observed(backend):
         errors.append(metrics.trajectory_errors(run.q, ref.q, np.array([1.0]))[0])
     observed = np.log2(errors[0] / errors[1])
     assert abs(observed - scheme.order) <= 0.5, (errors, observed)
+
+
+# --- contract point 9: the bare loop steps the model of `simulate` -----------------------
+
+def _catalog_starts():
+    """Each catalog row's first scenario at the default step: (id, numeric mechanism, the
+    reference's consistent initial state)."""
+    from mbfidelity.comparisons.runner import DEFAULT_DT, _engine_mechanism
+    from mbfidelity.systems import all_systems
+
+    for sid, system in sorted(all_systems().items()):
+        sc = system.scenarios[0]
+        values = system.parameter_values(None, scenario=sc)
+        ref = reference(system, sc, values, DEFAULT_DT, BARE_STEPS * DEFAULT_DT)
+        yield sid, _engine_mechanism(system, values, None), ref.q[0], ref.qd[0], DEFAULT_DT
+
+
+BARE_STEPS = 20
+
+
+def _angle_aware_gap(mech, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """|a - b| per coordinate, revolute angles compared modulo 2 pi: an engine that reads
+    a link's angle by atan2 gives the state, not the number of turns, after a bare loop."""
+    from mbfidelity.systems.model import Revolute
+
+    gap = np.abs(a - b)
+    for i, joint in enumerate(mech.joints):
+        if isinstance(joint, Revolute):
+            gap[i] = abs(np.angle(np.exp(1j * (a[i] - b[i]))))
+    return gap
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_bare_loop_ends_in_the_state_of_simulate(backend):
+    """On every catalog row the engine expresses: after the same steps from the same state,
+    the bare loop (nothing read per step) ends where `simulate` ends. Both step the same
+    model, so they agree to round-off: the only difference is the map back to description
+    coordinates of one row against many (a matrix product whose summation order may
+    differ), bounded by 64 unit round-offs of the state's size."""
+    checked = 0
+    for sid, mech, q0, qd0, dt in _catalog_starts():
+        if not backend.support(mech).ok:
+            continue
+        run = backend.simulate(mech, q0, qd0, BARE_STEPS * dt, dt)
+        bare = backend.bare_loop_run(mech, q0, qd0, BARE_STEPS * dt, dt)
+        assert isinstance(bare.cpu_time, float) and bare.cpu_time >= 0.0
+        for got, want in ((bare.q, run.q[-1]), (bare.qd, run.qd[-1])):
+            bound = 64 * np.finfo(float).eps * np.maximum(1.0, np.abs(want))
+            assert np.all(_angle_aware_gap(mech, got, want) <= bound), sid
+        checked += 1
+    assert checked >= 10
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_bare_loop_check_tells_a_different_model_apart(backend):
+    """The check above rejects a bare loop of another model: the compound pendulum with
+    its weight 1 % larger and its inertia about the pivot kept changes the acceleration by
+    1 %, and the rate after 20 steps far beyond the round-off bound."""
+    _, values, mech = _pendulum(1.0)
+    heavier = SYSTEM.numeric_mechanism({**values, "m": values["m"] * 1.01})
+    q0, qd0, dt = np.array([1.0]), np.array([0.0]), 1e-3
+    run = backend.simulate(mech, q0, qd0, BARE_STEPS * dt, dt)
+    bare = backend.bare_loop_run(heavier, q0, qd0, BARE_STEPS * dt, dt)
+    assert np.any(np.abs(bare.qd - run.qd[-1]) > 1e3 * 64 * np.finfo(float).eps)
+
+
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_the_base_refuses_what_the_backend_cannot_run(backend):
+    """The run's frame (simulators/base.py, point 6) is the base's: a step that is not
+    positive and an unknown reaction joint are refused before any engine is built."""
+    _, _, mech = _pendulum(1.0)
+    with pytest.raises(ValueError, match="step must be positive"):
+        backend.simulate(mech, np.array([1.0]), np.array([0.0]), 0.01, 0.0)
+    with pytest.raises(KeyError):
+        backend.simulate(mech, np.array([1.0]), np.array([0.0]), 0.01, 1e-3, None, ("nope",))

@@ -35,7 +35,11 @@ conventions 1-8) into one engine and runs it. The contract:
 6. `simulate(mechanism, q0, qd0, t_end, dt, settings, reaction_joints)` builds a fresh
    model, integrates from the state (q0, qd0) (description coordinates) with fixed step
    dt for round(t_end/dt) steps, and returns a `RunResult` sampled at every step,
-   including t = 0:
+   including t = 0. The base owns it (in the manner of SciPy's `OdeSolver.step`): it
+   resolves the settings, refuses an unsupported mechanism or an unknown reaction joint,
+   counts the steps, takes the order from `scheme` and assembles and checks the
+   `RunResult`; a backend writes `_simulate_impl`, which builds, steps (timed with
+   `Stopwatch`) and reads out into `Samples`:
    - ``q``, ``qd``: shape (N+1, n), in the description's coordinates and sign
      conventions (engines with relative or maximal coordinates map back);
    - ``reactions``: for each requested joint, shape (N+1, 2): the force the parent
@@ -65,8 +69,10 @@ conventions 1-8) into one engine and runs it. The contract:
    Discrete-time eigenvalues are mapped with ln(lambda)/dt.
 8. Backends never change the mechanism: a substitute (an intermediate slider body of
    small mass, a penalty spring) is named in the settings and its own error is measured.
-9. `bare_loop(mechanism, q0, qd0, t_end, dt, settings)` builds the same model as
-   `simulate` with the same arguments, sets the same initial state and runs the engine's
+9. `bare_loop(mechanism, q0, qd0, t_end, dt, settings)` (owned by the base; a backend
+   writes `_bare_loop_impl`, which also reads the final state, outside the timed loop, so
+   that `bare_loop_run` can show it is the state `simulate` ends in) builds the same
+   model as `simulate` with the same arguments, sets the same initial state and runs the engine's
    loop for the same round(t_end/dt) steps with nothing per step beyond what the engine
    needs to step (the force laws it calls back, the loads and moving anchors it must be
    given before a step): no read-out, no samples. It returns the CPU seconds
@@ -104,6 +110,7 @@ from __future__ import annotations
 
 import copy
 import math
+import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import ClassVar, Mapping, Sequence
@@ -247,6 +254,54 @@ class RunResult:
             raise ValueError("RunResult: t, q and qd lengths differ")
 
 
+def step_count(t_end: float, dt: float) -> int:
+    """The number of fixed steps of a run of `t_end` seconds (contract point 6)."""
+    return int(round(t_end / dt))
+
+
+class Stopwatch:
+    """Wall and CPU seconds of the stepping a backend times (contract points 6 and 9):
+    ``with Stopwatch() as clock: ...`` then ``clock.wall``, ``clock.cpu``."""
+
+    wall: float = 0.0
+    cpu: float = 0.0
+
+    def __enter__(self) -> "Stopwatch":
+        self._wall, self._cpu = time.perf_counter(), time.process_time()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.cpu = time.process_time() - self._cpu
+        self.wall = time.perf_counter() - self._wall
+
+
+@dataclass
+class Samples:
+    """What a backend's `_simulate_impl` reads out (contract point 6): the samples in the
+    description's coordinates, the forces, the stepping's `clock`, and `extras`, attributes
+    beyond the contract set on the `RunResult` (a substitute's own constraint violation,
+    a contact's report), read by the reports when present."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    clock: Stopwatch
+    reactions: dict[str, np.ndarray] = field(default_factory=dict)
+    constraint_forces: dict[str, np.ndarray] = field(default_factory=dict)
+    actuator_forces: dict[str, np.ndarray] = field(default_factory=dict)
+    error_control: ErrorControl | None = None
+    extras: dict[str, object] = field(default_factory=dict)
+
+
+@dataclass
+class BareLoop:
+    """A bare loop's CPU seconds (contract point 9) and the state it ended in
+    (description coordinates), read after the timed loop."""
+
+    cpu_time: float
+    q: np.ndarray
+    qd: np.ndarray
+
+
 @dataclass(frozen=True)
 class BeamElement:
     """One kind of an engine's own flexible element (contract point 12): how it expresses
@@ -366,16 +421,66 @@ class Backend(ABC):
                 return Support(False, f"{kind} {element.name}: {e.how}")
         return Support(True)
 
-    @abstractmethod
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:
-        """See the contract in the module docstring."""
+        """See contract point 6: the run's frame, around the backend's `_simulate_impl`."""
+        cfg, steps = self._run_frame(mechanism, t_end, dt, settings)
+        for name in reaction_joints:
+            mechanism.joint(name)  # KeyError for an unknown joint
+        order = self.scheme(mechanism, cfg).order
+        out = self._simulate_impl(mechanism, np.asarray(q0, dtype=float),
+                                  np.asarray(qd0, dtype=float), steps, dt, cfg,
+                                  tuple(reaction_joints))
+        t = np.arange(steps + 1) * dt
+        n = len(mechanism.joints)
+        if out.q.shape != (steps + 1, n) or out.qd.shape != (steps + 1, n):
+            raise RuntimeError(f"{self.id} returned samples of shape {out.q.shape}, "
+                               f"{out.qd.shape}; expected {(steps + 1, n)}")
+        run = RunResult(t=t, q=out.q, qd=out.qd, reactions=out.reactions,
+                        wall_time=out.clock.wall, integrator_order=order, settings=cfg,
+                        steps=steps, constraint_forces=out.constraint_forces,
+                        cpu_time=out.clock.cpu, actuator_forces=out.actuator_forces,
+                        error_control=out.error_control)
+        for key, value in out.extras.items():
+            setattr(run, key, value)
+        return run
 
-    @abstractmethod
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:
-        """See the contract in the module docstring."""
+        """See contract point 9: the CPU seconds of the bare loop."""
+        return self.bare_loop_run(mechanism, q0, qd0, t_end, dt, settings).cpu_time
+
+    def bare_loop_run(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                      t_end: float, dt: float, settings: Mapping | None = None) -> BareLoop:
+        """The bare loop's CPU seconds and the state it ended in (contract point 9)."""
+        cfg, steps = self._run_frame(mechanism, t_end, dt, settings)
+        return self._bare_loop_impl(mechanism, np.asarray(q0, dtype=float),
+                                    np.asarray(qd0, dtype=float), steps, dt, cfg)
+
+    def _run_frame(self, mechanism: Mechanism, t_end: float, dt: float,
+                   settings: Mapping | None) -> tuple[dict, int]:
+        """The resolved settings and the step count; ValueError for a mechanism the
+        backend cannot express or a step that is not positive."""
+        cfg = self.resolve_settings(settings)
+        if not (dt > 0 and math.isfinite(dt)):
+            raise ValueError(f"the step must be positive and finite; got {dt!r}")
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"{self.id} cannot express this mechanism: {support.reason}")
+        return cfg, step_count(t_end, dt)
+
+    @abstractmethod
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
+        """Build the mechanism, set (q0, qd0), take `steps` steps of `dt` timed by a
+        `Stopwatch`, and read out every sample (contract point 6)."""
+
+    @abstractmethod
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        steps: int, dt: float, cfg: dict) -> BareLoop:
+        """The model of `_simulate_impl`, stepped with nothing read (contract point 9)."""
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme | None:
         """See the contract in the module docstring (None: not known before stepping)."""

@@ -52,7 +52,6 @@ runs Runge-Kutta 3 at a fixed step (`CONVERGENCE_SETTINGS`), so that the step is
 """
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
@@ -67,7 +66,9 @@ from .base import (
     ErrorControl,
     Expression,
     Linearization,
-    RunResult,
+    BareLoop,
+    Samples,
+    Stopwatch,
     Scheme,
     Setting,
 )
@@ -503,18 +504,16 @@ class DrakeBackend(Backend):
         simulator.Initialize()
         return simulator, integrator, plant_context
 
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        cfg = self.resolve_settings(settings)
-        steps = int(round(t_end / dt))
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
         built = self._build(mechanism, cfg)
         q0, qd0 = _driven_state(mechanism, q0, qd0)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
         n = len(mechanism.joints)
         state = np.empty((steps + 1, 2 * n))
-        index = np.concatenate([built.positions, plant.num_positions() + built.velocities])
+        index = self._state_index(built)
         vector = plant_context.get_continuous_state_vector()
         wanted = [(name, mechanism.joints.index(mechanism.joint(name))) for name in reaction_joints]
         forces = {name: np.empty((steps + 1, 2)) for name, _ in wanted}
@@ -536,11 +535,10 @@ class DrakeBackend(Backend):
         read(0)
         # the integrator's steps end on each sample; reactions need the accelerations
         # there, so every read-out happens as the run passes its sample
-        start, cpu_start = time.perf_counter(), time.process_time()
-        for k in range(1, steps + 1):
-            simulator.AdvanceTo(k * dt)
-            read(k)
-        wall, cpu = time.perf_counter() - start, time.process_time() - cpu_start
+        with Stopwatch() as clock:
+            for k in range(1, steps + 1):
+                simulator.AdvanceTo(k * dt)
+                read(k)
         t = np.arange(steps + 1) * dt
         q = built.cmap.coordinates(state[:, :n])
         qd = built.cmap.rates(state[:, n:])
@@ -548,25 +546,29 @@ class DrakeBackend(Backend):
         reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd,
                                                             actuator_forces)
                      for name, i in wanted}
-        scheme = self.scheme(mechanism, cfg)
         control = None if cfg["fixed_step"] else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
-        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                         integrator_order=scheme.order, settings=cfg, steps=steps, cpu_time=cpu,
-                         error_control=control, actuator_forces=actuator_forces)
+        return Samples(q, qd, clock, reactions, actuator_forces=actuator_forces,
+                       error_control=control)
 
-    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                  dt: float, settings: Mapping | None = None) -> float:
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        steps: int, dt: float, cfg: dict) -> BareLoop:
         """The diagram of `simulate`, advanced to the same sample times, nothing read."""
-        cfg = self.resolve_settings(settings)
-        steps = int(round(t_end / dt))
         built = self._build(mechanism, cfg)
         q0, qd0 = _driven_state(mechanism, q0, qd0)
-        simulator, _, _ = self._simulator(built, q0, qd0, dt, cfg)
-        cpu_start = time.process_time()
-        for k in range(1, steps + 1):
-            simulator.AdvanceTo(k * dt)
-        return time.process_time() - cpu_start
+        simulator, _, plant_context = self._simulator(built, q0, qd0, dt, cfg)
+        with Stopwatch() as clock:
+            for k in range(1, steps + 1):
+                simulator.AdvanceTo(k * dt)
+        x = plant_context.get_continuous_state_vector().CopyToVector()[self._state_index(built)]
+        n = len(mechanism.joints)
+        return BareLoop(clock.cpu, built.cmap.coordinates(x[None, :n])[0],
+                        built.cmap.rates(x[None, n:])[0])
+
+    @staticmethod
+    def _state_index(built: _Built) -> np.ndarray:
+        """Where the description's joints sit in the plant's state vector (q, then v)."""
+        return np.concatenate([built.positions, built.plant.num_positions() + built.velocities])
 
     @staticmethod
     def _slide_force(mech: Mechanism, built: _Built, i: int, t: np.ndarray, q: np.ndarray,

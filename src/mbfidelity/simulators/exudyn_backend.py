@@ -105,7 +105,23 @@ from ..systems.model import (
 )
 from ..analytic.linear import quadratic_eigenvalues
 from ..systems._continua import Beam
-from .base import RK3_STABILITY, RK4_STABILITY, Scheme, EXACT, SOFT, UNSUPPORTED, Backend, BeamElement, BeamModes, Expression, Linearization, RunResult, Setting
+from .base import (
+    EXACT,
+    RK3_STABILITY,
+    RK4_STABILITY,
+    SOFT,
+    UNSUPPORTED,
+    Backend,
+    BareLoop,
+    BeamElement,
+    BeamModes,
+    Expression,
+    Linearization,
+    Samples,
+    Scheme,
+    Setting,
+    Stopwatch,
+)
 from .plan import (
     spatial_tree_reason,
     BODY,
@@ -226,6 +242,10 @@ class _Geometry:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
         row, const = self.angle_rows[body]
         return u @ row + const + self.beta[body]
+
+    def coordinates(self, u: np.ndarray, ut: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Engine values and rates (rows) -> the description's coordinates and rates."""
+        return u @ self.T.T + self.c, ut @ self.T.T
 
 
 _AXIS_JOINTS = {(1.0, 0.0, 0.0): "RevoluteX", (0.0, 1.0, 0.0): "RevoluteY",
@@ -863,7 +883,10 @@ class ExudynBackend(Backend):
             raise ValueError("the script starts from a scenario's initial state: none given")
         name, (q0, qd0) = next(iter(initial_states.items()))
         cfg = self.resolve_settings(settings)
-        solver = self._checked_solver(mechanism, cfg)
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
+        solver = self._solver_for(mechanism, cfg)
         q0, qd0 = self._driven_state(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
@@ -903,12 +926,10 @@ class ExudynBackend(Backend):
         return Scheme(solver, _SOLVER_ORDER[solver], limits.get(solver))
 
     # --- simulation ------------------------------------------------------------------------
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        cfg = self.resolve_settings(settings)
-        solver = self._checked_solver(mechanism, cfg)
-        steps = int(round(t_end / dt))
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
+        solver = self._solver_for(mechanism, cfg)
         t_run = steps * dt
         q0, qd0 = self._driven_state(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
@@ -949,8 +970,8 @@ class ExudynBackend(Backend):
         acc0 = (self._initial_accelerations(exu, mbs, cfg, s_acc)
                 if s_acc and not (closures or driven) else {})
         lam0 = self._consistent_start(exu, mbs, cfg, mechanism, driven) if driven else None
-        wall, cpu = self._solve(exu, mbs, cfg, solver, bool(closures or driven), t_run, steps,
-                                initial_accelerations=not driven)
+        clock = self._solve(exu, mbs, cfg, solver, bool(closures or driven), t_run, steps,
+                            initial_accelerations=not driven)
 
         U = np.asarray(mbs.GetSensorStoredData(s_u))
         Ut = np.asarray(mbs.GetSensorStoredData(s_ut))
@@ -958,8 +979,7 @@ class ExudynBackend(Backend):
         if len(t) != steps + 1 or abs(t[-1] - t_run) > 1e-9 * max(1.0, t_run):
             raise RuntimeError(f"exudyn sensors returned {len(t)} samples, expected {steps + 1}")
         u, ut = U[:, 1:], Ut[:, 1:]
-        q = u @ geo.T.T + geo.c
-        qd = ut @ geo.T.T
+        q, qd = geo.coordinates(u, ut)
 
         constraint_forces = {
             c.name: self._closure_force(c, np.asarray(mbs.GetSensorStoredData(s_closure[c.name])),
@@ -981,17 +1001,12 @@ class ExudynBackend(Backend):
                 reactions[name] = self._reaction(mechanism, geo, name, t, q, qd, u, acc,
                                                  conn_force, constraint_forces,
                                                  actuator_forces)
-        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                         integrator_order=_SOLVER_ORDER[solver], settings=cfg, steps=steps,
-                         constraint_forces=constraint_forces, cpu_time=cpu,
-                         actuator_forces=actuator_forces)
+        return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
 
-    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                  dt: float, settings: Mapping | None = None) -> float:
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        steps: int, dt: float, cfg: dict) -> BareLoop:
         """The system of `simulate` without its sensors, solved by the same solver."""
-        cfg = self.resolve_settings(settings)
-        solver = self._checked_solver(mechanism, cfg)
-        steps = int(round(t_end / dt))
+        solver = self._solver_for(mechanism, cfg)
         # SC owns mbs: it stays referenced until the solve returns
         q0, qd0 = self._driven_state(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
@@ -1000,18 +1015,17 @@ class ExudynBackend(Backend):
         mbs.Assemble()
         if driven:
             self._consistent_start(exu, mbs, cfg, mechanism, driven)
-        return self._solve(exu, mbs, cfg, solver, bool(closures or driven), steps * dt,
-                           steps, initial_accelerations=not driven)[1]
-
-    def _checked_solver(self, mechanism: Mechanism, cfg: dict) -> str:
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
-        return self._solver_for(mechanism, cfg)
+        clock = self._solve(exu, mbs, cfg, solver, bool(closures or driven), steps * dt,
+                            steps, initial_accelerations=not driven)
+        current = exu.ConfigurationType.Current
+        u = np.asarray(mbs.systemData.GetODE2Coordinates(configuration=current))
+        ut = np.asarray(mbs.systemData.GetODE2Coordinates_t(configuration=current))
+        q, qd = geo.coordinates(u[None, :], ut[None, :])
+        return BareLoop(clock.cpu, q[0], qd[0])
 
     def _solve(self, exu, mbs, cfg: dict, solver: str, constrained: bool, t_run: float,
-               steps: int, initial_accelerations: bool = True) -> tuple[float, float]:
-        """SolveDynamic over `steps` steps of the assembled system; (wall, CPU) seconds.
+               steps: int, initial_accelerations: bool = True) -> Stopwatch:
+        """SolveDynamic over `steps` steps of the assembled system, timed.
         `initial_accelerations` False: the implicit solver starts from the accelerations
         already in the initial state instead of computing its own."""
         import exudyn.solver as exu_solver
@@ -1028,9 +1042,9 @@ class ExudynBackend(Backend):
         threshold = exu_solver.solverCheckMemoryAllocationsThreshold
         exu_solver.solverCheckMemoryAllocationsThreshold = float("inf")
         try:
-            start, cpu_start = time.perf_counter(), time.process_time()
-            mbs.SolveDynamic(sim, solverType=solver_type)
-            return time.perf_counter() - start, time.process_time() - cpu_start
+            with Stopwatch() as clock:
+                mbs.SolveDynamic(sim, solverType=solver_type)
+            return clock
         finally:
             exu_solver.solverCheckMemoryAllocationsThreshold = threshold
 

@@ -112,7 +112,9 @@ from .base import (
     BeamModes,
     Expression,
     Linearization,
-    RunResult,
+    BareLoop,
+    Samples,
+    Stopwatch,
     Setting,
 )
 from ..systems._continua import Beam
@@ -1487,65 +1489,62 @@ class MujocoBackend(Backend):
         return Scheme(f"semi-implicit Euler ({integrator})", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
     # --- simulation ----------------------------------------------------------------------
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
         import mujoco
 
-        s = self.resolve_settings(settings)
-        plan = self._plan(mechanism, s, dt=dt)
-        for name in reaction_joints:
-            mechanism.joint(name)  # KeyError for an unknown joint
-        comp = _Compiled(plan, s["integrator"], dt, bool(s["autoreset"]))
+        comp = self._compiled(mechanism, cfg, dt, q0, qd0)
         m, d = comp.model, comp.data
-        steps = int(round(t_end / dt))
-        comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
         # every sample is one row (qpos, qvel), written by one mj_getState call per step
         spec = int(mujoco.mjtState.mjSTATE_QPOS) | int(mujoco.mjtState.mjSTATE_QVEL)
         states = np.empty((steps + 1, mujoco.mj_stateSize(m, spec)))
         step, get_state = mujoco.mj_step, mujoco.mj_getState
         get_state(m, d, states[0], spec)
         with _CallbacksInstalled(comp.callback, comp.control):
-            start, cpu_start = time.perf_counter(), time.process_time()
-            for row in states[1:]:
-                step(m, d)
-                get_state(m, d, row, spec)
-            cpu = time.process_time() - cpu_start
-            wall = time.perf_counter() - start
+            with Stopwatch() as clock:
+                for row in states[1:]:
+                    step(m, d)
+                    get_state(m, d, row, spec)
             qpos, qvel = states[:, :m.nq], states[:, m.nq:]
             t = dt * np.arange(steps + 1)
             reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
             forces, violation = self._closures(comp, qpos, qvel, t)
             actuators = self._actuators(comp, qpos, qvel, t)
-        V = qpos[:, comp.qadr]
-        VD = qvel[:, comp.vadr]
-        q = (V - plan.b) @ plan.Ainv.T
-        qd = VD @ plan.Ainv.T
-        run = RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                        integrator_order=_INTEGRATORS[s["integrator"]], settings=s,
-                        steps=steps, constraint_forces=forces, cpu_time=cpu,
-                        actuator_forces=actuators)
-        # the substitute's own error: each closure's violation at every sample (not part
-        # of the contract; read by the reports when present)
-        run.constraint_violation = violation
-        return run
+        q, qd = self._coordinates(comp, qpos, qvel)
+        # the substitute's own error: each closure's violation at every sample
+        return Samples(q, qd, clock, reactions, forces, actuators,
+                       extras={"constraint_violation": violation})
 
-    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                  dt: float, settings: Mapping | None = None) -> float:
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        steps: int, dt: float, cfg: dict) -> BareLoop:
         """The model of `simulate`, stepped by one mj_step(nstep=N) call (the passive
         callback installed, as MuJoCo calls it at every stage)."""
         import mujoco
 
-        s = self.resolve_settings(settings)
-        comp = _Compiled(self._plan(mechanism, s, dt=dt), s["integrator"], dt,
-                         bool(s["autoreset"]))
-        comp.set_state(np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float))
-        steps = int(round(t_end / dt))
+        comp = self._compiled(mechanism, cfg, dt, q0, qd0)
         with _CallbacksInstalled(comp.callback, comp.control):
-            start = time.process_time()
-            if steps:
-                mujoco.mj_step(comp.model, comp.data, nstep=steps)
-            return time.process_time() - start
+            with Stopwatch() as clock:
+                if steps:
+                    mujoco.mj_step(comp.model, comp.data, nstep=steps)
+        q, qd = self._coordinates(comp, comp.data.qpos[None, :], comp.data.qvel[None, :])
+        return BareLoop(clock.cpu, q[0], qd[0])
+
+    def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
+                  qd0: np.ndarray) -> _Compiled:
+        comp = _Compiled(self._plan(mechanism, cfg, dt=dt), cfg["integrator"], dt,
+                         bool(cfg["autoreset"]))
+        comp.set_state(q0, qd0)
+        return comp
+
+    @staticmethod
+    def _coordinates(comp: _Compiled, qpos: np.ndarray,
+                     qvel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Engine joint values (rows) -> the description's coordinates and rates."""
+        plan = comp.plan
+        q = (qpos[:, comp.qadr] - plan.b) @ plan.Ainv.T
+        qd = qvel[:, comp.vadr] @ plan.Ainv.T
+        return q, qd
 
     def _actuators(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
                    t: np.ndarray) -> dict[str, np.ndarray]:
@@ -1626,8 +1625,7 @@ class MujocoBackend(Backend):
                 ten[k, :, 0] = ten_length[tids]
                 ten[k, :, 1] = ten_velocity[tids]
                 spos[k] = site_xpos[sid][:, :, :2]
-        q = (qpos[:, comp.qadr] - plan.b) @ plan.Ainv.T
-        qd = qvel[:, comp.vadr] @ plan.Ainv.T
+        q, qd = self._coordinates(comp, qpos, qvel)
         out: dict[str, np.ndarray] = {}
         for name in joints:
             joint = mech.joint(name)

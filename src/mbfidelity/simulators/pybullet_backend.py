@@ -86,7 +86,6 @@ step: refused.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, replace
 from typing import Callable, Mapping, Sequence
 
@@ -117,7 +116,9 @@ from .base import (
     BeamElement,
     Expression,
     Linearization,
-    RunResult,
+    BareLoop,
+    Samples,
+    Stopwatch,
     Setting,
 )
 from .plan import (
@@ -1269,49 +1270,44 @@ class PyBulletBackend(Backend):
 
         return drive, list(zip(links, scale, (m.element.name for m in driven)))
 
-    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                  dt: float, settings: Mapping | None = None) -> float:
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        steps: int, dt: float, cfg: dict) -> BareLoop:
         """The world of `simulate` stepped with only the per-step inputs (`_inputs`) and
         the drive of the prescribed coordinates (`_drivers`)."""
         import pybullet as p
 
-        cfg = self.resolve_settings(settings)
         world = self._open(p, mechanism, q0, qd0, dt, cfg)
         try:
-            steps = int(round(t_end / dt))
             inputs = self._inputs(p, world, dt)
             step, cid = p.stepSimulation, world.cid
+            get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
             drive, _ = self._drivers(p, world, mechanism, dt, cfg)
-            if drive is not None:
-                get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
-                apply = inputs[0] if inputs is not None else None
-                start = time.process_time()
-                for k in range(steps):
-                    js = get_states(body, links, physicsClientId=cid)
-                    jv = [s[0] for s in js]
-                    if apply is not None:
-                        apply(k, jv, [s[1] for s in js])
-                    drive(k, jv)
-                    step(physicsClientId=cid)
-                return time.process_time() - start
             apply, needs_state = inputs if inputs is not None else (None, False)
-            if apply is None:
-                start = time.process_time()
-                for _ in range(steps):
-                    step(physicsClientId=cid)
-            elif not needs_state:
-                start = time.process_time()
-                for k in range(steps):
-                    apply(k, [], [])
-                    step(physicsClientId=cid)
-            else:
-                get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
-                start = time.process_time()
-                for k in range(steps):
-                    js = get_states(body, links, physicsClientId=cid)
-                    apply(k, [s[0] for s in js], [s[1] for s in js])
-                    step(physicsClientId=cid)
-            return time.process_time() - start
+            with Stopwatch() as clock:
+                if drive is not None:
+                    for k in range(steps):
+                        js = get_states(body, links, physicsClientId=cid)
+                        jv = [s[0] for s in js]
+                        if apply is not None:
+                            apply(k, jv, [s[1] for s in js])
+                        drive(k, jv)
+                        step(physicsClientId=cid)
+                elif apply is None:
+                    for _ in range(steps):
+                        step(physicsClientId=cid)
+                elif not needs_state:
+                    for k in range(steps):
+                        apply(k, [], [])
+                        step(physicsClientId=cid)
+                else:
+                    for k in range(steps):
+                        js = get_states(body, links, physicsClientId=cid)
+                        apply(k, [s[0] for s in js], [s[1] for s in js])
+                        step(physicsClientId=cid)
+            js = get_states(body, links, physicsClientId=cid)
+            plan = world.plan
+            return BareLoop(clock.cpu, plan.coordinates(np.array([[s[0] for s in js]]))[0],
+                            plan.rates(np.array([[s[1] for s in js]]))[0])
         finally:
             p.disconnect(physicsClientId=world.cid)
 
@@ -1360,19 +1356,18 @@ class PyBulletBackend(Backend):
             pybullet.disconnect(physicsClientId=world.cid)
         return text, outside
 
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
         import pybullet as p
 
-        cfg = self.resolve_settings(settings)
         joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
         world = self._open(p, mechanism, q0, qd0, dt, cfg,
                            sensor_joints=joint_ids if use_sensor else ())
         cid, body, eidx, plan, cids = world.cid, world.body, world.eidx, world.plan, world.cids
         contact, coupling = world.contact, world.coupling
-        n, steps = plan.n, int(round(t_end / dt))
+        n = plan.n
         n_all = len(plan.links)
         closures = plan.closures
         # one extra step gives the reaction/acceleration (and the constraint forces) of
@@ -1407,41 +1402,39 @@ class PyBulletBackend(Backend):
                 disc_link = eidx[plan.link_of[contact.inner]]
 
             js = get_states(body, all_links, physicsClientId=cid)
-            t0, c0 = time.perf_counter(), time.process_time()
-            for k in range(total):
-                jv = [s[0] for s in js]
-                jvd = [s[1] for s in js]
-                JV[k] = jv
-                JVD[k] = jvd
-                if apply is not None:
-                    tau, forces = apply(k, jv, jvd)
-                    if tau is not None:
-                        tau_applied[k] = tau
-                    if forces is not None:
-                        f_point[k] = forces
-                if drive is not None:
-                    drive(k, jv)
-                step(physicsClientId=cid)
-                js = get_states(body, all_links, physicsClientId=cid)
-                # the motor's force read after a step belongs to the state before it
-                for r, slot in enumerate(driven_slots):
-                    motor[k, r] = js[slot][3]
-                # constraint and contact forces read after a step belong to the state
-                # before it
-                for r in range(n_cs):
-                    st = get_cstate(cids[r], physicsClientId=cid)
-                    CF[k, r, : len(st)] = st
-                if contact is not None:
-                    FC[k] = self._contact_force(
-                        get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
-                        ring_links, disc_link)
-                if use_sensor:
-                    # the feedback read after a step belongs to the state before it
-                    for r, slot in enumerate(sensor_slots):
-                        rf = js[slot][2]
-                        sensor[k, r] = rf[0], rf[1]
-            cpu = time.process_time() - c0
-            wall = time.perf_counter() - t0
+            with Stopwatch() as clock:
+                for k in range(total):
+                    jv = [s[0] for s in js]
+                    jvd = [s[1] for s in js]
+                    JV[k] = jv
+                    JVD[k] = jvd
+                    if apply is not None:
+                        tau, forces = apply(k, jv, jvd)
+                        if tau is not None:
+                            tau_applied[k] = tau
+                        if forces is not None:
+                            f_point[k] = forces
+                    if drive is not None:
+                        drive(k, jv)
+                    step(physicsClientId=cid)
+                    js = get_states(body, all_links, physicsClientId=cid)
+                    # the motor's force read after a step belongs to the state before it
+                    for r, slot in enumerate(driven_slots):
+                        motor[k, r] = js[slot][3]
+                    # constraint and contact forces read after a step belong to the state
+                    # before it
+                    for r in range(n_cs):
+                        st = get_cstate(cids[r], physicsClientId=cid)
+                        CF[k, r, : len(st)] = st
+                    if contact is not None:
+                        FC[k] = self._contact_force(
+                            get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
+                            ring_links, disc_link)
+                    if use_sensor:
+                        # the feedback read after a step belongs to the state before it
+                        for r, slot in enumerate(sensor_slots):
+                            rf = js[slot][2]
+                            sensor[k, r] = rf[0], rf[1]
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
 
@@ -1487,15 +1480,11 @@ class PyBulletBackend(Backend):
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
         actuators = {name: a * motor[: steps + 1, r] for r, (_, a, name) in enumerate(driven)}
-        run = RunResult(t=np.arange(steps + 1) * dt, q=q, qd=qd, reactions=reactions,
-                        wall_time=wall, integrator_order=1, settings=cfg, steps=steps,
-                        constraint_forces=forces, cpu_time=cpu, actuator_forces=actuators)
-        # the substitutes' own error: each closure's violation at every sample (not part
-        # of the contract; read by the reports when present)
-        run.constraint_violation = violation
+        # the substitutes' own error: each closure's violation at every sample
+        extras = {"constraint_violation": violation}
         if contact_report is not None:
-            run.contact = contact_report
-        return run
+            extras["contact"] = contact_report
+        return Samples(q, qd, clock, reactions, forces, actuators, extras=extras)
 
     # --- rolling by friction contact ---------------------------------------------------
     def _contact_shapes(self, p, cid: int, plan: _Plan, cfg: dict

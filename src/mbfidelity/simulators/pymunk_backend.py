@@ -97,7 +97,6 @@ first order (semi-implicit Euler with velocity-level constraints).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
@@ -133,7 +132,9 @@ from .base import (
     BeamElement,
     Expression,
     Linearization,
-    RunResult,
+    BareLoop,
+    Samples,
+    Stopwatch,
     Setting,
 )
 from .plan import (
@@ -1766,13 +1767,10 @@ class PymunkBackend(Backend):
 
         return read_batch
 
-    def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                  dt: float, settings: Mapping | None = None) -> float:
+    def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                        n_steps: int, dt: float, cfg: dict) -> BareLoop:
         """The space of `simulate` stepped with only its element forces: those need the
         state at the start of each step, the rest runs step after step."""
-        cfg = self.resolve_settings(settings)
-        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
-        n_steps = int(round(t_end / dt))
         h = float(dt)
         layout, comp, space, bodies, mechanism, movers = self._prepare(mechanism, q0, qd0, cfg, h)
         H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
@@ -1783,27 +1781,29 @@ class PymunkBackend(Backend):
             zip(layout.engine, bodies)))
         iterations = int(cfg["iterations"])
         space.iterations = max(iterations, int(cfg["start_iterations"]))
-        start = time.process_time()
-        if loads is None:
-            for k in range(n_steps):
-                for constraint, attribute, values in schedule:
-                    setattr(constraint, attribute, values[k])
-                step(h)
-                if k == 0:
-                    space.iterations = iterations
-        else:
-            read = self._reader(space, layout, bodies)
-            for k in range(n_steps):
-                out = loads(*read(), H, (k + shift) * h)
-                for i, b in enumerate(targets):
-                    b.force = (out[3 * i], out[3 * i + 1])
-                    b.torque = out[3 * i + 2]
-                for constraint, attribute, values in schedule:
-                    setattr(constraint, attribute, values[k])
-                step(h)
-                if k == 0:
-                    space.iterations = iterations
-        return time.process_time() - start
+        with Stopwatch() as clock:
+            if loads is None:
+                for k in range(n_steps):
+                    for constraint, attribute, values in schedule:
+                        setattr(constraint, attribute, values[k])
+                    step(h)
+                    if k == 0:
+                        space.iterations = iterations
+            else:
+                read = self._reader(space, layout, bodies)
+                for k in range(n_steps):
+                    out = loads(*read(), H, (k + shift) * h)
+                    for i, b in enumerate(targets):
+                        b.force = (out[3 * i], out[3 * i + 1])
+                        b.torque = out[3 * i + 2]
+                    for constraint, attribute, values in schedule:
+                        setattr(constraint, attribute, values[k])
+                    step(h)
+                    if k == 0:
+                        space.iterations = iterations
+        q, qd = self._coordinates(mechanism, comp, np.array([self._reader(space, layout, bodies)()]),
+                                  q0, np.array([n_steps * h]))
+        return BareLoop(clock.cpu, q[0], qd[0])
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
@@ -1843,12 +1843,9 @@ class PymunkBackend(Backend):
             names=dict(zip(bodies, layout.engine)), dt=dt, not_in_script=outside)
         return text, outside
 
-    def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
-                 dt: float, settings: Mapping | None = None,
-                 reaction_joints: Sequence[str] = ()) -> RunResult:
-        cfg = self.resolve_settings(settings)
-        q0, qd0 = np.asarray(q0, float), np.asarray(qd0, float)
-        n_steps = int(round(t_end / dt))
+    def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
+                       n_steps: int, dt: float, cfg: dict,
+                       reaction_joints: tuple[str, ...]) -> Samples:
         h = float(dt)
         layout, comp, space, bodies, mechanism, movers = self._prepare(mechanism, q0, qd0, cfg, h)
         # loads at x + h v and t + h (see setting notes), or at the sampled state
@@ -1863,39 +1860,31 @@ class PymunkBackend(Backend):
         iterations = int(cfg["iterations"])
         # the first step has no cached impulses to start from (see start_iterations)
         space.iterations = max(iterations, int(cfg["start_iterations"]))
-        start, cpu_start = time.perf_counter(), time.process_time()
-        if loads is None:
-            for k in range(n_steps):
-                for constraint, attribute, values in schedule:
-                    setattr(constraint, attribute, values[k])
-                step(h)
-                rows.append(read())
-                if k == 0:
-                    space.iterations = iterations
-        else:
-            for k in range(n_steps):
-                out = loads(*rows[-1], H, (k + shift) * h)
-                for i, b in enumerate(targets):
-                    b.force = (out[3 * i], out[3 * i + 1])
-                    b.torque = out[3 * i + 2]
-                for constraint, attribute, values in schedule:
-                    setattr(constraint, attribute, values[k])
-                step(h)
-                rows.append(read())
-                if k == 0:
-                    space.iterations = iterations
-        cpu = time.process_time() - cpu_start
-        wall = time.perf_counter() - start
+        with Stopwatch() as clock:
+            if loads is None:
+                for k in range(n_steps):
+                    for constraint, attribute, values in schedule:
+                        setattr(constraint, attribute, values[k])
+                    step(h)
+                    rows.append(read())
+                    if k == 0:
+                        space.iterations = iterations
+            else:
+                for k in range(n_steps):
+                    out = loads(*rows[-1], H, (k + shift) * h)
+                    for i, b in enumerate(targets):
+                        b.force = (out[3 * i], out[3 * i + 1])
+                        b.torque = out[3 * i + 2]
+                    for constraint, attribute, values in schedule:
+                        setattr(constraint, attribute, values[k])
+                    step(h)
+                    rows.append(read())
+                    if k == 0:
+                        space.iterations = iterations
 
         S = np.array(rows)
-        n = len(mechanism.joints)
         t = np.arange(n_steps + 1) * h
-        cols = [np.broadcast_to(np.asarray(c, float), t.shape) for c in comp.coords_np(*S.T)]
-        q, qd = np.column_stack(cols[:n]), np.column_stack(cols[n:])
-        for i, j in enumerate(mechanism.joints):
-            if isinstance(j, Revolute):  # angles of eliminated links come from atan2
-                col = np.unwrap(q[:, i])
-                q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
+        q, qd = self._coordinates(mechanism, comp, S, q0, t)
         constraint_forces: dict[str, np.ndarray] = {}
         if mechanism.constraints:
             joint_forces, constraint_forces = self._forces(mechanism, comp, S, H, shift, h, t)
@@ -1906,10 +1895,21 @@ class PymunkBackend(Backend):
         g = num(mechanism.gravity)
         actuator_forces = {name: drive.force(S, h, g, H, shift, t)
                            for name, drive in comp.drives.items()}
-        return RunResult(t=t, q=q, qd=qd, reactions=reactions, wall_time=wall,
-                         integrator_order=1, settings=cfg, steps=n_steps,
-                         constraint_forces=constraint_forces, cpu_time=cpu,
-                         actuator_forces=actuator_forces)
+        return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
+
+    @staticmethod
+    def _coordinates(mechanism: Mechanism, comp: _Compiled, S: np.ndarray, q0: np.ndarray,
+                     t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Engine body states (rows of `S`) -> the description's coordinates and rates;
+        the angles of eliminated links, which come from atan2, continued from q0."""
+        n = len(mechanism.joints)
+        cols = [np.broadcast_to(np.asarray(c, float), t.shape) for c in comp.coords_np(*S.T)]
+        q, qd = np.column_stack(cols[:n]), np.column_stack(cols[n:])
+        for i, j in enumerate(mechanism.joints):
+            if isinstance(j, Revolute):
+                col = np.unwrap(q[:, i])
+                q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
+        return q, qd
 
     @staticmethod
     def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
