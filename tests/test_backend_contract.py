@@ -80,6 +80,11 @@ def test_every_element_kind_is_declared(backend):
         assert cases and all(e.level in LEVELS and e.how for e in cases), kind
         if len(cases) > 1:
             assert all(e.when for e in cases), f"{kind}: several cases need their conditions"
+            # each condition is code beside its statement; the last case holds otherwise
+            assert all(callable(e.applies) for e in cases[:-1]), kind
+            assert cases[-1].applies is None, kind
+        else:
+            assert cases[0].applies is None, kind
 
 
 @pytest.mark.parametrize("backend", BACKENDS, ids=lambda b: b.id)

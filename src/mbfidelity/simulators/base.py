@@ -23,7 +23,8 @@ conventions 1-8) into one engine and runs it. The contract:
    backend's `EXPRESSIONS` table gives, per kind, the `Expression`(s) it can build, each
    exact, soft, substitute or unsupported, with how and why; where the case depends on
    the element (a massless link that can or cannot be folded, a slot through the centres
-   of mass or not), `choose` picks it. A soft or substitute expression names the metrics
+   of mass or not), each case carries its condition as code (`Expression.applies`), so
+   that the declaration and the rule that selects it are one thing. A soft or substitute expression names the metrics
    it is expected to fail wherever the element occurs (`expected_failures`, with the
    physical `reason`); the comparisons derive the strict expected failures of a
    mechanism from them (`expected_failures(backend, mechanism)`), so system modules
@@ -113,7 +114,7 @@ import math
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
-from typing import ClassVar, Mapping, Sequence
+from typing import Callable, ClassVar, Mapping, Sequence
 
 import numpy as np
 
@@ -130,7 +131,9 @@ LEVELS = (EXACT, SOFT, SUBSTITUTE, UNSUPPORTED)
 class Expression:
     """How a backend expresses one element kind (contract point 5): `level` (exact, soft,
     substitute, unsupported), `how` (the engine construct, and why it is or is not
-    exact), `when` (the condition, where a kind has several cases). A soft or substitute
+    exact), `when` (the condition, where a kind has several cases) and `applies`, that
+    condition as code: a kind's cases are tried in order and the first that applies is
+    the element's (the last one, without a condition, holds otherwise). A soft or substitute
     expression may name `expected_failures`, metric patterns (fnmatch, as in
     `Expectation.metric`) it is expected to push beyond the gates wherever the element
     occurs, with the physical `reason`: one strict declaration, met when at least one
@@ -141,6 +144,10 @@ class Expression:
     when: str = ""
     expected_failures: tuple[str, ...] = ()
     reason: str = ""
+    #: the condition `when` states, as code: (numeric mechanism, element) -> bool; None
+    #: for a kind's only case and for the case that holds otherwise (the last one)
+    applies: Callable[[Mechanism, object], bool] | None = field(
+        default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.level not in LEVELS:
@@ -387,13 +394,11 @@ class Backend(ABC):
         cases = self.EXPRESSIONS.get(kind, ())
         if not cases:
             return Expression(UNSUPPORTED, f"{self.id} has no translation of a {kind}")
-        return cases[0] if len(cases) == 1 else self.choose(mechanism, kind, element, cases)
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        """The case of `kind` that `element` takes, for kinds declared with several."""
-        raise NotImplementedError(f"{self.id} declares several cases of {kind} but does "
-                                  "not choose among them")
+        for case in cases:
+            if case.applies is None or case.applies(mechanism, element):
+                return case
+        raise RuntimeError(f"{self.id}: no declared case of {kind} applies to "
+                           f"{getattr(element, 'name', element)!r}")
 
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:

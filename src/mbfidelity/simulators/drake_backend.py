@@ -92,6 +92,7 @@ from .plan import (
     coordinate_map,
     motions,
     num,
+    massive_below,
 )
 
 #: order of the solution each integrator propagates (Drake's documentation of each class)
@@ -206,7 +207,7 @@ class DrakeBackend(Backend):
         MASSLESS_BODY: (
             Expression(EXACT, "a zero-mass body: the articulated inertia stays regular "
                               "while a massive descendant carries its coordinates",
-                       when="a massive body below it"),
+                       when="a massive body below it", applies=massive_below),
             Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the "
                                     "plant's mass matrix would be singular",
                        when="only massless bodies below it"),
@@ -225,7 +226,8 @@ class DrakeBackend(Backend):
         POINT_TO_POINT_CUSTOM: (
             Expression(EXACT, "externally applied spatial forces on both bodies from a "
                               "LeafSystem, evaluated at every integrator stage",
-                       when="the law is continuous"),
+                       when="the law is continuous",
+                       applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
             Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
         COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
                                                     "the joint's damping where the law acts "
@@ -235,7 +237,8 @@ class DrakeBackend(Backend):
         COORDINATE_FORCE_CUSTOM: (
             Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
                               "evaluated at every integrator stage",
-                       when="the law is continuous"),
+                       when="the law is continuous",
+                       applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
             Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
         TIME_LOAD: (Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
                                       "the stage time"),),
@@ -254,13 +257,6 @@ class DrakeBackend(Backend):
                                        "at the stage's state and time); that force is the "
                                        "actuator force"),),
     }
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        if kind in (COORDINATE_FORCE_CUSTOM, POINT_TO_POINT_CUSTOM):
-            return cases[1] if _jumps(ForceLaw.of(element).expr) else cases[0]
-        massive = any(not mechanism.body(b).massless for b in mechanism.subtree(element.name))
-        return cases[0] if massive else cases[1]
 
     # --- the scheme --------------------------------------------------------------------------
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:

@@ -144,6 +144,7 @@ from .plan import (
     motions,
     num,
     rot,
+    massive_below,
 )
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
@@ -459,7 +460,9 @@ class ExudynBackend(Backend):
             Expression(EXACT, "a zero-mass link: the mass matrix stays regular while a "
                               "massive descendant carries its coordinates, or a closure "
                               "constraint holds it (augmented matrix [M C^T; C 0])",
-                       when="a massive body below it, or a constraint on its subtree"),
+                       when="a massive body below it, or a constraint on its subtree",
+                       applies=lambda mech, body: massive_below(mech, body) or bool(
+                           constrained_bodies(mech) & set(mech.subtree(body.name)))),
             Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
                                     "kinematic tree's mass matrix would be singular",
                        when="only massless bodies below it, none constrained"),
@@ -496,7 +499,9 @@ class ExudynBackend(Backend):
                               "started from consistent accelerations; actuator force "
                               "-multiplier / scale; order 2 (TrapezoidalIndex2) in the "
                               "coordinates and the force",
-                       when="the prescribed coordinate is one engine joint value"),
+                       when="the prescribed coordinate is one engine joint value",
+                       applies=lambda mech, prescribed: _engine_coordinate(
+                           coordinate_map(mech).T, mech.coordinates.index(prescribed.coordinate))),
             Expression(UNSUPPORTED, "an absolute angle on a turning parent is a combination "
                                     "of engine joint values, which Exudyn's coordinate "
                                     "constraint (one coordinate, time offset) cannot hold",
@@ -522,21 +527,6 @@ class ExudynBackend(Backend):
 
     def translation_reason(self, mechanism: Mechanism) -> str:
         return _spatial_reason(mechanism) if mechanism.spatial else ""
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        if kind == PRESCRIBED:
-            # a CoordinateConstraint holds one engine coordinate: the prescribed
-            # coordinate must be one joint value (not an absolute angle on a turning parent)
-            index = mechanism.coordinates.index(element.coordinate)
-            return cases[0] if _engine_coordinate(coordinate_map(mechanism).T, index) else cases[1]
-        # a massless body with nothing massive below it makes the tree's mass matrix
-        # singular; with closure constraints the implicit solver's augmented matrix
-        # [M C_q^T; C_q 0] can still be regular when a constraint fixes that subtree
-        sub = mechanism.subtree(element.name)
-        if not all(mechanism.body(x).massless for x in sub):
-            return cases[0]
-        return cases[0] if constrained_bodies(mechanism) & set(sub) else cases[1]
 
     # --- model building --------------------------------------------------------------------
     def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict):

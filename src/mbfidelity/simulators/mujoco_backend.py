@@ -140,6 +140,8 @@ from .plan import (
     motions,
     num,
     rot,
+    rigid_body,
+    point_mass,
 )
 
 #: what MuJoCo's soft equalities cost (docs/engines.md; the numbers per mechanism are
@@ -884,7 +886,7 @@ class _Compiled:
         rows = plan.Ainv[[mv.index for mv in moves]]  # q_p = rows (v - b)
         Tp = np.zeros((k, nv))
         Tp[:, self.vadr] = rows
-        qadr, vadr, b = self.qadr, self.vadr, plan.b
+        qadr, b = self.qadr, plan.b
         stack = np.zeros((1 + k, nv))  # the free force and the actuators' columns
         stack[1:] = Tp
         solved = np.zeros_like(stack)
@@ -1288,14 +1290,14 @@ class MujocoBackend(Backend):
         BODY: (
             Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
                               "explicit <inertial> (planar inertia on z, the same on x and y)",
-                       when="mass and inertia > 0"),
+                       when="mass and inertia > 0", applies=rigid_body),
             Expression(SUBSTITUTE, "a point mass: an explicit <inertial> of inertia m r^2, "
                                    "r the setting point_mass_gyration. MuJoCo's compiler "
                                    "rejects moving bodies whose inertia is below mjMINVAL "
                                    "(also when a welded child carries the mass); the "
                                    "substitute changes the body's moment about any point by "
                                    "m r^2, relative (r/d)^2 at a distance d",
-                       when="mass > 0, inertia 0"),
+                       when="mass > 0, inertia 0", applies=point_mass),
             Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass",
                        when="mass 0, inertia > 0"),
         ),
@@ -1303,7 +1305,8 @@ class MujocoBackend(Backend):
             Expression(EXACT, "folded: its joints become a chain of joints of its single "
                               "child's MJCF body, anchors and axes at the reference "
                               "configuration",
-                       when="one child joint, and no constraint or point force on it"),
+                       when="one child joint, and no constraint or point force on it",
+                       applies=lambda mech, body: body.name in _foldable(mech)),
             Expression(SUBSTITUTE, "a body of small mass (link_mass_ratio of the lightest "
                                    "body for a kinematic link, massless_mass_ratio where a "
                                    "constraint or a point force loads it), weight cancelled: "
@@ -1353,13 +1356,6 @@ class MujocoBackend(Backend):
                                        "the stage time; setting prescribed_motion); the "
                                        "applied force is the actuator force"),),
     }
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        if kind == BODY:
-            mass, inertia = num(element.mass), num(element.inertia)
-            return cases[0] if mass > 0 and inertia > 0 else cases[1] if mass > 0 else cases[2]
-        return cases[0] if element.name in _foldable(mechanism) else cases[1]
 
     SPATIAL_REASON = ""
 

@@ -160,6 +160,21 @@ def _(element: Prescribed) -> str:
     return PRESCRIBED
 
 
+def rigid_body(mech: Mechanism, body: Body) -> bool:
+    """Mass and central inertia both positive (an `Expression.applies` condition)."""
+    return num(body.mass) > 0 and num(body.inertia) > 0
+
+
+def point_mass(mech: Mechanism, body: Body) -> bool:
+    """Mass positive (with `rigid_body` false: central inertia zero)."""
+    return num(body.mass) > 0
+
+
+def massive_below(mech: Mechanism, body: Body) -> bool:
+    """Some body of the subtree from `body` (itself included) has mass."""
+    return any(not mech.body(b).massless for b in mech.subtree(body.name))
+
+
 def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
     """(kind, element) for every element of the description, in description order."""
     for group in (mech.bodies, mech.joints, mech.forces, mech.constraints, mech.prescribed):

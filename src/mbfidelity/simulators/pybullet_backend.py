@@ -98,8 +98,7 @@ from ..systems.model import (
     Mechanism,
     PointOnLine,
     PointOnPoint,
-    PointToPoint,
-    Prismatic,
+    Prescribed,
     Revolute,
     RollingContact,
     inertia_matrix,
@@ -256,6 +255,18 @@ def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
             c1 = c1 / np.linalg.norm(c1)
             return float(c1[0]), float(c1[1])
     raise ValueError("zero slot direction")
+
+
+def _two_joint_gear(mech: Mechanism, coupling: LinearCoupling) -> bool:
+    """The coupling, written on the engine joint values, involves exactly two of them."""
+    cmap = coordinate_map(mech)
+    return int(np.count_nonzero(_gear_terms(coupling, mech.coordinates, cmap.T, cmap.b)[2])) == 2
+
+
+def _one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
+    """The prescribed coordinate is one engine joint value (not a sum of them)."""
+    i = mech.coordinates.index(prescribed.coordinate)
+    return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
 
 
 def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
@@ -732,11 +743,14 @@ class PyBulletBackend(Backend):
         MASSLESS_BODY: (
             Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body "
                               "algorithm inverts only each joint's articulated inertia, "
-                              "which its child carries", when="it carries a child"),
+                              "which its child carries", when="it carries a child",
+                       applies=lambda mech, body: any(j.parent == body.name
+                                                      for j in mech.joints)),
             Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of "
                                    "the smallest body's), since zero would make the "
                                    "articulated-body algorithm singular",
-                       when="it carries nothing but a closure constraint holds it"),
+                       when="it carries nothing but a closure constraint holds it",
+                       applies=lambda mech, body: body.name in constrained_bodies(mech)),
             Expression(UNSUPPORTED, "a massless link that carries nothing is singular for "
                                     "the articulated-body algorithm",
                        when="it carries nothing and no constraint holds it"),
@@ -768,7 +782,7 @@ class PyBulletBackend(Backend):
         LINEAR_COUPLING: (
             Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, "
                               "solved at velocity level (exact for a linear constraint)",
-                       when="two engine joint values"),
+                       when="two engine joint values", applies=_two_joint_gear),
             Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
                                     "(jv_a + ratio jv_b = target); its gearAuxLink only adds "
                                     "that joint's current velocity as a target, it is not a "
@@ -779,7 +793,8 @@ class PyBulletBackend(Backend):
             Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h "
                               "with a force that never saturates (prescribed_motion): the "
                               "coordinate lands on q(t+h) at every step; actuator force from "
-                              "getJointState", when="the coordinate is one engine joint value"),
+                              "getJointState", when="the coordinate is one engine joint value",
+                       applies=_one_joint_value),
             Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an "
                                     "absolute angle on a turning parent): one joint motor "
                                     "cannot impose it", when="otherwise"),
@@ -790,22 +805,6 @@ class PyBulletBackend(Backend):
 
     def translation_reason(self, mechanism: Mechanism) -> str:
         return _spatial_reason(mechanism) if mechanism.spatial else ""
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        if kind == PRESCRIBED:
-            A = coordinate_map(mechanism).A
-            i = mechanism.coordinates.index(element.coordinate)
-            return cases[0] if np.count_nonzero(A[i]) == 1 else cases[1]
-        if kind == MASSLESS_BODY:
-            if any(j.parent == element.name for j in mechanism.joints):
-                return cases[0]
-            return cases[1] if element.name in constrained_bodies(mechanism) else cases[2]
-        cmap = coordinate_map(mechanism)
-        _, _, w, _ = _gear_terms(element, mechanism.coordinates, cmap.T, cmap.b)
-        k = int(np.count_nonzero(w))
-        return cases[0] if k == 2 else replace(
-            cases[1], how=f"it involves {k} engine joint value(s): {cases[1].how}")
 
     # --- model building ----------------------------------------------------------------
     def _build(self, p, cid: int, plan: _Plan, settings: dict,

@@ -159,6 +159,8 @@ from .plan import (
     num,
     point_state,
     rot,
+    rigid_body,
+    point_mass,
 )
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
@@ -1224,6 +1226,24 @@ class _Balance:
         self.external = sp.lambdify([*state, H, TIME], flat, modules="numpy", cse=True)
 
 
+def _default_layout(mech: Mechanism) -> _Layout | None:
+    """The layout at the default settings (None: refused as a whole, translation_reason)."""
+    layout = _plan(mech, BACKEND.default_settings())
+    return None if isinstance(layout, str) else layout
+
+
+def _carried(mech: Mechanism, slot: PointOnLine) -> bool:
+    """The slot's pin or line sits on a substitute carrier body."""
+    layout = _default_layout(mech)
+    return layout is not None and any(car.constraint == slot.name for car in layout.carriers)
+
+
+def _pitched(mech: Mechanism, coupling: LinearCoupling) -> bool:
+    """The coupling is held by a pivot moved to the pitch point of a carrier."""
+    layout = _default_layout(mech)
+    return layout is not None and any(p.name == coupling.name for p in layout.pitches)
+
+
 class PymunkBackend(Backend):
     id = "pymunk"
     SETTINGS = {
@@ -1367,14 +1387,14 @@ class PymunkBackend(Backend):
         BODY: (
             Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
                               "(centre of gravity at its origin), no shapes",
-                       when="mass and inertia > 0"),
+                       when="mass and inertia > 0", applies=rigid_body),
             Expression(SUBSTITUTE, "a point mass: pymunk.Body(mass, m r^2), r the setting "
                                    "point_mass_gyration. Chipmunk divides by the moment "
                                    "(its constraint solver uses the inverse moment, "
                                    "infinite at zero); the substitute changes the body's "
                                    "moment about any point by m r^2, relative (r/d)^2 at "
                                    "a distance d",
-                       when="mass > 0, inertia 0"),
+                       when="mass > 0, inertia 0", applies=point_mass),
             Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
                                     "for a massless link that can be eliminated)",
                        when="mass 0, inertia > 0"),
@@ -1400,7 +1420,8 @@ class PymunkBackend(Backend):
             Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot "
                                                   "body's centre of mass (or the slot is on "
                                                   "the world or a body whose rotation is "
-                                                  "fixed) and the pin is the pin body's"),
+                                                  "fixed) and the pin is the pin body's",
+                       applies=lambda mech, slot: not _carried(mech, slot)),
             Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
                                    "carrier (glued to the slot body, centred on the line) in "
                                    "an exact GrooveJoint, their mass taken out of the host "
@@ -1418,7 +1439,8 @@ class PymunkBackend(Backend):
                                                  "chord to the next"),),
         LINEAR_COUPLING: (
             Expression(EXACT, "GearJoint on the absolute angles of two bodies",
-                       when="two body angles"),
+                       when="two body angles",
+                       applies=lambda mech, coupling: not _pitched(mech, coupling)),
             Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
                               "moved to the pitch point before every solve: its tangential "
                               "row is the coupling (gear pair, belt, rolling); other "
@@ -1437,19 +1459,6 @@ class PymunkBackend(Backend):
                                        "scheme's (setting prescribed_motion). Refused "
                                        "(support) on a joint with a massless body"),),
     }
-
-    def choose(self, mechanism: Mechanism, kind: str, element,
-               cases: tuple[Expression, ...]) -> Expression:
-        if kind == BODY:
-            mass, inertia = num(element.mass), num(element.inertia)
-            return cases[0] if mass > 0 and inertia > 0 else cases[1] if mass > 0 else cases[2]
-        layout = _plan(mechanism, self.default_settings())
-        if isinstance(layout, str):  # refused as a whole: see translation_reason
-            return cases[0]
-        if kind == POINT_ON_LINE:
-            substituted = any(car.constraint == element.name for car in layout.carriers)
-            return cases[1] if substituted else cases[0]
-        return cases[1] if any(p.name == element.name for p in layout.pitches) else cases[0]
 
     SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
                       "tensor, hinges about horizontal axes) has no expression in it")
