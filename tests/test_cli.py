@@ -173,7 +173,7 @@ def test_engine_failure_is_recorded_not_raised():
 # Kapitza (Landau & Lifshitz, Mechanics §30), for eq. 80 with the equivalent length
 # L_e = (I_G + m l^2)/(m l): the inverted position is stable to leading order in Y/L_e when
 # Y^2 Omega^2 > 2 g L_e, and otherwise leaves at the rate of the averaged (effective)
-# potential, sqrt(g/L_e - Y^2 Omega^2 / (2 L_e^2)). Defaults (MECHANISMS.md D): m = 1,
+# potential, sqrt(g/L_e - Y^2 Omega^2 / (2 L_e^2)). Defaults (the project's): m = 1,
 # l = 0.2, I_G = 0.001, Omega = 2 pi 50: Y = 0.01 gives a ratio Y^2 Omega^2/(2 g L_e) of
 # 2.45 (stable), Y = 0.005 one of 0.61 (unstable); the O(Y/L_e) corrections are 0.05 at most.
 def _kapitza_rate(Y, m=1.0, l=0.2, I_G=0.001, W=2 * np.pi * 50, g=9.81):

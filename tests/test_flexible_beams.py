@@ -2,7 +2,7 @@
 (Fig. 17: simply supported beam l = 1, EI = 100, rho = 1 kg/m, block m at a = l/2; issue 12
 item 4), with expected values from sources independent of our code:
 
-- SIMULATORS.md's probe ("Beams and distributed mass"), measured on a bare steel bar by
+- An independent probe of the engines' beams, measured on a bare steel bar by
   another route (axial coordinates free, different units): relative errors are
   dimensionless functions of N for the bare beam, so they carry over. ANCF cable:
   N = 4: 2.6e-4 / 3.9e-3 / 1.8e-2; N = 16: 1.0e-6 / 1.6e-5 / 8.3e-5. MuJoCo 1-D flex, first
@@ -49,7 +49,7 @@ def _need(engine):
 
 
 def test_beam_is_data_with_the_catalog_defaults():
-    # MECHANISMS.md, §6.1 row: l = 1, EI = 100, rho = 1, c = 0.5
+    # §6.1, Fig. 17, the project's defaults: l = 1, EI = 100, rho = 1, c = 0.5
     beam = Beam.from_parameters({"m": 1, "c": 0.25})
     assert (beam.length, beam.EI, beam.rho, beam.point_mass, beam.point_position) == \
         (1.0, 100.0, 1.0, 1.0, 0.25)
@@ -63,7 +63,7 @@ def test_beam_is_data_with_the_catalog_defaults():
 
 
 def test_exact_reference_is_the_printed_bare_beam():
-    # MECHANISMS.md: w1 = pi^2 sqrt(EI / (rho l^4)), 1.5708 sqrt(EI/(rho l^4)) in Hz
+    # w1 = pi^2 sqrt(EI / (rho l^4)), 1.5708 sqrt(EI/(rho l^4)) in Hz
     assert exact_frequencies_hz(BARE, 1)[0] == pytest.approx(math.pi / 2 * 10, rel=1e-12)
 
 
@@ -102,7 +102,7 @@ def test_a_size_without_a_node_under_the_block_is_dropped_with_the_reason():
 
 def test_exudyn_ancf_matches_the_probe_and_converges_as_h4():
     """§6.1, Fig. 17, bare beam. ANCF cable elements (cubic Hermite, consistent mass):
-    frequencies from above (Rayleigh-Ritz), and SIMULATORS.md's independent probe to its
+    frequencies from above (Rayleigh-Ritz), and the independent probe to its
     printed two digits (tolerance 6 %: half a unit of the second digit of 1.0e-6 is 5 %)."""
     _need("exudyn")
     probe = {4: (2.6e-4, 3.9e-3, 1.8e-2), 16: (1.0e-6, 1.6e-5, 8.3e-5)}
@@ -155,7 +155,7 @@ def test_exudyn_geometrically_exact_converges_as_h2():
 
 
 def test_mujoco_flex_first_mode_matches_the_probe_and_is_second_order():
-    """§6.1, Fig. 17, bare beam, MuJoCo's 1-D flex: SIMULATORS.md's probe, -8.2e-3 at N = 10
+    """§6.1, Fig. 17, bare beam, MuJoCo's 1-D flex: the independent probe, -8.2e-3 at N = 10
     and -2.1e-3 at N = 20 (tolerance 3 %: half a unit of the second digit of 2.1e-3 is
     2.4 %), hence order near 2 (central differences)."""
     _need("mujoco")

@@ -99,3 +99,22 @@ def test_no_system_id_outside_systems():
             for m in pattern.finditer(text):
                 found.append(f"{path.relative_to(PACKAGE)}:{line}: {m.group(1)}")
     assert not found, "\n".join(found)
+
+
+#: documents of the workplace that are not part of the repository: the repository cites
+#: the monograph (by section, figure and equation) and the published sources, never these
+OUTSIDE_DOCUMENTS = re.compile(r"MECHANISMS\.md|SIMULATORS\.md|BENCHMARKS\.md|DESIGN\.md"
+                               r"|\.\./shared\b")
+
+
+def test_the_repository_cites_nothing_outside_itself():
+    root = PACKAGE.parent.parent
+    texts = [p for folder in ("src", "tests", "docs", "benchmarks", "examples")
+             for p in (root / folder).rglob("*") if p.suffix in (".py", ".md", ".txt", ".json")
+             and "egg-info" not in str(p)]
+    texts += [root / "README.md"]
+    assert len(texts) > 50
+    cited = [f"{p.relative_to(root)}:{i}" for p in texts if p.exists()
+             for i, line in enumerate(p.read_text(errors="replace").splitlines(), 1)
+             if OUTSIDE_DOCUMENTS.search(line) and p.name != "test_layers.py"]
+    assert not cited, cited

@@ -33,7 +33,7 @@ HAND = facts()
 FEW = settings(max_examples=5, derandomize=True, database=None, deadline=None,
                suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])
 
-#: the catalog's formulas (MECHANISMS.md, ground rules), written out here
+#: the catalog's default formulas (each system module's parameters), written out here
 FORMULAS = {
     "compound_pendulum": {"l": lambda v: v["L"] / 2, "I_O": lambda v: v["m"] * v["L"] ** 2 / 3},
     "double_pendulum": {"I": lambda v: v["m"] * (2 * v["l"]) ** 2 / 12},
@@ -46,7 +46,7 @@ FORMULAS = {
     "base_excited_msd": {"Omega": lambda v: v["ratio"] * (v["k"] / v["m"]) ** 0.5},
     "unbalanced_rotor": {"omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
     "inertial_shaker": {"Omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
-    # the rotor symmetric about its axis but for I23 (MECHANISMS.md: I1 = I2; eq. 88)
+    # the rotor symmetric about its axis but for I23 (I1 = I2; eq. 88)
     "dynamic_unbalance": {"I2": lambda v: v["I1"]},
     # parametric resonance: the pumping at twice the small-swing frequency (Fig. 11)
     "variable_length_pendulum": {"Omega": lambda v: 2 * (v["g"] / v["l0"]) ** 0.5},

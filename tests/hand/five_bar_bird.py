@@ -1,4 +1,4 @@
-"""Fig. 40 (§10.1), worked by hand on the pinned geometry of MECHANISMS.md:
+"""Fig. 40 (§10.1), worked by hand on the geometry the system module pins:
 
   Q = l(-s1, -c1), Q' = (e, 0) + l(-s2, -c2), P = Q + a(s3, -c3) = Q' + a(-s4, -c4),
   G1 = Q + b(-s3, c3), G2 = Q' + b(s4, c4)      (s_i = sin phi_i, c_i = cos phi_i)

@@ -31,7 +31,7 @@ MISPRINTS = set()
 # With the free length that §4.4 implies (the spring guarantees the equilibrium at 45 deg),
 # every printed formula of the section agrees: eq. 34 (T and E_p up to 8 m^2 g^2/k), eq. 35,
 # eq. 36, phi_eq = 45 deg, and the linearized inertia and stiffness.
-# (Reading the spring as relaxed at 45 deg, as MECHANISMS.md does, would make E_p, eq. 35,
+# (Reading the spring as relaxed at 45 deg would make E_p, eq. 35,
 # eq. 36, phi_eq and the stiffness all wrong by the preload term 8 m g l (cos phi - sqrt2/2).)
 
 

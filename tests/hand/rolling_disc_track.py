@@ -1,4 +1,4 @@
-"""Fig. 39, eq. 110, derived by hand from the geometry pinned in MECHANISMS.md.
+"""Fig. 39, eq. 110, derived by hand from the geometry the system module pins.
 
 Positions (theta clockwise, phi absolute from the downward vertical):
     C = R (cos th, -sin th),  G = C + e (-sin th, -cos th),  D = C + (R - r)(sin ph, -cos ph).

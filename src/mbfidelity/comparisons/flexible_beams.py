@@ -42,7 +42,7 @@ MARGIN = 3.0
 #: geometrically exact element's second and third modes are its rotary ones, errors 1e3)
 ASYMPTOTIC_ERROR = 0.3
 MIN_FIT_POINTS = 3
-#: the catalog's cases (MECHANISMS.md, §6.1 row): the bare beam and the block of 1 kg at
+#: the catalog's cases (§6.1, Fig. 17): the bare beam and the block of 1 kg at
 #: mid-span
 DEFAULT_CASES = ({"m": 0.0}, {"m": 1.0})
 

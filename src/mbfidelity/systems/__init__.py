@@ -38,7 +38,7 @@ from .model import (
     Scenario,
 )
 
-#: checks as MECHANISMS.md names them
+#: the kinds of checks a scenario names
 CHECK_KINDS = ("trajectory", "reaction", "frequency")
 
 #: separates a catalog id from the structural parameters of one of its specialisations

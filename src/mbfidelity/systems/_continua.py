@@ -22,7 +22,7 @@ from typing import Mapping
 SIMPLY_SUPPORTED = "simply supported"
 SUPPORTS = (SIMPLY_SUPPORTED,)
 
-#: parameter names as in MECHANISMS.md (§6.1 row) -> Beam field
+#: parameter names as in §6.1 (Fig. 17) -> Beam field
 PARAMETER_FIELDS = {"l": "length", "EI": "EI", "rho": "rho", "m": "point_mass"}
 
 

@@ -33,19 +33,19 @@ from .model import (LENGTH, LENGTH_RATE, TIME, Body, CoordinateForce, Mechanism,
 GAP = 0.3
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the block", "MECHANISMS.md D; Fig. 25"),
-    Parameter("k", 100.0, "N/m", "spring constant", "MECHANISMS.md D; Fig. 25"),
-    Parameter("c", 2.0, "N s/m", "viscous damping", "MECHANISMS.md D; Fig. 25",
+    Parameter("m", 1.0, "kg", "mass of the block", "Fig. 25"),
+    Parameter("k", 100.0, "N/m", "spring constant", "Fig. 25"),
+    Parameter("c", 2.0, "N s/m", "viscous damping", "Fig. 25",
               domain="nonnegative"),
     Parameter("m_P", 0.5, "kg", "mass of the moving base that carries P (not in the catalog: "
               "the engines need a body to drive; it changes the actuator force only)",
               "chosen here"),
     Parameter("Y", 0.01, "m", "amplitude of the base motion y(t) = Y sin(Omega t)",
-              "MECHANISMS.md D", domain="real"),
+              "project default", domain="real"),
     Parameter("ratio", 1.0, "1", "base frequency over the natural frequency sqrt(k/m) (the "
               "transmissibility scenarios set it)", "chosen here"),
     Parameter("Omega", "ratio*sqrt(k/m)", "rad/s", "angular frequency of the base motion",
-              "MECHANISMS.md D"),
+              "project default"),
 )
 
 

@@ -65,13 +65,13 @@ from .model import (Body, Circle, CoordinateForce, Mechanism, Parameter, PointOn
                     Revolute, Scenario, Segment, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("l", 1.0, "m", "span between the supports", "MECHANISMS.md B; Fig. 17"),
-    Parameter("EI", 100.0, "N m^2", "bending stiffness", "MECHANISMS.md B; Fig. 17"),
-    Parameter("rho", 1.0, "kg/m", "mass per length of the beam", "MECHANISMS.md B; Fig. 17"),
+    Parameter("l", 1.0, "m", "span between the supports", "Fig. 17"),
+    Parameter("EI", 100.0, "N m^2", "bending stiffness", "Fig. 17"),
+    Parameter("rho", 1.0, "kg/m", "mass per length of the beam", "Fig. 17"),
     Parameter("m", 1.0, "kg", "mass of the block (the catalog also runs m = 0)",
-              "MECHANISMS.md B", domain="nonnegative"),
+              "project default", domain="nonnegative"),
     Parameter("c", 0.5, "1", "position of the block, a = c l from the pin (structural: the "
-              "block sits on the node c N of the chain)", "MECHANISMS.md B; Fig. 17",
+              "block sits on the node c N of the chain)", "Fig. 17",
               shapes=True),
     Parameter("N", 4, "1", "number of rigid segments (structural: it sets the coordinates; "
               "4 keeps the checks fast)", "chosen here", domain="count"),

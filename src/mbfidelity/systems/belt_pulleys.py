@@ -47,20 +47,20 @@ from .model import (COORD_RATE, Body, Circle, CoordinateForce, LinearCoupling, M
 
 PARAMETERS = (
     Parameter("I1", 0.01, "kg m^2", "moment of inertia of pulley 1 about its centre O",
-              "MECHANISMS.md E; Fig. 38"),
-    Parameter("r1", 0.05, "m", "radius of pulley 1", "MECHANISMS.md E; Fig. 38"),
+              "Fig. 38"),
+    Parameter("r1", 0.05, "m", "radius of pulley 1", "Fig. 38"),
     Parameter("I2", 0.04, "kg m^2", "central moment of inertia of pulley 2",
-              "MECHANISMS.md E; Fig. 38"),
-    Parameter("r2", 0.1, "m", "radius of pulley 2", "MECHANISMS.md E; Fig. 38"),
-    Parameter("m2", 2.0, "kg", "mass of pulley 2", "MECHANISMS.md E; Fig. 38"),
+              "Fig. 38"),
+    Parameter("r2", 0.1, "m", "radius of pulley 2", "Fig. 38"),
+    Parameter("m2", 2.0, "kg", "mass of pulley 2", "Fig. 38"),
     Parameter("l", 0.4, "m", "arm length OC (distance between the pulley centres)",
-              "MECHANISMS.md E; Fig. 38"),
+              "Fig. 38"),
     Parameter("c1", 0.01, "N m s", "viscous friction of pulley 1 on the arm",
-              "MECHANISMS.md E; Fig. 38", domain="nonnegative"),
+              "Fig. 38", domain="nonnegative"),
     Parameter("c2", 0.02, "N m s", "viscous friction of pulley 2 on the arm",
-              "MECHANISMS.md E; Fig. 38", domain="nonnegative"),
+              "Fig. 38", domain="nonnegative"),
     Parameter("c3", 0.1, "N m s", "viscous friction of the arm on the wall",
-              "MECHANISMS.md E; Fig. 38", domain="nonnegative"),
+              "Fig. 38", domain="nonnegative"),
 )
 
 

@@ -10,7 +10,7 @@ Geometry (φ from the downward vertical, counter-clockwise positive)::
 
 The bar frame has its y axis along G->O, so the pivot is the body point (0, l) and
 G = (l sin φ, -l cos φ); the bar's central inertia is I_O - m l^2. The defaults of l and
-I_O are the uniform bar's formulas, l = L/2 and I_O = m L^2/3 (MECHANISMS.md), evaluated
+I_O are the uniform bar's formulas, l = L/2 and I_O = m L^2/3 (eq. 5), evaluated
 at the user's m and L unless l or I_O are given too. The exact motion from rest at any
 amplitude below π is given by Jacobi's elliptic functions.
 """
@@ -20,13 +20,13 @@ from . import Condition, PrintedFormula, System, coordinate_symbols
 from .model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the bar", "MECHANISMS.md A; Fig. 7"),
-    Parameter("L", 1.0, "m", "length of the bar (pinned at one end)", "MECHANISMS.md A"),
+    Parameter("m", 1.0, "kg", "mass of the bar", "Fig. 7"),
+    Parameter("L", 1.0, "m", "length of the bar (pinned at one end)", "project default"),
     Parameter("l", "L/2", "m", "distance from the pivot O to the centre of mass (default: "
-              "uniform bar, L/2)", "MECHANISMS.md A; Fig. 7"),
+              "uniform bar, L/2)", "Fig. 7"),
     Parameter("I_O", "m*L**2/3", "kg m^2", "moment of inertia about the pivot O (default: "
-              "uniform bar, m L^2/3)", "MECHANISMS.md A; eq. 5"),
-    Parameter("phi0", 0.05, "rad", "initial angle, released from rest", "MECHANISMS.md A",
+              "uniform bar, m L^2/3)", "eq. 5"),
+    Parameter("phi0", 0.05, "rad", "initial angle, released from rest", "project default",
               domain="real"),
 )
 

@@ -37,22 +37,22 @@ from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter, Pri
                     Rectangle, Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 2.0, "kg", "mass of the block", "MECHANISMS.md C; §7.2"),
-    Parameter("k", 500.0, "N/m", "spring constant", "MECHANISMS.md C; §7.2"),
-    Parameter("c", 2.0, "N s/m", "viscous damping", "MECHANISMS.md C; §7.2",
+    Parameter("m", 2.0, "kg", "mass of the block", "§7.2"),
+    Parameter("k", 500.0, "N/m", "spring constant", "§7.2"),
+    Parameter("c", 2.0, "N s/m", "viscous damping", "§7.2",
               domain="nonnegative"),
     Parameter("alpha", math.radians(25.0), "rad", "inclination of the belt (25 degrees)",
-              "MECHANISMS.md C; §7.2"),
+              "§7.2"),
     Parameter("v0", 0.29, "m/s", "speed of the belt (Fig. 23; the scenarios span "
-              "0.29-0.31)", "MECHANISMS.md C; §7.2, Fig. 22-23"),
+              "0.29-0.31)", "§7.2, Fig. 22-23"),
     Parameter("a2", 10.0, "N s^2/m^2", "quadratic coefficient of the belt force Ft(v)",
-              "MECHANISMS.md C; §7.2"),
+              "§7.2"),
     Parameter("a1", 8.0, "N s/m", "linear coefficient of the belt force (Ft falls with "
-              "the slip speed where a1 > 2 a2 v)", "MECHANISMS.md C; §7.2"),
+              "the slip speed where a1 > 2 a2 v)", "§7.2"),
     Parameter("a0", 4.0, "N", "belt force at vanishing slip (the bound of the sticking "
-              "force)", "MECHANISMS.md C; §7.2", domain="nonnegative"),
+              "force)", "§7.2", domain="nonnegative"),
     Parameter("xd0", 0.1, "m/s", "initial velocity (the initial position is x_eq)",
-              "MECHANISMS.md C; §7.2", domain="real"),
+              "§7.2", domain="real"),
 )
 
 STICK_SLIP_DRIFT = (

@@ -19,11 +19,11 @@ from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of each bar", "MECHANISMS.md E; Fig. 37"),
-    Parameter("l", 0.5, "m", "half length of each bar (bars are 2l long)", "MECHANISMS.md E"),
+    Parameter("m", 1.0, "kg", "mass of each bar", "Fig. 37"),
+    Parameter("l", 0.5, "m", "half length of each bar (bars are 2l long)", "project default"),
     Parameter("I", "m*(2*l)**2/12", "kg m^2",
               "central moment of inertia of each bar (default: uniform bar, m(2l)^2/12)",
-              "MECHANISMS.md E"),
+              "project default"),
 )
 
 

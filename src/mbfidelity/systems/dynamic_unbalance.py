@@ -35,17 +35,17 @@ from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, P
 
 PARAMETERS = (
     Parameter("I_Gb", 0.05, "kg m^2", "moment of inertia of the frame about the vertical",
-              "MECHANISMS.md D; Fig. 32"),
-    Parameter("k_t", 10.0, "N m/rad", "torsional spring constant", "MECHANISMS.md D; Fig. 32"),
+              "Fig. 32"),
+    Parameter("k_t", 10.0, "N m/rad", "torsional spring constant", "Fig. 32"),
     Parameter("I1", 0.01, "kg m^2", "rotor's central moment about e1 (horizontal, across "
-              "the spin axis)", "MECHANISMS.md D; Fig. 32"),
+              "the spin axis)", "Fig. 32"),
     Parameter("I2", "I1", "kg m^2", "rotor's central moment about e2 (default: I1, the "
-              "case of eq. 88)", "MECHANISMS.md D; Fig. 32"),
+              "case of eq. 88)", "Fig. 32"),
     Parameter("I3", 0.015, "kg m^2", "rotor's central moment about its spin axis e3",
-              "MECHANISMS.md D; Fig. 32"),
+              "Fig. 32"),
     Parameter("I23", 0.001, "kg m^2", "rotor's product of inertia of e2 and e3 (the dynamic "
-              "unbalance)", "MECHANISMS.md D; Fig. 32", domain="real"),
-    Parameter("omega", 5.0, "rad/s", "spin speed of the rotor", "MECHANISMS.md D; Fig. 32"),
+              "unbalance)", "Fig. 32", domain="real"),
+    Parameter("omega", 5.0, "rad/s", "spin speed of the rotor", "Fig. 32"),
     Parameter("m_b", 2.0, "kg", "mass of the frame (no part in the motion: its centre of "
               "mass is on the axis)", "chosen here"),
     Parameter("m_r", 1.0, "kg", "mass of the rotor (no part in the motion: its centre of "

@@ -1,7 +1,7 @@
 """Eccentric disc lifting a guided block, with a preloaded spring (monograph §2.4, Fig. 8,
 eq. 7-9; reduced inertia and reduced forces of the same example in §4.1, §4.2, §4.4).
 
-Geometry (pinned in MECHANISMS.md; the sense of phi is free: eq. 7 is even in phi)::
+Geometry (pinned by the project where the figure is not in the text; the sense of phi is free: eq. 7 is even in phi)::
 
               | |
             [block m_b]    guided vertically (coordinate y, dependent); its bottom face
@@ -40,21 +40,21 @@ from .model import (COORD_RATE, LENGTH, Body, Circle, CoordinateForce, Mechanism
 BLOCK_HALF_HEIGHT = 0.02
 
 PARAMETERS = (
-    Parameter("m_e", 2.0, "kg", "mass of the eccentric disc", "MECHANISMS.md A; Fig. 8"),
+    Parameter("m_e", 2.0, "kg", "mass of the eccentric disc", "Fig. 8"),
     Parameter("I_O", 0.02, "kg m^2", "moment of inertia of the disc about the pivot O",
-              "MECHANISMS.md A; Fig. 8"),
-    Parameter("R", 0.1, "m", "radius of the disc", "MECHANISMS.md A; Fig. 8"),
+              "Fig. 8"),
+    Parameter("R", 0.1, "m", "radius of the disc", "Fig. 8"),
     Parameter("e", 0.02, "m", "eccentricity: disc centre below O at phi = 0",
-              "MECHANISMS.md A; Fig. 8"),
-    Parameter("m_b", 0.5, "kg", "mass of the block", "MECHANISMS.md A; Fig. 8"),
-    Parameter("k", 1000.0, "N/m", "spring constant", "MECHANISMS.md A; Fig. 8"),
-    Parameter("T0", 20.0, "N", "spring tension at phi = 0", "MECHANISMS.md A; eq. 7"),
+              "Fig. 8"),
+    Parameter("m_b", 0.5, "kg", "mass of the block", "Fig. 8"),
+    Parameter("k", 1000.0, "N/m", "spring constant", "Fig. 8"),
+    Parameter("T0", 20.0, "N", "spring tension at phi = 0", "eq. 7"),
     Parameter("r", 0.05, "m", "distance from O to the spring's end on the disc",
-              "MECHANISMS.md A; eq. 7"),
+              "eq. 7"),
     Parameter("h", 0.2, "m", "distance from O to the spring's fixed end",
-              "MECHANISMS.md A; eq. 7"),
+              "eq. 7"),
     Parameter("c", 0.0, "N s/m", "viscous friction of the block's guide (§4.2 variant: 5)",
-              "MECHANISMS.md A; §4.2", domain="nonnegative"),
+              "§4.2", domain="nonnegative"),
 )
 
 

@@ -19,9 +19,9 @@ from .model import (Body, Circle, Mechanism, Parameter, PointToPoint, Prismatic,
                     Scenario, linear_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the body", "MECHANISMS.md E; Fig. 33"),
-    Parameter("I_G", 0.01, "kg m^2", "central moment of inertia of the body", "MECHANISMS.md E"),
-    Parameter("k", 100.0, "N/m", "spring constant (free length 0)", "MECHANISMS.md E"),
+    Parameter("m", 1.0, "kg", "mass of the body", "Fig. 33"),
+    Parameter("I_G", 0.01, "kg m^2", "central moment of inertia of the body", "project default"),
+    Parameter("k", 100.0, "N/m", "spring constant (free length 0)", "project default"),
 )
 
 

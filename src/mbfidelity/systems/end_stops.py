@@ -43,15 +43,15 @@ GRAZING_CONTACT = (
     "are judged and pass.")
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the block", "MECHANISMS.md; Fig. 2"),
-    Parameter("k1", 200.0, "N/m", "stiffness of each of the two springs", "MECHANISMS.md; Fig. 2"),
+    Parameter("m", 1.0, "kg", "mass of the block", "Fig. 2"),
+    Parameter("k1", 200.0, "N/m", "stiffness of each of the two springs", "Fig. 2"),
     Parameter("c", 0.25, "N s/m", "damping coefficient of each of the two dampers",
-              "MECHANISMS.md; Fig. 2", domain="nonnegative"),
-    Parameter("k2", 200.0, "N/m", "stiffness of each elastic stop", "MECHANISMS.md; Fig. 2"),
+              "Fig. 2", domain="nonnegative"),
+    Parameter("k2", 200.0, "N/m", "stiffness of each elastic stop", "Fig. 2"),
     Parameter("l", 0.05, "m", "gap between the block at x = 0 and each stop",
-              "MECHANISMS.md; Fig. 2"),
-    Parameter("x0", 0.1, "m", "initial displacement", "MECHANISMS.md; Fig. 2", domain="real"),
-    Parameter("v0", 0.0, "m/s", "initial velocity", "MECHANISMS.md; Fig. 2", domain="real"),
+              "Fig. 2"),
+    Parameter("x0", 0.1, "m", "initial displacement", "Fig. 2", domain="real"),
+    Parameter("v0", 0.0, "m/s", "initial velocity", "Fig. 2", domain="real"),
 )
 
 

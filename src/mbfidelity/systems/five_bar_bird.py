@@ -1,6 +1,6 @@
 """Flapping-bird mobile as a five-bar linkage (monograph §10.1, Fig. 40, eq. 113-116).
 
-Geometry, pinned in MECHANISMS.md ("Pinned geometry: five_bar_bird"), which reproduces the
+Geometry, pinned by the project (the figure is not in the text), which reproduces the
 loop equations (eq. 113) and the potential energy (eq. 115)::
 
        O=(0,0)                      O'=(e,0)      fixed pivots
@@ -81,14 +81,14 @@ from .model import Body, Circle, Mechanism, Parameter, PointOnPoint, Revolute, S
 
 PARAMETERS = (
     Parameter("l", 0.3, "m", "length of the massless bars O-Q and O'-Q'",
-              "MECHANISMS.md E; Fig. 40"),
-    Parameter("a", 0.15, "m", "distance from a wing's hinge Q to the body P", "MECHANISMS.md E"),
+              "Fig. 40"),
+    Parameter("a", 0.15, "m", "distance from a wing's hinge Q to the body P", "project default"),
     Parameter("b", 0.1, "m", "distance from a wing's hinge to its centre of mass (beyond Q)",
-              "MECHANISMS.md E"),
-    Parameter("e", 0.2, "m", "distance between the fixed pivots O and O'", "MECHANISMS.md E"),
-    Parameter("m", 0.05, "kg", "mass of each wing", "MECHANISMS.md E"),
-    Parameter("I", 3e-4, "kg m^2", "central moment of inertia of each wing", "MECHANISMS.md E"),
-    Parameter("m_c", 0.1, "kg", "mass of the body (point mass at P)", "MECHANISMS.md E"),
+              "project default"),
+    Parameter("e", 0.2, "m", "distance between the fixed pivots O and O'", "project default"),
+    Parameter("m", 0.05, "kg", "mass of each wing", "project default"),
+    Parameter("I", 3e-4, "kg m^2", "central moment of inertia of each wing", "project default"),
+    Parameter("m_c", 0.1, "kg", "mass of the body (point mass at P)", "project default"),
 )
 
 

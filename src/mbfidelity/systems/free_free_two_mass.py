@@ -38,10 +38,10 @@ from .model import (Body, CoordinateForce, Mechanism, Parameter, Prismatic, Rect
                     Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of each of the two bodies", "MECHANISMS.md; Fig. 5.1"),
-    Parameter("k", 100.0, "N/m", "spring constant", "MECHANISMS.md; Fig. 5.1"),
+    Parameter("m", 1.0, "kg", "mass of each of the two bodies", "Fig. 5.1"),
+    Parameter("k", 100.0, "N/m", "spring constant", "Fig. 5.1"),
     Parameter("F", 10.0, "N", "constant force on mass 1, along the line of the masses "
-              "(positive towards mass 2)", "MECHANISMS.md; Fig. 5.1", domain="real"),
+              "(positive towards mass 2)", "Fig. 5.1", domain="real"),
     Parameter("l0", 0.5, "m", "free length of the spring (drawing only; chosen here)"),
 )
 

@@ -29,17 +29,17 @@ from .model import (TIME, Body, CoordinateForce, Mechanism, Parameter, Prescribe
 
 PARAMETERS = (
     Parameter("M", 5.0, "kg", "mass of the frame (inner mass excluded)",
-              "MECHANISMS.md D; Fig. 30"),
-    Parameter("k", 2000.0, "N/m", "spring constant", "MECHANISMS.md D; Fig. 30"),
-    Parameter("c", 10.0, "N s/m", "viscous damping", "MECHANISMS.md D; Fig. 30",
+              "Fig. 30"),
+    Parameter("k", 2000.0, "N/m", "spring constant", "Fig. 30"),
+    Parameter("c", 10.0, "N s/m", "viscous damping", "Fig. 30",
               domain="nonnegative"),
-    Parameter("m", 0.5, "kg", "inner mass", "MECHANISMS.md D; Fig. 30"),
+    Parameter("m", 0.5, "kg", "inner mass", "Fig. 30"),
     Parameter("Y", 0.02, "m", "amplitude of the inner mass's motion y(t) = Y sin(Omega t) "
-              "relative to the frame", "MECHANISMS.md D", domain="real"),
+              "relative to the frame", "project default", domain="real"),
     Parameter("ratio", 1.0, "1", "drive frequency over the natural frequency sqrt(k/(M + m)) "
               "(the scenarios set it)", "chosen here"),
     Parameter("Omega", "ratio*sqrt(k/(M + m))", "rad/s", "angular frequency of the drive",
-              "MECHANISMS.md D; eq. 85"),
+              "eq. 85"),
 )
 
 #: drive frequencies of the scenarios, as ratios to the natural frequency sqrt(k/(M + m))

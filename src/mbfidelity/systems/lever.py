@@ -31,20 +31,20 @@ from .model import (TIME, Body, CoordinateForce, Mechanism, Parameter, Revolute,
 
 PARAMETERS = (
     Parameter("I_O", 0.1, "kg m^2", "moment of inertia of the lever about O",
-              "MECHANISMS.md A; Fig. 10"),
-    Parameter("m", 1.0, "kg", "mass of the lever", "MECHANISMS.md A; Fig. 10"),
+              "Fig. 10"),
+    Parameter("m", 1.0, "kg", "mass of the lever", "Fig. 10"),
     Parameter("e", 0.2, "m", "distance from O to the centre of mass, along the lever",
-              "MECHANISMS.md A; eq. 12"),
-    Parameter("k", 20.0, "N m/rad", "torsional spring constant", "MECHANISMS.md A; Fig. 10"),
+              "eq. 12"),
+    Parameter("k", 20.0, "N m/rad", "torsional spring constant", "Fig. 10"),
     Parameter("phi0", float(sp.pi / 6), "rad", "equilibrium angle with F = 0 (30 deg)",
-              "MECHANISMS.md A; Fig. 10", domain="real"),
+              "Fig. 10", domain="real"),
     Parameter("phi_n", "phi0 + m*g*e*cos(phi0)/k", "rad",
               "neutral angle of the torsional spring (default: the preload that makes phi0 "
-              "the equilibrium)", "MECHANISMS.md A; eq. 12", domain="real"),
-    Parameter("l", 0.4, "m", "distance from O to where F acts", "MECHANISMS.md A; eq. 12"),
-    Parameter("F_a", 1.0, "N", "amplitude of F(t) = F_a sin(Omega t)", "MECHANISMS.md A",
+              "the equilibrium)", "eq. 12", domain="real"),
+    Parameter("l", 0.4, "m", "distance from O to where F acts", "eq. 12"),
+    Parameter("F_a", 1.0, "N", "amplitude of F(t) = F_a sin(Omega t)", "project default",
               domain="real"),
-    Parameter("Omega", 10.0, "rad/s", "angular frequency of F(t)", "MECHANISMS.md A"),
+    Parameter("Omega", 10.0, "rad/s", "angular frequency of F(t)", "project default"),
 )
 
 

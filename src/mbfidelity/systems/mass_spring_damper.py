@@ -17,12 +17,12 @@ from .model import (TIME, Body, CoordinateForce, Mechanism, Parameter, Prismatic
                     Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass", "MECHANISMS.md C; Fig. 19"),
-    Parameter("k", 100.0, "N/m", "spring constant", "MECHANISMS.md C"),
-    Parameter("c", 2.0, "N s/m", "viscous damping", "MECHANISMS.md C", domain="nonnegative"),
-    Parameter("F0", 1.0, "N", "force amplitude of F(t) = F0 sin(Omega t)", "MECHANISMS.md C",
+    Parameter("m", 1.0, "kg", "mass", "Fig. 19"),
+    Parameter("k", 100.0, "N/m", "spring constant", "project default"),
+    Parameter("c", 2.0, "N s/m", "viscous damping", "project default", domain="nonnegative"),
+    Parameter("F0", 1.0, "N", "force amplitude of F(t) = F0 sin(Omega t)", "project default",
               domain="real"),
-    Parameter("Omega", 10.0, "rad/s", "forcing angular frequency", "MECHANISMS.md C"),
+    Parameter("Omega", 10.0, "rad/s", "forcing angular frequency", "project default"),
     Parameter("x0", 0.0, "m", "initial displacement (free run: 0.01, chosen here)",
               domain="real"),
 )

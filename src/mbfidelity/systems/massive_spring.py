@@ -53,11 +53,11 @@ from .model import (Body, Circle, CoordinateForce, Mechanism, Parameter, Prismat
                     Scenario, Segment, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("k", 100.0, "N/m", "stiffness of the whole spring", "MECHANISMS.md B; Fig. 18"),
-    Parameter("l", 1.0, "m", "unstretched length of the spring", "MECHANISMS.md B; Fig. 18"),
+    Parameter("k", 100.0, "N/m", "stiffness of the whole spring", "Fig. 18"),
+    Parameter("l", 1.0, "m", "unstretched length of the spring", "Fig. 18"),
     Parameter("rho", 0.3, "kg/m", "mass of the spring per unit unstretched length (rho l = "
-              "0.3 kg)", "MECHANISMS.md B; Fig. 18"),
-    Parameter("m", 1.0, "kg", "mass of the block at the spring's end", "MECHANISMS.md B"),
+              "0.3 kg)", "Fig. 18"),
+    Parameter("m", 1.0, "kg", "mass of the block at the spring's end", "project default"),
     Parameter("N", 8, "1", "number of elements of the lumped chain (structural: it sets the "
               "coordinates; 8 keeps the checks fast, the convergence study goes to 32)",
               "chosen here", domain="count"),

@@ -80,7 +80,7 @@ MAX_COUNT = 32
 
 @dataclass(frozen=True)
 class Parameter:
-    """A named, overridable parameter (names as in MECHANISMS.md, ASCII spelling).
+    """A named, overridable parameter (names as in the monograph, ASCII spelling).
 
     `default` is a number, or a formula: an expression of the other parameters in SymPy
     syntax (e.g. ``"m*(2*l)**2/12"``, the inertia of a uniform bar), evaluated after the
@@ -91,7 +91,7 @@ class Parameter:
     default: float | str
     unit: str
     meaning: str
-    source: str = "MECHANISMS.md"
+    source: str = "project default"
     #: "positive", "nonnegative" or "real": checked on every value (given or derived);
     #: "count": a structural parameter, an integer >= 1 that shapes the mechanism itself
     #: (the number of elements of a discretized continuum): `build` receives it as a

@@ -19,10 +19,10 @@ from .model import (Body, CoordinateForce, Mechanism, Parameter, Prismatic, Rect
                     Revolute, Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the block", "MECHANISMS.md E; Fig. 12"),
-    Parameter("I_G", 0.01, "kg m^2", "central moment of inertia of the block", "MECHANISMS.md E"),
-    Parameter("k", 200.0, "N/m", "spring constant along the arm", "MECHANISMS.md E"),
-    Parameter("rho0", 0.5, "m", "rest position of the block at phi = 0", "MECHANISMS.md E"),
+    Parameter("m", 1.0, "kg", "mass of the block", "Fig. 12"),
+    Parameter("I_G", 0.01, "kg m^2", "central moment of inertia of the block", "project default"),
+    Parameter("k", 200.0, "N/m", "spring constant along the arm", "project default"),
+    Parameter("rho0", 0.5, "m", "rest position of the block at phi = 0", "project default"),
 )
 
 

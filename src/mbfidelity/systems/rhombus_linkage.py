@@ -16,8 +16,7 @@ phi is the angle of the bars OA and BP above the horizontal (counter-clockwise);
 OB and AP make the angle pi - phi. Each bar: mass m, length 2l, central inertia I_G.
 
 Where each choice comes from:
-- Rhombus O-A-P-B with P on the vertical through O: Fig. 13 as described in §4.4 and
-  MECHANISMS.md. Every bar turns at the rate |phi_dot| and the centres of the upper bars
+- Rhombus O-A-P-B with P on the vertical through O: Fig. 13 as described in §4.4. Every bar turns at the rate |phi_dot| and the centres of the upper bars
   are at (+-l cos phi, 3 l sin phi); this gives 4 I_G + (4 + 16 cos^2 phi) m l^2, the
   printed inertia of eq. 34-35, only if phi is measured from the HORIZONTAL.
 - Sense of phi (P above O for phi > 0): the weight of a rhombus whose diagonal OP is
@@ -33,10 +32,9 @@ Where each choice comes from:
   constant 8 m^2 g^2/k: its term 8 m g l (cos phi - sqrt2/2), which no weight can produce,
   is the work of that preload, grouped with the weight. With this free length every
   printed formula of §4.4 follows (phi_eq = 45 deg, eq. 35, 36 and the linearized
-  equation). MECHANISMS.md reads the spring as relaxed at 45 deg instead; then 45 deg is
+  equation). A spring relaxed at 45 deg instead (a reading of §4.4's words alone): then 45 deg is
   not an equilibrium (V'(45 deg) = 4 sqrt2 m g l), the standing rhombus has no equilibrium
-  at the defaults and it hangs at phi ~ -55.2 deg (see the helper's report; the variant is
-  one line in `build`).
+  at the defaults and it hangs far below (the variant is one line in `build`).
 
 Equilibria at the defaults (V = 8 m g l sin phi + k/2 (2 l |cos phi| - l0)^2): 45 deg
 (stable) and 27.6 deg (unstable: the standing rhombus is only held against a collapse
@@ -58,14 +56,14 @@ from .model import (Body, Mechanism, Parameter, PointOnLine, PointOnPoint, Point
                     Revolute, Scenario, Segment, linear_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of each bar", "MECHANISMS.md A; Fig. 13"),
-    Parameter("l", 0.25, "m", "half length of each bar (bars are 2l long)", "MECHANISMS.md A"),
+    Parameter("m", 1.0, "kg", "mass of each bar", "Fig. 13"),
+    Parameter("l", 0.25, "m", "half length of each bar (bars are 2l long)", "project default"),
     Parameter("I_G", "m*(2*l)**2/12", "kg m^2",
               "central moment of inertia of each bar (default: uniform bar, m(2l)^2/12)",
-              "MECHANISMS.md A"),
+              "project default"),
     Parameter("k", 400.0, "N/m",
               "spring constant (free length sqrt2 l - 4 m g/k: tension 4 m g at 45 deg)",
-              "MECHANISMS.md A; eq. 34"),
+              "eq. 34"),
 )
 
 
@@ -158,5 +156,5 @@ SYSTEM = System(
                              "from 0.2 rad above 45 deg the rhombus would collapse)"),
     ),
     notes="spring free length sqrt2 l - 4 m g/k (tension 4 m g at 45 deg), reconstructed "
-          "from eq. 34; MECHANISMS.md's 'relaxed at 45 deg' contradicts every printed formula",
+          "from eq. 34; a spring 'relaxed at 45 deg' contradicts every printed formula",
 )

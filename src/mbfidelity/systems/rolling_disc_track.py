@@ -1,7 +1,7 @@
 """Disc rolling inside an oscillating circular track (monograph §9.8 example 3, Fig. 39,
 eq. 110 and the equations and matrices after it).
 
-Geometry (pinned in MECHANISMS.md, "Pinned geometry: rolling_disc_track")::
+Geometry (pinned by the project: the figure is not in the monograph's text)::
 
       O (world origin): the track's pivot, on the track's rim
       +------------- C = (R cos theta, -R sin theta)   theta turns the track CLOCKWISE
@@ -52,8 +52,8 @@ Contact forces at J:
   least |f|/N: a release from rest far up the track (phi = 1.5 rad with theta = 0.3)
   drives N negative, which is why the large scenario starts at phi = 1.2 rad.
 
-Driving torque T_m(t) of eq. 110: modelled as T_m sin(Omega t) on theta; T_m = 0 by default
-(MECHANISMS.md), Omega is a parameter not in the catalog, needed only to give the torque
+Driving torque T_m(t) of eq. 110: modelled as T_m sin(Omega t) on theta; T_m = 0 by default,
+Omega is a parameter not in the monograph, needed only to give the torque
 input a frequency (H(omega) of the monograph is the linear response to it).
 
 Printed formulas coded below: E_c and E_p of eq. 110, both equations of motion as
@@ -73,26 +73,26 @@ from .model import (COORD, COORD_RATE, TIME, Body, Circle, CoordinateForce, Line
                     Mechanism, Parameter, Revolute, RollingContact, Scenario, Segment)
 
 PARAMETERS = (
-    Parameter("m_p", 4.0, "kg", "mass of the track", "MECHANISMS.md E; Fig. 39"),
-    Parameter("I_p", 0.5, "kg m^2", "central moment of inertia of the track", "MECHANISMS.md E"),
-    Parameter("R", 0.5, "m", "radius of the track (= distance OC)", "MECHANISMS.md E"),
+    Parameter("m_p", 4.0, "kg", "mass of the track", "Fig. 39"),
+    Parameter("I_p", 0.5, "kg m^2", "central moment of inertia of the track", "project default"),
+    Parameter("R", 0.5, "m", "radius of the track (= distance OC)", "project default"),
     Parameter("e", 0.1, "m", "offset of the track's centre of mass from C, perpendicular to OC",
-              "MECHANISMS.md E"),
-    Parameter("m_d", 1.0, "kg", "mass of the disc", "MECHANISMS.md E"),
-    Parameter("r", 0.1, "m", "radius of the disc", "MECHANISMS.md E"),
+              "project default"),
+    Parameter("m_d", 1.0, "kg", "mass of the disc", "project default"),
+    Parameter("r", 0.1, "m", "radius of the disc", "project default"),
     Parameter("I_d", "m_d*r**2/2", "kg m^2",
               "central moment of inertia of the disc (default: uniform disc, m_d r^2/2)",
-              "MECHANISMS.md E"),
-    Parameter("k_t", 50.0, "N m/rad", "torsional spring constant on theta", "MECHANISMS.md E"),
+              "project default"),
+    Parameter("k_t", 50.0, "N m/rad", "torsional spring constant on theta", "project default"),
     Parameter("M0", "(m_p + m_d)*g*R", "N m",
               "spring moment at theta = 0, against theta (default: (m_p + m_d) g R, so that "
-              "theta = 0 is the equilibrium)", "MECHANISMS.md E; Fig. 39", domain="real"),
+              "theta = 0 is the equilibrium)", "Fig. 39", domain="real"),
     Parameter("c_O", 0.5, "N m s", "viscous moment at the pivot O, on theta'",
-              "MECHANISMS.md E", domain="nonnegative"),
+              "project default", domain="nonnegative"),
     Parameter("c_J", 0.05, "N m s", "viscous rolling resistance on theta' + phi'",
-              "MECHANISMS.md E", domain="nonnegative"),
+              "project default", domain="nonnegative"),
     Parameter("T_m", 0.0, "N m", "amplitude of the motor torque T_m(t) = T_m sin(Omega t)",
-              "MECHANISMS.md E (T_m(t) = 0)", domain="real"),
+              "project default (T_m(t) = 0)", domain="real"),
     Parameter("Omega", 5.0, "rad/s", "angular frequency of the motor torque (not in the "
               "catalog: only used when T_m is not 0)", "chosen here"),
 )

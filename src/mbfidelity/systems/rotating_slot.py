@@ -24,12 +24,12 @@ from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, P
                     Prismatic, Rectangle, Revolute, Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("m", 0.5, "kg", "mass of the block", "MECHANISMS.md D; Fig. 29"),
-    Parameter("k", 50.0, "N/m", "spring constant (relaxed at O)", "MECHANISMS.md D; Fig. 29"),
-    Parameter("c", 0.5, "N s/m", "viscous damping along the slot", "MECHANISMS.md D; Fig. 29",
+    Parameter("m", 0.5, "kg", "mass of the block", "Fig. 29"),
+    Parameter("k", 50.0, "N/m", "spring constant (relaxed at O)", "Fig. 29"),
+    Parameter("c", 0.5, "N s/m", "viscous damping along the slot", "Fig. 29",
               domain="nonnegative"),
     Parameter("omega", 5.0, "rad/s", "angular speed of the disc (scenarios: 5, 9.5, 10.5)",
-              "MECHANISMS.md D; eq. 84"),
+              "eq. 84"),
     Parameter("I_d", 0.05, "kg m^2", "moment of inertia of the disc about O (not in the "
               "catalog: it changes the actuator torque only)", "chosen here"),
     Parameter("I_b", 1e-4, "kg m^2", "central moment of inertia of the block (not in the "

@@ -30,15 +30,15 @@ from .model import (LENGTH, Body, Circle, CoordinateForce, Mechanism, Parameter,
 BLOCK_WIDTH = 0.3
 
 PARAMETERS = (
-    Parameter("I_O", 0.005, "kg m^2", "moment of inertia of the disc about O", "MECHANISMS.md A; Fig. 14"),
-    Parameter("m", 1.0, "kg", "mass of the block", "MECHANISMS.md A"),
-    Parameter("r", 0.05, "m", "radius of the pin P", "MECHANISMS.md A; Fig. 16"),
-    Parameter("h", 0.2, "m", "depth of the spring's fixed end below O", "MECHANISMS.md A; Fig. 16"),
-    Parameter("b", 0.1, "m", "distance from the slot to the spring's end on the block", "MECHANISMS.md A"),
-    Parameter("l0", 0.2, "m", "free length of the cot spring", "MECHANISMS.md A"),
-    Parameter("F0", "m*g", "N", "spring constant of eq. 43 (default: m g)", "MECHANISMS.md A"),
+    Parameter("I_O", 0.005, "kg m^2", "moment of inertia of the disc about O", "Fig. 14"),
+    Parameter("m", 1.0, "kg", "mass of the block", "project default"),
+    Parameter("r", 0.05, "m", "radius of the pin P", "Fig. 16"),
+    Parameter("h", 0.2, "m", "depth of the spring's fixed end below O", "Fig. 16"),
+    Parameter("b", 0.1, "m", "distance from the slot to the spring's end on the block", "project default"),
+    Parameter("l0", 0.2, "m", "free length of the cot spring", "project default"),
+    Parameter("F0", "m*g", "N", "spring constant of eq. 43 (default: m g)", "project default"),
     Parameter("c", 0.0, "N s/m", "viscous friction of the block's guide (§7 variant: 0.5)",
-              "MECHANISMS.md A; §7", domain="nonnegative"),
+              "§7", domain="nonnegative"),
 )
 
 

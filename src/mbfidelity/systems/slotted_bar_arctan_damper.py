@@ -1,7 +1,7 @@
 """Slotted bar driving a guided block through an arctangent damper (monograph §7.1,
 Fig. 20).
 
-Geometry (pinned in MECHANISMS.md; the bar hangs down at phi = 0 because the printed
+Geometry (pinned by the project; the bar hangs down at phi = 0 because the printed
 weight potential is m1 g l (1 - cos phi))::
 
             O  pivot of the bar (world origin), phi counter-clockwise from the downward
@@ -44,16 +44,16 @@ SOFT_SLOT_DAMPING = (
 
 PARAMETERS = (
     Parameter("I_O", 0.05, "kg m^2", "moment of inertia of the bar about O",
-              "MECHANISMS.md C; Fig. 20"),
-    Parameter("m1", 1.0, "kg", "mass of the bar", "MECHANISMS.md C; Fig. 20"),
+              "Fig. 20"),
+    Parameter("m1", 1.0, "kg", "mass of the bar", "Fig. 20"),
     Parameter("l", 0.2, "m", "distance from O to the bar's centre of mass",
-              "MECHANISMS.md C; Fig. 20"),
-    Parameter("m2", 0.5, "kg", "mass of the block", "MECHANISMS.md C; Fig. 20"),
-    Parameter("h", 0.3, "m", "depth of the block's guide below O", "MECHANISMS.md C; Fig. 20"),
+              "Fig. 20"),
+    Parameter("m2", 0.5, "kg", "mass of the block", "Fig. 20"),
+    Parameter("h", 0.3, "m", "depth of the block's guide below O", "Fig. 20"),
     Parameter("k", 200.0, "N/m", "spring on the block, relaxed at phi = 0",
-              "MECHANISMS.md C; Fig. 20"),
-    Parameter("F0", 1.0, "N", "saturation force of the arctangent damper", "MECHANISMS.md C; §7.1"),
-    Parameter("v0", 0.1, "m/s", "velocity scale of the arctangent damper", "MECHANISMS.md C; §7.1"),
+              "Fig. 20"),
+    Parameter("F0", 1.0, "N", "saturation force of the arctangent damper", "§7.1"),
+    Parameter("v0", 0.1, "m/s", "velocity scale of the arctangent damper", "§7.1"),
 )
 
 

@@ -25,7 +25,8 @@ of §9.7)::
   offset l from O, i.e. P runs in a fixed vertical slot at x = l and the solid's slot
   passes through O. The §9.7 energies, with O displaced to x, have (l - x) tan(phi):
   the horizontal distance from O to P's slot, which fixes that P's slot is at x = l
-  (MECHANISMS.md says "the same slot"; the printed energies put it a distance l away).
+  (a reading of the figure as "the same slot" would put it at O; the printed energies put
+  it a distance l away).
 - P is massless (no P term in E_c): a massless body on a prismatic joint along x = l
   (coordinate s = its height = the spring's length) and a point-on-line constraint into
   the solid's slot. The spring-damper lies along that prismatic joint, so it is written
@@ -57,17 +58,17 @@ from .model import (COORD, COORD_RATE, Body, Circle, CoordinateForce, Mechanism,
                     PointOnLine, Prismatic, Revolute, Scenario, Segment)
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the solid", "MECHANISMS.md E; Fig. 34"),
+    Parameter("m", 1.0, "kg", "mass of the solid", "Fig. 34"),
     Parameter("I_G", 0.02, "kg m^2", "central moment of inertia of the solid",
-              "MECHANISMS.md E; Fig. 34"),
+              "Fig. 34"),
     Parameter("b", 0.3, "m", "distance from the pin O to the centre of mass G",
-              "MECHANISMS.md E; Fig. 34"),
-    Parameter("k", 400.0, "N/m", "spring constant", "MECHANISMS.md E; Fig. 34"),
-    Parameter("c", 4.0, "N s/m", "damper constant", "MECHANISMS.md E; Fig. 34",
+              "Fig. 34"),
+    Parameter("k", 400.0, "N/m", "spring constant", "Fig. 34"),
+    Parameter("c", 4.0, "N s/m", "damper constant", "Fig. 34",
               domain="nonnegative"),
-    Parameter("l0", 0.3, "m", "free length of the spring", "MECHANISMS.md E; Fig. 34"),
+    Parameter("l0", 0.3, "m", "free length of the spring", "Fig. 34"),
     Parameter("l", 0.2, "m", "horizontal distance between the slots of O and of P",
-              "MECHANISMS.md E; eq. 99 and §9.7"),
+              "eq. 99 and §9.7"),
 )
 
 

@@ -49,16 +49,16 @@ from .model import (GRAVITY, LENGTH, TIME, Body, Mechanism, Parameter, PointToPo
 SPRING_LENGTH = sp.Rational(1, 2)
 
 PARAMETERS = (
-    Parameter("m", 250.0, "kg", "sprung mass (a quarter of the car)", "MECHANISMS.md A; Fig. 4"),
+    Parameter("m", 250.0, "kg", "sprung mass (a quarter of the car)", "Fig. 4"),
     Parameter("k_s", 2e4, "N/m", "small-compression stiffness of the suspension",
-              "MECHANISMS.md A; Fig. 4"),
+              "Fig. 4"),
     Parameter("x_s", 0.1, "m", "compression at which the cubic term equals the linear one "
-              "(hardening)", "MECHANISMS.md A; Fig. 4"),
+              "(hardening)", "Fig. 4"),
     Parameter("Y", 0.01, "m", "amplitude of the road profile y(t) = Y sin(2 pi v t / lam)",
-              "MECHANISMS.md A; Fig. 9", domain="real"),
-    Parameter("v", 20.0, "m/s", "speed of the car along the road", "MECHANISMS.md A; Fig. 9"),
+              "Fig. 9", domain="real"),
+    Parameter("v", 20.0, "m/s", "speed of the car along the road", "Fig. 9"),
     Parameter("lam", 5.0, "m", "wavelength lambda of the road profile (spelled lam: lambda "
-              "is a Python keyword)", "MECHANISMS.md A; Fig. 9"),
+              "is a Python keyword)", "Fig. 9"),
     Parameter("m_P", 30.0, "kg", "mass of the road point / wheel P that the road moves (not "
               "in the catalog: the engines need a body to drive; it changes the actuator "
               "force only)", "chosen here"),

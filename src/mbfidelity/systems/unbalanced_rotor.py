@@ -19,17 +19,17 @@ from .model import (TIME, Body, Circle, CoordinateForce, Mechanism, Parameter, P
                     Prismatic, Rectangle, Revolute, Scenario, coordinate_spring_damper)
 
 PARAMETERS = (
-    Parameter("M", 10.0, "kg", "mass of the frame (rotor excluded)", "MECHANISMS.md D; Fig. 31"),
-    Parameter("m", 1.0, "kg", "mass of the rotor", "MECHANISMS.md D; Fig. 31"),
+    Parameter("M", 10.0, "kg", "mass of the frame (rotor excluded)", "Fig. 31"),
+    Parameter("m", 1.0, "kg", "mass of the rotor", "Fig. 31"),
     Parameter("e", 0.001, "m", "eccentricity of the rotor's centre of mass",
-              "MECHANISMS.md D; Fig. 31", domain="nonnegative"),
-    Parameter("k", 1e5, "N/m", "spring constant", "MECHANISMS.md D; Fig. 31"),
-    Parameter("c", 50.0, "N s/m", "viscous damping", "MECHANISMS.md D; Fig. 31",
+              "Fig. 31", domain="nonnegative"),
+    Parameter("k", 1e5, "N/m", "spring constant", "Fig. 31"),
+    Parameter("c", 50.0, "N s/m", "viscous damping", "Fig. 31",
               domain="nonnegative"),
     Parameter("ratio", 1.0, "1", "rotor speed over the natural frequency sqrt(k/(M + m)) "
-              "(the scenarios span 0.5-2)", "MECHANISMS.md D"),
+              "(the scenarios span 0.5-2)", "project default"),
     Parameter("omega", "ratio*sqrt(k/(M + m))", "rad/s", "angular speed of the rotor",
-              "MECHANISMS.md D"),
+              "project default"),
     Parameter("I_r", 1e-3, "kg m^2", "central moment of inertia of the rotor (not in the "
               "catalog: it changes the actuator torque only)", "chosen here"),
 )

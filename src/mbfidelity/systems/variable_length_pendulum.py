@@ -37,15 +37,15 @@ PYBULLET_TIME_VARYING_INERTIA = (
     "every step (the error and the gate both halve with the step).")
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the particle", "MECHANISMS.md A; Fig. 11"),
+    Parameter("m", 1.0, "kg", "mass of the particle", "Fig. 11"),
     Parameter("I_G", 1e-5, "kg m^2", "central inertia of the particle (not in the catalog: "
               "the engines need one; the printed equations take it zero)", "chosen here"),
-    Parameter("l0", 1.0, "m", "free length of the string with h = 0", "MECHANISMS.md A; Fig. 11"),
+    Parameter("l0", 1.0, "m", "free length of the string with h = 0", "Fig. 11"),
     Parameter("h_a", 0.05, "m", "amplitude of the end's height h(t) = h_a sin(Omega t)",
-              "MECHANISMS.md A", domain="real"),
+              "project default", domain="real"),
     Parameter("Omega", "2*sqrt(g/l0)", "rad/s", "angular frequency of h(t) (twice the "
-              "small-swing frequency: parametric resonance)", "MECHANISMS.md A"),
-    Parameter("phi0", 0.05, "rad", "initial angle, released from rest", "MECHANISMS.md A",
+              "small-swing frequency: parametric resonance)", "project default"),
+    Parameter("phi0", 0.05, "rad", "initial angle, released from rest", "project default",
               domain="real"),
 )
 

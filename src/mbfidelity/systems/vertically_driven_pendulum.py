@@ -49,18 +49,18 @@ PYBULLET_VERTICAL_MOTOR = (
 RESONANT_OMEGA = 2 * (1.0 * 9.81 * 0.2 / (0.001 + 1.0 * 0.2**2)) ** 0.5
 
 PARAMETERS = (
-    Parameter("m", 1.0, "kg", "mass of the pendulum", "MECHANISMS.md D; Fig. 27"),
+    Parameter("m", 1.0, "kg", "mass of the pendulum", "Fig. 27"),
     Parameter("l", 0.2, "m", "distance from the pivot O to the centre of mass G",
-              "MECHANISMS.md D; Fig. 27"),
+              "Fig. 27"),
     Parameter("I_G", 0.001, "kg m^2", "central moment of inertia of the pendulum",
-              "MECHANISMS.md D; eq. 80"),
+              "eq. 80"),
     Parameter("m_c", 0.5, "kg", "mass of the carriage that carries the pivot (not in the "
               "catalog: the engines need a body to drive; it changes the actuator force only)",
               "chosen here"),
     Parameter("Y", 0.01, "m", "amplitude of the pivot motion y(t) = Y cos(Omega t)",
-              "MECHANISMS.md D", domain="real"),
+              "project default", domain="real"),
     Parameter("Omega", 2 * math.pi * 50, "rad/s", "angular frequency of the pivot motion",
-              "MECHANISMS.md D"),
+              "project default"),
     Parameter("phi0", 0.05, "rad", "initial angle (released from rest), measured from the "
               "rest state the scenario starts near", "chosen here", domain="real"),
 )
