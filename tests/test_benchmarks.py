@@ -184,3 +184,41 @@ def test_analyze_reports_the_published_values():
     level = analyze(A01, {"g": 0.0})["published"]
     assert level and not any(p["applies"] for p in level)
     assert all("g > 0" in p["note"] for p in level)
+
+
+def test_the_mechanism_page_shows_the_published_solutions():
+    """The run saves the published comparison with the system (results_folder) and the
+    page lists it: A03's seven angles at t = 0.03 s, each within 1e-9 relative of the
+    reference (the acceptance's bound). The test set's values differ from the reference by
+    more than the reference's own error estimate (the reference is stable under tighter
+    tolerances; the source's solution is itself numerical): the page flags each such row
+    and gives the source's account beside it; a row within the estimate is marked as
+    agreeing, and a misprint injected into one value is flagged."""
+    from mbfidelity.comparisons.results_folder import published_solutions
+    from markupsafe import escape
+
+    from mbfidelity.reports import site
+
+    entries = published_solutions(get_system(A03))
+    angles = [p for p in entries if p["applies"] and p["time"] == 0.03
+              and not p["quantity"].endswith("_dot")]
+    assert len(angles) == 7
+    assert all(p["relative_difference"] < 1e-9 for p in angles)
+
+    def page(published):
+        return site.MECHANISM.render(
+            style="", system=A03, title="", source="", drawing="", model={}, errata=[],
+            published=published, sections=[], errata_page=False, script="", convergence="")
+
+    shown = page(entries)
+    assert "<h2>Published solutions</h2>" in shown
+    flagged = [p for p in entries if p["applies"] and p["beyond_reference_error"]]
+    assert shown.count('<tr class="fail">') == len(flagged)
+    assert shown.count('<tr class="pass">') == sum(
+        1 for p in entries if p["applies"] and not p["beyond_reference_error"])
+    assert all(p["note"] for p in flagged) and str(escape(flagged[0]["note"])) in shown
+    within = dict(angles[0], beyond_reference_error=False)
+    misprint = dict(within, published_value=within["published_value"] * 1.001,
+                    relative_difference=1e-3, beyond_reference_error=True)
+    assert page([within]).count('<tr class="pass">') == 1
+    assert page([misprint]).count('<tr class="fail">') == 1

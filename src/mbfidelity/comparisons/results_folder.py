@@ -38,6 +38,7 @@ import sympy as sp
 from ..analytic.errata import errata
 from ..analytic.linear import operating_equilibrium
 from ..analytic.numeric import numeric_model
+from ..analytic.published import compare_published
 from ..simulators import all_backends
 from ..systems import get_system
 from ..systems.model import WORLD, Circle, Rectangle, Segment
@@ -300,14 +301,28 @@ def save_system(out: Path, system_id: str) -> None:
     doc = {"drawing": mechanism_geometry(system_id),
            "model": typeset.model_document(system_id),
            "errata": with_typeset([e.as_dict() for e in errata(system)])
-           + typeset.section6_entries(system_id)}
+           + typeset.section6_entries(system_id),
+           "published": published_solutions(system)}
     path = out / REPORT_DATA / f"{system_id}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     _write_json(path, doc)
 
 
+def published_solutions(system) -> list[dict]:
+    """The values a benchmark's sources publish against the reference at the run's
+    (default) parameters (analytic/published.py); a comparison that cannot be made is one
+    entry saying why, so that the page shows it instead of losing the rest."""
+    if not system.published(system.symbols):
+        return []
+    try:
+        return compare_published(system, system.parameter_values())
+    except Exception as exc:  # noqa: BLE001 - shown on the page, the run goes on
+        return [{"quantity": "*", "error": f"{type(exc).__name__}: {exc}"}]
+
+
 def load_system(out: Path, system_id: str) -> dict:
-    """{"drawing": ..., "model": ..., "errata": [...]} as `save_system` saved them."""
+    """{"drawing": ..., "model": ..., "errata": [...], "published": [...]} as
+    `save_system` saved them."""
     return json.loads((out / REPORT_DATA / f"{system_id}.json").read_text())
 
 

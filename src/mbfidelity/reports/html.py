@@ -173,6 +173,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
         (out / site.page_name(system)).write_text(site.MECHANISM.render(
             style=site.STYLE, system=system, title=described.title, source=described.source,
             drawing=drawing, model=files.get("model", {}), errata=files.get("errata", []),
+            published=files.get("published", []),
             sections=sections, errata_page=errata_page, script=script,
             convergence=convergence.name if convergence.exists() else ""))
     if errata_page:  # (again) now that it can link the mechanism pages

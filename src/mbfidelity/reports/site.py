@@ -113,6 +113,15 @@ its incidents below).</p>{% else %}
 {% else %}<p>{{ model.get("operating_point_note", "")|e }}</p>{% endif %}
 {% if model.get("equilibria") %}<h3>Equilibria found</h3><table><tr><th>equilibrium</th><th>stable</th><th>frequencies (Hz)</th></tr>
 {% for e in model.equilibria %}<tr><td>{{ e.q }}</td><td>{{ "yes" if e.stable else "no" }}</td><td>{{ e.frequencies_hz|map("round", 6)|join(", ") }}</td></tr>{% endfor %}</table>{% endif %}{% endif %}
+{% if published %}<h2>Published solutions</h2>
+<p>What the problem's sources publish, against the derived reference at these parameters.
+A difference within the reference's own error estimate (its change from its tolerance to a
+ten times looser one) is the published value's rounding; one beyond it is flagged, with the
+source's account where it gives one.</p>
+<table><tr><th>quantity</th><th>t (s)</th><th>published</th><th>reference</th><th>relative difference</th><th>reference error</th><th>source</th></tr>
+{% for p in published %}{% if p.get("error") %}<tr class="fail"><td colspan="7">not compared: {{ p.error|e }}</td></tr>
+{% elif not p.applies %}<tr><td>{{ p.quantity|e }}</td><td>{{ p.time if p.time is not none else "" }}</td><td colspan="4">{{ p.get("note", "")|e }}</td><td>{{ p.source|e }}</td></tr>
+{% else %}<tr class="{{ 'fail' if p.beyond_reference_error else 'pass' }}"><td>{{ p.quantity|e }}{% if p.get("note") %}<br><small>{{ p.note|e }}</small>{% endif %}</td><td>{{ p.time if p.time is not none else "(period)" }}</td><td>{{ "%.12g"|format(p.published_value) }}</td><td>{{ "%.12g"|format(p.reference_value) }}</td><td>{{ "%.2e"|format(p.relative_difference) }}</td><td>{{ "%.1e"|format(p.reference_error) }}</td><td>{{ p.source|e }}</td></tr>{% endif %}{% endfor %}</table>{% endif %}
 {% if errata %}<h2>The printed formulas beside the derived ones</h2>
 <p>Terms found on one side only are marked; printed equations of motion are first scaled to the
 derived row's normalisation. A formula agrees when it matches the derivation to 1e-9 relative
