@@ -97,6 +97,7 @@ first order (semi-implicit Euler with velocity-level constraints).
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
@@ -1779,40 +1780,48 @@ class PymunkBackend(Backend):
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         n_steps: int, dt: float, cfg: dict) -> BareLoop:
         """The space of `simulate` stepped with only its element forces: those need the
-        state at the start of each step, the rest runs step after step."""
-        h = float(dt)
+        state at the start of each step, the rest runs step after step. Angles of
+        eliminated links (read by atan2) are given on the branch nearest the start."""
+        run = self._run(mechanism, q0, qd0, n_steps, float(dt), cfg, record=False)
+        q, qd = self._coordinates(run.mechanism, run.comp, np.array([run.read()]), q0,
+                                  np.array([n_steps * float(dt)]))
+        return BareLoop(run.clock.cpu, q[0], qd[0])
+
+    def _run(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, n_steps: int,
+             h: float, cfg: dict, record: bool) -> SimpleNamespace:
+        """Build the space and take `n_steps` steps of `h`, timed; with `record` every
+        sample's body states are read (`rows`), otherwise only what the element forces
+        need. Returns the run's parts: mechanism (as balanced), comp, clock, read, rows,
+        H and shift (where the loads are evaluated)."""
         layout, comp, space, bodies, mechanism, movers = self._prepare(mechanism, q0, qd0, cfg, h)
+        # loads at x + h v and t + h (see setting notes), or at the sampled state
         H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
+        read = self._reader(space, layout, bodies)
+        rows = [read()] if record else []
         step = space.step
         loads = comp.loads_math
         targets = [bodies[k] for k in comp.loaded]
         schedule = self._schedule(mechanism, layout, movers, n_steps, h, dict(
             zip(layout.engine, bodies)))
         iterations = int(cfg["iterations"])
+        # the first step has no cached impulses to start from (see start_iterations)
         space.iterations = max(iterations, int(cfg["start_iterations"]))
         with Stopwatch() as clock:
-            if loads is None:
-                for k in range(n_steps):
-                    for constraint, attribute, values in schedule:
-                        setattr(constraint, attribute, values[k])
-                    step(h)
-                    if k == 0:
-                        space.iterations = iterations
-            else:
-                read = self._reader(space, layout, bodies)
-                for k in range(n_steps):
-                    out = loads(*read(), H, (k + shift) * h)
+            for k in range(n_steps):
+                if loads is not None:
+                    out = loads(*(rows[-1] if record else read()), H, (k + shift) * h)
                     for i, b in enumerate(targets):
                         b.force = (out[3 * i], out[3 * i + 1])
                         b.torque = out[3 * i + 2]
-                    for constraint, attribute, values in schedule:
-                        setattr(constraint, attribute, values[k])
-                    step(h)
-                    if k == 0:
-                        space.iterations = iterations
-        q, qd = self._coordinates(mechanism, comp, np.array([self._reader(space, layout, bodies)()]),
-                                  q0, np.array([n_steps * h]))
-        return BareLoop(clock.cpu, q[0], qd[0])
+                for constraint, attribute, values in schedule:
+                    setattr(constraint, attribute, values[k])
+                step(h)
+                if record:
+                    rows.append(read())
+                if k == 0:
+                    space.iterations = iterations
+        return SimpleNamespace(mechanism=mechanism, comp=comp, clock=clock, read=read,
+                               rows=rows, H=H, shift=shift)
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
@@ -1856,41 +1865,9 @@ class PymunkBackend(Backend):
                        n_steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
         h = float(dt)
-        layout, comp, space, bodies, mechanism, movers = self._prepare(mechanism, q0, qd0, cfg, h)
-        # loads at x + h v and t + h (see setting notes), or at the sampled state
-        H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
-        read = self._reader(space, layout, bodies)
-        rows = [read()]
-        step = space.step
-        loads = comp.loads_math
-        targets = [bodies[k] for k in comp.loaded]
-        schedule = self._schedule(mechanism, layout, movers, n_steps, h, dict(
-            zip(layout.engine, bodies)))
-        iterations = int(cfg["iterations"])
-        # the first step has no cached impulses to start from (see start_iterations)
-        space.iterations = max(iterations, int(cfg["start_iterations"]))
-        with Stopwatch() as clock:
-            if loads is None:
-                for k in range(n_steps):
-                    for constraint, attribute, values in schedule:
-                        setattr(constraint, attribute, values[k])
-                    step(h)
-                    rows.append(read())
-                    if k == 0:
-                        space.iterations = iterations
-            else:
-                for k in range(n_steps):
-                    out = loads(*rows[-1], H, (k + shift) * h)
-                    for i, b in enumerate(targets):
-                        b.force = (out[3 * i], out[3 * i + 1])
-                        b.torque = out[3 * i + 2]
-                    for constraint, attribute, values in schedule:
-                        setattr(constraint, attribute, values[k])
-                    step(h)
-                    rows.append(read())
-                    if k == 0:
-                        space.iterations = iterations
-
+        run = self._run(mechanism, q0, qd0, n_steps, h, cfg, record=True)
+        mechanism, comp, clock, rows, H, shift = (run.mechanism, run.comp, run.clock,
+                                                  run.rows, run.H, run.shift)
         S = np.array(rows)
         t = np.arange(n_steps + 1) * h
         q, qd = self._coordinates(mechanism, comp, S, q0, t)
