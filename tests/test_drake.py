@@ -122,3 +122,44 @@ def test_the_exported_script_rebuilds_the_simulated_plant(tmp_path):
     run = backend.simulate(mech, q0, qd0, 1.0, 1e-3)
     assert list(printed) == list(system.coordinates)
     np.testing.assert_allclose(list(printed.values()), run.q[-1], rtol=0, atol=1e-12)
+
+
+def test_the_error_falls_with_the_target_accuracy_down_to_a_model_errors_floor():
+    """The convergence study's knob for Drake is its target accuracy (comparisons/
+    convergence.py). On Fig. 7's pendulum (exact elliptic reference) the error falls by
+    at least MIN_ACCURACY_DECREASE per decade over the judged accuracies (the gate
+    passes). With the engine's mass a millionth heavier (its build only) the error stops
+    falling at that model's own distance from the true motion (the exact models of both
+    masses, an independent measure), and the gate rejects the curve."""
+    from mbfidelity.analytic.reference import reference
+    from mbfidelity.comparisons import metrics
+    from mbfidelity.comparisons.convergence import (ACCURACY_METRIC, DEFAULT_STEPS,
+                                                    MIN_FIT_POINTS, convergence, judge_order)
+
+    _drake()
+    true = convergence("compound_pendulum", "drake")
+    assert true.knob == "accuracy" and len(true.judged_accuracies) >= MIN_FIT_POINTS
+    metric = judge_order(true)
+    assert metric.name == ACCURACY_METRIC and metric.status == "pass", true.as_dict()
+    assert metric.value <= 1 / tolerances.MIN_ACCURACY_DECREASE
+    errors = [p.error for p in true.points if p.accuracy in true.judged_accuracies]
+    assert all(b < a for a, b in zip(errors, errors[1:]))  # monotone where judged
+
+    heavier = convergence("compound_pendulum", "drake", engine_scale={"m": 1 + 1e-6})
+    wrong = judge_order(heavier)
+    assert wrong.status == "fail" and wrong.value > 1 / tolerances.MIN_ACCURACY_DECREASE
+    # the floor: the exact motion of the heavier pendulum against the true one, sampled
+    # as the study samples
+    system = get_system("compound_pendulum")
+    sc = system.scenarios[0]
+    values = system.parameter_values(scenario=sc)
+    k = int(round(heavier.points[0].dt / DEFAULT_STEPS[2]))
+    exact = reference(system, sc, values, DEFAULT_STEPS[2], 2.0)
+    model = reference(system, sc, {**values, "m": values["m"] * (1 + 1e-6)},
+                      DEFAULT_STEPS[2], 2.0)
+    floor, _ = metrics.trajectory_errors(model.q[::k], exact.q[::k],
+                                         metrics.amplitude(exact.q, np.zeros(1)))
+    # by the triangle inequality they differ by at most Drake's own error on the heavier
+    # model, about its error on the true one (a millionth apart): twice that bounds it
+    assert abs(heavier.points[-1].error - floor) <= 2 * true.points[-1].error
+    assert floor > 1e3 * true.points[-1].error  # the floor is the model's, not Drake's

@@ -449,11 +449,13 @@ def discretization(system_id: str, params: Mapping[str, float] | None = None,
 
 def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
                 steps: Iterable[float] | None = None, t_end: float = 2.0, *,
-                scheduler: str | None = None, out: str | Path | None = None) -> dict:
+                scheduler: str | None = None, out: str | Path | None = None,
+                knob: str = "auto") -> dict:
     """Error against the step and work-precision for every system x engine (default:
-    every installed engine), the fitted order against the declared one; `failed` lists
-    the studies whose order gate fails. With `out`, convergence.json, its page and
-    figures are written there."""
+    every installed engine), the fitted order against the declared one; an
+    error-controlled engine by its target accuracy (`knob` "auto"; "step" runs it at
+    fixed steps too); `failed` lists the studies whose gate fails. With `out`,
+    convergence.json, its page and figures are written there."""
     import json
 
     import numpy as np
@@ -477,8 +479,13 @@ def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None
     checked_duration("t_end", t_end)
     if out is not None:
         out = checked_output_folder(out)
-    studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler)
+    if knob not in ("auto", "step"):
+        raise ValueError(f"the knob is 'auto' or 'step'; got {knob!r}")
+    studies = conv.convergence_matrix(sys_ids, sim_ids, dts, t_end, scheduler=scheduler,
+                                      knob=knob)
     doc = {"provenance": provenance(), "steps": dts or "automatic", "t_end": t_end,
+           "knob": knob, "accuracies": list(conv.DEFAULT_ACCURACIES),
+           "min_accuracy_decrease": conv.tolerances.MIN_ACCURACY_DECREASE,
            "order_tolerance": conv.ORDER_TOLERANCE, "min_decrease": conv.MIN_DECREASE,
            "reference_margin": conv.REFERENCE_MARGIN, "studies": studies}
     doc["failed"] = [f"{s['system']}/{s['simulator']}" for s in studies

@@ -556,6 +556,10 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
                                               "default: 4, 2, 1, 0.5 ms, scaled down for a "
                                               "fast motion)"),
                     t_end: float = typer.Option(2.0, "--t-end", help="simulated time, s"),
+                    knob: str = typer.Option(
+                        "auto", "--knob", help="auto: an error-controlled engine (drake) "
+                                               "by its target accuracy, the others by the "
+                                               "step; step: every engine by the step"),
                     out: Optional[Path] = typer.Option(
                         None, "--out", callback=_out_folder, help="also write convergence.json, convergence.html "
                                             "and the figures there"),
@@ -565,8 +569,9 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
                     as_json: bool = typer.Option(False, "--json"),
                     ) -> None:
     """Error against the step and work-precision, per system x engine: the fitted order
-    next to the engine's declared order (gate: within 0.5, where the curve still falls).
-    Exit 1 when an order gate fails."""
+    next to the engine's declared order (gate: within 0.5, where the curve still falls);
+    an error-controlled engine's error against its target accuracy (gate: it falls by 2
+    per decade down to the reference's floor). Exit 1 when a gate fails."""
     from . import api
 
     dts = None
@@ -577,7 +582,7 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
             _fail(f"--steps expects numbers A,B,...; got {steps!r}")
     try:
         doc = api.convergence(_split(systems) or None, _split(sims) or None, dts, t_end,
-                              scheduler=scheduler, out=out)
+                              scheduler=scheduler, out=out, knob=knob)
     except ValueError as exc:
         _fail(str(exc))
     studies, failed = doc["studies"], doc["failed"]
@@ -587,6 +592,12 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
         _json(doc)
     else:
         for s in studies:
+            if s["knob"] == "accuracy":
+                worst = s["worst_decrease"]
+                typer.echo(f"{s['system']:28s} {s['simulator']:9s} error ratio per accuracy "
+                           f"decade {'-' if worst is None else f'{worst:.2g}'} / "
+                           f"{s['metric']['tolerance']:g}  {s['metric']['status']}")
+                continue
             order = (f"{s['observed_order']:.2f}" if s["observed_order"] is not None else "-")
             typer.echo(f"{s['system']:28s} {s['simulator']:9s} order {order:>5s} / "
                        f"{s['integrator_order']}  {s['metric']['status']}")

@@ -17,7 +17,22 @@ needs `MIN_FIT_POINTS` of them; otherwise the order is not judged (`flattened`, 
 unresolved). The judged metric ``convergence.order`` is |fitted - declared| against
 ORDER_TOLERANCE, with the expectations of comparisons (a system's or a backend's
 declaration of the metric). Every mechanism x engine is one item of the sweep facility
-(comparisons/sweep.py)."""
+(comparisons/sweep.py).
+
+An engine that chooses its own steps (an error-controlled integrator: the backend's
+`ACCURACY_SETTING`) is studied by its knob instead, the target accuracy eps, swept by
+decades (DEFAULT_ACCURACIES) at one sampling step, its CPU seconds on the same
+work-precision figure as the fixed-step engines' (the knob "step" runs it at a fixed step
+under the backend's CONVERGENCE_SETTINGS, as the others). The sampling step is about 1/w
+(`accuracy_sampling_step`), so that the controller, not the sampling, sets the steps
+over the whole sweep. The judged metric ``convergence.accuracy`` is the largest ratio
+e(eps / 10) / e(eps) over the judged decades, against 1 / MIN_ACCURACY_DECREASE: the
+error must fall with the accuracy until it reaches the reference's floor
+(comparisons/tolerances.py gives the rule, its reason and its range: the mean step
+T/N within w h <= asymptotic_limit, ACCURACY_CONTROLLED_STEPS steps per sample at
+least). A model error stops the fall at its own floor, above the reference's, and fails
+it. The slope of log(error) against log(eps) over the judged points is reported
+(between q/(q+1) and 1 for an error estimate of order q)."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
@@ -49,6 +64,13 @@ REFERENCE_MARGIN = 3.0
 DEFAULT_T_END = 2.0
 #: the name of the judged metric
 ORDER_METRIC = "convergence.order"
+#: the judged metric of an error-controlled engine's study
+ACCURACY_METRIC = "convergence.accuracy"
+#: the target accuracies of an error-controlled engine's study, loose to tight
+DEFAULT_ACCURACIES = tuple(10.0 ** -k for k in range(4, 13))
+#: an accuracy study samples at about 1/w (w dt = SAMPLING_WH), at least MIN_SAMPLES times
+SAMPLING_WH = 1.0
+MIN_SAMPLES = 20
 
 
 @dataclass
@@ -57,7 +79,10 @@ class ConvergencePoint:
     error: float          # max |q - q_ref| / amplitude
     wall_time: float      # s of stepping
     cpu_time: float       # CPU s of stepping
-    steps: int
+    steps: int            # samples
+    #: an accuracy study's target accuracy and the steps its integrator took (else None)
+    accuracy: float | None = None
+    integrator_steps: int | None = None
 
 
 @dataclass
@@ -84,6 +109,13 @@ class ConvergenceStudy:
     #: the motion's fastest angular frequency w (rad/s): steps with w h beyond the
     #: scheme's asymptotic range are not fitted
     frequency: float = 0.0
+    #: the study's knob: "step" (fixed steps) or "accuracy" (an error-controlled engine)
+    knob: str = "step"
+    #: an accuracy study's judged accuracies (where the rule holds, above the floor), the
+    #: largest error ratio per decade over them, and the slope of log(error) on log(eps)
+    judged_accuracies: list[float] = field(default_factory=list)
+    worst_decrease: float | None = None
+    accuracy_slope: float | None = None
 
     @property
     def order_matches(self) -> bool | None:
@@ -130,20 +162,29 @@ def automatic_steps(w: float, order: int) -> tuple[float, ...]:
 
 def convergence(system_id: str, simulator: str, scenario: str | None = None,
                 dts: Sequence[float] | None = None, t_end: float | None = DEFAULT_T_END,
-                settings: Mapping | None = None) -> ConvergenceStudy:
+                settings: Mapping | None = None, knob: str = "auto",
+                accuracies: Sequence[float] | None = None,
+                engine_scale: Mapping[str, float] | None = None) -> ConvergenceStudy:
     """The study of one engine on one scenario (default: the system's first), over
     `t_end` seconds (None: the scenario's), at the steps `dts` (None: `automatic_steps`
     for the motion's fastest frequency). Steps outside the asymptotic range are run and
-    shown but not fitted."""
+    shown but not fitted. `knob` "auto" studies an error-controlled engine by its target
+    accuracy (`accuracies`, default DEFAULT_ACCURACIES) and the others by the step;
+    "step" studies every engine by the step. `engine_scale` multiplies parameters in the
+    engine's build only (an injected model error; the reference keeps the true values)."""
     from ..analytic.steady_state import excitation_frequencies
     from .runner import characteristic_frequency
 
+    if knob not in ("auto", "step"):
+        raise ValueError(f"the knob is 'auto' or 'step'; got {knob!r}")
     system = get_system(system_id)
     sc = system.scenario(scenario) if scenario else system.scenarios[0]
     values = system.parameter_values(scenario=sc)
     backend = get_backend(simulator)
-    settings = {**backend.CONVERGENCE_SETTINGS, **(settings or {})}
-    mech = system.numeric_mechanism(values)
+    by_accuracy = knob == "auto" and bool(backend.ACCURACY_SETTING)
+    settings = {**({} if by_accuracy else backend.CONVERGENCE_SETTINGS), **(settings or {})}
+    scale = engine_scale or {}
+    mech = system.numeric_mechanism({k: v * scale.get(k, 1.0) for k, v in values.items()})
     eq = operating_equilibrium(system, values)
     T = sc.t_end if t_end is None else min(t_end, sc.t_end)
     support = backend.support(mech)
@@ -156,6 +197,9 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     w = characteristic_frequency(eq.modes, probe.q[:, free], probe.qd[:, free], eq.q[free])
     if system.driven:
         w = max([w] + excitation_frequencies(system, values))
+    if by_accuracy:
+        return _accuracy_study(system, sc.name, backend, mech, probe, free, eq.q[free], w,
+                               T, order, settings, accuracies or DEFAULT_ACCURACIES)
     dts = tuple(sorted(dts if dts is not None else automatic_steps(w, max(order, 1)),
                        reverse=True))
     finest = min(dts)
@@ -208,10 +252,117 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     return study
 
 
+def accuracy_sampling_step(w: float, t_end: float, finest: float) -> float:
+    """The sampling step of an accuracy study: about SAMPLING_WH / w, at most t_end /
+    MIN_SAMPLES, a multiple of the reference's step `finest`. The integrator's steps end
+    on the samples, so a sampling step well above the controller's keeps the sampling from
+    setting the steps."""
+    wanted = min(SAMPLING_WH / w if w > 0 else t_end, t_end / MIN_SAMPLES)
+    return max(1, int(wanted / finest + 1e-9)) * finest
+
+
+def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
+                    q_eq: np.ndarray,
+                    w: float, T: float, order: int, settings: Mapping,
+                    accuracies: Sequence[float]) -> ConvergenceStudy:
+    """An error-controlled engine's study: its error at each target accuracy (loose to
+    tight), sampled every `accuracy_sampling_step`, against the reference `ref` (sampled
+    at DEFAULT_STEPS[2]), judged by the rule of tolerances.MIN_ACCURACY_DECREASE."""
+    finest = DEFAULT_STEPS[2]
+    dt = accuracy_sampling_step(w, T, finest)
+    k = int(round(dt / finest))
+    scale = metrics.amplitude(ref.q[:, free], q_eq)
+    exact = ref.method.startswith("closed form")
+    reference_error = 0.0 if exact else float(
+        np.max(np.asarray(ref.error_estimate)[free] / scale) * TIGHT / LOOSE)
+    points: list[ConvergencePoint] = []
+    study = ConvergenceStudy(system.id, scenario, backend.id,
+                             backend.version(), order, points, None,
+                             reference_error=reference_error, frequency=w, knob="accuracy")
+    support = backend.support(mech)
+    if not support.ok:
+        study.unsupported = f"{backend.id} cannot express {system.id}: {support.reason}"
+        return study
+    q_ref = ref.q[::k, free]
+    for eps in sorted(accuracies, reverse=True):
+        try:
+            run = backend.simulate(mech, ref.q[0], ref.qd[0], T, dt,
+                                   {**settings, backend.ACCURACY_SETTING: float(eps)})
+        except Exception as exc:  # an engine's failure is a result of the study
+            study.failure = f"accuracy {eps:g}: {type(exc).__name__}: {exc}"
+            return study
+        n = min(len(run.t), len(q_ref))
+        err, _ = metrics.trajectory_errors(run.q[:n, free], q_ref[:n], scale)
+        taken = run.error_control.steps if run.error_control else n - 1
+        points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1,
+                                       float(eps), int(taken)))
+        study.integrator_order = run.integrator_order
+    _judge_accuracy_points(study, T)
+    return study
+
+
+def _judge_accuracy_points(study: ConvergenceStudy, T: float) -> None:
+    """The rule of tolerances.MIN_ACCURACY_DECREASE on the study's points, in place: the
+    judged points (the controller's steps asymptotic and its own), the largest error
+    ratio per decade among them while above the reference's floor, and the slope."""
+    limit = tolerances.asymptotic_limit(study.integrator_order)
+    floor = REFERENCE_MARGIN * study.reference_error
+    judged = [p for p in study.points
+              if p.integrator_steps >= tolerances.ACCURACY_CONTROLLED_STEPS * p.steps
+              and study.frequency * T / p.integrator_steps <= limit * (1 + 1e-9)]
+    ratios, above = [], judged[:1]
+    for a, b in zip(judged, judged[1:]):
+        if not (np.isfinite(a.error) and a.error > floor):
+            break
+        above.append(b)
+        if not (np.isfinite(b.error) and b.error <= floor):  # reaching the floor is falling
+            decades = np.log10(a.accuracy / b.accuracy)
+            ratios.append((b.error / a.error) ** (1.0 / decades) if np.isfinite(b.error)
+                          else float("inf"))
+    study.judged_accuracies = [p.accuracy for p in above]
+    if len(above) < MIN_FIT_POINTS or not ratios:
+        study.flattened = (
+            f"{len(judged)} of {len(study.points)} accuracies where the controller sets "
+            f"asymptotic steps (mean step T/N with w h <= {limit:g}, w = "
+            f"{study.frequency:.4g} rad/s, and at least "
+            f"{tolerances.ACCURACY_CONTROLLED_STEPS:g} steps per sample), "
+            f"{len(above)} of them from above the reference's floor "
+            f"{floor:.2g}: {MIN_FIT_POINTS} needed")
+        return
+    study.worst_decrease = float(max(ratios))
+    fitted = [p for p in above if p.error > floor]
+    if len(fitted) >= 2:
+        study.accuracy_slope = observed_order([p.accuracy for p in fitted],
+                                              [p.error for p in fitted])
+
+
+def judge_accuracy(study: ConvergenceStudy) -> Metric:
+    """The metric ``convergence.accuracy`` of an accuracy study: the largest error ratio
+    per decade of accuracy against 1 / MIN_ACCURACY_DECREASE; unresolved where too few
+    accuracies are judged."""
+    system = get_system(study.system)
+    tolerance = 1.0 / tolerances.MIN_ACCURACY_DECREASE
+    if study.unsupported:
+        return Metric(ACCURACY_METRIC, float("nan"), tolerance, False, "unsupported",
+                      study.unsupported, "ratio")
+    if study.failure:
+        return Metric(ACCURACY_METRIC, float("nan"), tolerance, False, "fail",
+                      study.failure, "ratio")
+    value = float("nan") if study.worst_decrease is None else study.worst_decrease
+    metric = _judge(system, study.simulator, ACCURACY_METRIC, value,
+                    tolerances.Gate(tolerance, study.flattened), "ratio")
+    if metric.status == "pass" and metric.reason:
+        metric.status = "xpass"
+    return metric
+
+
 def judge_order(study: ConvergenceStudy) -> Metric:
     """The metric ``convergence.order``: |fitted - declared order| against
     ORDER_TOLERANCE; unresolved where the curve flattened; failed for a failed study. A
-    declared expected failure that passes is an unexpected pass (strict)."""
+    declared expected failure that passes is an unexpected pass (strict). An accuracy
+    study is judged by `judge_accuracy`."""
+    if study.knob == "accuracy":
+        return judge_accuracy(study)
     system = get_system(study.system)
     if study.unsupported:
         return Metric(ORDER_METRIC, float("nan"), ORDER_TOLERANCE, False, "unsupported",
@@ -236,9 +387,9 @@ def judge_order(study: ConvergenceStudy) -> Metric:
 
 def _study_item(item: tuple) -> dict:
     """One system x engine (`dts` None: automatic steps)."""
-    system_id, simulator, dts, t_end = item
+    system_id, simulator, dts, t_end, knob = item
     try:
-        study = convergence(system_id, simulator, None, dts, t_end)
+        study = convergence(system_id, simulator, None, dts, t_end, knob=knob)
     except Exception as exc:  # one failed study fails its item only
         system = get_system(system_id)
         study = ConvergenceStudy(system.id, system.scenarios[0].name, simulator,
@@ -250,11 +401,13 @@ def _study_item(item: tuple) -> dict:
 def convergence_matrix(systems: Sequence[str], simulators: Sequence[str],
                        dts: Sequence[float] | None = None,
                        t_end: float | None = DEFAULT_T_END,
-                       scheduler: str | None = None, workers: int | None = None) -> list[dict]:
+                       scheduler: str | None = None, workers: int | None = None,
+                       knob: str = "auto") -> list[dict]:
     """Every system x engine as one item of the sweep (local pool, or a Dask cluster at
     `scheduler`); the studies as dictionaries with their judged `metric`, in matrix
-    order."""
+    order. `knob` as in `convergence`."""
     from .sweep import sweep
 
-    items = [(s, e, tuple(dts) if dts else None, t_end) for s in systems for e in simulators]
+    items = [(s, e, tuple(dts) if dts else None, t_end, knob)
+             for s in systems for e in simulators]
     return sweep(_study_item, items, scheduler=scheduler, workers=workers)

@@ -154,6 +154,26 @@ faster forcing).
   It holds while the error estimate is asymptotic (the accepted steps are small against
   1/w; tight eps) and the motion is not chaotic (the same proviso as above); the range
   w h of the fixed-step bounds does not apply, the ceiling MAX_TRAJECTORY_TOLERANCE does.
+* Convergence of an error-controlled integrator (the convergence study's knob is its
+  target accuracy eps, swept by decades; comparisons/convergence.py). The controller keeps
+  each accepted step's error estimate, of order q (the embedded scheme's: Drake's
+  Runge-Kutta 5 estimates with order 4, Runge-Kutta 3 and Radau 3 with order 2), at about
+  eps: steps h ~ eps^(1/(q+1)), N ~ T/h of them. The global error is the sum of the local
+  errors: N eps ~ eps^(q/(q+1)) without local extrapolation, and N h^(p+1) ~ eps with it
+  (a propagated solution of order p = q + 1). So each decade of eps lowers the error by
+  10^(q/(q+1)) at least: 3.2 for q = 1 (the slowest scheme offered), more for the others.
+  Gate: every tightening by a decade lowers the error by MIN_ACCURACY_DECREASE = 2 at
+  least (slope 0.3 on the log-log scale; the margin below the slowest rate absorbs the
+  controller's irregularity: its safety factor, rejected steps, steps shortened to end
+  on a sample), until the error reaches the floor of what the comparison resolves (the
+  reference's own error times the convergence study's REFERENCE_MARGIN). A model error
+  (a mass off, a law changed) sets a floor of its own that no accuracy lowers, far
+  above the reference's: the error stops falling there and the gate fails. It holds
+  where the error estimate is asymptotic and the controller, not the sampling, sets the
+  steps: the mean step T/N within the fixed-step range w h <= ASYMPTOTIC_LIMIT[p], and at
+  least twice as many steps as samples (ACCURACY_CONTROLLED_STEPS); looser accuracies are
+  run and drawn, not judged (loose estimates are not asymptotic, and a step capped by the
+  sampling makes the error independent of eps).
 * Where the bounds hold. Each bound above is the leading term of the error's expansion
   in powers of w h. It holds while the neglected terms stay below it: for the order-p >= 2
   schemes used here (RK4, trapezoidal, generalized-alpha) the next term is smaller by
@@ -238,6 +258,11 @@ ASYMPTOTIC_LIMIT = {1: 0.2}
 ASYMPTOTIC_LIMIT_HIGHER_ORDER = 0.5
 MAX_TRAJECTORY_TOLERANCE = 0.1
 MAX_FREQUENCY_TOLERANCE = 0.05
+#: an error-controlled integrator's error must fall by this factor per decade of its target
+#: accuracy (see the module docstring: at least 10^(1/2) expected)
+MIN_ACCURACY_DECREASE = 2.0
+#: a run's steps per sample above which the controller, not the sampling, chose its steps
+ACCURACY_CONTROLLED_STEPS = 2.0
 
 
 #: largest shortfall of the observed order below the declared one in the refinement rule

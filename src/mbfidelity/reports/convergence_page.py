@@ -1,7 +1,9 @@
-"""The convergence page: for every mechanism, the error against the step and the error
-against the CPU seconds of the stepping (work-precision) of each engine on one figure, and
-the table of fitted against declared orders, rendered from the saved convergence.json
-(`mbfidelity convergence --out DIR`)."""
+"""The convergence page: for every mechanism, the error against the step (fixed-step
+engines), against the target accuracy (error-controlled engines) and against the CPU
+seconds of the stepping (work-precision, every engine) on one figure, and the table of
+fitted against declared orders (per decade of accuracy: the largest error ratio against
+its gate), rendered from the saved convergence.json (`mbfidelity convergence --out
+DIR`)."""
 from __future__ import annotations
 
 import json
@@ -27,11 +29,14 @@ img{max-width:100%}
 {{ doc.t_end }} s of each system's first scenario. Error: max |q - q_ref| over the run, relative to the
 amplitude. The order is fitted on the steps whose error still falls (by {{ doc.min_decrease }} per halving
 at least) and stays {{ doc.reference_margin }} times above the reference's own error; it must match the
-order the engine declares within {{ doc.order_tolerance }}.</p>
+order the engine declares within {{ doc.order_tolerance }}. An error-controlled engine is studied by its target
+accuracy ({{ doc.accuracies|map("string")|join(", ") }}) at a sampling step of about 1/w: its error must fall by
+{{ doc.min_accuracy_decrease }} per decade of accuracy at least (the cell: the largest ratio per decade, the gate, and
+the slope of log error on log accuracy), where the controller sets asymptotic steps, down to the reference's floor.</p>
 <table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}: fitted / declared order</th>{% endfor %}</tr>
 {% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
 {% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s %}<td class="{{ s.metric.status }}" title="{{ s.metric.reason or s.flattened or s.failure or s.unsupported }}">
-{{ "%.2f"|format(s.observed_order) if s.observed_order is not none else "-" }} / {{ s.integrator_order }} {{ s.metric.status }}</td>{% else %}<td>-</td>{% endif %}{% endfor %}</tr>{% endfor %}
+{% if s.knob == "accuracy" %}ratio {{ "%.2g"|format(s.worst_decrease) if s.worst_decrease is not none else "-" }} / {{ s.metric.tolerance }}{% if s.accuracy_slope is not none %}, slope {{ "%.2f"|format(s.accuracy_slope) }}{% endif %}{% else %}{{ "%.2f"|format(s.observed_order) if s.observed_order is not none else "-" }} / {{ s.integrator_order }}{% endif %} {{ s.metric.status }}</td>{% else %}<td>-</td>{% endif %}{% endfor %}</tr>{% endfor %}
 </table>
 {% for sys in systems %}<h2 id="{{ sys }}">{{ sys }}</h2>
 <ul>{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s and (s.metric.reason or s.flattened or s.failure) %}<li><b>{{ sim }}</b> ({{ s.metric.status }}): {{ s.failure or s.metric.reason or s.flattened }}</li>{% endif %}{% endfor %}</ul>
@@ -40,12 +45,27 @@ order the engine declares within {{ doc.order_tolerance }}.</p>
 
 
 def _figure(system: str, studies: list[dict], out: Path) -> str:
-    fig, (steps, work) = plt.subplots(1, 2, figsize=(11, 4))
-    for s in studies:
+    by_accuracy = any(s.get("knob") == "accuracy" and any(p["error"] > 0 for p in s["points"])
+                      for s in studies)
+    fig, axes = plt.subplots(1, 3 if by_accuracy else 2, figsize=(16 if by_accuracy else 11, 4))
+    steps, work = axes[0], axes[-1]
+    for i, s in enumerate(studies):
         points = [p for p in s["points"] if p["error"] > 0]
         if not points:
             continue
+        if s.get("knob") == "accuracy":  # by_accuracy holds: it has points
+            line, = axes[1].loglog([p["accuracy"] for p in points],
+                                   [p["error"] for p in points], "s-", color=f"C{i}",
+                                   label=f"{s['simulator']} (order {s['integrator_order']})")
+            judged = [p for p in points if p["accuracy"] in s["judged_accuracies"]]
+            axes[1].loglog([p["accuracy"] for p in judged], [p["error"] for p in judged], "o",
+                           color=line.get_color(), mfc="none", ms=10)
+            work.loglog([max(p["cpu_time"], 1e-6) for p in points],
+                        [p["error"] for p in points], "s-", color=line.get_color(),
+                        label=f"{s['simulator']} (target accuracy)")
+            continue
         line, = steps.loglog([p["dt"] for p in points], [p["error"] for p in points], "o-",
+                             color=f"C{i}",
                              label=f"{s['simulator']} (order {s['integrator_order']})")
         # the declared order's slope through the coarsest point
         dt0, e0 = points[0]["dt"], points[0]["error"]
@@ -58,6 +78,10 @@ def _figure(system: str, studies: list[dict], out: Path) -> str:
     steps.set_ylabel("max |q - q_ref| / amplitude")
     steps.set_title("error against the step (dotted: declared order)")
     steps.legend(fontsize=7)
+    if by_accuracy:
+        axes[1].set_xlabel("target accuracy")
+        axes[1].set_title("error-controlled: error against the accuracy (circled: judged)")
+        axes[1].legend(fontsize=7)
     work.set_xlabel("CPU seconds of stepping")
     work.set_title("work-precision")
     work.legend(fontsize=7)

@@ -355,6 +355,10 @@ class Backend(ABC):
     #: the settings under which the step is a convergence study's knob (an engine that
     #: chooses its own steps runs at a fixed step there); empty: its defaults
     CONVERGENCE_SETTINGS: ClassVar[Mapping[str, object]] = {}
+    #: the setting that holds an error-controlled integrator's target accuracy, the
+    #: convergence study's knob for the engine (its step study stays available under
+    #: CONVERGENCE_SETTINGS); empty: the engine steps at a fixed step, its knob is the step
+    ACCURACY_SETTING: ClassVar[str] = ""
     #: why the backend does not build spatial mechanisms (model convention 10); empty
     #: when it does
     SPATIAL_REASON: ClassVar[str] = (

@@ -47,8 +47,9 @@ coordinates then follow q(t) to the integrator's accuracy.
 
 A continuous-time plant refuses constraints, so closure constraints and rolling couplings
 are not built (declared in `EXPRESSIONS`), and neither is a law that jumps (dry
-friction): the error control has no event location. The convergence study
-runs Runge-Kutta 3 at a fixed step (`CONVERGENCE_SETTINGS`), so that the step is its knob.
+friction): the error control has no event location. The convergence study sweeps
+the target accuracy (`ACCURACY_SETTING`); its step study runs Runge-Kutta 3 at a fixed
+step (`CONVERGENCE_SETTINGS`).
 """
 from __future__ import annotations
 
@@ -175,7 +176,7 @@ class DrakeBackend(Backend):
         "fixed_step": Setting(
             False, bool,
             "Drake default (error control) kept; True runs the integrator at the fixed "
-            "step dt (the convergence study's knob), for runge_kutta3, radau3 and "
+            "step dt (the knob of the convergence study by steps), for runge_kutta3, radau3 and "
             "implicit_euler."),
         "native_elements": Setting(
             True, bool,
@@ -189,8 +190,10 @@ class DrakeBackend(Backend):
             "one Drake's Linearize differentiates automatically and this is unused."),
     }
 
-    #: the convergence study's knob is the step: Runge-Kutta 3 at a fixed step dt
+    #: the step study (`mbfidelity convergence --knob step`): Runge-Kutta 3 at a fixed step dt
     CONVERGENCE_SETTINGS = {"integrator": "runge_kutta3", "fixed_step": True}
+    #: the work-precision study's knob: the error-controlled default at a swept accuracy
+    ACCURACY_SETTING = "target_accuracy"
 
     # --- identity --------------------------------------------------------------------------
     ENGINE_MODULES = ('pydrake.multibody.plant', 'pydrake.systems.analysis')
