@@ -19,15 +19,16 @@ ORDER_TOLERANCE, with the expectations of comparisons (a system's or a backend's
 declaration of the metric). Every mechanism x engine is one item of the sweep facility
 (comparisons/sweep.py).
 
-An engine that chooses its own steps (an error-controlled integrator: the backend's
-`ACCURACY_SETTING`) is studied by its knob instead, the target accuracy eps, swept by
+An engine that chooses its own steps for the mechanism (an error-controlled integrator:
+the backend's `accuracy_knob`) is studied by its knob instead, the target accuracy eps, swept by
 decades (DEFAULT_ACCURACIES) at one sampling step, its CPU seconds on the same
 work-precision figure as the fixed-step engines' (the knob "step" runs it at a fixed step
 under the backend's CONVERGENCE_SETTINGS, as the others). The sampling step is about 1/w
 (`accuracy_sampling_step`), so that the controller, not the sampling, sets the steps
 over the whole sweep. The judged metric ``convergence.accuracy`` is the largest ratio
-e(eps / 10) / e(eps) over the judged decades, against 1 / MIN_ACCURACY_DECREASE: the
-error must fall with the accuracy until it reaches the reference's floor
+per decade (e(eps / 100) / e(eps))^(1/2) over the judged accuracies (two decades apart:
+tolerances.ACCURACY_SPAN_DECADES), against 1 / MIN_ACCURACY_DECREASE: the error must
+fall with the accuracy until it reaches the reference's floor
 (comparisons/tolerances.py gives the rule, its reason and its range: the mean step
 T/N within w h <= asymptotic_limit, ACCURACY_CONTROLLED_STEPS steps per sample at
 least). A model error stops the fall at its own floor, above the reference's, and fails
@@ -181,10 +182,10 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     sc = system.scenario(scenario) if scenario else system.scenarios[0]
     values = system.parameter_values(scenario=sc)
     backend = get_backend(simulator)
-    by_accuracy = knob == "auto" and bool(backend.ACCURACY_SETTING)
-    settings = {**({} if by_accuracy else backend.CONVERGENCE_SETTINGS), **(settings or {})}
     scale = engine_scale or {}
     mech = system.numeric_mechanism({k: v * scale.get(k, 1.0) for k, v in values.items()})
+    by_accuracy = knob == "auto" and bool(backend.accuracy_knob(mech, settings))
+    settings = {**({} if by_accuracy else backend.CONVERGENCE_SETTINGS), **(settings or {})}
     eq = operating_equilibrium(system, values)
     T = sc.t_end if t_end is None else min(t_end, sc.t_end)
     support = backend.support(mech)
@@ -303,34 +304,39 @@ def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
 
 def _judge_accuracy_points(study: ConvergenceStudy, T: float) -> None:
     """The rule of tolerances.MIN_ACCURACY_DECREASE on the study's points, in place: the
-    judged points (the controller's steps asymptotic and its own), the largest error
-    ratio per decade among them while above the reference's floor, and the slope."""
+    judged points (the controller's steps asymptotic and its own, down to the first at the
+    reference's floor), the largest error ratio per decade over ACCURACY_SPAN_DECADES
+    among them, and the slope."""
     limit = tolerances.asymptotic_limit(study.integrator_order)
     floor = REFERENCE_MARGIN * study.reference_error
-    judged = [p for p in study.points
-              if p.integrator_steps >= tolerances.ACCURACY_CONTROLLED_STEPS * p.steps
-              and study.frequency * T / p.integrator_steps <= limit * (1 + 1e-9)]
-    ratios, above = [], judged[:1]
-    for a, b in zip(judged, judged[1:]):
-        if not (np.isfinite(a.error) and a.error > floor):
-            break
-        above.append(b)
-        if not (np.isfinite(b.error) and b.error <= floor):  # reaching the floor is falling
-            decades = np.log10(a.accuracy / b.accuracy)
-            ratios.append((b.error / a.error) ** (1.0 / decades) if np.isfinite(b.error)
-                          else float("inf"))
-    study.judged_accuracies = [p.accuracy for p in above]
-    if len(above) < MIN_FIT_POINTS or not ratios:
+    span = tolerances.ACCURACY_SPAN_DECADES
+    judged = []
+    for p in study.points:
+        if (p.integrator_steps >= tolerances.ACCURACY_CONTROLLED_STEPS * p.steps
+                and study.frequency * T / p.integrator_steps <= limit * (1 + 1e-9)):
+            judged.append(p)
+            if np.isfinite(p.error) and p.error <= floor:  # the floor: nothing further
+                break
+    ratios = []
+    for i, a in enumerate(judged):
+        later = [b for b in judged[i + 1:]
+                 if np.log10(a.accuracy / b.accuracy) >= span * (1 - 1e-9)]
+        if not later or (np.isfinite(later[0].error) and later[0].error <= floor):
+            continue  # no point far enough, or the error fell to the floor
+        b = later[0]
+        ratios.append((b.error / a.error) ** (1.0 / np.log10(a.accuracy / b.accuracy))
+                      if np.isfinite(b.error) and a.error > 0 else float("inf"))
+    study.judged_accuracies = [p.accuracy for p in judged]
+    if len(judged) < MIN_FIT_POINTS or not ratios:
         study.flattened = (
             f"{len(judged)} of {len(study.points)} accuracies where the controller sets "
             f"asymptotic steps (mean step T/N with w h <= {limit:g}, w = "
             f"{study.frequency:.4g} rad/s, and at least "
-            f"{tolerances.ACCURACY_CONTROLLED_STEPS:g} steps per sample), "
-            f"{len(above)} of them from above the reference's floor "
-            f"{floor:.2g}: {MIN_FIT_POINTS} needed")
+            f"{tolerances.ACCURACY_CONTROLLED_STEPS:g} steps per sample) above the "
+            f"reference's floor {floor:.2g}: {MIN_FIT_POINTS} spanning {span} decades needed")
         return
     study.worst_decrease = float(max(ratios))
-    fitted = [p for p in above if p.error > floor]
+    fitted = [p for p in judged if p.error > floor]
     if len(fitted) >= 2:
         study.accuracy_slope = observed_order([p.accuracy for p in fitted],
                                               [p.error for p in fitted])

@@ -404,6 +404,11 @@ class Backend(ABC):
         raise RuntimeError(f"{self.id}: no declared case of {kind} applies to "
                            f"{getattr(element, 'name', element)!r}")
 
+    def accuracy_knob(self, mechanism: Mechanism, settings: Mapping | None = None) -> str:
+        """`ACCURACY_SETTING` where the engine's integrator chooses its own steps for this
+        mechanism (the convergence study's knob), '' where it steps at a fixed step."""
+        return self.ACCURACY_SETTING
+
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """A spatial mechanism's central inertia as the engine stored it, read back from

@@ -45,23 +45,34 @@ matrix and its other generalized forces (force elements, gravity, bias, the Pyth
 it solves for the generalized force that gives q''(t), the actuator force; the
 coordinates then follow q(t) to the integrator's accuracy.
 
-A continuous-time plant refuses constraints, so closure constraints and rolling couplings
-are not built (declared in `EXPRESSIONS`), and neither is a law that jumps (dry
-friction): the error control has no event location. The convergence study sweeps
+A continuous-time plant refuses constraints, and its error control has no event location
+for a law that jumps (dry friction). A mechanism with a closure (`PointOnPoint` ->
+``AddBallConstraint``), a coupling of two joint values (`LinearCoupling` ->
+``AddCouplerConstraint``) or a jumping law is built on the discrete plant instead
+(time step dt, Drake's SAP solver): a first-order step whose velocity update is implicit
+in the constraint impulses and the joints' damping, explicit in the other forces, and
+whose positions follow the new velocities (semi-implicit Euler), whose
+constraints are compliant (declared soft in `EXPRESSIONS`), and whose constraint forces
+Drake does not report (NaN). The convergence study sweeps
 the target accuracy (`ACCURACY_SETTING`); its step study runs Runge-Kutta 3 at a fixed
 step (`CONVERGENCE_SETTINGS`).
 """
 from __future__ import annotations
 
+from functools import lru_cache
 from dataclasses import dataclass, field
 from typing import Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import WORLD, CoordinateForce, Mechanism, PointToPoint, Prismatic, Revolute
+from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointOnLine,
+                             PointOnPoint, PointToPoint, Prismatic, Revolute)
 from .base import (
     EXACT,
     RK3_STABILITY,
+    SEMI_IMPLICIT_EULER_STABILITY,
+    SOFT,
+    SUBSTITUTE,
     UNSUPPORTED,
     Backend,
     ErrorControl,
@@ -103,13 +114,21 @@ _ORDER = {"runge_kutta5": 5, "runge_kutta3": 3, "bogacki_shampine3": 3, "radau3"
 #: (explicit: the 3-stage third-order scheme, R = the cubic Taylor polynomial) or none
 #: (implicit); Drake's runge_kutta5 is meant for error control and is not offered fixed
 _FIXED_STABILITY = {"runge_kutta3": RK3_STABILITY, "radau3": None, "implicit_euler": None}
-_CLOSURE_REASON = ("Drake's continuous-time plant refuses constraints; its discrete plant "
-                   "(SAP) holds them compliantly, which this backend does not build")
-_JUMP_REASON = ("the law jumps (a force discontinuous in the state): Drake's error "
-                "control has no event location, so it shrinks the step toward zero at every "
-                "crossing of the jump, and a sticking motion crosses it at every step")
+#: what the discrete plant's constraints cost (the numbers per mechanism are measured)
+SAP_CONSTRAINT = (
+    "Drake's constraints are held by its discrete plant (SAP), whose step is first order "
+    "and whose constraints are compliant: near-rigid, with a stiffness and a dissipation "
+    "time scale tied to the step, so each closure gives a little and dissipates a little "
+    "energy at every step; the constraint forces, and the contact forces read from them, "
+    "are not reported by the plant.")
+#: the metrics a SAP constraint is expected to push beyond the first-order gates: its own
+#: force (not reported) and the contact forces read from it, the motion and the energy it
+#: carries, the order of convergence
+SAP_CONSTRAINT_METRICS = ("*.constraint_*", "*.contact_*", "*.trajectory_*", "*.energy_drift",
+                          "convergence.order")
 
 
+@lru_cache(maxsize=None)
 def _jumps(expr) -> bool:
     """Whether a law is discontinuous: a sign or step function, or a Piecewise whose
     pieces differ across one of its boundaries (checked on either side of each root of
@@ -137,6 +156,70 @@ def _jumps(expr) -> bool:
     return False
 
 
+#: the share of the pin body's mass a slot's slider carries (`EXPRESSIONS`): small, so that
+#: the pin's body keeps a physical inertia, large enough for a well-conditioned solve
+_SLIDER_SHARE = 1e-3
+
+
+def _can_lend(mech: Mechanism, slot: PointOnLine) -> bool:
+    """Whether the pin's body can lend a slider the point mass _SLIDER_SHARE m at the pin
+    and keep a physical inertia (each planar moment about its frame stays positive)."""
+    if slot.body == WORLD or not num(mech.body(slot.body).mass) > 0:
+        return False
+    _, _, unit = _inertia(mech, mech.body(slot.body))
+    return min(unit[:3]) > 0 and unit[0] * unit[1] > unit[3] ** 2
+
+
+def _inertia(mech: Mechanism, body) -> tuple[float, list, tuple]:
+    """(mass, centre of mass in the body frame, unit inertia about the frame: Ixx, Iyy,
+    Izz, Ixy, Ixz, Iyz) of a body as built: its planar moment on z and half of it on x and
+    y (a lamina), less the point masses _SLIDER_SHARE m it lends at the pins of its slots."""
+    mass, izz = num(body.mass), num(body.inertia)
+    if not mass:  # Drake stores the inertia per unit mass; a massless body has none
+        return 0.0, [0.0] * 3, (0.0,) * 6
+    tensor = np.diag([izz / 2, izz / 2, izz])
+    first_moment = np.zeros(3)
+    kept = mass
+    for c in mech.constraints:
+        if isinstance(c, PointOnLine) and c.body == body.name:
+            lent, pin = _SLIDER_SHARE * mass, np.array([num(c.point[0]), num(c.point[1]), 0.0])
+            tensor -= lent * (pin @ pin * np.eye(3) - np.outer(pin, pin))
+            first_moment -= lent * pin
+            kept -= lent
+    unit = tensor / kept
+    return kept, list(first_moment / kept), (unit[0, 0], unit[1, 1], unit[2, 2], unit[0, 1],
+                                             0.0, 0.0)
+
+
+def _discrete(mech: Mechanism, cfg: Mapping) -> bool:
+    """Whether the mechanism is built on the discrete plant: asked for, or needed (a
+    closure or coupling, which a continuous plant refuses; a law that jumps, which its
+    error control cannot cross)."""
+    return (cfg["plant"] == "discrete" or bool(mech.constraints)
+            or any(isinstance(f, (CoordinateForce, PointToPoint))
+                   and ForceLaw.of(f).linear is None and _jumps(ForceLaw.of(f).expr)
+                   for f in mech.forces))
+
+
+def _coupler(mech: Mechanism, coupling: LinearCoupling
+             ) -> tuple[int, int, float, float] | None:
+    """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset, the coupling
+    sum a_k q_k = C written on the engine joint values (q = T v + c: (a T) v = C - a c);
+    None unless it relates exactly two of them."""
+    cmap = coordinate_map(mech)
+    a = np.zeros(len(mech.coordinates))
+    for name, coefficient in coupling.coefficients:
+        a[mech.coordinates.index(name)] += num(coefficient)
+    row = a @ cmap.T
+    row = np.where(np.abs(row) < 1e-12 * np.max(np.abs(row)), 0.0, row)
+    nonzero = np.flatnonzero(row)
+    if len(nonzero) != 2:
+        return None
+    i0, i1 = (int(i) for i in nonzero)
+    return i0, i1, float(-row[i1] / row[i0]), float((num(coupling.constant) - a @ cmap.c)
+                                                    / row[i0])
+
+
 @dataclass
 class _Built:
     """A diagram built from a mechanism, with what the read-out needs."""
@@ -150,6 +233,9 @@ class _Built:
     python_forces: bool               # whether a Python LeafSystem computes forces
     slide_laws: dict = field(default_factory=dict)  # prismatic joint -> its coordinate laws
     forces: object = None             # the Python force system, when there is one
+    #: per slot: (its slider joint, the pin's body frame, the pin point, the slot's frame,
+    #: the slot's unit direction), for the slider's initial state
+    slots: list = field(default_factory=list)
 
 
 class DrakeBackend(Backend):
@@ -178,11 +264,24 @@ class DrakeBackend(Backend):
             "Drake default (error control) kept; True runs the integrator at the fixed "
             "step dt (the knob of the convergence study by steps), for runge_kutta3, radau3 and "
             "implicit_euler."),
+        "plant": Setting(
+            "auto", ("auto", "discrete"),
+            "Backend choice: auto builds the continuous-time plant (error-controlled) "
+            "unless the mechanism has a closure, a coupling or a jumping law, which need "
+            "the discrete plant (time step dt, the SAP solver); discrete builds every "
+            "mechanism on it."),
+        "sap_near_rigid_threshold": Setting(
+            1.0, float,
+            "Drake's default (1.0) kept: the SAP solver's near-rigid threshold beta, which "
+            "caps a constraint's stiffness at the value the step resolves (smaller: stiffer, "
+            "worse conditioned). Discrete plant only."),
         "native_elements": Setting(
             True, bool,
             "Backend choice: springs and dampers that Drake's own elements express exactly "
             "(LinearSpringDamper, RevoluteSpring, PrismaticSpring, joint damping) use them; "
-            "False sends every law through the Python force system (same model, slower)."),
+            "False sends every law through the Python force system (same model, slower). "
+            "The discrete plant always does: its solver takes the joints' damping "
+            "implicitly, a step other than the semi-implicit Euler its gates derive."),
         "linearization_step": Setting(
             1e-6, float,
             "linearize() with a Python force system: step of the central differences of "
@@ -231,7 +330,10 @@ class DrakeBackend(Backend):
                               "LeafSystem, evaluated at every integrator stage",
                        when="the law is continuous",
                        applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
-            Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
+            Expression(EXACT, "externally applied spatial forces from a LeafSystem, "
+                              "evaluated at the start of each step of the discrete plant (the "
+                              "error control cannot cross a jump: it has no event location)",
+                       when="the law jumps (dry friction)")),
         COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
                                                     "the joint's damping where the law acts "
                                                     "on one joint value with non-negative "
@@ -242,15 +344,41 @@ class DrakeBackend(Backend):
                               "evaluated at every integrator stage",
                        when="the law is continuous",
                        applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
-            Expression(UNSUPPORTED, _JUMP_REASON, when="the law jumps (dry friction)")),
+            Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
+                              "evaluated at the start of each step of the discrete plant (the "
+                              "error control cannot cross a jump: it has no event location)",
+                       when="the law jumps (dry friction)")),
         TIME_LOAD: (Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
                                       "the stage time"),),
-        POINT_ON_POINT: (Expression(UNSUPPORTED, _CLOSURE_REASON),),
-        POINT_ON_LINE: (Expression(UNSUPPORTED, _CLOSURE_REASON),),
-        LINEAR_COUPLING: (Expression(UNSUPPORTED, "a rolling or gear coupling is a constraint, "
-                                                  "which the continuous-time plant refuses; "
-                                                  "the discrete plant's coupler constraint is "
-                                                  "compliant and not built here"),),
+        POINT_ON_POINT: (Expression(SOFT, "AddBallConstraint between the two points on the "
+                                          "discrete plant (its out-of-plane row is void: "
+                                          "every body moves in the plane)",
+                                    expected_failures=SAP_CONSTRAINT_METRICS,
+                                    reason=SAP_CONSTRAINT),),
+        POINT_ON_LINE: (
+            Expression(SUBSTITUTE, "no point-on-line constraint: a slider body on a "
+                                   "PrismaticJoint along the slot, held to the pin by "
+                                   "AddBallConstraint on the discrete plant; it carries a point "
+                                   "mass taken out of the pin's body at the pin (exact while "
+                                   "the constraints hold: the pin point carries it either way)",
+                       when="the pin's body can lend the slider a point mass at the pin",
+                       applies=lambda mech, slot: _can_lend(mech, slot),
+                       expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
+            Expression(UNSUPPORTED, "Drake has no point-on-line constraint, and the pin's "
+                                    "body cannot lend the substitute slider a point mass at "
+                                    "the pin (massless, the world, or too little inertia "
+                                    "about the pin): a slider without mass makes the plant's "
+                                    "mass matrix singular",
+                       when="the pin's body cannot lend it")),
+        LINEAR_COUPLING: (
+            Expression(SOFT, "AddCouplerConstraint v0 = rho v1 + offset on the discrete "
+                             "plant, the coupling written on the engine joint values",
+                       when="it relates two joint values",
+                       applies=lambda mech, coupling: _coupler(mech, coupling) is not None,
+                       expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
+            Expression(UNSUPPORTED, "Drake's coupler constraint relates two joints; this "
+                                    "coupling involves one or more than two joint values",
+                       when="it relates one or more than two joint values")),
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact geometry is built: the "
                                                   "continuous plant's point contact is a "
                                                   "penalty (compliant) model"),),
@@ -261,10 +389,17 @@ class DrakeBackend(Backend):
                                        "actuator force"),),
     }
 
+    def accuracy_knob(self, mechanism: Mechanism, settings: Mapping | None = None) -> str:
+        return "" if _discrete(mechanism, self.resolve_settings(settings)) else \
+            self.ACCURACY_SETTING
+
     # --- the scheme --------------------------------------------------------------------------
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         cfg = self.resolve_settings(settings)
         name = str(cfg["integrator"])
+        if _discrete(mechanism, cfg):
+            return Scheme("discrete plant, SAP (semi-implicit Euler)", 1,
+                          SEMI_IMPLICIT_EULER_STABILITY)
         if cfg["fixed_step"]:
             if name not in _FIXED_STABILITY:
                 raise ValueError(f"drake fixed_step runs {', '.join(_FIXED_STABILITY)}; "
@@ -276,10 +411,12 @@ class DrakeBackend(Backend):
                       _ORDER[name], None)
 
     # --- building ----------------------------------------------------------------------------
-    def _build(self, mech: Mechanism, cfg: dict, recorder: "_Recorder | None" = None) -> _Built:
-        """The diagram; every plant call goes through `recorder` (`export` writes them)."""
+    def _build(self, mech: Mechanism, cfg: dict, dt: float,
+               recorder: "_Recorder | None" = None) -> _Built:
+        """The diagram (a discrete plant of step `dt` where `_discrete`); every plant call
+        goes through `recorder` (`export` writes them)."""
         from pydrake.math import RigidTransform, RotationMatrix
-        from pydrake.multibody.plant import MultibodyPlant
+        from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
         from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
                                             LinearSpringDamper, PrismaticJoint,
                                             PrismaticSpring, RevoluteJoint, RevoluteSpring,
@@ -291,21 +428,28 @@ class DrakeBackend(Backend):
             raise ValueError(f"drake cannot express this mechanism: {support.reason}")
         rec = recorder or _Recorder()
         builder = DiagramBuilder()
+        discrete = _discrete(mech, cfg)
         plant = rec("plant", builder.AddSystem, "builder.AddSystem",
-                    rec(None, MultibodyPlant, "MultibodyPlant", time_step=0.0))
+                    rec(None, MultibodyPlant, "MultibodyPlant",
+                        time_step=float(dt) if discrete else 0.0))
+        if discrete:
+            rec.names[id(DiscreteContactApproximation.kSap)] = "DiscreteContactApproximation.kSap"
+            rec("", plant.set_discrete_contact_approximation,
+                "plant.set_discrete_contact_approximation", DiscreteContactApproximation.kSap)
+            rec("", plant.set_sap_near_rigid_threshold, "plant.set_sap_near_rigid_threshold",
+                float(cfg["sap_near_rigid_threshold"]))
         rec("", plant.mutable_gravity_field().set_gravity_vector,
             "plant.mutable_gravity_field().set_gravity_vector", [0.0, -num(mech.gravity), 0.0])
         bodies = {WORLD: rec("world", plant.world_body, "plant.world_body")}
         for b in mech.bodies:
-            mass, izz = num(b.mass), num(b.inertia)
-            # Drake stores the inertia per unit mass; a massless body has none at all
-            unit = (izz / mass / 2, izz / mass / 2, izz / mass) if mass else (0.0, 0.0, 0.0)
+            mass, com, unit = _inertia(mech, b)
             bodies[b.name] = rec(f"body_{len(bodies)}", plant.AddRigidBody, "plant.AddRigidBody",
-                                 b.name, rec(None, SpatialInertia, "SpatialInertia", mass,
-                                             [0.0, 0.0, 0.0],
+                                 b.name, rec(None, SpatialInertia, "SpatialInertia", mass, com,
                                              rec(None, UnitInertia, "UnitInertia", *unit)))
         cmap = coordinate_map(mech)
-        native = bool(cfg["native_elements"])
+        # on the discrete plant every law is explicit, as semi-implicit Euler's gates
+        # assume: its solver would take the joints' damping implicitly
+        native = bool(cfg["native_elements"]) and not discrete
         springs, damping, python_laws = self._coordinate_laws(mech, cmap, native)
 
         def frame(body: str, name: str, anchor, angle: float):
@@ -359,6 +503,35 @@ class DrakeBackend(Backend):
                               bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
                               free_length, stiffness, damper)
             rec("", plant.AddForceElement, "plant.AddForceElement", element)
+        slots = []
+        for c in mech.constraints:
+            if isinstance(c, PointOnLine):
+                # a slider along the slot, held to the pin, carrying a point mass lent by
+                # the pin's body (`EXPRESSIONS`)
+                slider = rec(f"body_{len(bodies) + len(slots)}", plant.AddRigidBody,
+                             "plant.AddRigidBody", f"{c.name}_slider",
+                             rec(None, SpatialInertia, "SpatialInertia",
+                                 _SLIDER_SHARE * num(mech.body(c.body).mass), [0.0] * 3,
+                                 rec(None, UnitInertia, "UnitInertia", 0.0, 0.0, 0.0)))
+                axis = np.array([num(c.direction[0]), num(c.direction[1]), 0.0])
+                axis /= np.linalg.norm(axis)
+                line = frame(c.line_body, f"{c.name}_line", c.line_point, 0.0)
+                pin = [num(c.point[0]), num(c.point[1]), 0.0]
+                slide = rec(f"slider_{len(slots)}", plant.AddJoint, "plant.AddJoint",
+                            rec(None, PrismaticJoint, "PrismaticJoint", f"{c.name}_slide", line,
+                                rec(None, slider.body_frame, f"{rec.code(slider)}.body_frame"),
+                                axis))
+                rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body],
+                    pin, slider, [0.0] * 3)
+                slots.append((slide, bodies[c.body].body_frame(), np.array(pin), line, axis))
+            elif isinstance(c, PointOnPoint):
+                rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body_a],
+                    [num(c.point_a[0]), num(c.point_a[1]), 0.0], bodies[c.body_b],
+                    [num(c.point_b[0]), num(c.point_b[1]), 0.0])
+            else:  # a LinearCoupling of two joint values (`EXPRESSIONS`)
+                i0, i1, ratio, offset = _coupler(mech, c)
+                rec("", plant.AddCouplerConstraint, "plant.AddCouplerConstraint", joints[i0],
+                    joints[i1], ratio, offset)
         rec.python_forces = [f.name for f in mech.forces
                              if any(f is w for w in python_p2p)
                              or any(law.element is f for _, law in python_laws)]
@@ -378,7 +551,7 @@ class DrakeBackend(Backend):
                           if isinstance(f, CoordinateForce) and i in f.weights(mech.coordinates)]
                       for i, j in enumerate(mech.joints) if isinstance(j, Prismatic)}
         return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
-                      python_forces, slide_laws, forces)
+                      python_forces, slide_laws, forces, slots)
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -393,7 +566,7 @@ class DrakeBackend(Backend):
         name, (q0, qd0) = next(iter(initial_states.items()))
         cfg = self.resolve_settings(settings)
         recorder = _Recorder()
-        built = self._build(mechanism, cfg, recorder)
+        built = self._build(mechanism, cfg, dt, recorder)
         cmap = built.cmap
         accuracy = ("integrator.set_fixed_step_mode(True)" if cfg["fixed_step"] else
                     f"integrator.set_target_accuracy({float(cfg['target_accuracy'])!r})")
@@ -405,7 +578,7 @@ class DrakeBackend(Backend):
             '"""',
             "import numpy as np",
             "from pydrake.math import RigidTransform, RotationMatrix",
-            "from pydrake.multibody.plant import MultibodyPlant",
+            "from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant",
             "from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw, "
             "LinearSpringDamper,",
             "                                    PrismaticJoint, PrismaticSpring, RevoluteJoint, "
@@ -492,6 +665,15 @@ class DrakeBackend(Backend):
         vd0[built.velocities] = built.cmap.A @ np.asarray(qd0, dtype=float)
         built.plant.SetPositions(plant_context, v0)
         built.plant.SetVelocities(plant_context, vd0)
+        for slide, pin_frame, pin, line, axis in built.slots:
+            # each slider starts under its pin, moving with it along the slot
+            from pydrake.multibody.tree import JacobianWrtVariable
+
+            at = built.plant.CalcPointsPositions(plant_context, pin_frame, pin, line)[:, 0]
+            J = built.plant.CalcJacobianTranslationalVelocity(
+                plant_context, JacobianWrtVariable.kV, pin_frame, pin, line, line)
+            slide.set_translation(plant_context, float(at @ axis))
+            slide.set_translation_rate(plant_context, float(J @ vd0 @ axis))
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
         integrator = ResetIntegratorFromFlags(simulator, str(cfg["integrator"]), max_step)
         if cfg["fixed_step"]:
@@ -506,31 +688,40 @@ class DrakeBackend(Backend):
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                        steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
-        built = self._build(mechanism, cfg)
+        built = self._build(mechanism, cfg, dt)
         q0, qd0 = _driven_state(mechanism, q0, qd0)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
         n = len(mechanism.joints)
-        state = np.empty((steps + 1, 2 * n))
+        state = np.empty((steps + 2, 2 * n))
         index = self._state_index(built)
-        vector = plant_context.get_continuous_state_vector()
+        discrete = _discrete(mechanism, cfg)
         wanted = [(name, mechanism.joints.index(mechanism.joint(name))) for name in reaction_joints]
-        forces = {name: np.empty((steps + 1, 2)) for name, _ in wanted}
+        forces = {name: np.empty((steps + 2, 2)) for name, _ in wanted}
         driven = [p.name for p in mechanism.prescribed]
-        actuators = np.empty((steps + 1, len(driven)))
+        actuators = np.empty((steps + 2, len(driven)))
 
         def read(k: int) -> None:
-            state[k] = vector.CopyToVector()[index]
+            x = plant.GetPositionsAndVelocities(plant_context)
+            state[k] = x[index]
             if driven:
-                x = vector.CopyToVector()
                 actuators[k] = built.forces.actuators(x, k * dt, built.forces._laws(x, k * dt))
             if wanted:
+                # a discrete plant reports the reactions of the step just taken, which the
+                # state of its start (sample k - 1, turned as there) determines
                 reaction = plant.get_reaction_forces_output_port().Eval(plant_context)
                 for name, i in wanted:
                     joint = built.joints[i]
-                    turn = joint.frame_on_child().CalcRotationMatrixInWorld(plant_context)
-                    forces[name][k] = (turn.matrix() @ reaction[int(joint.index())].translational())[:2]
+                    force = reaction[int(joint.index())].translational()
+                    turn = joint.frame_on_child().CalcRotationMatrixInWorld(
+                        plant_context).matrix()
+                    if not discrete:
+                        forces[name][k] = (turn @ force)[:2]
+                    elif k > 0:
+                        forces[name][k - 1] = (turns[name] @ force)[:2]
+                    turns[name] = turn
 
+        turns: dict[str, np.ndarray] = {}
         read(0)
         # the integrator's steps end on each sample; reactions need the accelerations
         # there, so every read-out happens as the run passes its sample
@@ -538,6 +729,11 @@ class DrakeBackend(Backend):
             for k in range(1, steps + 1):
                 simulator.AdvanceTo(k * dt)
                 read(k)
+        if discrete and wanted:  # the last sample's reactions: one step beyond the run
+            simulator.AdvanceTo((steps + 1) * dt)
+            read(steps + 1)
+        state, actuators = state[:steps + 1], actuators[:steps + 1]
+        forces = {name: f[:steps + 1] for name, f in forces.items()}
         t = np.arange(steps + 1) * dt
         q = built.cmap.coordinates(state[:, :n])
         qd = built.cmap.rates(state[:, n:])
@@ -545,21 +741,24 @@ class DrakeBackend(Backend):
         reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd,
                                                             actuator_forces)
                      for name, i in wanted}
-        control = None if cfg["fixed_step"] else ErrorControl(
+        control = None if cfg["fixed_step"] or discrete else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
-        return Samples(q, qd, clock, reactions, actuator_forces=actuator_forces,
-                       error_control=control)
+        # Drake reports no constraint forces (`EXPRESSIONS`)
+        closures = {c.name: np.full((steps + 1, 1 if isinstance(c, LinearCoupling) else 2),
+                                    np.nan) for c in mechanism.constraints}
+        return Samples(q, qd, clock, reactions, constraint_forces=closures,
+                       actuator_forces=actuator_forces, error_control=control)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The diagram of `simulate`, advanced to the same sample times, nothing read."""
-        built = self._build(mechanism, cfg)
+        built = self._build(mechanism, cfg, dt)
         q0, qd0 = _driven_state(mechanism, q0, qd0)
         simulator, _, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         with Stopwatch() as clock:
             for k in range(1, steps + 1):
                 simulator.AdvanceTo(k * dt)
-        x = plant_context.get_continuous_state_vector().CopyToVector()[self._state_index(built)]
+        x = built.plant.GetPositionsAndVelocities(plant_context)[self._state_index(built)]
         n = len(mechanism.joints)
         return BareLoop(clock.cpu, built.cmap.coordinates(x[None, :n])[0],
                         built.cmap.rates(x[None, n:])[0])
@@ -596,13 +795,14 @@ class DrakeBackend(Backend):
     # --- linearization -------------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        # a driven mechanism moves about a motion, not an equilibrium
-        if not self.support(mechanism).ok or mechanism.prescribed:
-            return None
         cfg = self.resolve_settings(settings)
+        # a driven mechanism moves about a motion, not an equilibrium; a discrete plant's
+        # constraints are SAP's, whose solve is not differentiated here
+        if not self.support(mechanism).ok or mechanism.prescribed or _discrete(mechanism, cfg):
+            return None
         # the autonomous system: the excitation e(t) does not belong to the equilibrium
         mech = mechanism.without_time_loads()
-        built = self._build(mech, cfg)
+        built = self._build(mech, cfg, dt)
         context = built.diagram.CreateDefaultContext()
         plant_context = built.plant.GetMyMutableContextFromRoot(context)
         v_eq = np.zeros(built.plant.num_positions())

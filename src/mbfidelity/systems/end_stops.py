@@ -109,12 +109,6 @@ CORNER_ORDER = (
     "h^2 (comparisons/tolerances.py, corner_velocity_error), so the motion converges at "
     "order 2 while the scheme declares 4 (mbfidelity convergence). The first-order "
     "engines keep their order.")
-CORNER_ACCURACY = (
-    "Drake's error control does not locate the stops' corners either: the step across one, "
-    "where the law's slope jumps by k2, has an error of order h^2 whose embedded estimate "
-    "depends on where in the step the corner falls and can be small where the error is "
-    "not, so once the corners' errors dominate the error no longer falls steadily as the "
-    "target accuracy tightens (mbfidelity convergence).")
 
 SYSTEM = System(
     id="end_stops",
@@ -135,6 +129,5 @@ SYSTEM = System(
         Expectation(engine, "fig2.band_entry_time", "unresolved", GRAZING_CONTACT)
         for engine in ("pybullet", "pymunk")) + tuple(
         Expectation(engine, "convergence.order", "xfail", CORNER_ORDER)
-        for engine in ("mujoco", "exudyn")) + (
-        Expectation("drake", "convergence.accuracy", "xfail", CORNER_ACCURACY),),
+        for engine in ("mujoco", "exudyn")),
 )
