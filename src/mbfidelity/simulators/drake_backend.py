@@ -19,8 +19,8 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   ``PrismaticSpring`` plus the joint's viscous damping; a `PointToPoint` element whose
   law is a spring of positive free length and stiffness with a non-negative damper is
   Drake's ``LinearSpringDamper``, a spring of zero free length without damper an
-  isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time loads e(t), springs
-  Drake's elements cannot hold) is evaluated by one Python ``LeafSystem`` from the plan's
+  isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time
+  loads e(t), springs Drake's elements cannot hold) is evaluated by one Python ``LeafSystem`` from the plan's
   compiled laws at every integrator stage (the stage's time and state): coordinate laws
   as the plant's applied generalized force (tau = T^T Q), point-to-point laws as
   externally applied spatial forces on the two bodies (so that they are not booked as
@@ -46,21 +46,26 @@ it solves for the generalized force that gives q''(t), the actuator force; the
 coordinates then follow q(t) to the integrator's accuracy.
 
 A continuous-time plant refuses constraints, and its error control has no event location
-for a law that jumps (dry friction). A mechanism with a closure (`PointOnPoint` ->
-``AddBallConstraint``), a coupling of two joint values (`LinearCoupling` ->
-``AddCouplerConstraint``) or a jumping law is built on the discrete plant instead
-(time step dt, Drake's SAP solver): a first-order step whose velocity update is implicit
-in the constraint impulses and the joints' damping, explicit in the other forces, and
-whose positions follow the new velocities (semi-implicit Euler), whose
-constraints are compliant (declared soft in `EXPRESSIONS`), and whose constraint forces
-Drake does not report (NaN). The convergence study sweeps
-the target accuracy (`ACCURACY_SETTING`); its step study runs Runge-Kutta 3 at a fixed
-step (`CONVERGENCE_SETTINGS`).
+for a law that jumps (dry friction). A mechanism with a closure, a coupling or a jumping
+law is built on the discrete plant instead (time step dt, Drake's SAP solver): a
+first-order step whose velocity update is implicit in the constraint impulses and
+explicit in the forces (every law then goes through the LeafSystem, evaluated at the
+step's start), whose positions follow the new velocities (semi-implicit Euler). Its
+constraints are compliant (declared soft in `EXPRESSIONS`) and their forces are not
+reported (NaN): `PointOnPoint` -> ``AddBallConstraint`` (the out-of-plane row is void);
+a `LinearCoupling` of two engine joint values -> ``AddCouplerConstraint``; `PointOnLine`
+(Drake has no point-on-line constraint) -> a slider body on a ``PrismaticJoint`` along
+the slot held to the pin by a ball constraint, carrying a point mass that the pin's body
+lends at the pin (exact while the constraints hold). A discrete step's reactions are
+those of the step that starts at the sample. The convergence study sweeps the target
+accuracy of the continuous plant (`ACCURACY_SETTING`); its step study runs Runge-Kutta 3
+at a fixed step (`CONVERGENCE_SETTINGS`), and the discrete plant at its step.
 """
 from __future__ import annotations
 
-from functools import lru_cache
+import inspect
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -233,8 +238,8 @@ class _Built:
     python_forces: bool               # whether a Python LeafSystem computes forces
     slide_laws: dict = field(default_factory=dict)  # prismatic joint -> its coordinate laws
     forces: object = None             # the Python force system, when there is one
-    #: per slot: (its slider joint, the pin's body frame, the pin point, the slot's frame,
-    #: the slot's unit direction), for the slider's initial state
+    #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
+    #: slot's unit direction), for the slider's initial state (`_place_slider`)
     slots: list = field(default_factory=list)
 
 
@@ -523,7 +528,7 @@ class DrakeBackend(Backend):
                                 axis))
                 rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body],
                     pin, slider, [0.0] * 3)
-                slots.append((slide, bodies[c.body].body_frame(), np.array(pin), line, axis))
+                slots.append((slide, bodies[c.body], np.array(pin), line, axis))
             elif isinstance(c, PointOnPoint):
                 rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body_a],
                     [num(c.point_a[0]), num(c.point_a[1]), 0.0], bodies[c.body_b],
@@ -603,6 +608,10 @@ class DrakeBackend(Backend):
             "    velocities[joint.velocity_start()] = rate",
             "plant.SetPositions(context, positions)",
             "plant.SetVelocities(context, velocities)",
+            *([f"{inspect.getsource(_place_slider)}"] if built.slots else []),
+            *[f"_place_slider(plant, context, {recorder.code(slide)}, {recorder.code(body)}, "
+              f"{recorder.code(pin)}, {recorder.code(line)}, np.array({recorder.code(axis)}))"
+              for slide, body, pin, line, axis in built.slots],
             f"integrator = ResetIntegratorFromFlags(simulator, {cfg['integrator']!r}, "
             f"{max_step!r})",
             accuracy,
@@ -665,15 +674,8 @@ class DrakeBackend(Backend):
         vd0[built.velocities] = built.cmap.A @ np.asarray(qd0, dtype=float)
         built.plant.SetPositions(plant_context, v0)
         built.plant.SetVelocities(plant_context, vd0)
-        for slide, pin_frame, pin, line, axis in built.slots:
-            # each slider starts under its pin, moving with it along the slot
-            from pydrake.multibody.tree import JacobianWrtVariable
-
-            at = built.plant.CalcPointsPositions(plant_context, pin_frame, pin, line)[:, 0]
-            J = built.plant.CalcJacobianTranslationalVelocity(
-                plant_context, JacobianWrtVariable.kV, pin_frame, pin, line, line)
-            slide.set_translation(plant_context, float(at @ axis))
-            slide.set_translation_rate(plant_context, float(J @ vd0 @ axis))
+        for slide, body, pin, line, axis in built.slots:
+            _place_slider(built.plant, plant_context, slide, body, pin, line, axis)
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
         integrator = ResetIntegratorFromFlags(simulator, str(cfg["integrator"]), max_step)
         if cfg["fixed_step"]:
@@ -841,6 +843,18 @@ class DrakeBackend(Backend):
         return Linearization(eigenvalues=eig[np.argsort(eig.imag)], method=how,
                              extra={"coordinates": "the plant's joint values and rates "
                                                    "(eigenvalues are invariant)"})
+
+
+def _place_slider(plant, context, slide, body, pin, line, axis) -> None:
+    """A slot's slider under its pin, moving with it along the slot (the pin's state
+    already set)."""
+    from pydrake.multibody.tree import JacobianWrtVariable
+
+    at = plant.CalcPointsPositions(context, body.body_frame(), pin, line)[:, 0]
+    J = plant.CalcJacobianTranslationalVelocity(context, JacobianWrtVariable.kV,
+                                                body.body_frame(), pin, line, line)
+    slide.set_translation(context, float(at @ axis))
+    slide.set_translation_rate(context, float(J @ plant.GetVelocities(context) @ axis))
 
 
 def _driven_state(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray
