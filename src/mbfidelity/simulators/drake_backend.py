@@ -332,13 +332,9 @@ class DrakeBackend(Backend):
                                                   "integrator stage"),),
         POINT_TO_POINT_CUSTOM: (
             Expression(EXACT, "externally applied spatial forces on both bodies from a "
-                              "LeafSystem, evaluated at every integrator stage",
-                       when="the law is continuous",
-                       applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
-            Expression(EXACT, "externally applied spatial forces from a LeafSystem, "
-                              "evaluated at the start of each step of the discrete plant (the "
-                              "error control cannot cross a jump: it has no event location)",
-                       when="the law jumps (dry friction)")),
+                              "LeafSystem, evaluated at every integrator stage (at the start "
+                              "of each step where the plant is discrete, as for a law that "
+                              "jumps: the error control has no event location)"),),
         COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
                                                     "the joint's damping where the law acts "
                                                     "on one joint value with non-negative "
