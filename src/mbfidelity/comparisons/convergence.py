@@ -20,8 +20,8 @@ declaration of the metric). Every mechanism x engine is one item of the sweep fa
 (comparisons/sweep.py).
 
 An engine that chooses its own steps for the mechanism (an error-controlled integrator:
-the backend's `accuracy_knob`) is studied by its knob instead, the target accuracy eps, swept by
-decades (DEFAULT_ACCURACIES) at one sampling step, its CPU seconds on the same
+the backend's `accuracy_knob`) is studied by its knob instead, the target accuracy eps,
+swept by decades (DEFAULT_ACCURACIES) at one sampling step, its CPU seconds on the same
 work-precision figure as the fixed-step engines' (the knob "step" runs it at a fixed step
 under the backend's CONVERGENCE_SETTINGS, as the others). The sampling step is about 1/w
 (`accuracy_sampling_step`), so that the controller, not the sampling, sets the steps
@@ -263,8 +263,7 @@ def accuracy_sampling_step(w: float, t_end: float, finest: float) -> float:
 
 
 def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
-                    q_eq: np.ndarray,
-                    w: float, T: float, order: int, settings: Mapping,
+                    q_eq: np.ndarray, w: float, T: float, order: int, settings: Mapping,
                     accuracies: Sequence[float]) -> ConvergenceStudy:
     """An error-controlled engine's study: its error at each target accuracy (loose to
     tight), sampled every `accuracy_sampling_step`, against the reference `ref` (sampled
@@ -277,9 +276,9 @@ def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
     reference_error = 0.0 if exact else float(
         np.max(np.asarray(ref.error_estimate)[free] / scale) * TIGHT / LOOSE)
     points: list[ConvergencePoint] = []
-    study = ConvergenceStudy(system.id, scenario, backend.id,
-                             backend.version(), order, points, None,
-                             reference_error=reference_error, frequency=w, knob="accuracy")
+    study = ConvergenceStudy(system.id, scenario, backend.id, backend.version(), order, points,
+                             None, reference_error=reference_error, frequency=w,
+                             knob="accuracy")
     support = backend.support(mech)
     if not support.ok:
         study.unsupported = f"{backend.id} cannot express {system.id}: {support.reason}"

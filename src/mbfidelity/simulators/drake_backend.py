@@ -20,8 +20,8 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   law is a spring of positive free length and stiffness with a non-negative damper is
   Drake's ``LinearSpringDamper``, a spring of zero free length without damper an
   isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time
-  loads e(t), springs Drake's elements cannot hold) is evaluated by one Python ``LeafSystem`` from the plan's
-  compiled laws at every integrator stage (the stage's time and state): coordinate laws
+  loads e(t), springs Drake's elements cannot hold) is evaluated by one Python
+  ``LeafSystem`` from the plan's compiled laws at every integrator stage (the stage's time and state): coordinate laws
   as the plant's applied generalized force (tau = T^T Q), point-to-point laws as
   externally applied spatial forces on the two bodies (so that they are not booked as
   forces through the joints);
