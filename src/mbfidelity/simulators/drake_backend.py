@@ -207,21 +207,18 @@ def _discrete(mech: Mechanism, cfg: Mapping) -> bool:
 
 def _coupler(mech: Mechanism, coupling: LinearCoupling
              ) -> tuple[int, int, float, float] | None:
-    """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset, the coupling
-    sum a_k q_k = C written on the engine joint values (q = T v + c: (a T) v = C - a c);
-    None unless it relates exactly two of them."""
-    cmap = coordinate_map(mech)
+    """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset: the coupling
+    written on the engine joint values (`CoordinateMap.on_engine_values`); None unless it
+    relates exactly two of them."""
     a = np.zeros(len(mech.coordinates))
     for name, coefficient in coupling.coefficients:
         a[mech.coordinates.index(name)] += num(coefficient)
-    row = a @ cmap.T
-    row = np.where(np.abs(row) < 1e-12 * np.max(np.abs(row)), 0.0, row)
+    row, constant = coordinate_map(mech).on_engine_values(a, num(coupling.constant))
     nonzero = np.flatnonzero(row)
     if len(nonzero) != 2:
         return None
     i0, i1 = (int(i) for i in nonzero)
-    return i0, i1, float(-row[i1] / row[i0]), float((num(coupling.constant) - a @ cmap.c)
-                                                    / row[i0])
+    return i0, i1, float(-row[i1] / row[i0]), constant / float(row[i0])
 
 
 @dataclass

@@ -409,6 +409,15 @@ class CoordinateMap:
         """The body's angle at q (rows of q give one angle per row)."""
         return q @ self.angle_c[body] + self.angle_d[body]
 
+    def on_engine_values(self, coefficients: np.ndarray, constant: float
+                         ) -> tuple[np.ndarray, float]:
+        """A linear relation sum a_k q_k = C on the coordinates written on the engine
+        joint values: (a T, C - a c), since q = T v + c; weights below 1e-12 of the
+        largest are round-off of T and set to zero."""
+        row = np.asarray(coefficients, dtype=float) @ self.T
+        row = np.where(np.abs(row) <= 1e-12 * np.max(np.abs(row), initial=0.0), 0.0, row)
+        return row, float(constant - np.asarray(coefficients, dtype=float) @ self.c)
+
 
 def coordinate_map(mech: Mechanism) -> CoordinateMap:
     """The `CoordinateMap` of a numeric mechanism."""
