@@ -160,24 +160,43 @@ def _jumps(expr) -> bool:
     return False
 
 
-#: the share of the pin body's mass a slot's slider carries (`EXPRESSIONS`): small, so that
-#: the pin's body keeps a physical inertia, large enough for a well-conditioned solve
-_SLIDER_SHARE = 1e-3
+def _slider_mass(mech: Mechanism, slot: PointOnLine) -> float:
+    """The point mass a slot's slider takes from the pin's body at the pin (`EXPRESSIONS`).
+    SAP regularizes a constraint by the inverse masses it joins, so a light slider makes
+    the pin's constraint soft; the pin's body keeps a physical inertia (in-plane central
+    moments izz/2 and izz/2 - m_s m |p|^2 / (m - m_s) >= 0 for a pin at p from its centre
+    of mass: m_s / (m - m_s) <= rho = izz / (2 m |p|^2)). Half the largest share that
+    allows, at most half the mass, divided among the body's slots; 0 where it has none
+    to lend (massless, the world, a point mass pinned off its centre)."""
+    if slot.body == WORLD:
+        return 0.0
+    body = mech.body(slot.body)
+    mass, izz = num(body.mass), num(body.inertia)
+    pin = np.hypot(num(slot.point[0]), num(slot.point[1]))
+    if not mass > 0:
+        return 0.0
+    rho = izz / (2 * mass * pin ** 2) if pin > 0 else np.inf
+    share = 0.5 if rho == np.inf else min(0.5, 0.5 * rho / (1 + rho))
+    slots = sum(1 for c in mech.constraints if isinstance(c, PointOnLine) and c.body == body.name)
+    return share * mass / slots
 
 
 def _can_lend(mech: Mechanism, slot: PointOnLine) -> bool:
-    """Whether the pin's body can lend a slider the point mass _SLIDER_SHARE m at the pin
-    and keep a physical inertia (each planar moment about its frame stays positive)."""
-    if slot.body == WORLD or not num(mech.body(slot.body).mass) > 0:
+    """Whether the pin's body can lend the slider its point mass and keep a physical
+    inertia (in-plane central moments non-negative, checked on the body as built)."""
+    if not _slider_mass(mech, slot) > 0:
         return False
-    _, _, unit = _inertia(mech, mech.body(slot.body))
-    return min(unit[:3]) > 0 and unit[0] * unit[1] > unit[3] ** 2
+    mass, com, unit = _inertia(mech, mech.body(slot.body))
+    c = np.asarray(com)
+    central = (np.array([[unit[0], unit[3]], [unit[3], unit[1]]])
+               - (c @ c * np.eye(3) - np.outer(c, c))[:2, :2])
+    return bool(np.min(np.linalg.eigvalsh(central)) >= 0)
 
 
 def _inertia(mech: Mechanism, body) -> tuple[float, list, tuple]:
     """(mass, centre of mass in the body frame, unit inertia about the frame: Ixx, Iyy,
     Izz, Ixy, Ixz, Iyz) of a body as built: its planar moment on z and half of it on x and
-    y (a lamina), less the point masses _SLIDER_SHARE m it lends at the pins of its slots."""
+    y (a lamina), less the point masses it lends at the pins of its slots (`_slider_mass`)."""
     mass, izz = num(body.mass), num(body.inertia)
     if not mass:  # Drake stores the inertia per unit mass; a massless body has none
         return 0.0, [0.0] * 3, (0.0,) * 6
@@ -186,7 +205,7 @@ def _inertia(mech: Mechanism, body) -> tuple[float, list, tuple]:
     kept = mass
     for c in mech.constraints:
         if isinstance(c, PointOnLine) and c.body == body.name:
-            lent, pin = _SLIDER_SHARE * mass, np.array([num(c.point[0]), num(c.point[1]), 0.0])
+            lent, pin = _slider_mass(mech, c), np.array([num(c.point[0]), num(c.point[1]), 0.0])
             tensor -= lent * (pin @ pin * np.eye(3) - np.outer(pin, pin))
             first_moment -= lent * pin
             kept -= lent
@@ -508,7 +527,7 @@ class DrakeBackend(Backend):
                 slider = rec(f"body_{len(bodies) + len(slots)}", plant.AddRigidBody,
                              "plant.AddRigidBody", f"{c.name}_slider",
                              rec(None, SpatialInertia, "SpatialInertia",
-                                 _SLIDER_SHARE * num(mech.body(c.body).mass), [0.0] * 3,
+                                 _slider_mass(mech, c), [0.0] * 3,
                                  rec(None, UnitInertia, "UnitInertia", 0.0, 0.0, 0.0)))
                 axis = np.array([num(c.direction[0]), num(c.direction[1]), 0.0])
                 axis /= np.linalg.norm(axis)

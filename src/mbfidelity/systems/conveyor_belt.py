@@ -174,7 +174,7 @@ SYSTEM = System(
         *(Expectation(engine, "v0_0_29.trajectory_*", "unresolved", STICK_SLIP_DRIFT)
           for engine in ("mujoco", "exudyn")),
         *(Expectation(engine, "convergence.order", "unresolved", FIRST_ORDER_MIXED)
-          for engine in ("pybullet", "pymunk")),
+          for engine in ("pybullet", "pymunk", "drake")),
         *(Expectation(engine, metric, "unresolved", FIRST_ORDER_NEUTRAL)
           for engine in ("pybullet", "pymunk", "drake")
           for metric in ("v0_0_30.final_amplitude",)),

@@ -190,7 +190,7 @@ SYSTEM = System(
                       "the study's steps for this short, fast run are few per turn of the "
                       "crank and lie outside the first-order scheme's asymptotic range: the "
                       "error falls faster than first order over them")
-          for engine in ("pybullet", "pymunk")),
+          for engine in ("pybullet", "pymunk", "drake")),
         Expectation("exudyn", "published.completed", "xfail",
                     "Exudyn's implicit scheme solves each step by Newton's method, which "
                     "does not converge when the crank turns about a radian within one "
