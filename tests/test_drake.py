@@ -177,12 +177,12 @@ def test_closed_loops_run_on_the_discrete_plant_and_a_model_error_is_rejected():
         mech = system.numeric_mechanism(system.parameter_values())
         assert backend.support(mech).ok
         assert backend.scheme(mech).order == 1 and backend.accuracy_knob(mech) == ""
-        result = compare(system_id, "drake", scenarios=["small"], t_end=1.0)
+        result = compare(system_id, "drake", scenarios=["small"], t_end=0.5)
         by_name = {m.name: m for m in result.metrics}
         assert by_name["small.trajectory_max"].status == "pass", by_name["small.trajectory_max"]
         forces = [m for m in result.metrics if m.name.startswith("small.constraint_")]
         assert forces and all(m.status == "xfail" for m in forces)
-    heavier = compare("belt_pulleys", "drake", scenarios=["small"], t_end=1.0,
+    heavier = compare("belt_pulleys", "drake", scenarios=["small"], t_end=0.5,
                       engine_scale={"l": 1.02})
     bad = {m.name: m for m in heavier.metrics}["small.trajectory_max"]
     assert bad.status in ("fail", "xfail") and bad.value > bad.tolerance
