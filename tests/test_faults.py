@@ -108,7 +108,7 @@ def test_run_completes_beside_a_system_that_fails_and_the_report_shows_it(tmp_pa
 def test_convergence_item_that_fails_fails_alone(user_modules):
     from mbfidelity.comparisons.convergence import _study_item
 
-    doc = _study_item(("user_blowup_force", "pymunk", None, 0.5))
+    doc = _study_item(("user_blowup_force", "pymunk", None, 0.5, "auto"))
     assert doc["metric"]["status"] == "fail" and "reference" in doc["failure"]
 
 
