@@ -31,8 +31,9 @@ amplitude. The order is fitted on the steps whose error still falls (by {{ doc.m
 at least) and stays {{ doc.reference_margin }} times above the reference's own error; it must match the
 order the engine declares within {{ doc.order_tolerance }}. An error-controlled engine is studied by its target
 accuracy ({{ doc.accuracies|map("string")|join(", ") }}) at a sampling step of about 1/w: its error must fall by
-{{ doc.min_accuracy_decrease }} per decade of accuracy at least (the cell: the largest ratio per decade, the gate, and
-the slope of log error on log accuracy), where the controller sets asymptotic steps, down to the reference's floor.</p>
+{{ doc.min_accuracy_decrease }} per decade of accuracy at least, over every two decades (the cell: the largest ratio per
+decade, the gate, and the slope of log error on log accuracy), where the controller sets asymptotic steps, down to the
+reference's floor.</p>
 <table><tr><th>system</th>{% for sim in sims %}<th>{{ sim }}: fitted / declared order</th>{% endfor %}</tr>
 {% for sys in systems %}<tr><td><a href="#{{ sys }}">{{ sys }}</a></td>
 {% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s %}<td class="{{ s.metric.status }}" title="{{ s.metric.reason or s.flattened or s.failure or s.unsupported }}">

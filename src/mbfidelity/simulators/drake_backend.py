@@ -21,10 +21,10 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   Drake's ``LinearSpringDamper``, a spring of zero free length without damper an
   isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time
   loads e(t), springs Drake's elements cannot hold) is evaluated by one Python
-  ``LeafSystem`` from the plan's compiled laws at every integrator stage (the stage's time and state): coordinate laws
-  as the plant's applied generalized force (tau = T^T Q), point-to-point laws as
-  externally applied spatial forces on the two bodies (so that they are not booked as
-  forces through the joints);
+  ``LeafSystem`` from the plan's compiled laws at every integrator stage (the stage's
+  time and state): coordinate laws as the plant's applied generalized force
+  (tau = T^T Q), point-to-point laws as externally applied spatial forces on the two
+  bodies (so that they are not booked as forces through the joints);
 - the run is sampled at t = k dt by ``Simulator.AdvanceTo`` (the integrator's own steps
   are error-controlled between samples and end on them);
 - reactions: the plant's reaction forces output (the force on the child at its joint
@@ -282,8 +282,8 @@ class DrakeBackend(Backend):
         "fixed_step": Setting(
             False, bool,
             "Drake default (error control) kept; True runs the integrator at the fixed "
-            "step dt (the knob of the convergence study by steps), for runge_kutta3, radau3 and "
-            "implicit_euler."),
+            "step dt (the knob of the convergence study by steps), for runge_kutta3, "
+            "radau3 and implicit_euler."),
         "plant": Setting(
             "auto", ("auto", "discrete"),
             "Backend choice: auto builds the continuous-time plant (error-controlled) "
