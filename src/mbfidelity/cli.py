@@ -571,7 +571,8 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
     """Error against the step and work-precision, per system x engine: the fitted order
     next to the engine's declared order (gate: within 0.5, where the curve still falls);
     an error-controlled engine's error against its target accuracy (gate: it falls by 2
-    per decade down to the reference's floor). Exit 1 when a gate fails."""
+    per decade over every two decades, down to the reference's floor). Exit 1 when a gate
+    fails."""
     from . import api
 
     dts = None
