@@ -143,7 +143,7 @@ SYSTEM = System(
        Expectation("drake", "convergence.order", "xfail",
                    "Drake's fixed-step Runge-Kutta 3 error here falls faster than the third "
                    "order it declares (within the asymptotic range of the fast shaking; "
-                   "mbfidelity convergence), while it shows third order on every other "
+                   "mbfidelity convergence --knob step), while it shows third order on every other "
                    "mechanism it runs: the cause (a cancellation of the scheme's leading "
                    "term on the parametrically shaken pendulum, or the route of its "
                    "actuator) is not established.")),
