@@ -347,6 +347,9 @@ class Derivation:
         sympy solves the constraints uniquely (None otherwise). Cached."""
         if not hasattr(self, "_explicit_dependent"):
             self._explicit_dependent = None
+            if self.mechanism.branch:
+                self._explicit_dependent = self._branch()
+                return self._explicit_dependent
             # an unsimplified chain's loop is no case for sympy's solve (it does not return)
             if self.m and self.mechanism.simplify:
                 dep = [self.q[i] for i in self.dependent]
@@ -362,6 +365,27 @@ class Derivation:
                 if len(sols) == 1 and set(sols[0]) == set(dep):
                     self._explicit_dependent = dict(sols[0])
         return self._explicit_dependent
+
+    def _branch(self) -> dict:
+        """The mechanism's assembly branch (`Mechanism.branch`) as dependent symbol ->
+        expression of the independent ones, checked: every constraint row vanishes on it
+        identically (ValueError otherwise)."""
+        names = self.mechanism.coordinates
+        independent = {self.q[i] for i in self.independent}
+        out = {}
+        for name, expr in self.mechanism.branch:
+            expr = sp.sympify(expr).xreplace({coordinate_symbols(c)[0]: self.q[names.index(c)]
+                                              for c in names})
+            if not expr.free_symbols & set(self.q) <= independent:
+                raise ValueError(f"branch of {name}: a function of the independent "
+                                 f"coordinates only, not {expr}")
+            out[self.q[names.index(name)]] = expr
+        on_branch = self.Phi.xreplace(out)
+        for k, row in enumerate(on_branch):
+            if sp.simplify(sp.expand_trig(row)) != 0:
+                raise ValueError(f"the branch does not close the mechanism: constraint row "
+                                 f"{k} is {sp.simplify(row)} on it")
+        return out
 
     @property
     def linear_statics(self) -> bool:

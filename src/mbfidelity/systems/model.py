@@ -470,6 +470,14 @@ class Mechanism:
     #: sums grows exponentially with N, so the derivation keeps its exact unsimplified
     #: expressions (lambdify's common-subexpression elimination compacts them)
     simplify: bool = True
+    #: the assembly branch in closed form: (dependent coordinate, expression of the
+    #: independent coordinates' symbols) for every dependent coordinate. Where the
+    #: constraint Jacobian loses rank along the motion (a linkage passing a change point,
+    #: where branches cross), solving the closure by Newton's method from the independent
+    #: coordinates is singular; the branch the motion stays on, given so, keeps the
+    #: reduced equations regular there (analytic/derivation.py checks that the
+    #: constraints vanish on it identically)
+    branch: tuple[tuple[str, Expr], ...] = ()
 
     @property
     def spatial(self) -> bool:
@@ -560,6 +568,12 @@ class Mechanism:
                 raise ValueError(f"independent coordinates not in the mechanism: {unknown}")
         elif self.constraints:
             raise ValueError("a constrained mechanism must name its independent coordinates")
+        if self.branch:
+            given = [name for name, _ in self.branch]
+            dependent = [c for c in coords if c not in (self.independent or ())]
+            if sorted(given) != sorted(dependent) or len(set(given)) != len(given):
+                raise ValueError(f"the branch gives {sorted(given)}: it must give every "
+                                 f"dependent coordinate once, {sorted(dependent)}")
 
     @property
     def coordinates(self) -> tuple[str, ...]:
@@ -672,6 +686,7 @@ class Mechanism:
             independent=self.independent,
             prescribed=tuple(replace(p, motion=ev(p.motion)) for p in self.prescribed),
             up=ev(self.up),
+            branch=tuple((name, ev(e)) for name, e in self.branch),
         )
 
 

@@ -1,0 +1,96 @@
+"""IFToMM A02, the N-four-bar mechanism through its singular positions: the reference on
+the parallelogram branch against the pendulum equation of that branch (written here from
+its kinetic and potential energies, integrated by SciPy independently of the
+derivation), its energy integral, the published values, and the branch's own check."""
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from mbfidelity.analytic.derivation import Derivation
+from mbfidelity.analytic.numeric import numeric_model
+from mbfidelity.analytic.reference import reference
+from mbfidelity.systems import get_system
+
+A02 = "iftomm_a02_four_bar"
+
+
+def _pendulum_b0(v, times):
+    """B0 at `times` from the parallelogram's one-degree-of-freedom equation, written from
+    T = J th'^2 / 2, V = G sin th (cranks: uniform bars turning about their pins; couplers:
+    translating with the cranks' tips), by DOP853 at rtol = atol = 1e-12."""
+    N, L, m, mc, g = (v[k] for k in ("N", "L", "m", "mc", "g"))
+    J = (N + 1) * m * L * L / 3 + N * mc * L * L
+    G = g * L * ((N + 1) * m / 2 + N * mc)
+    sol = solve_ivp(lambda t, y: [y[1], -G * math.cos(y[0]) / J], (0, max(times)),
+                    [math.pi / 2, -v["v0"] / L], method="DOP853", rtol=1e-12, atol=1e-12,
+                    t_eval=times)
+    return L * np.cos(sol.y[0]), L * np.sin(sol.y[0]), J, G
+
+
+@pytest.mark.parametrize("N", [1, 2])
+def test_reference_crosses_the_singular_positions_on_the_parallelogram(N):
+    """Over 10 s the chain passes the flat (singular) position about seven times; B0 at
+    every 0.5 s within 1e-8 m of the independent one-degree-of-freedom solution (both
+    DOP853 at 1e-12: their errors, a few 1e-10 over this run, stay far below it), and
+    the energy constant to 1e-8 J (the integrator's tolerance over the run)."""
+    s = get_system(A02)
+    v = s.parameter_values({"N": N}, scenario=s.scenarios[0])
+    ref = reference(s, s.scenarios[0], v, 1e-2, t_end=10.0)
+    th0 = ref.q[:, list(s.with_structure(v).coordinates).index("th0")]
+    times = np.arange(0, 10.0001, 0.5)
+    rows = np.rint(times / 1e-2).astype(int)
+    x, y, J, G = _pendulum_b0(v, times)
+    assert np.max(np.abs(v["L"] * np.cos(th0[rows]) - x)) < 1e-8
+    assert np.max(np.abs(v["L"] * np.sin(th0[rows]) - y)) < 1e-8
+    # the motion did cross the singular positions (th0 = 0 and pi, mod 2 pi)
+    assert np.ptp(th0) > 6 * math.pi
+    energy0 = J * (v["v0"] / v["L"]) ** 2 / 2 + G  # upright: V = G sin(pi/2)
+    assert ref.energy - ref.energy[0] == pytest.approx(np.zeros(len(ref.t)), abs=1e-8)
+    assert ref.energy[0] == pytest.approx(energy0, rel=1e-12)
+
+
+def test_published_b0_at_10_s_within_1e6_of_the_published_values():
+    """N = 2: the reference's B0 at t = 10 s against the closed form (Jacobi's amplitude,
+    exact to round-off) within 1e-9 m, and against the value Exudyn's test model records
+    at its finest step within 1e-6 m (its own second-order error is below that)."""
+    from mbfidelity.analytic.published import compare_published
+
+    s = get_system(A02)
+    v = s.parameter_values({"N": 2})
+    rows = compare_published(s, v)
+    at10 = [p for p in rows if p["time"] == 10.0]
+    assert len(at10) == 4 and all(p["applies"] for p in rows)
+    closed = [p for p in at10 if "closed form" in p["source"]]
+    exudyn = [p for p in at10 if "Exudyn" in p["source"]]
+    assert all(abs(p["reference_value"] - p["published_value"]) < 1e-9 for p in closed)
+    assert all(abs(p["reference_value"] - p["published_value"]) < 1e-6 for p in exudyn)
+    x, y, _, _ = _pendulum_b0(v, [10.0])
+    got = {p["quantity"]: p["reference_value"] for p in closed}
+    assert got["B0.x"] == pytest.approx(x[0], abs=1e-9)
+    assert got["B0.y"] == pytest.approx(y[0], abs=1e-9)
+
+
+def test_a_branch_that_does_not_close_the_mechanism_is_refused():
+    """Injected model error: the couplers said to turn with the cranks (psi = th0)."""
+    s = get_system(A02)
+    mech = s.with_structure({"N": 1}).mechanism
+    wrong = tuple((name, e if name.startswith("th") else mech.branch[0][1])
+                  for name, e in mech.branch)
+    with pytest.raises(ValueError, match="does not close"):
+        Derivation(replace(mech, branch=wrong)).explicit_dependent
+
+
+def test_the_flat_position_is_singular_for_newtons_method():
+    """Why the branch is needed: at th0 = 0 the constraint Jacobian has rank N, not 2N
+    (the mobility jumps to N + 1), so Newton's method on the dependent coordinates has no
+    regular matrix there."""
+    s = get_system(A02)
+    v = s.parameter_values({"N": 2})
+    model = numeric_model(s.id, v)
+    flat = np.zeros(model.n)
+    J = model.constraint_jacobian(flat)
+    assert np.linalg.matrix_rank(J) == 2
+    assert np.linalg.matrix_rank(J[:, model.dependent]) < model.m
