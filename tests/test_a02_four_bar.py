@@ -94,3 +94,51 @@ def test_the_flat_position_is_singular_for_newtons_method():
     J = model.constraint_jacobian(flat)
     assert np.linalg.matrix_rank(J) == 2
     assert np.linalg.matrix_rank(J[:, model.dependent]) < model.m
+
+
+# --- analyze flags a configuration where the constraint Jacobian loses rank -----------
+
+def _pose(N, th0, crank=None):
+    q = {f"th{i}": th0 for i in range(N + 1)}
+    q.update({f"psi{j}": 0.0 for j in range(1, N + 1)})
+    if crank is not None:
+        q["th1"] = crank
+    return q
+
+
+@pytest.mark.parametrize("th0,singular", [(0.0, True), (math.pi, True),
+                                          (math.pi / 2, False), (1e-3, False)])
+def test_the_constraint_rank_marks_the_flat_parallelogram_only(th0, singular):
+    """The flat parallelogram (th0 = 0 or pi) has rank N of 2N; the upright one and one
+    a milliradian from flat (an injected error of the pose) have full rank: the rank's
+    tolerance (1e-8 of the largest singular value) tells a pose solved to round-off
+    from one a milliradian away, whose smallest singular value is about 1e-3."""
+    from mbfidelity.api import _constraint_rank
+
+    s = get_system(A02)
+    v = s.parameter_values({"N": 2})
+    built = s.with_structure(v)
+    q = _pose(2, th0)
+    out = _constraint_rank(built, v, np.array([q[c] for c in built.coordinates]))
+    assert out["constraint_rows"] == 4 and out["singular"] is singular
+    assert out["constraint_rank"] == (2 if singular else 4)
+    assert ("warning" in out) is singular
+
+
+@pytest.mark.slow
+def test_analyze_flags_the_singular_equilibrium_in_json_and_text():
+    """Every equilibrium `analyze` lists carries the rank; those with a flat window are
+    flagged (JSON) and warned about (text), the hanging parallelogram is not."""
+    from typer.testing import CliRunner
+
+    from mbfidelity.api import analyze
+    from mbfidelity.cli import app
+
+    doc = analyze(A02, {"N": 1})
+    hanging = [e for e in doc["equilibria"] if e["stable"]
+               and abs(e["q"]["th0"] + math.pi / 2) < 1e-9 and abs(e["q"]["psi1"]) < 1e-9]
+    assert hanging and not hanging[0]["singular"]
+    flagged = [e for e in doc["equilibria"] if e["singular"]]
+    assert flagged and all(e["constraint_rank"] < e["constraint_rows"] for e in flagged)
+    text = CliRunner().invoke(app, ["analyze", A02, "--param", "N=1"]).output
+    assert text.count("warning: singular position") == len(flagged)

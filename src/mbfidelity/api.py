@@ -117,6 +117,26 @@ def analyze(system_id: str, params: Mapping[str, float] | None = None, *,
                            f"bytes; MBFIDELITY_WORKER_MEMORY raises it)") from None
 
 
+def _constraint_rank(system, values: Mapping[str, float], q) -> dict:
+    """The constraint Jacobian's rank at an equilibrium, and where it is below the number
+    of constraint rows a warning: a singular position ({} without constraints)."""
+    from .analytic.numeric import numeric_model
+
+    model = numeric_model(system.id, values)
+    if not model.constrained:
+        return {}
+    rank, _ = model.constraint_rank(q)
+    out = {"constraint_rank": rank, "constraint_rows": model.m,
+           "singular": rank < model.m}
+    if rank < model.m:
+        out["warning"] = (
+            f"singular position: the constraint Jacobian has rank {rank} of {model.m} "
+            f"here (assembly branches cross; the mobility is {model.n - rank}, not "
+            f"{model.n - model.m}): the stability and modes are those of the first-order "
+            f"motions allowed here, and a motion through it may change branch")
+    return out
+
+
 def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> dict:
     import numpy as np
 
@@ -149,6 +169,7 @@ def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> 
     equilibria = []
     for e in eqs:
         item = {"q": dict(zip(coords, e.q.tolist())), "stable": e.stable}
+        item.update(_constraint_rank(system, values, e.q))
         if e.stable or oscillatory_instability(e.eigenvalues):
             # a self-excited mode has a frequency and a negative damping ratio
             item["modes"] = modes(e)

@@ -207,6 +207,8 @@ def analyze(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                        f"over the period {f['period']:.6g} s)")
             continue
         typer.echo(f"{kind} {e['q']}: {'stable' if e['stable'] else 'unstable'}")
+        if e.get("singular"):
+            typer.echo(f"  warning: {e['warning']}")
     if "parametric_excitation" in doc:
         typer.echo(f"parametric excitation: {doc['parametric_excitation']}")
     typer.echo(f"at {doc['operating_point']}:")

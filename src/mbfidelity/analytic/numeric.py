@@ -35,6 +35,11 @@ from .derivation import Derivation, cache_key, derivation_of
 
 NEWTON_TOL = 1e-14
 NEWTON_MAX = 50
+#: singular values of the constraint Jacobian below this fraction of the largest count as
+#: zero: configurations are solved to about NEWTON_TOL, so a singular value that vanishes
+#: at a singular position is of that order there, while at a regular one each is of the
+#: order of the mechanism's lengths
+RANK_TOLERANCE = 1e-8
 
 
 #: derivatives of |length| carry DiracDelta(length): zero wherever the length is not
@@ -309,6 +314,17 @@ class NumericModel:
         if np.max(np.abs(self.constraint_values(q))) > 1e-10:
             raise RuntimeError("the constraint equations have no solution here")
         return q
+
+    def constraint_rank(self, q) -> tuple[int, np.ndarray]:
+        """(rank, singular values) of the constraint Jacobian at q, by its singular value
+        decomposition: singular values below RANK_TOLERANCE times the largest count as
+        zero. Full rank is the number of constraint rows; less marks a singular position
+        (branches of the assembly cross, the mobility is n - rank) or redundant
+        constraints."""
+        if not self.constrained:
+            return 0, np.zeros(0)
+        sv = np.linalg.svd(self.constraint_jacobian(q), compute_uv=False)
+        return int(np.sum(sv > RANK_TOLERANCE * sv.max())), sv
 
     def velocity_basis(self, q) -> np.ndarray:
         """S with q' = S q_i' (n x n_independent)."""
