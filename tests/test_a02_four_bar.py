@@ -142,3 +142,82 @@ def test_analyze_flags_the_singular_equilibrium_in_json_and_text():
     assert flagged and all(e["constraint_rank"] < e["constraint_rows"] for e in flagged)
     text = CliRunner().invoke(app, ["analyze", A02, "--param", "N=1"]).output
     assert text.count("warning: singular position") == len(flagged)
+
+
+# --- named points: reported by the reference and analyze, judged like coordinates -------
+
+def _a02_reference(N=2, dt=1e-2, t_end=10.0):
+    s = get_system(A02)
+    v = s.parameter_values({"N": N}, scenario=s.scenarios[0])
+    return s.with_structure(v), v, reference(s, s.scenarios[0], v, dt, t_end=t_end)
+
+
+def test_the_reference_reports_b0_as_the_first_cranks_tip():
+    """B0 = L (cos th0, sin th0), its velocity L th0' (-sin th0, cos th0): written here
+    from the geometry, against the reference's point (from the derivation's kinematics),
+    and its error estimate no larger than L times th0's."""
+    s, v, ref = _a02_reference()
+    i = list(s.coordinates).index("th0")
+    th, rate, L = ref.q[:, i], ref.qd[:, i], v["L"]
+    expected = np.column_stack([L * np.cos(th), L * np.sin(th),
+                                -L * rate * np.sin(th), L * rate * np.cos(th)])
+    assert np.max(np.abs(ref.points["B0"] - expected)) < 1e-12
+    assert ref.point_error_estimate["B0"] <= L * ref.error_estimate[i] * (1 + 1e-9)
+
+
+def test_analyze_reports_the_points_at_the_end_of_each_scenario():
+    """`analyze --json` `points`: B0 at the end of the published run (20 s) within 1e-8 m
+    of the closed form (Jacobi's amplitude)."""
+    from mbfidelity.api import _points_report
+    from mbfidelity.systems.benchmarks.iftomm_a02_four_bar import closed_form_th0
+
+    s = get_system(A02)
+    v = s.parameter_values()
+    (b0,) = _points_report(s.with_structure(v), v)
+    th = closed_form_th0(v, 20.0)
+    assert b0["point"] == "B0" and b0["time"] == pytest.approx(20.0)
+    assert b0["position"] == pytest.approx([v["L"] * math.cos(th), v["L"] * math.sin(th)],
+                                           abs=1e-8)
+    assert b0["path_extent"] == pytest.approx(2 * v["L"], rel=1e-3)
+
+
+def test_engine_points_take_the_shared_kinematics_of_the_coordinates():
+    """The engines' route (plan.py's planar forward kinematics of the coordinates) gives
+    the derivation's points along the reference's states, to round-off."""
+    from mbfidelity.comparisons.points import engine_points
+
+    s, v, ref = _a02_reference(t_end=2.0)
+    got = engine_points(s, v, s.numeric_mechanism(v), ref.q, ref.qd)
+    assert np.max(np.abs(got["B0"] - ref.points["B0"])) < 1e-12
+
+
+def test_the_point_gate_follows_the_coordinates_gate_and_sees_an_injected_error():
+    """The reference against itself measures zero; th0 shifted by 1e-4 rad (an injected
+    error) moves B0 by 1e-4 L, which the metric reports relative to B0's excursion; the
+    gate is the coordinates' times G = L s_th0 / excursion (B0 depends on th0 alone)."""
+    from types import SimpleNamespace
+
+    from mbfidelity.comparisons.points import judge_points, point_gain
+    from mbfidelity.comparisons.tolerances import Gate
+
+    s, v, ref = _a02_reference(t_end=2.0)
+    mech = s.numeric_mechanism(v)
+    i = list(s.coordinates).index("th0")
+    q_eq = s.operating_values(v)
+    scale = np.max(np.abs(ref.q - q_eq), axis=0)
+    excursion, gain = point_gain(s, v, ref, q_eq, scale)["B0"]
+    assert gain == pytest.approx(v["L"] * scale[i] / excursion, rel=1e-12)
+    recorded = {}
+
+    def judge(label, value, gate):
+        recorded[label] = (value, gate.tolerance)
+
+    judge_points(s, v, mech, ref, ref, len(ref.t), q_eq, scale, Gate(1e-3), "run", judge)
+    assert recorded["run.point_B0_max"][0] < 1e-12
+    assert recorded["run.point_B0_max"][1] == pytest.approx(1e-3 * gain)
+    shifted = ref.q.copy()
+    shifted[:, i] += 1e-4
+    judge_points(s, v, mech, ref, SimpleNamespace(q=shifted, qd=ref.qd), len(ref.t), q_eq,
+                 scale, Gate(1e-3), "run", judge)
+    assert recorded["run.point_B0_max"][0] == pytest.approx(1e-4 * v["L"] / excursion,
+                                                            rel=1e-3)

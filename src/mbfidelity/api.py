@@ -137,6 +137,37 @@ def _constraint_rank(system, values: Mapping[str, float], q) -> dict:
     return out
 
 
+#: reference samples per scenario for the named points' report
+POINT_SAMPLES = 2000
+
+
+def _points_report(system, values: Mapping[str, float]) -> list[dict]:
+    """Each named point (`System.points`) at the end of each scenario, from the
+    reference: its world position and velocity there, the largest distance over the run
+    between the reference's position and that of its error-estimating solve, and the
+    extent of its path (the largest distance from its start)."""
+    import numpy as np
+
+    from .analytic.reference import reference
+
+    out = []
+    for sc in system.scenarios:
+        ref = reference(system, sc, values, sc.t_end / POINT_SAMPLES)
+        for p in system.points(system.symbols):
+            state = ref.points[p.name]
+            d = state.shape[1] // 2
+            out.append({
+                "point": p.name, "body": p.body,
+                "position_in_body": [str(c) for c in p.position],
+                "scenario": sc.name, "time": float(ref.t[-1]),
+                "position": state[-1, :d].tolist(), "velocity": state[-1, d:].tolist(),
+                "error_estimate": ref.point_error_estimate[p.name],
+                "path_extent": float(np.max(np.linalg.norm(state[:, :d] - state[0, :d],
+                                                           axis=1))),
+            })
+    return out
+
+
 def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> dict:
     import numpy as np
 
@@ -214,6 +245,8 @@ def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> 
             doc["steady_state_note"] = response.reason
         else:
             doc["steady_state_harmonic_residual"] = response.harmonic_residual
+    if system.points(system.symbols):
+        doc["points"] = _points_report(system, values)
     if system.published(system.symbols):
         from .analytic.published import compare_published
 

@@ -610,6 +610,24 @@ class NumericModel:
         qd[:, dep] = -np.linalg.solve(J[:, :, dep], (J[:, :, ind] @ qdi[..., None]))[..., 0]
         return qd
 
+    def point_states(self, q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:
+        """World position and velocity of each named point of the system
+        (`System.points`) along N sampled states: (N, 2 d) per point, the d position
+        components then the d velocity components (d = 2 planar, 3 spatial)."""
+        system, d = get_system(self.compiled.system_id), self.derivation
+        q, qd = np.atleast_2d(np.asarray(q, float)), np.atleast_2d(np.asarray(qd, float))
+        out = {}
+        for p in system.points(system.symbols):
+            if p.body not in d.poses:
+                raise ValueError(f"{system.id}: point {p.name} is on {p.body!r}, which is not "
+                                 f"a body of the mechanism")
+
+            def build(p=p):
+                r = d.point(p.body, p.position)
+                return list(d.q) + list(d.qd), list(r) + list(d.velocity(r)), "numpy"
+            out[p.name] = self._along(f"point-{p.name}", build, (*q.T, *qd.T), len(q))
+        return out
+
     def _jacobians_along(self, q: np.ndarray) -> np.ndarray:
         """Phi_q at N samples, (N, m, n)."""
         d = self.derivation

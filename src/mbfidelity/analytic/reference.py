@@ -40,6 +40,12 @@ class Reference:
     #: actuator force of each prescribed coordinate, (N,) by actuator name (model
     #: convention 9; empty without prescribed motion)
     actuator_forces: dict | None = None
+    #: each named point's world position and velocity, (N, 2 d) by name
+    #: (`System.points`, `NumericModel.point_states`; empty without points)
+    points: dict | None = None
+    #: max distance, over the run, between each point's position and its position on the
+    #: comparison solve the coordinates' `error_estimate` comes from, by name
+    point_error_estimate: dict | None = None
 
 
 class ReferenceFailed(RuntimeError):
@@ -214,13 +220,14 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
         q_exact, qd_exact = exact(values, q0, qd0, t)
         # the closed form is exact to round-off; its distance to DOP853 bounds both
         error = np.max(np.abs(q_exact - q), axis=0)
-        q, qd = q_exact, qd_exact
+        other_q, q, qd = q, q_exact, qd_exact
         method = f"closed form ({system.exact_solution}); DOP853 rtol=atol={TIGHT:g} agrees"
     else:
         model._warm = np.array(q0, dtype=float)
-        loose_q = _positions(model, _dop853(model, y0, t, LOOSE), q0, t)
-        error = np.max(np.abs(loose_q - q), axis=0)
+        other_q = _positions(model, _dop853(model, y0, t, LOOSE), q0, t)
+        error = np.max(np.abs(other_q - q), axis=0)
         method = f"DOP853 rtol=atol={TIGHT:g}; error estimated against rtol=atol={LOOSE:g}"
+    points, point_error = _points(model, q, qd, other_q)
     if model.constrained:
         qdd, lam = model.dynamics_along(q, qd, t)
         constraint_forces = model.constraint_forces(q, lam)
@@ -235,7 +242,22 @@ def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
     reactions = {j: model.reaction(j, q, qd, qdd, t, lam) for j in joints}
     energy = model.energy(q, qd) if model.conservative else None
     return Reference(t, q, qd, qdd, reactions, energy, error, method, lam, constraint_forces,
-                     switches, model.actuator_forces(q, qd, qdd, t))
+                     switches, model.actuator_forces(q, qd, qdd, t), points, point_error)
+
+
+def _points(model, q: np.ndarray, qd: np.ndarray, other_q: np.ndarray) -> tuple[dict, dict]:
+    """(states, error estimates) of the system's named points: their states along (q, qd),
+    and the largest distance between their positions on q and on `other_q` (the solve
+    the coordinates' error estimate comes from)."""
+    states = model.point_states(q, qd)
+    if not states:
+        return {}, {}
+    other = model.point_states(other_q, np.zeros_like(other_q))
+    error = {}
+    for name, state in states.items():
+        d = state.shape[1] // 2
+        error[name] = float(np.max(np.linalg.norm(other[name][:, :d] - state[:, :d], axis=1)))
+    return states, error
 
 
 def _check_sliding(system, model, surfaces) -> None:
@@ -256,9 +278,10 @@ def _sliding_reference(system, model, surfaces, t, q0, qd0) -> Reference:
               f"(Filippov, analytic/sliding.py); error estimated against rtol=atol={LOOSE:g}")
     reactions = {j: model.reaction(j, x[:, None], v[:, None], a[:, None], t, np.zeros((len(t), 0)))
                  for j in system.reaction_joints}
+    points, point_error = _points(model, x[:, None], v[:, None], loose[:, None])
     return Reference(t, x[:, None], v[:, None], a[:, None], reactions, None, error, method,
                      np.zeros((len(t), 0)), {}, switches, model.actuator_forces(
-                         x[:, None], v[:, None], a[:, None], t))
+                         x[:, None], v[:, None], a[:, None], t), points, point_error)
 
 
 def sensitivity(system: System, scenario: Scenario, values: Mapping[str, float],

@@ -29,6 +29,7 @@ from ..systems import Expectation, System, get_system
 from ..systems.model import inertia_matrix
 from . import budget, checks, metrics, tolerances
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
+from .points import judge_points
 from .verdict import PASS
 from .verdict import verdict as verdict_of
 
@@ -546,6 +547,10 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
     emax, erms = metrics.trajectory_errors(run.q[:n, free], ref.q[:n, free], scale_free)
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_max", emax, tol))
     result.metrics.append(_judge(system, backend.id, f"{name}.trajectory_rms", erms, tol))
+    # the named points, by the engine-independent kinematics of its coordinates
+    judge_points(system, values, mech, ref, run, n, eq.q, scale, tol, name,
+                 lambda label, value, gate: result.metrics.append(
+                     _judge(system, backend.id, label, value, gate)))
     if system.driven:
         _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result)
     scenario_series: dict = {}
@@ -1226,7 +1231,9 @@ def _as_reference(system, values, ref, coarse, run):
                                     for a, v in run.actuator_forces.items()},
                    energy=(None if ref.energy is None
                            else _energy_of(system, values, run.q[:n], run.qd[:n])),
-                   error_estimate=np.zeros_like(ref.error_estimate))
+                   error_estimate=np.zeros_like(ref.error_estimate),
+                   points=(numeric_model(system.id, values).point_states(run.q[:n], run.qd[:n])
+                           if ref.points else ref.points))
 
 
 def _ceiling(name: str) -> float:

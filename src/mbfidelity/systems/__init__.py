@@ -135,6 +135,19 @@ class ContactOutput:
 
 
 @dataclass(frozen=True)
+class PointOutput:
+    """A named point of a body, whose world position and velocity the reference reports
+    and the comparisons judge like the coordinates (a benchmark publishes the trajectory
+    of a point, not the joints' angles). `position` is in the body's frame (its centre
+    of mass at the origin, model convention 2), written with the parameters."""
+
+    name: str
+    body: str
+    position: tuple[Expr, ...]
+    description: str = ""
+
+
+@dataclass(frozen=True)
 class Variant:
     """Another way some engines can build the mechanism (say rolling by friction contact
     instead of the coupling constraint), as description data: `constraints` (a function
@@ -266,6 +279,8 @@ class System:
     reaction_joints: tuple[str, ...] = ()
     #: physical contact forces (normal, friction) read from reactions or closure forces
     contacts: Callable[[SimpleNamespace], tuple[ContactOutput, ...]] = lambda P: ()
+    #: named body points whose positions and velocities are reported and judged
+    points: Callable[[SimpleNamespace], tuple[PointOutput, ...]] = lambda P: ()
     expectations: tuple[Expectation, ...] = ()
     variants: tuple[Variant, ...] = ()
     #: conditions on the parameters for the geometry to exist (checked on every set)

@@ -30,7 +30,7 @@ import math
 
 import sympy as sp
 
-from .. import Expectation, Published, System
+from .. import Expectation, PointOutput, Published, System
 from ..model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 SOURCE = ("IFToMM benchmark A01 (González et al., Multibody System Dynamics 16, 2006); "
@@ -103,6 +103,8 @@ SYSTEM = System(
     ),
     reaction_joints=("pivot",),
     published=published,
+    points=lambda P: (PointOutput("P1", "bob", (0, 0), "the point mass: the published "
+                                  "trajectory"),),
     expectations=tuple(
         Expectation(engine, "convergence.order", "unresolved",
                     "a fourth-order scheme resolves the swing to the reference's own error "

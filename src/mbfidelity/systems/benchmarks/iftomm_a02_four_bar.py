@@ -64,7 +64,7 @@ import math
 
 import sympy as sp
 
-from .. import Published, System, coordinate_symbols
+from .. import PointOutput, Published, System, coordinate_symbols
 from ..model import Body, Mechanism, Parameter, PointOnPoint, Revolute, Scenario, Segment
 
 SPECIFICATION = ("IFToMM benchmark A02 (González et al., Multibody System Dynamics 16, "
@@ -179,4 +179,6 @@ SYSTEM = System(
                              "(about a dozen singular positions)"),
     ),
     published=published,
+    points=lambda P: (PointOutput("B0", "crank0", (P.L / 2, 0),
+                                  "the first crank's tip: the published trajectory"),),
 )
