@@ -221,3 +221,24 @@ def test_the_point_gate_follows_the_coordinates_gate_and_sees_an_injected_error(
                  scale, Gate(1e-3), "run", judge)
     assert recorded["run.point_B0_max"][0] == pytest.approx(1e-4 * v["L"] / excursion,
                                                             rel=1e-3)
+
+
+def test_a_state_off_the_described_branch_is_refused_not_moved_onto_it():
+    """A chain with its second window folded (crank 2 pointing back, coupler 2 upright:
+    an assembly on another branch) is not on the parallelogram: the reference, which
+    follows the described branch only, refuses to start there, and the comparisons
+    release no run near such an equilibrium."""
+    from mbfidelity.analytic.reference import consistent_initial_state
+    from mbfidelity.systems.model import Scenario
+
+    s = get_system(A02)
+    v = s.parameter_values({"N": 2})
+    model = numeric_model(s.id, v)
+    folded = {"th0": -math.pi / 2, "th1": -math.pi / 2, "th2": -math.pi, "psi1": 0.0,
+              "psi2": math.pi / 2}
+    q = np.array([folded[c] for c in s.coordinates])
+    assert np.max(np.abs(model.constraint_values(q))) < 1e-12  # it is an assembly
+    assert not model.on_branch(q)
+    assert model.on_branch(np.array([_pose(2, 0.3)[c] for c in s.coordinates]))
+    with pytest.raises(ValueError, match="not on the mechanism's assembly branch"):
+        consistent_initial_state(s, Scenario("folded", folded, t_end=1.0), v)

@@ -315,6 +315,18 @@ class NumericModel:
             raise RuntimeError("the constraint equations have no solution here")
         return q
 
+    def on_branch(self, q, tol: float = 1e-8) -> bool:
+        """Whether the configuration q lies on the mechanism's described assembly branch
+        (`Mechanism.branch`; angles compared modulo 2 pi); True without one."""
+        if not self.derivation.mechanism.branch:
+            return True
+        q = np.asarray(q, dtype=float)
+        gap = np.array(self._explicit[0](*q[self.independent]), dtype=float) - q
+        mech = self.derivation.mechanism
+        angular = np.array([mech.angular(c) for c in mech.coordinates])
+        gap[angular] = np.remainder(gap[angular] + np.pi, 2 * np.pi) - np.pi
+        return bool(np.max(np.abs(gap)) <= tol)
+
     def constraint_rank(self, q) -> tuple[int, np.ndarray]:
         """(rank, singular values) of the constraint Jacobian at q, by its singular value
         decomposition: singular values below RANK_TOLERANCE times the largest count as

@@ -81,6 +81,10 @@ def consistent_initial_state(system: System, scenario: Scenario, values):
     if not model.constrained:
         return q0, qd0
     q = model.complete(q0)
+    if not model.on_branch(q):
+        raise ValueError(f"{system.id}: the initial state of {scenario.name} is not on the "
+                         f"mechanism's assembly branch (Mechanism.branch), the only one "
+                         f"the reference follows")
     return q, model.velocity_basis(q) @ qd0[model.independent]
 
 

@@ -453,6 +453,8 @@ def _near_equilibrium_scenarios(system: System, values: Mapping[str, float]) -> 
     for k, eq in enumerate(find_equilibria(system, values)):
         if not eq.stable or np.allclose(wrap_angles(system, eq.q, op.q), op.q, atol=1e-6):
             continue
+        if not model.on_branch(eq.q):
+            continue  # an assembly on another branch than the one the description names
         q0 = {}
         for i, c in enumerate(system.coordinates):
             step = NEAR_EQUILIBRIUM_OFFSET * (
