@@ -213,14 +213,14 @@ def test_the_point_gate_follows_the_coordinates_gate_and_sees_an_injected_error(
         recorded[label] = (value, gate.tolerance)
 
     judge_points(s, v, mech, ref, ref, len(ref.t), q_eq, scale, Gate(1e-3), "run", judge)
-    assert recorded["run.point_B0_max"][0] < 1e-12
-    assert recorded["run.point_B0_max"][1] == pytest.approx(1e-3 * gain)
+    assert recorded["run.trajectory_point_B0_max"][0] < 1e-12
+    assert recorded["run.trajectory_point_B0_max"][1] == pytest.approx(1e-3 * gain)
     shifted = ref.q.copy()
     shifted[:, i] += 1e-4
     judge_points(s, v, mech, ref, SimpleNamespace(q=shifted, qd=ref.qd), len(ref.t), q_eq,
                  scale, Gate(1e-3), "run", judge)
-    assert recorded["run.point_B0_max"][0] == pytest.approx(1e-4 * v["L"] / excursion,
-                                                            rel=1e-3)
+    assert recorded["run.trajectory_point_B0_max"][0] == pytest.approx(
+        1e-4 * v["L"] / excursion, rel=1e-3)
 
 
 def test_a_state_off_the_described_branch_is_refused_not_moved_onto_it():

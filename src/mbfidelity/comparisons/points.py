@@ -15,6 +15,10 @@ times G = max over the run of sum_k |dp/dq_k| s_k / (the point's excursion), wit
 the point's Jacobian along the reference. A point whose coordinates turn many times
 (a crank's tip) has G well above 1: its gate is looser than the coordinates', as their
 errors are relative to their whole travel.
+
+The metric is named as a trajectory metric (`<scenario>.trajectory_point_<name>_max`):
+a declaration about an engine's trajectories (a pattern `*.trajectory_*`) covers its
+points too, since a point's error is its coordinates' error carried by the kinematics.
 """
 from __future__ import annotations
 
@@ -72,7 +76,7 @@ def point_gain(system: System, values: Mapping[str, float], ref, q_eq: np.ndarra
 def judge_points(system: System, values: Mapping[str, float], mech: Mechanism, ref, run,
                  n: int, q_eq: np.ndarray, scale: np.ndarray, tol: Gate, scenario: str,
                  judge: Callable[[str, float, Gate], object]) -> None:
-    """One metric `<scenario>.point_<name>_max` per named point (see the module
+    """One metric `<scenario>.trajectory_point_<name>_max` per named point (see the module
     docstring), recorded through `judge(name, value, gate)`."""
     if not ref.points:
         return
@@ -81,5 +85,5 @@ def judge_points(system: System, values: Mapping[str, float], mech: Mechanism, r
         d = ref.points[name].shape[1] // 2
         distance = np.linalg.norm(got[name][:, :d] - ref.points[name][:n, :d], axis=1)
         value = float(np.max(distance)) / excursion if n else float("inf")
-        judge(f"{scenario}.point_{name}_max", value,
+        judge(f"{scenario}.trajectory_point_{name}_max", value,
               Gate(tol.tolerance * gain, tol.unresolved))
