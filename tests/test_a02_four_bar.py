@@ -52,6 +52,25 @@ def test_reference_crosses_the_singular_positions_on_the_parallelogram(N):
     assert ref.energy[0] == pytest.approx(energy0, rel=1e-12)
 
 
+@pytest.mark.slow
+def test_the_published_chain_of_forty_windows_over_the_published_duration():
+    """N = 40 (the specification's), 20 s: B0 at 10 s and 20 s within 1e-8 m of the
+    closed form, and the energy constant to 1e-7 J (81 bars: a total energy some forty
+    times the double chain's, DOP853 at 1e-12 relative)."""
+    from mbfidelity.systems.benchmarks.iftomm_a02_four_bar import closed_form_th0
+
+    s = get_system(A02)
+    v = s.parameter_values({"N": 40}, scenario=s.scenarios[0])
+    ref = reference(s, s.scenarios[0], v, 1e-2)
+    th0 = ref.q[:, list(s.with_structure(v).coordinates).index("th0")]
+    for time in (10.0, 20.0):
+        k = int(round(time / 1e-2))
+        th = closed_form_th0(v, time)
+        assert abs(math.cos(th0[k]) - math.cos(th)) < 1e-8
+        assert abs(math.sin(th0[k]) - math.sin(th)) < 1e-8
+    assert np.ptp(ref.energy) < 1e-7
+
+
 def test_published_b0_at_10_s_within_1e6_of_the_published_values():
     """N = 2: the reference's B0 at t = 10 s against the closed form (Jacobi's amplitude,
     exact to round-off) within 1e-9 m, and against the value Exudyn's test model records

@@ -64,7 +64,7 @@ import math
 
 import sympy as sp
 
-from .. import PointOutput, Published, System, coordinate_symbols
+from .. import Expectation, PointOutput, Published, System, coordinate_symbols
 from ..model import Body, Mechanism, Parameter, PointOnPoint, Revolute, Scenario, Segment
 
 SPECIFICATION = ("IFToMM benchmark A02 (González et al., Multibody System Dynamics 16, "
@@ -165,6 +165,26 @@ def published(P):
     return tuple(out)
 
 
+#: what the engines meet at the singular positions and over the top (the published run)
+SINGULAR_MUJOCO = (
+    "At each flat position the loop closures become linearly dependent (the constraint "
+    "Jacobian loses rank) and MuJoCo's constraint-space inertia is singular there; its "
+    "soft equalities carry the chain through the early passages on their regularization, "
+    "but at a later passage the constraint forces blow up and the state diverges")
+SINGULAR_EXUDYN = (
+    "Exudyn's implicit scheme solves each step by Newton's method on the equations of "
+    "motion together with the position-level closure equations; at a flat position the "
+    "closures are linearly dependent (the constraint Jacobian loses rank), so the "
+    "iteration matrix is singular, and a step that lands close enough to one stops the "
+    "solver")
+OVER_THE_TOP_PYMUNK = (
+    "The chain passes over its upright, unstable position slowly once per turn, where the "
+    "first-order scheme's energy error (of the order of the step, oscillating within the "
+    "turn) is a sizeable part of the kinetic energy: each passage over the top shifts the "
+    "phase, and the shifts add up turn after turn, faster than the linear growth the "
+    "trajectory bound assumes (Pymunk's sequential impulses leave the chain on the "
+    "parallelogram through the flat positions: the error is the phase's)")
+
 SYSTEM = System(
     id="iftomm_a02_four_bar",
     title="IFToMM A02: N-four-bar mechanism through singular positions",
@@ -183,4 +203,9 @@ SYSTEM = System(
     published=published,
     points=lambda P: (PointOutput("B0", "crank0", (P.L / 2, 0),
                                   "the first crank's tip: the published trajectory"),),
+    expectations=(
+        Expectation("mujoco", "published.completed", "xfail", SINGULAR_MUJOCO),
+        Expectation("exudyn", "published.completed", "xfail", SINGULAR_EXUDYN),
+        Expectation("pymunk", "published.trajectory_*", "xfail", OVER_THE_TOP_PYMUNK),
+    ),
 )
