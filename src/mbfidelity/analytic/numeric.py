@@ -498,7 +498,9 @@ class NumericModel:
         C = S.T @ _matrix(self._hess_D, *q) @ S
         if not self.constrained:
             return M, C, _matrix(self._hess_V, *q)
-        if self._hess_V_reduced is not None:
+        # the closed-form reduction holds on its own branch only (a described branch:
+        # `Mechanism.branch`; an equilibrium on another is differentiated numerically)
+        if self._hess_V_reduced is not None and self.on_branch(q):
             return M, C, _matrix(self._hess_V_reduced, *np.asarray(q)[self.independent])
         k = len(self.independent)
 
