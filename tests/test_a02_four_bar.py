@@ -192,7 +192,10 @@ def test_analyze_reports_the_points_at_the_end_of_each_scenario():
 
     s = get_system(A02)
     v = s.parameter_values()
-    (b0,) = _points_report(s.with_structure(v), v)
+    report = _points_report(s.with_structure(v), v)
+    assert [(p["point"], p["scenario"]) for p in report] == [
+        ("B0", sc.name) for sc in s.scenarios]
+    (b0,) = [p for p in report if p["scenario"] == "published"]
     th = closed_form_th0(v, 20.0)
     assert b0["point"] == "B0" and b0["time"] == pytest.approx(20.0)
     assert b0["position"] == pytest.approx([v["L"] * math.cos(th), v["L"] * math.sin(th)],

@@ -199,6 +199,10 @@ SYSTEM = System(
                  checks=("trajectory",),
                  description="the specification's run: upright, B0 at v0 along +x, 20 s "
                              "(about a dozen singular positions)"),
+        Scenario("first_flat", _upright, {"th0": "-v0/L"}, t_end=1.0,
+                 checks=("trajectory",),
+                 description="the same start through the first flat (singular) position "
+                             "only, 1 s"),
     ),
     published=published,
     points=lambda P: (PointOutput("B0", "crank0", (P.L / 2, 0),
