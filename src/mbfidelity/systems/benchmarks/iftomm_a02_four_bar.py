@@ -184,6 +184,13 @@ OVER_THE_TOP_PYMUNK = (
     "phase, and the shifts add up turn after turn, faster than the linear growth the "
     "trajectory bound assumes (Pymunk's sequential impulses leave the chain on the "
     "parallelogram through the flat positions: the error is the phase's)")
+FLAT_PYMUNK = (
+    "At a flat position the loop closures are linearly dependent, and Pymunk's "
+    "iterative impulse solver, which converges slowly there, leaves the couplers turned "
+    "slightly off the horizontal as the chain passes; the couplers' angles do not move in "
+    "the exact motion, so that error is judged against the floor of the coordinates' "
+    "scale, a small fraction of the cranks' travel (the cranks and B0 stay within their "
+    "gates)")
 
 SYSTEM = System(
     id="iftomm_a02_four_bar",
@@ -211,5 +218,6 @@ SYSTEM = System(
         Expectation("mujoco", "published.completed", "xfail", SINGULAR_MUJOCO),
         Expectation("exudyn", "published.completed", "xfail", SINGULAR_EXUDYN),
         Expectation("pymunk", "published.trajectory_*", "xfail", OVER_THE_TOP_PYMUNK),
+        Expectation("pymunk", "first_flat.trajectory_*", "xfail", FLAT_PYMUNK),
     ),
 )
