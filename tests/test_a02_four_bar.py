@@ -32,7 +32,7 @@ def _pendulum_b0(v, times):
 
 @pytest.mark.parametrize("N", [1, 2])
 def test_reference_crosses_the_singular_positions_on_the_parallelogram(N):
-    """Over 10 s the chain passes the flat (singular) position about seven times; B0 at
+    """Over 10 s the chain passes the flat (singular) position twice per turn; B0 at
     every 0.5 s within 1e-8 m of the independent one-degree-of-freedom solution (both
     DOP853 at 1e-12: their errors, a few 1e-10 over this run, stay far below it), and
     the energy constant to 1e-8 J (the integrator's tolerance over the run)."""

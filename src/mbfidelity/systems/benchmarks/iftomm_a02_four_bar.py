@@ -25,9 +25,9 @@ th0 is independent.
 
 Singular positions. Where the cranks lie along the ground line (th0 = 0 or pi) every
 window is flat: the constraint Jacobian loses rank (the mobility jumps from 1 to N + 1),
-several assembly branches cross (the parallelogram, and for L = b the folded windows
-whose crank turns alone), and Newton's method for the dependent coordinates from th0
-meets a singular matrix. The motion's branch is the parallelogram: every crank parallel
+several assembly branches cross (the parallelogram and the crossed antiparallelogram,
+which for L = b degenerates into folded windows whose crank turns alone), and Newton's
+method for the dependent coordinates from th0 meets a singular matrix. The motion's branch is the parallelogram: every crank parallel
 to the first and the couplers horizontal,
 
     th_i = th0,   psi_j = 0,
@@ -42,9 +42,12 @@ equation stays regular through the singular positions, where a projection on
 Phi_q = 0 does not. Why the motion stays on this branch: a motion is continuous in
 velocity (no impulse acts); at a singular position the velocity along the parallelogram
 (every crank turning at th0', the couplers translating) is tangent to the parallelogram
-branch and to no other (a folded window turns one crank alone), so a motion that arrives
-on the parallelogram leaves on it: the branch is the only one of the crossing branches
-whose tangent contains the arriving velocity.
+branch and to no other (on the others a window's two cranks do not turn together), so a
+motion that arrives on the parallelogram leaves on it: the branch is the only one of the
+crossing branches whose tangent contains the arriving velocity. The closure forces are
+not unique at a flat position (the multipliers of a rank-deficient Jacobian): the
+reference's multipliers are ill-conditioned near one, and no check of this row judges
+them.
 
 Closed form. On the branch the couplers translate and the cranks turn together: with
 I = m L^2 / 12,
@@ -205,7 +208,8 @@ SYSTEM = System(
         Scenario("published", _upright, {"th0": "-v0/L"}, t_end=20.0,
                  checks=("trajectory",),
                  description="the specification's run: upright, B0 at v0 along +x, 20 s "
-                             "(about a dozen singular positions)"),
+                             "(the chain turns over, passing the flat, singular position "
+                             "twice per turn)"),
         Scenario("first_flat", _upright, {"th0": "-v0/L"}, t_end=1.0,
                  checks=("trajectory",),
                  description="the same start through the first flat (singular) position "
