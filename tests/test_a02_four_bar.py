@@ -264,3 +264,15 @@ def test_a_state_off_the_described_branch_is_refused_not_moved_onto_it():
     assert model.on_branch(np.array([_pose(2, 0.3)[c] for c in s.coordinates]))
     with pytest.raises(ValueError, match="not on the mechanism's assembly branch"):
         consistent_initial_state(s, Scenario("folded", folded, t_end=1.0), v)
+
+
+def test_a_value_published_for_two_windows_does_not_apply_to_one():
+    """Exudyn's recorded B0 is for N = 2: under N = 1 it is reported as not applicable
+    (the closed form applies at any N)."""
+    from mbfidelity.analytic.published import compare_published
+
+    s = get_system(A02)
+    v = s.parameter_values({"N": 1})
+    rows = compare_published(s.with_structure(v), v)
+    assert {p["applies"] for p in rows if "Exudyn" in p["source"]} == {False}
+    assert all(p["applies"] for p in rows if "closed form" in p["source"])

@@ -19,7 +19,7 @@ import numpy as np
 import sympy as sp
 from scipy.interpolate import CubicHermiteSpline
 
-from ..systems import Published, System, coordinate_symbols
+from ..systems import Published, System, coordinate_symbols, get_system
 from scipy.integrate import solve_ivp
 
 from .numeric import numeric_model
@@ -35,7 +35,9 @@ def _applies(system: System, item: Published, values: Mapping[str, float],
     scenario's values); a closed form (a function) at any."""
     if callable(item.value):
         return True
-    published = system.parameter_values(scenario=scenario)
+    # the catalog's defaults (a specialisation's defaults are its own structure's, a count
+    # the user chose)
+    published = get_system(system.catalog_id).parameter_values(scenario=scenario)
     return all(math.isclose(values[k], v, rel_tol=1e-12, abs_tol=0.0)
                for k, v in published.items())
 
