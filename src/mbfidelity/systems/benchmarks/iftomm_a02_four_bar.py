@@ -194,6 +194,11 @@ FLAT_PYMUNK = (
     "the exact motion, so that error is judged against the floor of the coordinates' "
     "scale, a small fraction of the cranks' travel (the cranks and B0 stay within their "
     "gates)")
+SAP_BELOW_THE_GATE = (
+    "Drake holds the closures on its discrete plant (SAP), a first-order step whose "
+    "constraints give a little at every step; here the gates are those of a first-order "
+    "scheme over a fast, turning motion, and the closures' compliance, tied to the step, "
+    "lies below them through the flat positions as well: the metrics are judged")
 
 SYSTEM = System(
     id="iftomm_a02_four_bar",
@@ -223,5 +228,7 @@ SYSTEM = System(
         Expectation("exudyn", "published.completed", "xfail", SINGULAR_EXUDYN),
         Expectation("pymunk", "published.trajectory_*", "xfail", OVER_THE_TOP_PYMUNK),
         Expectation("pymunk", "first_flat.trajectory_*", "xfail", FLAT_PYMUNK),
+        Expectation("drake", "*.trajectory_*", "judged", SAP_BELOW_THE_GATE),
+        Expectation("drake", "*.energy_drift", "judged", SAP_BELOW_THE_GATE),
     ),
 )
