@@ -28,6 +28,7 @@ import scipy.optimize
 
 from ..systems import System
 from ..systems.model import CoordinateForce, PointOnLine, PointOnPoint, Prismatic
+from . import memo
 from .numeric import NumericModel, numeric_model
 
 #: relative size below which the real part of an eigenvalue counts as zero (conservative
@@ -405,8 +406,14 @@ def find_equilibria(system: System, values) -> list[Equilibrium]:
     operating point), each classified by its linearization. The operating point comes
     first when it is an equilibrium. Closed loops are also searched in all coordinates
     and multipliers, so that equilibria on other assembly branches are found. A driven
-    system's are the rest states of its free coordinates with the excitation off."""
+    system's are the rest states of its free coordinates with the excitation off. Kept
+    in the persistent cache (analytic/memo.py) under the parameter values."""
     system = system.with_structure(values)  # the chain of the number of elements in values
+    return memo.cached(system, "equilibria", (dict(values),),
+                       lambda: _find_equilibria(system, values))
+
+
+def _find_equilibria(system: System, values) -> list[Equilibrium]:
     if system.mechanism.prescribed:
         return _driven_equilibria(system, values, only_operating=False)
     if system.rigid_directions(system.symbols):
@@ -475,8 +482,18 @@ def _same_family(model: NumericModel, a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def operating_equilibrium(system: System, values) -> Equilibrium:
-    """The equilibrium the monograph studies (the system's operating point, refined)."""
+    """The equilibrium the monograph studies (the system's operating point, refined), with
+    its linearization and modes. Kept in the persistent cache (analytic/memo.py) under
+    the parameter values."""
     system = system.with_structure(values)  # the chain of the number of elements in values
+    return memo.cached(system, "operating_equilibrium", (dict(values),),
+                       lambda: solve_operating_equilibrium(system, values))
+
+
+def solve_operating_equilibrium(system: System, values) -> Equilibrium:
+    """`operating_equilibrium` computed, not looked up: for a scan over many parameter
+    values whose single points are not worth an entry each (analytic/stability.py)."""
+    system = system.with_structure(values)
     if system.mechanism.prescribed:
         found = _driven_equilibria(system, values, only_operating=True)
         if not found:

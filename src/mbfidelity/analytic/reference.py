@@ -12,12 +12,15 @@ from scipy.integrate import solve_ivp
 
 from ..systems import System
 from ..systems.model import Scenario
+from . import memo
 from .closed_forms import SOLUTIONS
 from .numeric import numeric_model
 from .sliding import Switch, integrate_with_sliding, model_acceleration, rate_surfaces
 
 TIGHT = 1e-12
 LOOSE = 1e-11
+#: DOP853 rtol = atol of the two solves `sensitivity` compares
+SENSITIVITY_TOLERANCE = 1e-11
 
 
 @dataclass
@@ -199,8 +202,22 @@ def reference(system: System, scenario: Scenario, values: Mapping[str, float],
     if key not in _CACHE:
         if len(_CACHE) >= _CACHE_SIZE:
             _CACHE.pop(next(iter(_CACHE)))
-        _CACHE[key] = _reference(system, scenario, values, dt, t_end, q0, qd0)
+        _CACHE[key] = _stored_reference(system, scenario, values, dt, t_end, q0, qd0)
     return _CACHE[key]
+
+
+def _stored_reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
+    """`_reference`, kept in the persistent cache (analytic/memo.py) under what it depends
+    on: the parameters, the initial state it starts from, t_end, the step and the
+    tolerances (the scenario's name is no part of it: two scenarios that start alike
+    share the solve)."""
+    t_end = scenario.t_end if t_end is None else t_end
+    if q0 is None:
+        q0, qd0 = consistent_initial_state(system, scenario, values)
+    q0, qd0 = np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float)
+    inputs = (dict(values), q0, qd0, dt, t_end, TIGHT, LOOSE)
+    return memo.cached(system, "reference", inputs,
+                       lambda: _reference(system, scenario, values, dt, t_end, q0, qd0))
 
 
 def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
@@ -292,26 +309,37 @@ def sensitivity(system: System, scenario: Scenario, values: Mapping[str, float],
                 perturbation: float = 1e-7) -> float:
     """Growth factor, over the scenario, of a small change of the first independent
     coordinate: ~1-20 for regular motion, orders of magnitude more for chaotic motion,
-    where trajectory gates (which assume linear error growth) are meaningless."""
-    model = numeric_model(system.id, values)
+    where trajectory gates (which assume linear error growth) are meaningless. Kept in
+    the persistent cache (analytic/memo.py) under the parameters, the initial state, the
+    scenario's duration and the perturbation."""
     q0, qd0 = consistent_initial_state(system, scenario, values)
+    inputs = (dict(values), np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float),
+              scenario.t_end, perturbation, SENSITIVITY_TOLERANCE)
+    return memo.cached(system, "sensitivity", inputs, lambda: _sensitivity(
+        system, scenario.t_end, values, q0, qd0, perturbation))
+
+
+def _sensitivity(system: System, t_end: float, values: Mapping[str, float], q0: np.ndarray,
+                 qd0: np.ndarray, perturbation: float) -> float:
+    model = numeric_model(system.id, values)
     ind = model.independent
     y0 = np.concatenate([q0[ind], qd0[ind]])
-    t = np.linspace(0.0, scenario.t_end, 501)
+    t = np.linspace(0.0, t_end, 501)
     surfaces = rate_surfaces(system, values)
     if surfaces:  # a force that jumps across a rate surface: the Filippov integration
         _check_sliding(system, model, surfaces)
         acc = model_acceleration(model, surfaces[0].coordinate)
 
         def positions(x0: float) -> np.ndarray:
-            return integrate_with_sliding(acc, x0, qd0[0], t, surfaces[0].rate, 1e-11)[0]
+            return integrate_with_sliding(acc, x0, qd0[0], t, surfaces[0].rate,
+                                         SENSITIVITY_TOLERANCE)[0]
         return float(np.max(np.abs(positions(q0[0]) - positions(q0[0] + perturbation)))
                      / perturbation)
     model._warm = np.array(q0, dtype=float)
-    a = _dop853(model, y0, t, 1e-11)
+    a = _dop853(model, y0, t, SENSITIVITY_TOLERANCE)
     y1 = y0.copy()
     y1[0] += perturbation
     model._warm = np.array(q0, dtype=float)
-    b = _dop853(model, y1, t, 1e-11)
+    b = _dop853(model, y1, t, SENSITIVITY_TOLERANCE)
     k = len(ind)
     return float(np.max(np.abs(a[:, :k] - b[:, :k])) / perturbation)

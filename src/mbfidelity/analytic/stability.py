@@ -16,7 +16,8 @@ import numpy as np
 import scipy.optimize
 
 from ..systems import System
-from .linear import operating_equilibrium
+from . import memo
+from .linear import solve_operating_equilibrium
 
 #: the scan covers [value / SPAN, value * SPAN]
 SPAN = 100.0
@@ -56,14 +57,21 @@ def growth_rate(system: System, values: Mapping[str, float], parameter: str,
     """max Re(s) of the operating equilibrium's linearization with the parameter at x."""
     trial = dict(values)
     trial[parameter] = float(x)
-    return float(np.max(operating_equilibrium(system, trial).eigenvalues.real))
+    return float(np.max(solve_operating_equilibrium(system, trial).eigenvalues.real))
 
 
 def stability_threshold(system: System, values: Mapping[str, float],
                         parameter: str | None = None) -> Threshold:
     """The crossings of max Re(s) = 0 in the parameter (the system's
-    `stability_parameter` by default), scanned around its value in `values`."""
+    `stability_parameter` by default), scanned around its value in `values`. Kept in the
+    persistent cache (analytic/memo.py) under the parameter values and the scan."""
     name = parameter or system.stability_parameter
+    return memo.cached(system, "stability_threshold", (dict(values), name, SPAN, GRID),
+                       lambda: _stability_threshold(system, values, name))
+
+
+def _stability_threshold(system: System, values: Mapping[str, float],
+                         name: str | None) -> Threshold:
     if name is None:
         raise ValueError(f"{system.id} names no stability parameter")
     value = float(values[name])

@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 
 from ..systems import System
+from . import memo
 from .linear import operating_equilibrium, unexcited_values
 from .numeric import numeric_model
 
@@ -68,7 +69,13 @@ def excitation_frequencies(system: System, values) -> list[float]:
 
 def steady_state(system: System, values) -> SteadyState:
     """The linear steady-state response (module docstring); empty with the reason when
-    the system has no excitation frequency or its rest state is unstable."""
+    the system has no excitation frequency or its rest state is unstable. Kept in the
+    persistent cache (analytic/memo.py) under the parameter values."""
+    return memo.cached(system, "steady_state", (dict(values), PERIODS, SAMPLES_PER_PERIOD),
+                       lambda: _steady_state(system, values))
+
+
+def _steady_state(system: System, values) -> SteadyState:
     freqs = excitation_frequencies(system, values)
     if not freqs:
         return SteadyState((), 0.0, "the system declares no harmonic excitation")
