@@ -167,7 +167,14 @@ def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...
     if values is None:
         values = system.parameter_values()
     return tuple((e,) for e in system.expectations
-                 if e.applies(system.structure, values)) + _declared(system.id, simulator)
+                 if _applies(e, tuple(sorted(system.structure.items())),
+                             tuple(sorted(values.items())))) + _declared(system.id, simulator)
+
+
+@lru_cache(maxsize=4096)
+def _applies(e: Expectation, structure: tuple, values: tuple) -> bool:
+    # parsed once per condition and parameter values, not once per metric judged
+    return e.applies(dict(structure), dict(values))
 
 
 @lru_cache(maxsize=None)
