@@ -1,8 +1,9 @@
 """Benchmark: what `mbfidelity run` costs beside the engines, from one invocation.
 
 Runs `mbfidelity run` on the default matrix (or --systems/--sims) twice with the same
-derivation cache folder (environment variable MBFIDELITY_CACHE_DIR, a fresh temporary
-folder): first cold (empty cache), then warm. For each run it measures
+cache folder (environment variable MBFIDELITY_CACHE_DIR, a fresh temporary folder: the
+derivations and the numerical results of analytic/memo.py, reference trajectories,
+equilibria, modes): first cold (empty cache), then warm. For each run it measures
 
 - total: CPU seconds of the whole run, every process (the command and its pool workers:
   resource.getrusage(RUSAGE_CHILDREN) around the command), minus the CPU seconds of the
@@ -16,6 +17,8 @@ folder): first cold (empty cache), then warm. For each run it measures
 and records the ratios total / stepping (targets: <= 2.0 cold, <= 1.3 warm) and stepping /
 bare per engine (target: <= 1.5). Absolute seconds depend on the machine's load; the ratios
 come from one run, where stepping and bare loop run back to back on the same model.
+The record says whether the run was the default matrix (`default_matrix`) or which systems
+and engines it ran, and how many result entries (by kind) the cold run left in the cache.
 
 Usage: .venv/bin/python benchmarks/cost.py [--systems a,b] [--sims x,y] [--out DIR]
            [--no-record]
@@ -159,6 +162,8 @@ def _measure(run_args: list[str], cache: Path, label: str) -> dict:
         "bare_cpu_s": sum(e["bare_cpu_s"] for e in engines.values()),
         "total_over_stepping": total / max(stepping, 1e-12),
         "comparisons": len(doc["comparisons"]),
+        "ran": {"systems": sorted({c["system"] for c in doc["comparisons"]}),
+                "sims": sorted({c["simulator"] for c in doc["comparisons"]})},
         "passed": sum(c["passed"] for c in doc["comparisons"]),
         "comparison_wall_time_s": sum(c["wall_time_s"] for c in doc["comparisons"]),
         "engines": engines,
@@ -194,6 +199,10 @@ def main() -> None:
     cache = Path(tempfile.mkdtemp(prefix="mbfidelity_cache_"))
     try:
         cold = _measure(run_args, cache, "cold")
+        entries: dict[str, int] = {}
+        for path in cache.glob("*/*.pickle"):
+            kind = path.name.rsplit("-", 1)[0] if "-" in path.name else path.stem
+            entries[kind] = entries.get(kind, 0) + 1
         warm = _measure(run_args, cache, "warm")
     finally:
         shutil.rmtree(cache, ignore_errors=True)
@@ -217,6 +226,10 @@ def main() -> None:
         "benchmark": "cost",
         "command": " ".join([Path(sys.executable).name, *sys.argv]),
         "run_command": " ".join(["mbfidelity", "run", *run_args]),
+        "default_matrix": not args.systems and not args.sims,
+        "systems": cold["ran"]["systems"],
+        "sims": cold["ran"]["sims"],
+        "cache_entries_after_cold": dict(sorted(entries.items())),
         "git_describe": _git_describe(),
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "cpu_count": os.cpu_count(),
