@@ -1,9 +1,9 @@
 """The persistent cache of numerical results (analytic/memo.py): reference trajectories,
-sensitivities, equilibria and modes, stability thresholds and steady states are bitwise
-the same computed into an empty cache, computed again and loaded from the filled one; a
-comparison's metrics are the same with a cold cache, a warm one and none; a damaged entry
-is recomputed; two processes filling one folder at once are safe; an entry's name follows
-every input."""
+sensitivities, equilibria and modes, stability thresholds, steady states and Floquet
+multipliers are bitwise the same computed into an empty cache, computed again and loaded
+from the filled one; a comparison's metrics are the same with a cold cache, a warm one
+and none; a damaged entry is recomputed; two processes filling one folder at once are
+safe; an entry's name follows every input."""
 from __future__ import annotations
 
 import dataclasses
@@ -23,12 +23,12 @@ from mbfidelity.analytic import cache, memo
 
 # an unconstrained system (its reference a column slice of the solver's output), a
 # constrained one (dependent coordinates, multipliers, reactions), a driven one (steady
-# state) and one with a stability parameter. With MBFIDELITY_EXPECT_LOADED set, every
+# state), one with a stability parameter and a parametrically excited one (Floquet). With MBFIDELITY_EXPECT_LOADED set, every
 # computation behind the cache raises: each result must come from the folder.
 PROBE = """
 import os, sys
 import numpy as np
-from mbfidelity.analytic import linear, reference as refmod, stability, steady_state as ss
+from mbfidelity.analytic import floquet, linear, reference as refmod, stability, steady_state as ss
 from mbfidelity.systems import get_system
 
 if os.environ.get("MBFIDELITY_EXPECT_LOADED"):
@@ -36,7 +36,8 @@ if os.environ.get("MBFIDELITY_EXPECT_LOADED"):
         raise AssertionError("computed, not loaded from the cache")
     for module, name in ((refmod, "_reference"), (refmod, "_sensitivity"),
                          (linear, "solve_operating_equilibrium"), (linear, "_find_equilibria"),
-                         (stability, "_stability_threshold"), (ss, "_steady_state")):
+                         (stability, "_stability_threshold"), (ss, "_steady_state"),
+                         (floquet, "_driven_floquet")):
         setattr(module, name, computed)
 
 out = {}
@@ -63,6 +64,8 @@ out["steady_state"] = np.array([h.phasor for h in ss.steady_state(s, s.parameter
 s = get_system("conveyor_belt")
 th = stability.stability_threshold(s, s.parameter_values())
 out["threshold"] = np.array([c.value for c in th.crossings])
+s = get_system("vertically_driven_pendulum")
+out["floquet"] = np.array([r.multipliers for _, r in floquet.driven_floquet(s, s.parameter_values())])
 np.savez(sys.argv[1], **out)
 """
 
@@ -113,7 +116,7 @@ def _entries(folder: Path, kind: str) -> list[Path]:
 def test_loaded_results_are_bitwise_those_computed(filled, tmp_path):
     folder, derivations, cold = filled
     for kind in ("reference", "sensitivity", "operating_equilibrium", "equilibria",
-                 "steady_state", "stability_threshold"):
+                 "steady_state", "stability_threshold", "driven_floquet"):
         assert _entries(folder, kind), kind
     assert not list(folder.glob("*/.*.tmp")), "a temporary file was left behind"
     written = sorted(folder.glob("*/*"))

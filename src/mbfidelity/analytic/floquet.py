@@ -26,6 +26,8 @@ import numpy as np
 import scipy.integrate
 import scipy.optimize
 
+from . import memo
+
 #: relative tolerance of the monodromy solve
 FLOQUET_RTOL = 1e-12
 #: relative tolerance of the check solve that estimates the error
@@ -145,7 +147,13 @@ def driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
     M(t) dq'' + C(t) dq' + K(t) dq = 0 of the free coordinates there, with the prescribed
     motion on, from the compiled model. Where the excitation also forces the free
     coordinates (R_f(t) != 0 at rest), that forcing is the inhomogeneous term and leaves
-    the multipliers of the variational equations unchanged."""
+    the multipliers of the variational equations unchanged. Kept in the persistent cache
+    (analytic/memo.py) under the parameter values."""
+    return memo.cached(system, "driven_floquet", (dict(values),),
+                       lambda: _driven_floquet(system, values))
+
+
+def _driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
     from .linear import companion_matrix, driven_coefficients, driven_rest_states
     from .numeric import numeric_model
 

@@ -1,5 +1,6 @@
 """Persistent cache of numerical results that are expensive and deterministic: reference
-trajectories, their sensitivity, equilibria with their modes, stability thresholds.
+trajectories, their sensitivity, equilibria with their modes, stability thresholds, steady
+states, Floquet multipliers.
 
 An entry lives beside the system's derivation (analytic/cache.py: the folder named by the
 content of the system's module and of the description machinery, its structure, SymPy and
