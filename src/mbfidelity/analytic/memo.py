@@ -24,7 +24,8 @@ checksum (a damaged entry is recomputed, never trusted) and the same atomic writ
 pickled object the computation returned, and a computed result is returned as it comes
 back from its pickle (the arrays contiguous, as a load gives them): what a computation
 then does with it is bitwise the same whether the entry was computed or loaded.
-Within one process, results are also kept in memory (the most recent `MEMORY_SIZE`).
+Within one process, results are also kept in memory (the most recent `MEMORY_SIZE`; a
+reference trajectory, large, in analytic/reference.py's own bounded memory instead).
 """
 from __future__ import annotations
 
@@ -40,7 +41,7 @@ from . import cache
 #: bump when the layout or the meaning of an entry changes
 FORMAT = "1"
 #: results kept in memory per process (a comparison matrix job reuses a handful)
-MEMORY_SIZE = 256
+MEMORY_SIZE = 128
 
 T = TypeVar("T")
 
@@ -90,9 +91,11 @@ def entry(system, kind: str, inputs: tuple) -> tuple[str, str] | None:
     return cache_key(system), f"{kind}-{hashlib.sha256(text.encode()).hexdigest()[:32]}.pickle"
 
 
-def cached(system, kind: str, inputs: tuple, compute: Callable[[], T]) -> T:
+def cached(system, kind: str, inputs: tuple, compute: Callable[[], T],
+           remember: bool = True) -> T:
     """`compute()`, or the result it returned before for the same system, kind and
-    inputs (in memory, else from the persistent cache). An exception is not stored."""
+    inputs (in memory, else from the persistent cache). An exception is not stored.
+    `remember=False`: not kept in memory (a large result its caller keeps itself)."""
     where = entry(system, kind, inputs)
     if where is None:
         return compute()
@@ -113,9 +116,10 @@ def cached(system, kind: str, inputs: tuple, compute: Callable[[], T]) -> T:
         # slice of the solver's output) comes back as a contiguous copy, and NumPy sums
         # a contiguous array in another order than a strided one
         result = pickle.loads(blob)
-    _memory[where] = result
-    if len(_memory) > MEMORY_SIZE:
-        _memory.popitem(last=False)
+    if remember:
+        _memory[where] = result
+        if len(_memory) > MEMORY_SIZE:
+            _memory.popitem(last=False)
     return result
 
 

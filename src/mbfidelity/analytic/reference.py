@@ -217,7 +217,8 @@ def _stored_reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference
     q0, qd0 = np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float)
     inputs = (dict(values), q0, qd0, dt, t_end, TIGHT, LOOSE)
     return memo.cached(system, "reference", inputs,
-                       lambda: _reference(system, scenario, values, dt, t_end, q0, qd0))
+                       lambda: _reference(system, scenario, values, dt, t_end, q0, qd0),
+                       remember=False)  # `reference` keeps its own
 
 
 def _reference(system, scenario, values, dt, t_end, q0, qd0) -> Reference:
