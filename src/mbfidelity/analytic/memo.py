@@ -123,9 +123,4 @@ def cached(system, kind: str, inputs: tuple, compute: Callable[[], T],
     return result
 
 
-def clear_memory() -> None:
-    """Forget the results kept in this process (the persistent entries stay)."""
-    _memory.clear()
-
-
 _MISSING = object()
