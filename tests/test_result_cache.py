@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import os
 import pickle
 import shutil
@@ -23,12 +22,14 @@ from mbfidelity.analytic import cache, memo
 
 # an unconstrained system (its reference a column slice of the solver's output), a
 # constrained one (dependent coordinates, multipliers, reactions), a driven one (steady
-# state), one with a stability parameter and a parametrically excited one (Floquet). With MBFIDELITY_EXPECT_LOADED set, every
-# computation behind the cache raises: each result must come from the folder.
+# state), one with a stability parameter and a parametrically excited one (Floquet). With
+# MBFIDELITY_EXPECT_LOADED set, every computation behind the cache raises: each result
+# must come from the folder.
 PROBE = """
 import os, sys
 import numpy as np
-from mbfidelity.analytic import floquet, linear, reference as refmod, stability, steady_state as ss
+from mbfidelity.analytic import floquet, linear, reference as refmod, stability
+from mbfidelity.analytic import steady_state as ss
 from mbfidelity.systems import get_system
 
 if os.environ.get("MBFIDELITY_EXPECT_LOADED"):
@@ -60,12 +61,14 @@ for sid in ("double_pendulum", "scotch_yoke"):
         arrays.update({f"eq{k}_q": e.q, f"eq{k}_s": e.eigenvalues})
     out.update({f"{sid}.{k}": x for k, x in arrays.items()})
 s = get_system("base_excited_msd")
-out["steady_state"] = np.array([h.phasor for h in ss.steady_state(s, s.parameter_values()).harmonics])
+harmonics = ss.steady_state(s, s.parameter_values()).harmonics
+out["steady_state"] = np.array([h.phasor for h in harmonics])
 s = get_system("conveyor_belt")
 th = stability.stability_threshold(s, s.parameter_values())
 out["threshold"] = np.array([c.value for c in th.crossings])
 s = get_system("vertically_driven_pendulum")
-out["floquet"] = np.array([r.multipliers for _, r in floquet.driven_floquet(s, s.parameter_values())])
+found = floquet.driven_floquet(s, s.parameter_values())
+out["floquet"] = np.array([r.multipliers for _, r in found])
 np.savez(sys.argv[1], **out)
 """
 
@@ -173,22 +176,38 @@ def test_two_processes_filling_one_folder_at_once(filled, tmp_path):
     _assert_same(cold, _probe(folder, tmp_path / "after.npz", MBFIDELITY_EXPECT_LOADED="1"))
 
 
-def test_a_comparisons_metrics_are_the_same_cold_warm_and_uncached(tmp_path):
+def test_a_comparisons_metrics_are_the_same_cold_warm_and_uncached(tmp_path, monkeypatch):
+    from collections import OrderedDict
+
+    from mbfidelity.analytic import reference as refmod
+    from mbfidelity.comparisons.runner import compare
+
     folder = tmp_path / "cache"
-    command = [str(Path(sys.executable).parent / "mbfidelity"), "compare",
-               "mass_spring_damper", "--sim", "mujoco", "--json"]
+    monkeypatch.delenv("MBFIDELITY_NO_CACHE", raising=False)
+    monkeypatch.setenv("MBFIDELITY_CACHE_DIR", str(folder))
 
-    def metrics(folder, *extra) -> list:
-        done = _run(command + list(extra), folder)
-        assert done.returncode == 0, done.stderr
-        return json.loads(done.stdout)["metrics"]
+    def metrics() -> list:
+        # nothing this process kept of an earlier comparison: each result is computed or
+        # read from the folder
+        monkeypatch.setattr(refmod, "_CACHE", {})
+        monkeypatch.setattr(memo, "_memory", OrderedDict())
+        result = compare("mass_spring_damper", "mujoco")
+        # repr: every float exactly, and a NaN equal to itself
+        return [(m.name, repr(m.value), repr(m.tolerance), m.status) for m in result.metrics]
 
-    cold = metrics(folder)
+    cold = metrics()
     assert _entries(folder, "reference")
-    warm = metrics(folder)
+    solve = refmod._reference
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the reference was solved, not loaded from the cache")
+    monkeypatch.setattr(refmod, "_reference", computed)
+    warm = metrics()
     assert len(cold) > 5
     assert warm == cold
-    assert metrics(None, "--no-cache") == cold
+    monkeypatch.setattr(refmod, "_reference", solve)
+    monkeypatch.setenv("MBFIDELITY_NO_CACHE", "1")
+    assert metrics() == cold
 
 
 def test_an_entry_name_follows_every_input(monkeypatch, tmp_path):
@@ -198,7 +217,8 @@ def test_an_entry_name_follows_every_input(monkeypatch, tmp_path):
     v = s.parameter_values()
     q0 = np.array([0.1, 0.2])
     base = memo.entry(s, "reference", (v, q0, 1e-3, 10.0))
-    assert base is not None and base == memo.entry(s, "reference", (dict(v), q0.copy(), 1e-3, 10.0))
+    assert base is not None
+    assert base == memo.entry(s, "reference", (dict(v), q0.copy(), 1e-3, 10.0))
     first = sorted(v)[0]
     nudged = dict(v, **{first: np.nextafter(v[first], np.inf)})
     q1 = q0.copy()
