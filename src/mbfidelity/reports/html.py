@@ -5,6 +5,7 @@ saved; from the descriptions it reads only titles, coordinate names and the decl
 expected failures."""
 from __future__ import annotations
 
+import fnmatch
 import json
 import os
 from concurrent.futures import ProcessPoolExecutor
@@ -212,7 +213,7 @@ def _section(out: Path, row: str, comps, figures: list[str], frequencies: dict,
             "metric_names": list(dict.fromkeys(m.name for c in comps for m in c.metrics)),
             "unsupported": {c.simulator: "cannot express: " + c.reason for c in comps
                             if not c.supported},
-            "expected": _expected(row), "liftoff": contact_warnings(comps),
+            "expected": _expected(row, comps), "liftoff": contact_warnings(comps),
             "frequencies": frequencies.get(row, {}), "figures": figures,
             "animation": site.embedded_json(frames) if frames.get("scenarios") else "",
             "animation_error": frames.get("error", "no saved series"),
@@ -327,14 +328,30 @@ def _title(shown: str) -> str:
     return f"{system.title}, variant {v.name}: {v.description}"
 
 
-def _expected(shown: str) -> list:
+def _expected(shown: str, comps=()) -> list:
+    """The row's declarations, each with the metrics it covers in `comps` as measured now
+    (engine, metric, value, gate, verdict, rule): a reason states the mechanism, the
+    numbers come from the run."""
     system = get_system(base_id(shown))
     if shown == system.id:
-        return [e for e in system.expectations
-                if e.applies(system.structure, system.parameter_values())]
+        declared = [SimpleNamespace(simulator=e.simulator, metric=e.metric, reason=e.reason,
+                                    kind=e.kind, measured=[])
+                    for e in system.expectations
+                    if e.applies(system.structure, system.parameter_values())]
+        for c in comps:
+            for m in c.metrics:
+                # the first declaration that matches a metric is the one that covers it
+                first = next((d for d in declared if fnmatch.fnmatch(c.simulator, d.simulator)
+                              and fnmatch.fnmatch(m.name, d.metric)), None)
+                if first is not None:
+                    first.measured.append(SimpleNamespace(
+                        simulator=c.simulator, name=m.name, value=m.value,
+                        tolerance=m.tolerance, status=m.status,
+                        rule=(m.rule or "a_priori").replace("_", "-")))
+        return declared
     v = system.variant(shown[len(system.id) + 1:-1])
     return [SimpleNamespace(simulator=", ".join(v.settings), metric="(measured, not gated)",
-                            reason=v.reason)]
+                            reason=v.reason, kind="measured", measured=[])]
 
 
 def contact_warnings(comps) -> list[dict]:

@@ -1,9 +1,10 @@
-"""Physical reasons for expected failures shared by several mechanisms (each measured;
-the numbers per mechanism are in the results)."""
+"""Physical reasons for expected failures shared by several mechanisms: each states the
+mechanism of the failure; the numbers come from the run (the results show each declared
+metric's value and gate)."""
 
 MUJOCO_MASSLESS_PIN = (
     "MuJoCo rejects massless moving bodies, so the massless pin P carries a substitute mass "
-    "(3e-4 of the lightest body) held by soft equalities; the added inertia and the soft "
+    "(a small fraction of the lightest body's) held by soft equalities; the added inertia and the soft "
     "slot trade against each other and no mass brings the motion or the second mode "
     "(off in proportion to the substitute mass) within the RK4 gates.")
 
@@ -15,6 +16,6 @@ SEMI_IMPLICIT_DRIFT = (
 
 VELOCITY_LEVEL_STARTUP = (
     "The engine's velocity-level constraint solve has no memory of the centripetal load "
-    "at the start of a fast spin (40 rad/s): the contact force misses m_b e w^2 on the "
+    "at the start of a fast spin: the contact force misses m_b e w^2 on the "
     "first step(s) and overshoots on the next, an error that does not shrink with dt; after "
     "that the force follows the reference within the gate.")

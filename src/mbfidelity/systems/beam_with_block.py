@@ -165,7 +165,7 @@ def released(P) -> dict:
 MIRROR_RELEASE_EXCITES_THE_FAST_MODES = (
     "The generic release near the mirrored equilibrium (the chain along -x, the same beam "
     "reflected: same modes) turns every independent angle by the same offset "
-    "(comparisons/runner.py), which bends the hinges by up to three times as much and puts "
+    "(comparisons/runner.py), which bends the hinges more than the mode shapes do and puts "
     "as much motion in the chain's fast modes, beyond the range of w h where a scheme's "
     "bound holds at the default step, as in the first; the reference departs from its own "
     "linear prediction by more than the amplitude (the fast modes' frequencies depend on "
@@ -183,7 +183,8 @@ SOFT_ROLLER_BELOW_THE_GATE = (
 SECOND_ORDER_RELEASE_BOUND_LIGHT_BLOCK = (
     "With a lighter block the first mode is faster and the release from the block-load "
     "deflection smaller, so Exudyn's second-order bound, (w h)^2 (1 + w T) mode by mode, "
-    "passes 0.1 of the amplitude over the release, where a pass would mean nothing; the "
+    "passes the ceiling a trajectory gate can tell apart over the release, where a pass "
+    "would mean nothing; the "
     "bound's leading coefficient is 1 where the trapezoidal rule's phase error is 1/12 of "
     "it.")
 
@@ -193,8 +194,8 @@ OFF_CENTRE_RELEASE_EXCITES_THE_FAST_MODES = (
     "release leaves at rest) a far larger share of the motion, and at the default step "
     "those modes lie beyond the range of w h where the scheme's bound holds, each counted "
     "at twice its amplitude; with the first mode faster (the beam is stiffer under an "
-    "off-centre load) the mode-by-mode bound passes 0.1 of the amplitude, where a pass "
-    "would mean nothing, and the engine's own refinement bounds its error above what a "
+    "off-centre load) the mode-by-mode bound passes the ceiling a trajectory gate can tell "
+    "apart, where a pass would mean nothing, and the engine's own refinement bounds its error above what a "
     "gate can tell apart. The frequencies are judged.")
 
 MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER = (

@@ -136,14 +136,16 @@ def _scenarios() -> tuple[Scenario, ...]:
 PULLED_FROM, RELAXED_FROM = 23, 26
 RK4_TRAJECTORY_BOUND_FROM_MANY_FAST_MODES = (
     "The trajectory gate is mode by mode: each of the chain's modes contributes its "
-    "amplitude times its own RK4 bound, and a mode past w h = 0.5 twice its amplitude. As "
-    "N grows, more modes pass w h = 0.5 at the default step and their small shares add "
-    "up: the bound exceeds 0.1 of the amplitude, where a pass would mean nothing.")
+    "amplitude times its own RK4 bound, and a mode beyond the range of w h where that "
+    "bound holds twice its amplitude. As N grows, more modes leave that range at the "
+    "default step and their small shares add up: the bound exceeds the ceiling a "
+    "trajectory gate can tell apart (comparisons/tolerances.py), where a pass would mean "
+    "nothing.")
 
 RK4_FIT_STEP_TOO_COARSE = (
-    "The chain's fastest modes (about 2 N sqrt(k / (rho l))) pass w h = 0.5 at the default "
-    "step, beyond RK4's bounded range, so their fits are unresolved; the slower modes and "
-    "the engines' linearizations are judged.")
+    "The chain's fastest modes (about 2 N sqrt(k / (rho l))) lie beyond the range of w h "
+    "where RK4's bound holds at the default step, so their fits are unresolved; the slower "
+    "modes and the engines' linearizations are judged.")
 
 SYSTEM = System(
     id="massive_spring",

@@ -135,8 +135,8 @@ SYSTEM = System(
     + tuple(Expectation(engine, "inverted_*.growth_rate", "unresolved", FAST_SHAKING)
             for engine in ("pybullet", "exudyn", "pymunk"))
     + (Expectation("pybullet", "convergence.order", "xfail",
-                   "PyBullet's error here falls nearly as dt^2 (within w h <= 0.2 of the "
-                   "shaking; mbfidelity convergence), faster than the first order its "
+                   "PyBullet's error here falls nearly as dt^2 (within the range of w h "
+                   "where its bound holds on the shaking; mbfidelity convergence), faster than the first order its "
                    "semi-implicit Euler declares, while Pymunk's same scheme shows first "
                    "order: the cause (the velocity-motor route that imposes the "
                    "pivot, or the first step's start term) is not established."),
