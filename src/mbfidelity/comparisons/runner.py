@@ -1134,10 +1134,17 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     scale = metrics.amplitude(ref.q[:, free], eq.q[free])
     reference_error = float(np.max(ref.error_estimate[free] / scale))
     scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
+    order = _refinement_order(system, sc, values, ref, run.integrator_order)
     runs, differences = [run], {m.name: [] for m in pending}
+    # the same differences on the samples of h, for the engine's limit
+    on_h = {m.name: [] for m in pending}
     gates: dict = {}
+    limit_gates: dict = {}
     for k in REFINEMENT_DIVISORS:
-        if k > 4 and all(not g.unresolved for g in gates.values()):
+        if k > 4 and all(not g.unresolved and (
+                g.tolerance <= _ceiling(name)
+                or limit_gates[name].limit_tolerance <= _ceiling(name))
+                for name, g in gates.items()):
             break
         fine = _guarded_run(backend, scratch, f"{sc.name}.refinement", t_end, mech, ref.q[0],
                             ref.qd[0], t_end, dt / k, settings, joints)
@@ -1154,20 +1161,64 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
         # each pair on the samples of its coarser run: the max over the samples of h is
         # at most that over the finer samples, so the telescoping bound still holds, and a
         # one-step error that every run makes at its first step is not hidden
-        scratch.metrics = []
-        _measure_scenario(system, backend, sc, values, mech,
-                          _as_reference(system, values, ref, runs[-1], _on_steps_of(fine, 2)),
-                          runs[-1], dt * 2 / k, settings, scratch, False, eq, refinement=True)
+        measured = _measured_between(system, backend, sc, values, mech, ref, eq, settings,
+                                     _on_steps_of(fine, 2), runs[-1], dt * 2 / k)
+        # and on the samples of h, where the finest run meets the reference
+        measured_on_h = measured if k == 2 else _measured_between(
+            system, backend, sc, values, mech, ref, eq, settings, _on_steps_of(fine, k),
+            _on_steps_of(runs[-1], k // 2), dt)
         runs.append(fine)
-        measured = {m.name: m.value for m in scratch.metrics}
         for name, d in differences.items():
             d.append(measured.get(name, float("nan")))
+            on_h[name].append(measured_on_h.get(name, float("nan")))
             if len(d) >= 2 and (name not in gates or gates[name].unresolved):
-                gates[name] = tolerances.refinement_gate(d, run.integrator_order,
-                                                         reference_error)
+                gates[name] = tolerances.refinement_gate(d, order, reference_error)
+            if len(d) >= 2:
+                limit_gates[name] = tolerances.refinement_gate(on_h[name], order,
+                                                               reference_error)
+    limits = _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gates,
+                     limit_gates)
     for m in pending:
         if m.name in gates:
-            _judge_refined(system, backend.id, m, gates[m.name])
+            _judge_refined(system, backend.id, m, gates[m.name], limits.get(m.name))
+
+
+def _measured_between(system, backend, sc, values, mech, ref, eq, settings, finer, coarser,
+                      dt: float) -> dict:
+    """name -> value of the scenario's metrics (checks left out) between two of the
+    engine's runs sampled alike, the `finer` in the reference's place."""
+    scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
+    _measure_scenario(system, backend, sc, values, mech,
+                      _as_reference(system, values, ref, coarser, finer), coarser, dt,
+                      settings, scratch, False, eq, refinement=True)
+    return {m.name: m.value for m in scratch.metrics}
+
+
+def _refinement_order(system, sc, values, ref, order: int) -> int:
+    """The order the refinement judges a scenario at: the scheme's, or lower where one of
+    the scenario's checks names an event that caps it (tolerances.py, "A posteriori")."""
+    capped = [f(system, sc, values, ref, order) for f in checks.refinement_orders(sc.checks)]
+    return min([order] + [q for q in capped if q is not None])
+
+
+def _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gates,
+            limit_gates) -> dict:
+    """For each metric whose refinement bound at h is above its ceiling, the engine's
+    limit judged on its finest run against the reference, both on the samples of h
+    (tolerances.py, "A posteriori"): name -> (v_K, its bound, the divisor 2^K), where
+    the differences on those samples confirm the order on their last pair."""
+    wanted = {name: limit_gates[name].limit_tolerance for name, g in gates.items()
+              if not g.unresolved and not g.tolerance <= _ceiling(name)
+              and name in limit_gates and not limit_gates[name].unresolved}
+    if not wanted:
+        return {}
+    divisor = 2 ** (len(runs) - 1)
+    scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
+    _measure_scenario(system, backend, sc, values, mech, ref, _on_steps_of(runs[-1], divisor),
+                      dt, settings, scratch, False, eq, refinement=True)
+    measured = {m.name: m.value for m in scratch.metrics}
+    return {name: (measured[name], bound, divisor) for name, bound in wanted.items()
+            if name in measured}
 
 
 def _refine_fit(system, backend, mech, q0, qd0, t_end, dt, settings, result, fitted,
@@ -1254,9 +1305,11 @@ def _ceiling(name: str) -> float:
 
 
 def _judge_refined(system: System, simulator: str, metric: Metric,
-                   gate: "tolerances.RefinementGate") -> None:
+                   gate: "tolerances.RefinementGate", limit: tuple | None = None) -> None:
     """`metric` (unresolved a priori) judged by the refinement gate, in place: pass or
-    fail (xfail where declared so), or still unresolved with the refinement's reason."""
+    fail (xfail where declared so), or still unresolved with the refinement's reason.
+    Where the bound at h is above the ceiling, `limit` (v_K, its bound, 2^K) judges the
+    engine's limit on its finest run (tolerances.py, "A posteriori")."""
     exp = expectation_for(system, simulator, metric.name)
     metric.rule = "refinement"
     metric.refinement = {**gate.as_dict(), "a_priori_tolerance": metric.tolerance}
@@ -1266,16 +1319,28 @@ def _judge_refined(system: System, simulator: str, metric: Metric,
         return
     ok = bool(metric.value <= gate.tolerance)
     ceiling = _ceiling(metric.name)
+    why = ""
     if ok and not gate.tolerance <= ceiling:
-        metric.reason = (f"{metric.reason}; refinement: the engine's own error bound "
-                         f"{gate.tolerance:.3g} exceeds {ceiling:g}: a pass would mean "
-                         f"nothing")
-        return
+        if limit is not None:
+            value, bound, divisor = limit
+            metric.refinement["limit"] = {"divisor": divisor, "value": value,
+                                          "tolerance": bound}
+        if limit is None or not bound <= ceiling:
+            metric.reason = (f"{metric.reason}; refinement: the engine's own error bound "
+                             f"{gate.tolerance:.3g} exceeds {ceiling:g}"
+                             + (f", and so does its remaining error at h/{divisor}, "
+                                f"{bound:.3g}: within the step budget" if limit else "")
+                             + ": a pass would mean nothing")
+            return
+        ok = bool(value <= bound)
+        if not ok:
+            why = (f"the engine's run at h/{divisor} is {value:.3g} from the reference, "
+                   f"beyond its own remaining error {bound:.3g}: its limit is another motion")
     metric.passed, metric.expected = ok, False
     if exp is not None and exp.kind == "xfail":
         metric.status, metric.reason = ("pass" if ok else "xfail"), exp.reason
     else:
-        metric.status, metric.reason = ("pass" if ok else "fail"), ""
+        metric.status, metric.reason = ("pass" if ok else "fail"), why
 
 
 # --- provenance and the matrix ---------------------------------------------------------

@@ -224,15 +224,38 @@ faster forcing).
   needs the bound below the ceiling the metric can discriminate (as for the a-priori
   gates, 0.1 of the amplitude, 0.05 of a frequency): a wider bound says the engine's own
   error at h leaves no room to tell its limit from the reference (a model error that
-  large would pass), and the metric stays unresolved; a value above the bound fails
-  whatever its width. Differences at or below STEP_INDEPENDENT of the scale
+  large would pass); a value above the bound fails whatever its width.
+  The engine's limit. Where the bound at h is above the ceiling but the order is
+  confirmed, the question the metric asks (is the engine's limit the exact motion?) is
+  put to the finest refined run, h_K = h/2^K, instead, on the samples of h where the
+  reference is known: with d'_k the same differences taken on those samples (an error
+  of a run's first steps, between samples of h, is then left out of every d'_k alike),
+  its distance to its own limit there is the tail d'_(K+1) + d'_(K+2) + ... <=
+  d'_K r / (1 - r), while the observed order log2(d'_(K-1) / d'_K) confirms the ratio r
+  (as above; otherwise no verdict), so an engine whose limit is the exact motion has
+  v_K = |Q_(h_K) - Q_ref| <= d'_K r / (1 - r) + eps_ref (v_K measured as v), and one
+  whose limit is off by D has v_K >= D - d'_K r / (1 - r): a model error D above twice
+  that bound fails. The metric passes when v <= the bound at h (its error at h is the
+  engine's own) and v_K <= d'_K r / (1 - r) + eps_ref, and that bound is below the
+  ceiling (r / (1 - r) = 2.41 for p = 1, 0.55 for p = 2, 0.097 for p = 4 at the margin
+  0.5). Where it is still above the ceiling at h/4 the engine is run at h/8 as
+  well; above it at h/8, the step budget, the metric stays unresolved: within the budget
+  the engine's error does not fall below what the metric can tell apart. Differences at or below STEP_INDEPENDENT of the scale
   are round-off: the quantity does not depend on the step (an imposed motion sampled
   exactly), and the order is not asked for. A free-vibration fit is refined alike (the
   same release at h/2, h/4, fitted alike: d_k the differences of successive fitted
   frequencies relative to the mode's, or of damping ratios); its resolution
   FIT_RESOLUTION is then the floor, and eps_ref (the fit on the exact motion is off by as
   much). Growth rates (judged against an eigenvalue, or by the Floquet check) and the
-  other checks' metrics (comparisons/checks) are not refined. Where the bound holds: in the engine's
+  other checks' metrics (comparisons/checks) are not refined.
+  An event the engine does not locate caps the order at which its error can fall,
+  whatever its scheme: a step that reaches a jump of the force leaves a velocity error of
+  at most a_J h ("Stick-slip": first order), one across a corner of the law
+  c_p (k2/m) |v| h^2 ("Switching instants": second order). Each further event adds one
+  such error, so the expansion Q_h = Q* + C h^q + ... holds with q = min(p, the event's
+  order) while the events keep their sequence (the ranges of those bounds); a scenario's
+  check names that order (comparisons/checks, `refinement_order`) and the refinement
+  judges at q: its range q - margin to p_top + margin, its r from q. Where the bound holds: in the engine's
   asymptotic regime, which the observed order confirms on the last pair of halvings (the
   next terms of the expansion shrink faster; a cancellation exactly at the finest pair
   would overstate the order, which the max norm over a run makes unlikely). Where the
@@ -241,6 +264,10 @@ faster forcing).
   stays `unresolved`, the observed order stated. The refinement runs cost six times the
   engine's run at h (h/2 and h/4; fourteen with h/8), only on the scenarios that have an
   unresolved metric.
+  The a-posteriori verdicts follow the a-priori ones in reach: a pass says the engine
+  converges, at its scheme's order, to a limit within the bound of the exact motion; an
+  engine whose error at h is its own but whose limit is another motion fails, however
+  wide its error at h (the refinement gate, or the limit's).
 * Stability. An explicit scheme diverges on a mode with w h above its stability limit on
   the imaginary axis (RK4: 2 sqrt 2; semi-implicit Euler: 2; each backend names its
   scheme and limit, simulators/base.py point 10); a comparison refuses such a step
@@ -248,6 +275,7 @@ faster forcing).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -494,6 +522,10 @@ class RefinementGate:
     differences: tuple[float, ...]
     reference_error: float
     unresolved: str = ""
+    #: the bound on the finest refined run's distance to the reference if the engine's
+    #: limit is the exact motion: its own remaining error plus `reference_error`
+    #: (tolerances.py, "A posteriori", the engine's limit)
+    limit_tolerance: float = math.inf
 
     def as_dict(self) -> dict:
         return {"observed_order": self.observed_order, "declared_order": self.declared_order,
@@ -519,8 +551,6 @@ def refinement_gate(differences: Sequence[float], order: int, reference_error: f
     order-`order` scheme (module docstring, "A posteriori"): the last pair confirms the
     order, the earlier differences add as they are. Differences at or below `floor` are
     the quantity's own resolution (round-off; a fit's FIT_RESOLUTION)."""
-    import math
-
     d = [float(x) for x in differences]
     shrink = 2.0 ** -(order - REFINEMENT_ORDER_MARGIN)
     head, (last, tail) = sum(d[:-2]), d[-2:]
@@ -529,9 +559,11 @@ def refinement_gate(differences: Sequence[float], order: int, reference_error: f
     if not all(math.isfinite(x) for x in d):
         return RefinementGate(math.inf, None, order, math.inf, tuple(d), reference_error,
                               "the refined runs give no finite difference")
+    remaining = shrink / (1.0 - shrink)  # the tail after the finest run, per its d_K
     if max(last, tail) <= floor:
         return RefinementGate(head + floor / (1.0 - shrink) + reference_error, None,
-                              order, head + floor, tuple(d), reference_error)
+                              order, head + floor, tuple(d), reference_error,
+                              limit_tolerance=floor * remaining + reference_error)
     observed = (math.log2(last / tail) if last > 0 and tail > 0
                 else math.inf if tail <= 0 else -math.inf)
     lowest, highest = order - REFINEMENT_ORDER_MARGIN, (
@@ -541,4 +573,5 @@ def refinement_gate(differences: Sequence[float], order: int, reference_error: f
         f"between its last halvings fall at order {observed:.2f}, outside the scheme's "
         f"{lowest:g} to {highest:g}")
     return RefinementGate(bound + reference_error, observed, order, predicted, tuple(d),
-                          reference_error, unresolved)
+                          reference_error, unresolved,
+                          math.inf if unresolved else tail * remaining + reference_error)

@@ -8,7 +8,10 @@ reference of the same scenario. A check whose physics widens the trajectory's er
 ``trajectory_allowance(system, scenario, values, reference, equilibrium, dt, order)``:
 the error it adds, relative to the amplitude, with its derivation; and
 ``period_allowance`` with the same arguments: what it adds to the mean period's relative
-error."""
+error; and ``refinement_order(system, scenario, values, reference, order)``: the order at
+which an engine's error can fall with the step in the scenario when a non-smooth element
+caps it below the scheme's (an event the engine does not locate), or None (the a-posteriori
+rule of comparisons/tolerances.py then judges the engine's refinement at that order)."""
 from __future__ import annotations
 
 import importlib
@@ -61,6 +64,7 @@ class ScenarioRun:
 _REGISTRY: dict[str, Callable[[ScenarioRun], None]] | None = None
 _ALLOWANCES: dict[str, Callable[..., float]] = {}
 _PERIOD_ALLOWANCES: dict[str, Callable[..., float]] = {}
+_REFINEMENT_ORDERS: dict[str, Callable[..., int | None]] = {}
 
 
 def trajectory_allowances(check_names) -> list[Callable[..., float]]:
@@ -73,6 +77,12 @@ def period_allowances(check_names) -> list[Callable[..., float]]:
     """The `period_allowance` functions of the checks named."""
     registry()
     return [_PERIOD_ALLOWANCES[c] for c in check_names if c in _PERIOD_ALLOWANCES]
+
+
+def refinement_orders(check_names) -> list[Callable[..., int | None]]:
+    """The `refinement_order` functions of the checks named."""
+    registry()
+    return [_REFINEMENT_ORDERS[c] for c in check_names if c in _REFINEMENT_ORDERS]
 
 
 def registry() -> dict[str, Callable[[ScenarioRun], None]]:
@@ -91,5 +101,7 @@ def registry() -> dict[str, Callable[[ScenarioRun], None]]:
                     _ALLOWANCES[name] = module.trajectory_allowance
                 if hasattr(module, "period_allowance"):
                     _PERIOD_ALLOWANCES[name] = module.period_allowance
+                if hasattr(module, "refinement_order"):
+                    _REFINEMENT_ORDERS[name] = module.refinement_order
         _REGISTRY = found
     return _REGISTRY

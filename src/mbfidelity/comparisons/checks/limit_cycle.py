@@ -74,6 +74,14 @@ def period_allowance(system, scenario, values, reference, equilibrium, dt: float
     return _cycle_shifts(system, values, reference, dt) / float(reference.t[-1])
 
 
+def refinement_order(system, scenario, values, reference, order: int) -> int | None:
+    """1 where the reference meets the rate surface: no engine locates the force's jump
+    there, and the step that reaches it leaves a velocity error of at most a_J h whatever
+    the scheme (comparisons/tolerances.py, "Stick-slip"), so the error falls at first
+    order however high the scheme's; None for a motion that never reaches it."""
+    return 1 if reference.switches else None
+
+
 def half_range(x: np.ndarray) -> float:
     return float(np.max(x) - np.min(x)) / 2.0
 

@@ -48,6 +48,13 @@ def crossings(t: np.ndarray, x: np.ndarray, l: float) -> list[tuple[float, str, 
     return out
 
 
+def refinement_order(system, scenario, values, reference, order: int) -> int | None:
+    """2: each step across a corner of the stop law leaves a velocity error of order h^2
+    whatever the scheme (comparisons/tolerances.py, "Switching instants"), so a scheme of
+    higher order converges at second order here."""
+    return 2
+
+
 def trajectory_allowance(system, scenario, values, reference, equilibrium, dt: float,
                          order: int) -> float:
     """What the switches add to the trajectory gate, relative to the amplitude (module
