@@ -1104,9 +1104,11 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
 
 # --- the a-posteriori rule: the engine's own refinement (tolerances.py) ----------------
 
-#: the refinement's steps, as divisors of the comparison's; the last only where the
-#: pair before it does not show the order (tolerances.py, "A posteriori")
-REFINEMENT_DIVISORS = (2, 4, 8)
+#: the refinement's steps, as divisors of the comparison's: h/8 only where the pair
+#: before it does not show the order or the engine's limit is not yet within the ceiling,
+#: h/16 only where the limit's observed order brings it within (tolerances.py, "A
+#: posteriori": the step budget)
+REFINEMENT_DIVISORS = (2, 4, 8, 16)
 
 
 #: metrics measured against something other than the reference's same quantity (the
@@ -1146,6 +1148,9 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
                 or limit_gates[name].limit_tolerance <= _ceiling(name))
                 for name, g in gates.items()):
             break
+        if k > 8 and not any(_limit_within_reach(name, g, limit_gates.get(name))
+                             for name, g in gates.items()):
+            break
         fine = _guarded_run(backend, scratch, f"{sc.name}.refinement", t_end, mech, ref.q[0],
                             ref.qd[0], t_end, dt / k, settings, joints)
         if fine is None or scratch.incidents:
@@ -1181,6 +1186,17 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     for m in pending:
         if m.name in gates:
             _judge_refined(system, backend.id, m, gates[m.name], limits.get(m.name))
+
+
+def _limit_within_reach(name: str, gate, limit_gate) -> bool:
+    """Whether one more halving is predicted, at the limit's observed order, to bring the
+    bound on the engine's limit within the ceiling where it is not yet."""
+    if gate.unresolved or gate.tolerance <= _ceiling(name) or limit_gate is None \
+            or limit_gate.unresolved or limit_gate.limit_tolerance <= _ceiling(name):
+        return False
+    shrink = 2.0 ** -(limit_gate.observed_order if limit_gate.observed_order is not None
+                      else limit_gate.declared_order)
+    return limit_gate.limit_tolerance * shrink <= _ceiling(name)
 
 
 def _measured_between(system, backend, sc, values, mech, ref, eq, settings, finer, coarser,

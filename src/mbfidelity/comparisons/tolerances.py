@@ -239,8 +239,10 @@ faster forcing).
   engine's own) and v_K <= d'_K r / (1 - r) + eps_ref, and that bound is below the
   ceiling (r / (1 - r) = 2.41 for p = 1, 0.55 for p = 2, 0.097 for p = 4 at the margin
   0.5). Where it is still above the ceiling at h/4 the engine is run at h/8 as
-  well; above it at h/8, the step budget, the metric stays unresolved: within the budget
-  the engine's error does not fall below what the metric can tell apart. Differences at or below STEP_INDEPENDENT of the scale
+  well, and at h/16 where the observed order of the d'_k predicts that one more halving
+  brings it within; h/16 is the step budget: a bound still above the ceiling there (or
+  predicted to stay above it) leaves the metric unresolved, the engine's error not
+  falling below what the metric can tell apart within the budget. Differences at or below STEP_INDEPENDENT of the scale
   are round-off: the quantity does not depend on the step (an imposed motion sampled
   exactly), and the order is not asked for. A free-vibration fit is refined alike (the
   same release at h/2, h/4, fitted alike: d_k the differences of successive fitted
@@ -262,8 +264,8 @@ faster forcing).
   order falls short down to h/8 (the differences stop shrinking with the step: a
   constraint's compliance, an event located to the step, a motion too fast), the metric
   stays `unresolved`, the observed order stated. The refinement runs cost six times the
-  engine's run at h (h/2 and h/4; fourteen with h/8), only on the scenarios that have an
-  unresolved metric.
+  engine's run at h (h/2 and h/4; fourteen with h/8, thirty with h/16), only on the
+  scenarios that have an unresolved metric.
   The a-posteriori verdicts follow the a-priori ones in reach: a pass says the engine
   converges, at its scheme's order, to a limit within the bound of the exact motion; an
   engine whose error at h is its own but whose limit is another motion fails, however
