@@ -509,11 +509,12 @@ def _compare_scenario(system, backend, sc, params, dt, t_end, settings, result, 
 
 
 def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings, result,
-                      keep_series, eq, refinement=False) -> set:
+                      keep_series, eq, refinement=False, refined_checks=()) -> set:
     """The metrics of one scenario from the engine's `run` against `ref`; returns the names
-    of those its checks (comparisons/checks) recorded. With `refinement` the `ref` is the
-    engine's own finer run (`_refine_scenario`): the checks, which run engines of their
-    own and judge on their own terms, are left out."""
+    of those its checks (comparisons/checks) recorded that the refinement leaves alone.
+    With `refinement` the `ref` is the engine's own finer run (`_refine_scenario`): the
+    checks, which run engines of their own and judge on their own terms, are left out,
+    but for `refined_checks` (whose ``REFINABLE`` metrics are wanted)."""
     name = sc.name
     joints = system.reaction_joints if "reaction" in sc.checks else ()
     contacts = system.contacts(system.symbols) if "constraint_force" in sc.checks else ()
@@ -564,7 +565,7 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
         _compare_driven(system, backend, sc, values, ref, run, n, tol, w, dt, eq, result)
     scenario_series: dict = {}
     before_checks = len(result.metrics)
-    for check in () if refinement else sc.checks:
+    for check in refined_checks if refinement else sc.checks:
         measure = checks.registry().get(check)
         if measure is None:
             continue
@@ -579,7 +580,8 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
             simulate=lambda m, a, b, t: _guarded_run(backend, result, f"{name}.{check}", t,
                                                      m, a, b, t, dt, settings, ()),
             series=scenario_series))
-    by_checks = {m.name for m in result.metrics[before_checks:]}
+    refinable = {f"{name}.{label}" for check in sc.checks for label in checks.refinable(check)}
+    by_checks = {m.name for m in result.metrics[before_checks:] if m.name not in refinable}
     if len(system.coordinates) == 1:
         p_ref = metrics.mean_period(ref.t, ref.q[:, 0] - eq.q[0])
         p_run = metrics.mean_period(run.t[:n], run.q[:n, 0] - eq.q[0])
@@ -1137,6 +1139,9 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     reference_error = float(np.max(ref.error_estimate[free] / scale))
     scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
     order = _refinement_order(system, sc, values, ref, run.integrator_order)
+    wanted = {m.name for m in pending}
+    refined_checks = tuple(c for c in sc.checks if any(
+        f"{sc.name}.{label}" in wanted for label in checks.refinable(c)))
     runs, differences = [run], {m.name: [] for m in pending}
     # the same differences on the samples of h, for the engine's limit
     on_h = {m.name: [] for m in pending}
@@ -1167,11 +1172,12 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
         # at most that over the finer samples, so the telescoping bound still holds, and a
         # one-step error that every run makes at its first step is not hidden
         measured = _measured_between(system, backend, sc, values, mech, ref, eq, settings,
-                                     _on_steps_of(fine, 2), runs[-1], dt * 2 / k)
+                                     _on_steps_of(fine, 2), runs[-1], dt * 2 / k,
+                                     refined_checks)
         # and on the samples of h, where the finest run meets the reference
         measured_on_h = measured if k == 2 else _measured_between(
             system, backend, sc, values, mech, ref, eq, settings, _on_steps_of(fine, k),
-            _on_steps_of(runs[-1], k // 2), dt)
+            _on_steps_of(runs[-1], k // 2), dt, refined_checks)
         runs.append(fine)
         for name, d in differences.items():
             d.append(measured.get(name, float("nan")))
@@ -1182,7 +1188,7 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
                 limit_gates[name] = tolerances.refinement_gate(on_h[name], order,
                                                                reference_error)
     limits = _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gates,
-                     limit_gates)
+                     limit_gates, refined_checks)
     for m in pending:
         if m.name in gates:
             _judge_refined(system, backend.id, m, gates[m.name], limits.get(m.name))
@@ -1200,13 +1206,15 @@ def _limit_within_reach(name: str, gate, limit_gate) -> bool:
 
 
 def _measured_between(system, backend, sc, values, mech, ref, eq, settings, finer, coarser,
-                      dt: float) -> dict:
-    """name -> value of the scenario's metrics (checks left out) between two of the
-    engine's runs sampled alike, the `finer` in the reference's place."""
+                      dt: float, refined_checks=()) -> dict:
+    """name -> value of the scenario's metrics (of the checks, `refined_checks` only)
+    between two of the engine's runs sampled alike, the `finer` in the reference's
+    place."""
     scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
     _measure_scenario(system, backend, sc, values, mech,
                       _as_reference(system, values, ref, coarser, finer), coarser, dt,
-                      settings, scratch, False, eq, refinement=True)
+                      settings, scratch, False, eq, refinement=True,
+                      refined_checks=refined_checks)
     return {m.name: m.value for m in scratch.metrics}
 
 
@@ -1218,7 +1226,7 @@ def _refinement_order(system, sc, values, ref, order: int) -> int:
 
 
 def _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gates,
-            limit_gates) -> dict:
+            limit_gates, refined_checks=()) -> dict:
     """For each metric whose refinement bound at h is above its ceiling, the engine's
     limit judged on its finest run against the reference, both on the samples of h
     (tolerances.py, "A posteriori"): name -> (v_K, its bound, the divisor 2^K), where
@@ -1231,7 +1239,8 @@ def _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gate
     divisor = 2 ** (len(runs) - 1)
     scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
     _measure_scenario(system, backend, sc, values, mech, ref, _on_steps_of(runs[-1], divisor),
-                      dt, settings, scratch, False, eq, refinement=True)
+                      dt, settings, scratch, False, eq, refinement=True,
+                      refined_checks=refined_checks)
     measured = {m.name: m.value for m in scratch.metrics}
     return {name: (measured[name], bound, divisor) for name, bound in wanted.items()
             if name in measured}

@@ -249,7 +249,9 @@ faster forcing).
   frequencies relative to the mode's, or of damping ratios); its resolution
   FIT_RESOLUTION is then the floor, and eps_ref (the fit on the exact motion is off by as
   much). Growth rates (judged against an eigenvalue, or by the Floquet check) and the
-  other checks' metrics (comparisons/checks) are not refined.
+  other checks' metrics (comparisons/checks) are not refined, but for those a check
+  names as a quantity of the run against the same quantity of the reference's
+  (``REFINABLE``, e.g. the amplitude over a final window), which are distances like v.
   An event the engine does not locate caps the order at which its error can fall,
   whatever its scheme: a step that reaches a jump of the force leaves a velocity error of
   at most a_J h ("Stick-slip": first order), one across a corner of the law

@@ -11,7 +11,11 @@ the error it adds, relative to the amplitude, with its derivation; and
 error; and ``refinement_order(system, scenario, values, reference, order)``: the order at
 which an engine's error can fall with the step in the scenario when a non-smooth element
 caps it below the scheme's (an event the engine does not locate), or None (the a-posteriori
-rule of comparisons/tolerances.py then judges the engine's refinement at that order)."""
+rule of comparisons/tolerances.py then judges the engine's refinement at that order).
+``REFINABLE`` names the metrics (labels) a check measures as a quantity of the engine's
+run against the same quantity of the reference's: measured between two of the engine's
+own runs they are their difference, so the refinement judges them as it does the
+trajectory (the other checks' metrics it leaves alone)."""
 from __future__ import annotations
 
 import importlib
@@ -65,6 +69,7 @@ _REGISTRY: dict[str, Callable[[ScenarioRun], None]] | None = None
 _ALLOWANCES: dict[str, Callable[..., float]] = {}
 _PERIOD_ALLOWANCES: dict[str, Callable[..., float]] = {}
 _REFINEMENT_ORDERS: dict[str, Callable[..., int | None]] = {}
+_REFINABLE: dict[str, tuple[str, ...]] = {}
 
 
 def trajectory_allowances(check_names) -> list[Callable[..., float]]:
@@ -85,6 +90,12 @@ def refinement_orders(check_names) -> list[Callable[..., int | None]]:
     return [_REFINEMENT_ORDERS[c] for c in check_names if c in _REFINEMENT_ORDERS]
 
 
+def refinable(check_name: str) -> tuple[str, ...]:
+    """The labels of the check's metrics the refinement judges (its ``REFINABLE``)."""
+    registry()
+    return _REFINABLE.get(check_name, ())
+
+
 def registry() -> dict[str, Callable[[ScenarioRun], None]]:
     """check name -> measure function, from the modules of this package."""
     global _REGISTRY
@@ -103,5 +114,6 @@ def registry() -> dict[str, Callable[[ScenarioRun], None]]:
                     _PERIOD_ALLOWANCES[name] = module.period_allowance
                 if hasattr(module, "refinement_order"):
                     _REFINEMENT_ORDERS[name] = module.refinement_order
+                _REFINABLE[name] = tuple(getattr(module, "REFINABLE", ()))
         _REGISTRY = found
     return _REGISTRY

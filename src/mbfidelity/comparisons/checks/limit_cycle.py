@@ -29,6 +29,9 @@ from .. import metrics, tolerances
 from . import ScenarioRun
 
 CHECK = "limit_cycle"
+#: the final amplitude compares the engine's run with the reference's over one window:
+#: refined as the trajectory (the cycle's metrics compare with the analytic cycle)
+REFINABLE = ("final_amplitude",)
 
 
 def _cycle_shifts(system, values, reference, dt: float) -> float:
