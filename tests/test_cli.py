@@ -150,16 +150,21 @@ def test_unstable_step_is_refused_before_any_work():
     assert "Traceback" not in res.output
 
 
-def test_coarse_step_cannot_pass():
+def test_coarse_step_cannot_pass_on_its_error_at_h():
     # w h = 0.2 x 7 rad/s: far outside semi-implicit Euler's asymptotic range (w h <= 0.2)
     res = runner.invoke(app, ["compare", "double_pendulum", "--sim", "pymunk", "--dt", "0.2",
                               "--t-end", "4", "--json"])
-    assert res.exit_code == 1, res.output
     doc = json.loads(res.stdout)
-    # the engine's own refinement predicts an error above what a trajectory can tell
-    # apart: no trajectory passes (a slow mode's fit, w h small, may be judged)
-    statuses = {m["status"] for m in doc["metrics"] if ".trajectory_" in m["name"]}
-    assert "pass" not in statuses and "unresolved" in statuses
+    # the engine's own refinement bounds its error at h above what a trajectory can tell
+    # apart: no trajectory passes on it; where the refinement reaches the asymptotic
+    # regime within the step budget, the engine's limit is judged on its finest run
+    # instead (comparisons/tolerances.py, "A posteriori"), and the JSON says so
+    trajectories = [m for m in doc["metrics"] if ".trajectory_" in m["name"]]
+    assert trajectories
+    for m in trajectories:
+        assert m["status"] == "unresolved" or (
+            m["rule"] == "refinement_limit" and m["tolerance"] > 0.1
+            and m["refinement"]["limit"]["tolerance"] <= 0.1), m
 
 
 def test_engine_failure_is_recorded_not_raised():

@@ -50,8 +50,10 @@ class Metric:
     detail: dict = field(default_factory=dict)
     #: an unresolved metric the system declares (it does not fail the comparison)
     expected: bool = False
-    #: which rule set the gate: "a_priori" (tolerances.py's bounds) or "refinement" (the
-    #: engine's own halvings, tolerances.py "A posteriori")
+    #: which rule set the gate: "a_priori" (tolerances.py's bounds), "refinement" (the
+    #: engine's own halvings, tolerances.py "A posteriori") or "refinement_limit" (the
+    #: same, the engine's limit judged on its finest run: its bound at h is above the
+    #: ceiling)
     rule: str = "a_priori"
     #: the refinement's numbers (observed and declared order, predicted error, ...)
     refinement: dict = field(default_factory=dict)
@@ -1357,6 +1359,7 @@ def _judge_refined(system: System, simulator: str, metric: Metric,
                                 f"{bound:.3g}: within the step budget" if limit else "")
                              + ": a pass would mean nothing")
             return
+        metric.rule = "refinement_limit"
         ok = bool(value <= bound)
         if not ok:
             why = (f"the engine's run at h/{divisor} is {value:.3g} from the reference, "
