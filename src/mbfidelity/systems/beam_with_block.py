@@ -170,8 +170,12 @@ MIRROR_RELEASE_EXCITES_THE_FAST_MODES = (
     "bound holds at the default step, as in the first; the reference departs from its own "
     "linear prediction by more than the amplitude (the fast modes' frequencies depend on "
     "their amplitude), so neither the fastest-mode nor the mode-by-mode bound says "
-    "anything. The engine's own refinement converges, but bounds its error at the default "
-    "step above what a gate can tell apart (MuJoCo's RK4 excepted, judged). The operating "
+    "anything. The engine's own refinement then judges the second- and fourth-order "
+    "engines (Exudyn, MuJoCo), whose error falls fast enough with the step; the "
+    "first-order engines' differences fall slowly at first (semi-implicit Euler on the "
+    "fast modes, well outside its range of w h until the finest steps), so that within "
+    "the step budget neither their error at the default step nor their finest run's "
+    "distance to its own limit comes below what a gate can tell apart. The operating "
     "release ('released') and the frequencies are judged.")
 
 SOFT_ROLLER_BELOW_THE_GATE = (
@@ -232,7 +236,7 @@ SYSTEM = System(
     near_equilibrium_t_end=0.5,
     expectations=(
         *(Expectation(engine, "eq*_small.*", "unresolved", MIRROR_RELEASE_EXCITES_THE_FAST_MODES)
-          for engine in ("exudyn", "pybullet", "pymunk")),
+          for engine in ("pybullet", "pymunk")),
         Expectation("mujoco", "released.*", "judged", SOFT_ROLLER_BELOW_THE_GATE),
         Expectation("mujoco", "eq*_small.*", "judged",
                     MIRROR_RELEASE_JUDGED_BLOCK_NEAR_THE_ROLLER, when="c > 0.55"),

@@ -30,7 +30,6 @@ that the motion never reaches from phi = 0 (|phi| = pi/2 would need x infinite).
 import sympy as sp
 
 from . import Condition, Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import SEMI_IMPLICIT_DRIFT
 from .model import (COORD_RATE, Body, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Rectangle, Revolute, Scenario, Segment,
                     coordinate_spring_damper)
@@ -127,7 +126,5 @@ SYSTEM = System(
     ),
     expectations=(
         Expectation("mujoco", "damping.fit_*", "xfail", SOFT_SLOT_DAMPING),
-        Expectation("pybullet", "large.trajectory_*", "xfail", SEMI_IMPLICIT_DRIFT),
-        Expectation("pybullet", "large.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),
     ),
 )

@@ -53,7 +53,7 @@ eq. 101 too. With the eq. 99 potential the positive root is a saddle and the neg
 import sympy as sp
 
 from . import Condition, Expectation, PrintedFormula, System, coordinate_symbols
-from ._reasons import MUJOCO_MASSLESS_PIN, SEMI_IMPLICIT_DRIFT
+from ._reasons import MUJOCO_MASSLESS_PIN
 from .model import (COORD, COORD_RATE, Body, Circle, CoordinateForce, Mechanism, Parameter,
                     PointOnLine, Prismatic, Revolute, Scenario, Segment)
 
@@ -242,8 +242,5 @@ SYSTEM = System(
         Expectation("mujoco", "frequency.*", "xfail", MUJOCO_MASSLESS_PIN),
         Expectation("mujoco", "damping.*", "xfail", MUJOCO_MASSLESS_PIN),
         Expectation("pybullet", "damping.fit_mode1", "xfail", PYBULLET_DAMPS_THE_FIRST_MODE),
-        Expectation("pybullet", "undamped.trajectory_*", "xfail", SEMI_IMPLICIT_DRIFT),
-        Expectation("pybullet", "undamped.energy_drift", "xfail", SEMI_IMPLICIT_DRIFT),
-        Expectation("pybullet", "undamped.constraint_*", "xfail", SEMI_IMPLICIT_DRIFT),
     ),
 )
