@@ -242,8 +242,9 @@ faster forcing).
   well, and at h/16 where the observed order of the d'_k predicts that one more halving
   brings it within; h/16 is the step budget: a bound still above the ceiling there (or
   predicted to stay above it) leaves the metric unresolved, the engine's error not
-  falling below what the metric can tell apart within the budget. Differences at or below STEP_INDEPENDENT of the scale
-  are round-off: the quantity does not depend on the step (an imposed motion sampled
+  falling below what the metric can tell apart within the budget. Such a verdict is
+  marked as the limit's (`rule` refinement_limit, with v_K and its bound).
+  Differences at or below STEP_INDEPENDENT of the scale are round-off: the quantity does not depend on the step (an imposed motion sampled
   exactly), and the order is not asked for. A free-vibration fit is refined alike (the
   same release at h/2, h/4, fitted alike: d_k the differences of successive fitted
   frequencies relative to the mode's, or of damping ratios); its resolution
@@ -259,8 +260,8 @@ faster forcing).
   such error, so the expansion Q_h = Q* + C h^q + ... holds with q = min(p, the event's
   order) while the events keep their sequence (the ranges of those bounds); a scenario's
   check names that order (comparisons/checks, `refinement_order`) and the refinement
-  judges at q: its range q - margin to p_top + margin, its r from q. Where the bound holds: in the engine's
-  asymptotic regime, which the observed order confirms on the last pair of halvings (the
+  judges at q: its range q - margin to p_top + margin, its r from q.
+  Where the bound holds: in the engine's asymptotic regime, which the observed order confirms on the last pair of halvings (the
   next terms of the expansion shrink faster; a cancellation exactly at the finest pair
   would overstate the order, which the max norm over a run makes unlikely). Where the
   order falls short down to h/8 (the differences stop shrinking with the step: a
