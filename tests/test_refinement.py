@@ -167,3 +167,21 @@ def test_a_refinable_check_metric_is_judged_and_rejects_a_damping_off():
     assert correct.rule.startswith("refinement") and correct.passed
     wrong = final_amplitude({"c": 1.01})
     assert wrong.rule.startswith("refinement") and wrong.status == "fail"
+
+
+@pytest.mark.slow
+def test_the_floquet_growth_rate_is_refined_and_rejects_g_off():
+    """The shaken inverted pendulum's growth rate (its Floquet exponent, read by the
+    per-period-maxima estimator) is judged by PyBullet's refinement, the estimator's
+    error on the exact motion added; g 5 % off in the engine's build moves the rate by
+    more than that and fails."""
+    def growth(scale):
+        result = compare("vertically_driven_pendulum", "pybullet",
+                         scenarios=["inverted_unstable"], engine_scale=scale)
+        return next(m for m in result.metrics if m.name == "inverted_unstable.growth_rate")
+
+    correct = growth(None)
+    assert correct.rule.startswith("refinement") and correct.passed
+    assert correct.tolerance >= correct.detail["reference_error"]
+    wrong = growth({"g": 1.05})
+    assert wrong.rule.startswith("refinement") and wrong.status == "fail"

@@ -581,7 +581,7 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
                                                                 f"{name}.{label}"))),
             simulate=lambda m, a, b, t: _guarded_run(backend, result, f"{name}.{check}", t,
                                                      m, a, b, t, dt, settings, ()),
-            series=scenario_series))
+            series=scenario_series, refinement=refinement))
     refinable = {f"{name}.{label}" for check in sc.checks for label in checks.refinable(check)}
     by_checks = {m.name for m in result.metrics[before_checks:] if m.name not in refinable}
     if len(system.coordinates) == 1:
@@ -1116,7 +1116,8 @@ REFINEMENT_DIVISORS = (2, 4, 8, 16)
 
 
 #: metrics measured against something other than the reference's same quantity (the
-#: growth rate against the linearization's eigenvalue): not refined
+#: growth rate against the linearization's eigenvalue): not refined, unless a check of
+#: the scenario names them refinable (the Floquet check's rate, comparisons/checks)
 NOT_REFINED = ("growth_rate",)
 
 
@@ -1127,8 +1128,9 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     scenario's metrics measured between successive runs on the samples of h
     (`_measure_scenario` with the finer run in the reference's place), and each metric
     judged by `tolerances.refinement_gate`. The a-priori verdicts stay as they are."""
-    pending = [m for m in measured_here if m.status == "unresolved"
-               and np.isfinite(m.value) and not m.name.endswith(NOT_REFINED)]
+    refinable = {f"{sc.name}.{label}" for check in sc.checks for label in checks.refinable(check)}
+    pending = [m for m in measured_here if m.status == "unresolved" and np.isfinite(m.value)
+               and (m.name in refinable or not m.name.endswith(NOT_REFINED))]
     if not pending:
         return
     joints = system.reaction_joints if "reaction" in sc.checks else ()
@@ -1149,6 +1151,10 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     on_h = {m.name: [] for m in pending}
     gates: dict = {}
     limit_gates: dict = {}
+    # the reference's own error in each metric: the trajectory's, or what a check's
+    # estimator misses on the exact motion (its detail)
+    own_error = {m.name: float(m.detail.get("reference_error", reference_error))
+                 for m in pending}
     for k in REFINEMENT_DIVISORS:
         if k > 4 and all(not g.unresolved and (
                 g.tolerance <= _ceiling(name)
@@ -1185,10 +1191,10 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
             d.append(measured.get(name, float("nan")))
             on_h[name].append(measured_on_h.get(name, float("nan")))
             if len(d) >= 2 and (name not in gates or gates[name].unresolved):
-                gates[name] = tolerances.refinement_gate(d, order, reference_error)
+                gates[name] = tolerances.refinement_gate(d, order, own_error[name])
             if len(d) >= 2:
                 limit_gates[name] = tolerances.refinement_gate(on_h[name], order,
-                                                               reference_error)
+                                                               own_error[name])
     limits = _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gates,
                      limit_gates, refined_checks)
     for m in pending:
@@ -1326,7 +1332,8 @@ def _as_reference(system, values, ref, coarse, run):
 def _ceiling(name: str) -> float:
     """What the metric can still discriminate (tolerances.py): a frequency, damping ratio
     or period 0.05, a trajectory-like error 0.1 of the amplitude."""
-    if name.startswith(("frequency.", "damping.")) or name.endswith(".period"):
+    if name.startswith(("frequency.", "damping.")) or name.endswith((".period",
+                                                                       ".growth_rate")):
         return tolerances.MAX_FREQUENCY_TOLERANCE
     return tolerances.MAX_TRAJECTORY_TOLERANCE
 

@@ -249,10 +249,13 @@ faster forcing).
   same release at h/2, h/4, fitted alike: d_k the differences of successive fitted
   frequencies relative to the mode's, or of damping ratios); its resolution
   FIT_RESOLUTION is then the floor, and eps_ref (the fit on the exact motion is off by as
-  much). Growth rates (judged against an eigenvalue, or by the Floquet check) and the
-  other checks' metrics (comparisons/checks) are not refined, but for those a check
-  names as a quantity of the run against the same quantity of the reference's
-  (``REFINABLE``, e.g. the amplitude over a final window), which are distances like v.
+  much). A growth rate judged against an eigenvalue and the other checks' metrics
+  (comparisons/checks) are not refined, but for those a check names as a quantity of the
+  run against the same quantity of the reference's (``REFINABLE``), which are distances
+  like v: the amplitude over a final window; the Floquet growth rate, its estimator
+  applied alike to two of the engine's runs, with eps_ref the estimator's error on the
+  exact motion (the engine's limit read by the same estimator is the exact motion's
+  reading, which is that far from ln|mu|max / T).
   An event the engine does not locate caps the order at which its error can fall,
   whatever its scheme: a step that reaches a jump of the force leaves a velocity error of
   at most a_J h ("Stick-slip": first order), one across a corner of the law

@@ -30,13 +30,6 @@ from . import Expectation, PrintedFormula, System, coordinate_symbols
 from .model import (TIME, Body, Mechanism, Parameter, Prescribed, Prismatic, Rectangle,
                     Revolute, Scenario, Segment)
 
-FAST_SHAKING = (
-    "The pivot is shaken fast: at the default step the growth rate's bound, (Omega h)^p "
-    "(Omega h for semi-implicit Euler), is far above what a fitted rate can tell apart "
-    "except for RK4, and a growth rate is not refined (comparisons/tolerances.py); the "
-    "inverted position's keeping or leaving is judged by the Floquet check, and the "
-    "motion by the engine's own refinement.")
-
 PYBULLET_VERTICAL_MOTOR = (
     "PyBullet's velocity motor on the vertical guide reports an actuator force away from "
     "the reference's by the same amount at every step (no convergence with the step, so "
@@ -132,8 +125,6 @@ SYSTEM = System(
     unexcited={"Y": 0.0},
     expectations=(Expectation("pybullet", "*.actuator_actuator", "xfail",
                               PYBULLET_VERTICAL_MOTOR),)
-    + tuple(Expectation(engine, "inverted_*.growth_rate", "unresolved", FAST_SHAKING)
-            for engine in ("pybullet", "exudyn", "pymunk"))
     + (Expectation("pybullet", "convergence.order", "xfail",
                    "PyBullet's error here falls nearly as dt^2 (within the range of w h "
                    "where its bound holds on the shaking; mbfidelity convergence), faster than the first order its "

@@ -55,6 +55,9 @@ class ScenarioRun:
     simulate: Callable[..., Any]
     #: arrays for the report's figures, by name (saved with the scenario's series)
     series: dict = field(default_factory=dict)
+    #: the `reference` is the engine's own finer run (the a-posteriori rule): a REFINABLE
+    #: metric then measures the distance between the two runs' quantities
+    refinement: bool = False
 
     @property
     def name(self) -> str:
