@@ -344,10 +344,14 @@ def _expected(shown: str, comps=()) -> list:
                 first = next((d for d in declared if fnmatch.fnmatch(c.simulator, d.simulator)
                               and fnmatch.fnmatch(m.name, d.metric)), None)
                 if first is not None:
+                    limit = (m.refinement or {}).get("limit")
                     first.measured.append(SimpleNamespace(
                         simulator=c.simulator, name=m.name, value=m.value,
                         tolerance=m.tolerance, status=m.status,
-                        rule=(m.rule or "a_priori").replace("_", "-")))
+                        rule=(m.rule or "a_priori").replace("_", "-"),
+                        limit=(f"; its limit, at h/{limit['divisor']}: "
+                               f"{limit['value']:.2e} / {limit['tolerance']:.1e}"
+                               if limit else "")))
         return declared
     v = system.variant(shown[len(system.id) + 1:-1])
     return [SimpleNamespace(simulator=", ".join(v.settings), metric="(measured, not gated)",
