@@ -1251,7 +1251,7 @@ def _limits(system, backend, sc, values, mech, ref, runs, dt, settings, eq, gate
                       refined_checks=refined_checks)
     measured = {m.name: m.value for m in scratch.metrics}
     return {name: (measured[name], bound, divisor) for name, bound in wanted.items()
-            if name in measured}
+            if np.isfinite(measured.get(name, float("nan")))}
 
 
 def _refine_fit(system, backend, mech, q0, qd0, t_end, dt, settings, result, fitted,
