@@ -1203,14 +1203,24 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
 
 
 def _limit_within_reach(name: str, gate, limit_gate) -> bool:
-    """Whether one more halving is predicted, at the limit's observed order, to bring the
-    bound on the engine's limit within the ceiling where it is not yet."""
+    """Whether one more halving is predicted to bring the bound on the engine's limit
+    within the ceiling where it is not yet: at the limit's observed order, or, where its
+    differences fall faster than any term of the scheme (they leave a pre-asymptotic
+    range: the order is not yet confirmed), at the scheme's fastest order."""
     if gate.unresolved or gate.tolerance <= _ceiling(name) or limit_gate is None \
-            or limit_gate.unresolved or limit_gate.limit_tolerance <= _ceiling(name):
+            or limit_gate.limit_tolerance <= _ceiling(name):
         return False
-    shrink = 2.0 ** -(limit_gate.observed_order if limit_gate.observed_order is not None
-                      else limit_gate.declared_order)
-    return limit_gate.limit_tolerance * shrink <= _ceiling(name)
+    order, observed = limit_gate.declared_order, limit_gate.observed_order
+    if limit_gate.unresolved:
+        if observed is None or not observed > (tolerances.highest_order(order)
+                                               + tolerances.REFINEMENT_ORDER_MARGIN):
+            return False
+        predicted = (limit_gate.differences[-1] * 2.0 ** -tolerances.highest_order(order)
+                     * tolerances.limit_factor(order) + limit_gate.reference_error)
+    else:
+        predicted = limit_gate.limit_tolerance * 2.0 ** -(observed if observed is not None
+                                                          else order)
+    return predicted <= _ceiling(name)
 
 
 def _measured_between(system, backend, sc, values, mech, ref, eq, settings, finer, coarser,

@@ -240,7 +240,9 @@ faster forcing).
   ceiling (r / (1 - r) = 2.41 for p = 1, 0.55 for p = 2, 0.097 for p = 4 at the margin
   0.5). Where it is still above the ceiling at h/4 the engine is run at h/8 as
   well, and at h/16 where the observed order of the d'_k predicts that one more halving
-  brings it within; h/16 is the step budget: a bound still above the ceiling there (or
+  brings it within (or, where the d'_k fall faster than any term of the scheme, leaving
+  a pre-asymptotic range so that the order is not yet confirmed, where one more halving
+  at the scheme's fastest order would); h/16 is the step budget: a bound still above the ceiling there (or
   predicted to stay above it) leaves the metric unresolved, the engine's error not
   falling below what the metric can tell apart within the budget. Such a verdict is
   marked as the limit's (`rule` refinement_limit, with v_K and its bound).
@@ -553,6 +555,13 @@ def refinement_safety(order: int) -> float:
     return (1.0 - 2.0 ** -order) / (1.0 - 2.0 ** -(order - REFINEMENT_ORDER_MARGIN))
 
 
+def limit_factor(order: int) -> float:
+    """r / (1 - r), r = 2^-(p - margin): the bound on the tail after the finest refined
+    run, per its last difference ("A posteriori", the engine's limit)."""
+    shrink = 2.0 ** -(order - REFINEMENT_ORDER_MARGIN)
+    return shrink / (1.0 - shrink)
+
+
 def refinement_gate(differences: Sequence[float], order: int, reference_error: float,
                     floor: float = STEP_INDEPENDENT) -> RefinementGate:
     """The gate from the differences d_k = |Q_(h/2^(k-1)) - Q_(h/2^k)| (at least two) of an
@@ -567,7 +576,7 @@ def refinement_gate(differences: Sequence[float], order: int, reference_error: f
     if not all(math.isfinite(x) for x in d):
         return RefinementGate(math.inf, None, order, math.inf, tuple(d), reference_error,
                               "the refined runs give no finite difference")
-    remaining = shrink / (1.0 - shrink)  # the tail after the finest run, per its d_K
+    remaining = limit_factor(order)  # the tail after the finest run, per its d_K
     if max(last, tail) <= floor:
         return RefinementGate(head + floor / (1.0 - shrink) + reference_error, None,
                               order, head + floor, tuple(d), reference_error,
