@@ -24,8 +24,8 @@ from .comparisons.diff import ResultsDiff, diff_runs, holds
 from .comparisons.runner import DEFAULT_DT, Comparison
 
 __all__ = ["list_systems", "analyze", "compare", "run", "errata", "strutt", "discretization",
-           "convergence", "beams", "check", "diff", "export", "Verdict", "CheckResult",
-           "DEFAULT_DT"]
+           "convergence", "beams", "check", "diff", "export", "power", "out_of_the_box",
+           "Verdict", "CheckResult", "DEFAULT_DT"]
 
 
 def _system(system_id: str):
@@ -791,4 +791,41 @@ def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
         (folder / OUT_OF_THE_BOX).write_text(json.dumps(study.out_of_the_box(), indent=1,
                                                         default=str))
         write_power_pages(folder)
+    return study
+
+
+def out_of_the_box(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
+                   out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+                   workers: int | None = None, progress=None):
+    """The out-of-the-box study (comparisons/out_of_the_box.py) of systems x engines
+    (default: all systems, every installed engine): each engine default the harness
+    neutralises switched back on alone and all together, its verdict and its effect
+    against the neutralised run; one job per system in a pool of `workers` processes
+    (default: up to 2), the longest first. With `out`, out_of_the_box.json and
+    out_of_the_box.html are written there; where the folder holds a run's results, its
+    site is written again so that each mechanism's page shows its row (`mbfidelity run`
+    into the folder afterwards does the same). Returns the `OutOfTheBoxStudy`."""
+    import json
+
+    from .comparisons.matrix import schedule
+    from .comparisons.out_of_the_box import out_of_the_box_study
+    from .comparisons.results_folder import load_job_costs
+
+    sys_ids, sim_ids = _matrix(systems, sims, installed_only=True)
+    checked_duration("dt", dt)
+    folder = checked_output_folder(out) if out is not None else None
+    order = schedule(sys_ids, load_job_costs(folder) if folder is not None else None)
+    study = out_of_the_box_study(sys_ids, sim_ids, dt, workers=workers, order=order,
+                                 progress=progress)
+    if folder is not None:
+        from .reports.power_page import OUT_OF_THE_BOX, write_out_of_the_box_page
+
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / OUT_OF_THE_BOX).write_text(json.dumps(study.as_dict(), indent=1,
+                                                        default=jsonable))
+        write_out_of_the_box_page(folder)
+        if (folder / "results.json").exists():
+            from .reports.html import write_report
+
+            write_report(folder)
     return study

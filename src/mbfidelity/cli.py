@@ -869,6 +869,59 @@ def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
                    f"{(out / 'out_of_the_box.html').resolve()}")
 
 
+@app.command("out-of-the-box")
+def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems",
+                                                                help="system ids"),
+                       sims: Optional[List[str]] = typer.Option(
+                           None, "--sims", help="simulator ids (default: every installed one)"),
+                       dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+                       out: Optional[Path] = typer.Option(
+                           None, "--out", callback=_out_folder,
+                           help="also write out_of_the_box.json and out_of_the_box.html there "
+                                "(and the site again, when the folder holds a run)"),
+                       workers: Optional[int] = typer.Option(
+                           None, "--workers", min=1, help="processes (default: up to 2)"),
+                       as_json: bool = typer.Option(False, "--json"),
+                       ) -> None:
+    """What each engine does out of the box: per system x engine, each default the harness
+    neutralises switched back on alone and all together, on every declared scenario and
+    the frequency checks; rejected by the gates or not, and its effect against the
+    neutralised run (motion change, energy drift, damping ratio)."""
+    from . import api
+
+    def progress(entry) -> None:
+        if as_json:
+            return
+        head = f"{entry.system:28s} {entry.simulator:9s}"
+        if not entry.supported:
+            typer.echo(f"{head} left out: {entry.reason}")
+            return
+        typer.echo(f"{head} {entry.wall_time_s:.1f} s"
+                   + ("" if entry.defaults else ", no default neutralised"))
+        for d in entry.defaults:
+            verdict = ("rejected by " + ", ".join(d.rejected_by[:3]) if d.rejected
+                       else "passes" if d.acts else "no effect")
+            change = d.motion.get("trajectory_change")
+            moved = (f"; motion change {change:.3g} (gate {d.motion['trajectory_gate']:.3g}, "
+                     f"{d.motion['scenario']})" if change is not None
+                     and "trajectory_gate" in d.motion else "")
+            typer.echo(f"    {d.setting} = {d.engine_value}: {verdict}{moved}")
+
+    start = time.perf_counter()
+    try:
+        study = api.out_of_the_box(_split(systems) or None, _split(sims) or None, out, dt=dt,
+                                   workers=workers, progress=progress)
+    except ValueError as exc:
+        _fail(str(exc))
+    if as_json:
+        _json(study.as_dict())
+        return
+    typer.echo(f"{len(study.entries)} system x engine readings in "
+               f"{time.perf_counter() - start:.1f} s")
+    if out is not None:
+        typer.echo(f"page: {(out / 'out_of_the_box.html').resolve()}")
+
+
 def main() -> None:
     try:
         app(args=global_options_first(sys.argv[1:]), prog_name="mbfidelity")

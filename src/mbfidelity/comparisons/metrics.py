@@ -53,6 +53,10 @@ def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess
     """Least-squares fit of x = A exp(-sigma t) cos(wd t + phase) + offset.
     Returns (undamped angular frequency, damping ratio)."""
     xs = x - np.mean(x[-len(x) // 5:]) if len(x) > 10 else x
+    # a record that does not cross its mean twice holds no oscillation (a joint locked by
+    # an engine's default motor): the least squares would spend their whole budget on it
+    if np.count_nonzero(np.diff(xs > 0)) < 2:
+        raise RuntimeError("free-vibration fit: the record does not oscillate")
     wd0 = w_guess * np.sqrt(max(1 - zeta_guess**2, 1e-6))
     sigma0 = zeta_guess * w_guess
     a0 = float(np.max(np.abs(xs[: max(len(xs) // 20, 3)])))

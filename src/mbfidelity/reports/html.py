@@ -26,6 +26,7 @@ from ..comparisons.results_folder import (base_id, load_animation, load_deviatio
 from ..systems import get_system  # noqa: E402
 from . import site  # noqa: E402
 from .check_figures import check_figure  # noqa: E402
+from .power_page import OUT_OF_THE_BOX, write_out_of_the_box_page  # noqa: E402
 
 #: why an engine deviates, in words a student can follow (docs/engines.md)
 EXPLANATIONS = {
@@ -162,6 +163,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
     versions = {c.simulator: c.engine_version for c in results if c.engine_version}
     script = site.write_script(out)
     errata_page = (out / "errata.json").exists()
+    box = _out_of_the_box_rows(out)
     for system, files in saved.items():
         mine = [row for row in rows if base_id(row) == system]
         drawing = next((f for row in mine for f in figures[row]
@@ -176,9 +178,12 @@ def write_report(out: Path, workers: int | None = None) -> Path:
             drawing=drawing, model=files.get("model", {}), errata=files.get("errata", []),
             published=files.get("published", []),
             sections=sections, errata_page=errata_page, script=script,
-            convergence=convergence.name if convergence.exists() else ""))
+            convergence=convergence.name if convergence.exists() else "",
+            out_of_the_box=box.get(system, [])))
     if errata_page:  # (again) now that it can link the mechanism pages
         write_errata_page(out)
+    if box:  # (again) now that it can link the index and the mechanism pages
+        write_out_of_the_box_page(out, {s: site.page_name(s) for s in saved})
     others = [(name, title) for name, title in site.OTHER_PAGES if (out / name).exists()]
     page = site.INDEX.render(
         style=site.STYLE, prov=prov, versions=versions, sims=sims, rows=rows,
@@ -193,6 +198,56 @@ def write_report(out: Path, workers: int | None = None) -> Path:
     index.write_text(page)
     (out / "summary.md").write_text(_markdown(results, prov))
     return index
+
+
+def _out_of_the_box_rows(out: Path) -> dict[str, list[dict]]:
+    """system -> its engines' out-of-the-box readings (out_of_the_box.json, when saved
+    there and readable), each default with what its row on the mechanism's page shows:
+    the verdict, the motion change in the scenario where it is largest against its gate,
+    the energy drift where it is largest with the default, and mode 1's fitted damping
+    ratio error, each beside the neutralised run's."""
+    try:
+        doc = json.loads((out / OUT_OF_THE_BOX).read_text())
+    except (OSError, ValueError):  # none saved, or damaged: the pages go without the row
+        return {}
+    rows: dict[str, list[dict]] = {}
+    for e in doc.get("entries", []):
+        defaults = []
+        for d in e.get("defaults", []):
+            motion = d.get("motion", {})
+            drifts = [(name, m) for name, m in motion.get("scenarios", {}).items()
+                      if m.get("energy_drift_switched_on") is not None]
+            energy = max(drifts, key=lambda item: item[1]["energy_drift_switched_on"],
+                         default=None)
+            damping = d.get("effect", {}).get("damping.fit_mode1")
+            verdict = ("rejected" if d["rejected"] else "passes" if d["acts"]
+                       else "no effect")
+            defaults.append({
+                "setting": d["setting"], "note": d.get("note", ""),
+                "engine_value": "each above" if d["setting"] == "all"
+                else json.dumps(d["engine_value"]),
+                "harness_value": "" if d.get("harness_value") is None
+                else json.dumps(d["harness_value"]),
+                "verdict": verdict, "cls": {"rejected": "fail", "passes": "pass"}.get(
+                    verdict, "unsupported"),
+                "rejected_by": ", ".join(d.get("rejected_by", [])),
+                "incidents": [i["outcome"] for i in d.get("incidents", [])],
+                "motion": ({"error": motion["error"]} if "error" in motion else {
+                    "change": motion.get("trajectory_change"),
+                    "gate": motion.get("trajectory_gate"),
+                    "scenario": motion.get("scenario", "")}),
+                "energy": None if energy is None else {
+                    "scenario": energy[0],
+                    "neutralised": energy[1]["energy_drift_neutralised"],
+                    "switched_on": energy[1]["energy_drift_switched_on"]},
+                "damping": None if damping is None else {
+                    "neutralised": damping["neutralised"],
+                    "switched_on": damping["switched_on"]}})
+        rows.setdefault(e["system"], []).append({
+            "simulator": e["simulator"], "supported": e["supported"],
+            "reason": e.get("reason", ""), "anchor": f"{e['system']}-{e['simulator']}",
+            "defaults": defaults})
+    return rows
 
 
 def _section(out: Path, row: str, comps, figures: list[str], frequencies: dict,

@@ -1,8 +1,10 @@
 """The power pages, rendered from the saved power.json and out_of_the_box.json only
-(`mbfidelity power --out DIR`): power.html, the smallest injected model error the gates
-reject per system x engine and error kind, and whether they reject each neutralised engine
-default switched back on; out_of_the_box.html, what each of those defaults does to the
-motion against the neutralised run."""
+(`mbfidelity power --out DIR`, `mbfidelity out-of-the-box --out DIR`): power.html, the
+smallest injected model error the gates reject per system x engine and error kind, and
+whether they reject each neutralised engine default switched back on; out_of_the_box.html,
+what each of those defaults does to the motion against the neutralised run. Each page links
+the other pages of the folder that exist when it is written (the site writes
+out_of_the_box.html again, `reports/html.py`)."""
 from __future__ import annotations
 
 import json
@@ -59,8 +61,11 @@ spot), grey where it does not (the error is below what the gates can see).</p>
 
 OUT_OF_THE_BOX_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="utf-8">
 <title>mbfidelity out of the box</title><style>{{ style }}</style></head><body>
+{% if links.index %}<nav><a href="index.html">index</a></nav>{% endif %}
 <h1>Out of the box: what each engine default the harness neutralises does</h1>
-<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. Each default (the engine's
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}.{% if doc.cost %} {{ doc.entries|length }}
+system x engine readings, {{ doc.cost.comparisons }} comparisons, {{ "%.0f"|format(doc.cost.wall_time_s) }} s of wall time
+on {{ doc.cost.workers }} worker processes.{% endif %} Each default (the engine's
 documented value, cited in its note: hover the setting) is switched back on alone, then all
 together ("all": the engine as it comes), on every scenario the system declares. "Motion
 change": the largest difference between the run with the default and the same run with the
@@ -70,8 +75,10 @@ change of the exact model's energy along the run, relative to the largest kineti
 Damping ratio: what the free-vibration fit of mode 1 finds added to the exact one. Verdict:
 rejected when a gate that holds with the harness's setting fails with the default (a run that
 does not complete counts as rejected: timed out, crashed); "no effect" when no metric moved.</p>
-{% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{{ e.system }} · {{ e.simulator }} {{ e.engine_version }}</h2>
-{% if not e.supported %}<p>unsupported: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default.</p>{% else %}
+{% set left = doc.entries|rejectattr("supported")|list %}{% if left %}<h2>Left out</h2><ul>
+{% for e in left %}<li><a href="#{{ e.system }}-{{ e.simulator }}">{{ e.system }} · {{ e.simulator }}</a>: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
+{% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{% if e.system in links.pages %}<a href="{{ links.pages[e.system] }}">{{ e.system }}</a>{% else %}{{ e.system }}{% endif %} · {{ e.simulator }} {{ e.engine_version }}</h2>
+{% if not e.supported %}<p>left out: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default declared by its backend (<code>Setting.engine_default</code>).</p>{% else %}
 <table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate)</th><th>energy drift: harness → default</th><th>damping ratio added (mode 1)</th><th>frequency error (mode 1)</th></tr>
 {% for d in e.defaults %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
 <tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ 'each above' if d.setting == 'all' else d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
@@ -80,17 +87,25 @@ does not complete counts as rejected: timed out, crashed); "no effect" when no m
 <td>{% if d.motion.energy_drift_switched_on is not none and not d.motion.error %}{{ d.motion.energy_drift_neutralised|num }} → {{ d.motion.energy_drift_switched_on|num }}{% else %}-{% endif %}</td>
 {% for m in (damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
 </table>{% endif %}{% endfor %}
-<p><a href="power.html">Gate power</a></p>
+{% if links.power %}<p><a href="power.html">Gate power</a></p>{% endif %}
 </body></html>""")
 
 
 def write_power_pages(out: Path) -> tuple[Path, Path]:
     """power.html and out_of_the_box.html in `out`, from the JSON saved there."""
     power = json.loads((out / POWER).read_text())
-    box = json.loads((out / OUT_OF_THE_BOX).read_text())
     kinds = list(power["error_kinds"])
     power_page = out / "power.html"
     power_page.write_text(POWER_TEMPLATE.render(doc=power, kinds=kinds, style=STYLE))
-    box_page = out / "out_of_the_box.html"
-    box_page.write_text(OUT_OF_THE_BOX_TEMPLATE.render(doc=box, style=STYLE))
-    return power_page, box_page
+    return power_page, write_out_of_the_box_page(out)
+
+
+def write_out_of_the_box_page(out: Path, pages: dict[str, str] | None = None) -> Path:
+    """out_of_the_box.html in `out`, from the out_of_the_box.json saved there; `pages`
+    maps a system to its mechanism page (linked from its heading)."""
+    box = json.loads((out / OUT_OF_THE_BOX).read_text())
+    links = {"index": (out / "index.html").exists() or bool(pages),
+             "power": (out / "power.html").exists(), "pages": pages or {}}
+    page = out / "out_of_the_box.html"
+    page.write_text(OUT_OF_THE_BOX_TEMPLATE.render(doc=box, style=STYLE, links=links))
+    return page

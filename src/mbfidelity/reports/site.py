@@ -89,7 +89,7 @@ the printed Rayleigh estimates, against the exact continuum (§6; <code>mbfideli
 MECHANISM = ENV.from_string("""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>{{ system|e }}: {{ title|e }}</title>
 <style>{{ style }}</style></head><body>
-<nav><a href="index.html">index</a>{% if errata_page %}<a href="errata.html">errata</a>{% endif %}</nav>
+<nav><a href="index.html">index</a>{% if errata_page %}<a href="errata.html">errata</a>{% endif %}{% if out_of_the_box %}<a href="#out-of-the-box">out of the box</a>{% endif %}</nav>
 <h1>{{ system|e }}</h1><p>{{ title|e }}{% if source %} ({{ source|e }}){% endif %}</p>
 {% if drawing %}<h2>Sketch</h2><img src="{{ drawing|url }}" alt="{{ system|e }} at its operating equilibrium">{% endif %}
 {% if not model %}<p class="fail">The derived model of this mechanism could not be saved (see
@@ -157,6 +157,29 @@ a real unilateral contact would open there.</p>{% endfor %}
 <h3>Scenarios: the coordinates and their errors against time</h3>
 {% for fig in r.figures %}<img src="{{ fig|url }}" alt="{{ fig|e }}">{% endfor %}
 {% endfor %}
+{% if out_of_the_box %}<h2 id="out-of-the-box">Out of the box: each engine's own defaults switched back on</h2>
+<p>The harness neutralises every engine default that would spoil the comparison. Here each one
+(the engine's documented value: hover over its name for the citation) is switched back on
+alone, then all together ("all": the engine as it comes), on every scenario and the frequency
+checks (<code>mbfidelity out-of-the-box</code>; <a href="out_of_the_box.html">every mechanism</a>).
+Verdict: rejected when a gate that holds with the harness's setting fails with the default (a
+run that does not complete counts as rejected); "no effect" when no metric moved. Motion
+change: the largest difference between the run with the default and the harness's run,
+relative to the amplitude, in the scenario where it is largest against that scenario's
+trajectory gate. Energy drift: the exact model's energy along the engine's run, its largest
+departure relative to the largest kinetic energy, in the scenario where it is largest with the
+default. Damping ratio: the error of mode 1's fitted damping ratio (what a default adds to a
+conservative mechanism). Each as harness &#x2192; default.</p>
+<table><tr><th>engine</th><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate, scenario)</th><th>energy drift (scenario)</th><th>damping ratio error, mode 1</th></tr>
+{% for e in out_of_the_box %}{% if not e.supported %}<tr><td><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td><td colspan="7" class="unsupported">left out: {{ e.reason|e }}</td></tr>
+{% elif not e.defaults %}<tr><td><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td><td colspan="7">no neutralised default declared by its backend</td></tr>
+{% else %}{% for d in e.defaults %}<tr>{% if loop.first %}<td rowspan="{{ e.defaults|length }}"><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td>{% endif %}
+<td title="{{ d.note|e }}">{{ d.setting|e }}</td><td><code>{{ d.engine_value|e }}</code></td><td><code>{{ d.harness_value|e }}</code></td>
+<td class="{{ d.cls }}" title="{{ d.rejected_by|e }}">{{ d.verdict }}{% for i in d.incidents %} ({{ i|e }}){% endfor %}</td>
+<td>{% if d.motion.get("error") %}{{ d.motion.error|e }}{% elif d.motion.change is not none %}{{ "%.3g"|format(d.motion.change) }}{% if d.motion.gate is not none %} <small>({{ "%.2g"|format(d.motion.gate) }}, {{ d.motion.scenario|e }})</small>{% endif %}{% else %}-{% endif %}</td>
+<td>{% if d.energy %}{{ "%.3g"|format(d.energy.neutralised) }} &#x2192; {{ "%.3g"|format(d.energy.switched_on) }} <small>({{ d.energy.scenario|e }})</small>{% else %}-{% endif %}</td>
+<td>{% if d.damping %}{{ "%.3g"|format(d.damping.neutralised) if d.damping.neutralised is not none else "-" }} &#x2192; {{ "%.3g"|format(d.damping.switched_on) }}{% else %}-{% endif %}</td></tr>{% endfor %}{% endif %}{% endfor %}
+</table>{% endif %}
 {% if convergence %}<h2>Convergence and work-precision</h2><img src="{{ convergence|url }}" alt="convergence of {{ system|e }}">{% endif %}
 <script src="{{ script }}"></script>
 </body></html>""")

@@ -1,0 +1,268 @@
+"""The out-of-the-box study: what each engine default the harness neutralises does to a
+mechanism when it is switched back on (the defaults-only reading of the power study,
+comparisons/power.py, without its model-error grid), cheap enough for the whole matrix.
+
+For every system x engine: the neutralised run (the harness's settings; every declared
+scenario and the frequency checks, `runner.compare(scenarios=declared)`), then each
+neutralised default (`Setting.engine_default`: the engine's documented value, cited in the
+setting's note) switched back on alone, and all of them together (the engine as a user gets
+it), each in the same comparison. Recorded per default, in the power study's format
+(`power.DefaultPower`): the gates' verdict (rejected when a metric that holds in the
+neutralised run fails with the default, or the run does not complete:
+`power.rejecting_metrics`), whether anything moved at all, the effect metric by metric
+against the neutralised run (trajectory error, energy drift, period, and the frequency and
+damping ratio of the free-vibration fits), and per scenario the motion change: the largest
+difference between the engine's motion with the default and without it, relative to the
+coordinate's amplitude (as the trajectory gate measures), against the scenario's
+trajectory gate.
+
+Cost: one job per system in a process pool (as `matrix.run_matrix`), its engines one after
+the other. The neutralised run is made in the job's process, so that the reference solves,
+derivations and equilibria it computes are shared by each default's run, a process forked
+from it (comparisons/isolation.py) with a wall-clock budget (`RUN_BUDGET_FACTOR` times the
+neutralised run, at least `RUN_BUDGET_FLOOR`): a default that makes its engine crash, or
+run past the budget, costs that run, recorded with its incident (it counts as rejected),
+and nothing else. A job whose own process dies (the neutralised run crashed its engine) is
+made again engine by engine, each in a worker of its own. The near-equilibrium checks and
+the model-error grid of `mbfidelity run` and `mbfidelity power` are not run.
+"""
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Mapping
+
+import numpy as np
+
+from ..simulators import get_backend
+from ..systems import get_system
+from .budget import become_worker
+from .isolation import WorkerCrashed, WorkerTimedOut, isolated
+from .power import (DefaultPower, PowerEntry, _effect, _free, _metric, _same_metrics,
+                    out_of_the_box_document, rejecting_metrics)
+from .runner import DEFAULT_DT, Comparison, compare, failed_comparison
+
+#: wall-clock budget of one default's run: this many times the neutralised run's wall
+#: time, at least RUN_BUDGET_FLOOR s. A default can make a run much longer than the
+#: harness's (a joint locked by a motor leaves the free-vibration fits a record without
+#: oscillation to search); beyond the budget the run is recorded as timed out
+RUN_BUDGET_FACTOR = 10.0
+RUN_BUDGET_FLOOR = 60.0
+#: wall-clock budget of one system x engine made again in a worker of its own after its
+#: job's process died
+ENTRY_TIMEOUT = 1800.0
+#: the name of every neutralised default switched on together
+ALL = "all"
+
+
+def engine_defaults(simulator: str, dt: float = DEFAULT_DT) -> dict[str, object]:
+    """setting -> the engine's own value at step `dt`, for each setting the harness
+    neutralises (its `engine_default` differs from the harness's value)."""
+    out = {}
+    for key, setting in get_backend(simulator).SETTINGS.items():
+        value = setting.out_of_the_box(dt)
+        if value is not None and value != setting.default:
+            out[key] = value
+    return out
+
+
+def _motion_change(neutral: Mapping[str, tuple], on: Comparison, free: list[int]) -> dict:
+    """Per scenario, the largest |q_on - q_off| over the free coordinates relative to
+    their amplitude (the trajectory gate's scale), from the two comparisons' series."""
+    out = {}
+    for name, series in on.series.items():
+        if name not in neutral:
+            continue
+        q_off, scale = neutral[name]
+        q_on = np.asarray(series["q"], dtype=float)
+        n = min(len(q_off), len(q_on))
+        with np.errstate(invalid="ignore"):
+            change = (float(np.max(np.abs(q_on[:n, free] - q_off[:n, free]) / scale[free]))
+                      if n else float("nan"))
+        out[name] = {"trajectory_change": change if np.isfinite(change) else float("inf")}
+    return out
+
+
+def _switched_on(system_id: str, simulator: str, dt: float, declared: list[str],
+                 settings: dict, neutral: Mapping[str, tuple], free: list[int]
+                 ) -> tuple[Comparison, dict]:
+    """One default's comparison (a worker's task): the comparison without its series and
+    the motion change against the neutralised run per scenario."""
+    c = compare(system_id, simulator, dt=dt, scenarios=declared, settings=settings,
+                keep_series=True)
+    motion = _motion_change(neutral, c, free)
+    c.series = {}
+    return c, motion
+
+
+def _reading(key: str, value: object, harness: object, note: str, neutral: Comparison,
+             run: Comparison, motion: dict, declared: list[str],
+             wall_time: float) -> DefaultPower:
+    """The default's verdict and effect against the neutralised run."""
+    by = rejecting_metrics(neutral, run)
+    scenarios = {}
+    for name in declared:
+        m = dict(motion.get(name, {}))
+        gate = _metric(neutral, f"{name}.trajectory_max")
+        if gate is not None and "trajectory_change" in m:
+            m["trajectory_gate"] = gate.tolerance
+            m["beyond_gate"] = bool(m["trajectory_change"] > gate.tolerance)
+        before, after = (_metric(c, f"{name}.energy_drift") for c in (neutral, run))
+        m["energy_drift_neutralised"] = before.value if before is not None else None
+        m["energy_drift_switched_on"] = after.value if after is not None else None
+        scenarios[name] = m
+    d = DefaultPower(key, value, harness, bool(by), by, run.passed,
+                     acts=not _same_metrics(neutral, run), effect=_effect(neutral, run),
+                     note=note, incidents=run.incidents, wall_time_s=wall_time)
+    d.motion["scenarios"] = scenarios
+    measured = {k: v for k, v in scenarios.items() if "trajectory_change" in v}
+    if measured:
+        # the scenario where the default moves the motion most, against its gate
+        worst = max(measured.items(), key=lambda item: (
+            item[1]["trajectory_change"] / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
+        d.motion.update(worst[1], scenario=worst[0])
+    else:
+        d.motion["error"] = "; ".join(f"{i['outcome']}: {i['message']}"
+                                      for i in run.incidents) or "no motion recorded"
+    d.motion["beyond_gate"] = any(m.get("beyond_gate", False) for m in scenarios.values())
+    return d
+
+
+def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> PowerEntry:
+    """The out-of-the-box reading of one system on one engine (see the module doc)."""
+    started = time.perf_counter()
+    system = get_system(system_id)
+    backend = get_backend(simulator)
+    declared = [sc.name for sc in system.scenarios]
+    entry = PowerEntry(system.id, simulator, scenario=declared[0],
+                       defaults_scenarios=declared, dt=dt)
+    ok, why = backend.available()
+    if not ok:
+        entry.supported, entry.reason = False, f"engine not available: {why}"
+        return entry
+    entry.engine_version = backend.version()
+    switched = engine_defaults(simulator, dt)
+    if not switched:  # nothing to switch on: no run
+        return entry
+    values = system.parameter_values(None, scenario=system.scenarios[0])
+    free = _free(system.with_structure(values), values)
+    entry.comparisons += 1
+    neutral = compare(system.id, simulator, dt=dt, scenarios=declared, keep_series=True)
+    entry.engine_time_s += neutral.wall_time
+    if not neutral.supported:
+        entry.supported, entry.reason = False, neutral.reason
+        entry.wall_time_s = time.perf_counter() - started
+        return entry
+    series = {name: (np.asarray(s["q"], dtype=float), np.asarray(s["scale"], dtype=float))
+              for name, s in neutral.series.items()}
+    neutral.series = {}
+    entry.baseline_passed = neutral.passed
+    entry.baseline_not_holding = [m.name for m in neutral.metrics
+                                  if m.status not in ("pass", "xpass", "measured")]
+    budget = max(RUN_BUDGET_FLOOR, RUN_BUDGET_FACTOR * (time.perf_counter() - started))
+    chosen = [(key, {key: value}) for key, value in switched.items()]
+    if len(switched) > 1:
+        chosen.append((ALL, dict(switched)))
+    for key, settings in chosen:
+        began = time.perf_counter()
+        entry.comparisons += 1
+        try:
+            run, motion = isolated(_switched_on, system.id, simulator, dt, declared, settings,
+                                   series, free, timeout=budget)
+        except (ValueError, KeyError):
+            raise
+        except Exception as exc:  # crashed or past its budget: the run's incident
+            outcome = ("timed_out" if isinstance(exc, WorkerTimedOut) else
+                       "crashed" if isinstance(exc, WorkerCrashed) else "failed")
+            run = failed_comparison(system.id, simulator, None, dt, "", "worker", exc, outcome)
+            motion = {}
+        entry.engine_time_s += run.wall_time
+        setting = backend.SETTINGS.get(key)
+        entry.defaults.append(_reading(
+            key, settings[key] if key in settings else settings,
+            setting.default if setting is not None else None,
+            setting.note if setting is not None else
+            "every neutralised default switched back on together: the engine as it comes",
+            neutral, run, motion, declared, time.perf_counter() - began))
+    entry.wall_time_s = time.perf_counter() - started
+    return entry
+
+
+def _system_job(system_id: str, sims: list[str], dt: float) -> list[PowerEntry]:
+    return [defaults_entry(system_id, sim, dt) for sim in sims]
+
+
+def _isolated_entry(system_id: str, simulator: str, dt: float) -> PowerEntry:
+    """`defaults_entry` in a worker of its own: a process that dies gives an entry that
+    says so, with every default unmeasured."""
+    try:
+        return isolated(defaults_entry, system_id, simulator, dt, timeout=ENTRY_TIMEOUT)
+    except (ValueError, KeyError):
+        raise
+    except Exception as exc:
+        return PowerEntry(system_id, simulator, supported=False, dt=dt,
+                          reason=f"the neutralised run did not complete "
+                                 f"({type(exc).__name__}: {exc})"[:500])
+
+
+@dataclass
+class OutOfTheBoxStudy:
+    entries: list[PowerEntry]
+    provenance: dict = field(default_factory=dict)
+    wall_time_s: float = 0.0
+    workers: int = 1
+
+    def as_dict(self) -> dict:
+        """The document of the out-of-the-box page (`power.out_of_the_box_document`), with
+        the study's cost."""
+        doc = out_of_the_box_document({"provenance": self.provenance,
+                                       "entries": [e.as_dict() for e in self.entries]})
+        doc["cost"] = {"wall_time_s": self.wall_time_s, "workers": self.workers,
+                       "comparisons": sum(e.comparisons for e in self.entries),
+                       "per_entry_wall_time_s": {f"{e.system}/{e.simulator}": e.wall_time_s
+                                                 for e in self.entries}}
+        return doc
+
+
+def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
+                         dt: float = DEFAULT_DT, workers: int | None = None,
+                         order: Iterable[str] | None = None,
+                         progress: Callable[[PowerEntry], None] | None = None
+                         ) -> OutOfTheBoxStudy:
+    """`defaults_entry` for every system x engine, in `systems` x `sims` order; one job
+    per system in a pool of `workers` processes (default: up to 2), dispatched in `order`
+    (default: `systems`; the longest first keeps the pool busy to the end)."""
+    from .runner import provenance
+
+    started = time.perf_counter()
+    systems, sims = list(systems), list(sims)
+    order = [s for s in (order or systems) if s in systems]
+    workers = max(1, min(workers or min(2, os.cpu_count() or 1), len(systems)))
+    found: dict[str, list[PowerEntry]] = {}
+
+    def collect(system_id: str, entries: list[PowerEntry]) -> None:
+        found[system_id] = entries
+        if progress is not None:
+            for e in entries:
+                progress(e)
+
+    crashed = []
+    if workers == 1:
+        for s in order:
+            collect(s, _system_job(s, sims, dt))
+    else:
+        with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
+                                 initargs=(os.getpid(),)) as pool:
+            futures = {pool.submit(_system_job, s, sims, dt): s for s in order}
+            for fut in as_completed(futures):
+                try:
+                    collect(futures[fut], fut.result())
+                except BrokenProcessPool:
+                    crashed.append(futures[fut])
+    for s in crashed:
+        collect(s, [_isolated_entry(s, sim, dt) for sim in sims])
+    entries = [e for s in systems for e in found[s]]
+    return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers)
