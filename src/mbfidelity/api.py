@@ -796,27 +796,37 @@ def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
 
 def out_of_the_box(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
                    out: str | Path | None = None, *, dt: float = DEFAULT_DT,
-                   workers: int | None = None, progress=None):
+                   workers: int | None = None, defaults: Iterable[str] | None = None,
+                   progress=None):
     """The out-of-the-box study (comparisons/out_of_the_box.py) of systems x engines
     (default: all systems, every installed engine): each engine default the harness
     neutralises switched back on alone and all together, its verdict and its effect
     against the neutralised run; one job per system in a pool of `workers` processes
-    (default: up to 2), the longest first. With `out`, out_of_the_box.json and
+    (default: up to 2), the longest first. `defaults` names the defaults switched on
+    (each alone; default: every one, and all together). With `out`, out_of_the_box.json and
     out_of_the_box.html are written there; where the folder holds a run's results, its
     site is written again so that each mechanism's page shows its row (`mbfidelity run`
     into the folder afterwards does the same). Returns the `OutOfTheBoxStudy`."""
     import json
 
     from .comparisons.matrix import schedule
-    from .comparisons.out_of_the_box import out_of_the_box_study
+    from .comparisons.out_of_the_box import engine_defaults, out_of_the_box_study
     from .comparisons.results_folder import load_job_costs
 
     sys_ids, sim_ids = _matrix(systems, sims, installed_only=True)
     checked_duration("dt", dt)
+    if defaults is not None:
+        defaults = list(defaults)
+        known = {k for sim in sim_ids for k in engine_defaults(sim, dt)}
+        unknown = [k for k in defaults if k not in known]
+        if unknown:
+            raise ValueError(f"no engine among {', '.join(sim_ids)} neutralises "
+                             f"{', '.join(unknown)}; its neutralised defaults: "
+                             f"{', '.join(sorted(known)) or 'none'}")
     folder = checked_output_folder(out) if out is not None else None
     order = schedule(sys_ids, load_job_costs(folder) if folder is not None else None)
     study = out_of_the_box_study(sys_ids, sim_ids, dt, workers=workers, order=order,
-                                 progress=progress)
+                                 progress=progress, only=defaults)
     if folder is not None:
         from .reports.power_page import OUT_OF_THE_BOX, write_out_of_the_box_page
 

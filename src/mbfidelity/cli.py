@@ -881,6 +881,10 @@ def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--syst
                                 "(and the site again, when the folder holds a run)"),
                        workers: Optional[int] = typer.Option(
                            None, "--workers", min=1, help="processes (default: up to 2)"),
+                       default: Optional[List[str]] = typer.Option(
+                           None, "--default", help="switch on only this neutralised default "
+                                                   "(repeatable; default: each one, and all "
+                                                   "together)"),
                        as_json: bool = typer.Option(False, "--json"),
                        ) -> None:
     """What each engine does out of the box: per system x engine, each default the harness
@@ -910,7 +914,8 @@ def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--syst
     start = time.perf_counter()
     try:
         study = api.out_of_the_box(_split(systems) or None, _split(sims) or None, out, dt=dt,
-                                   workers=workers, progress=progress)
+                                   workers=workers, defaults=_split(default) or None,
+                                   progress=progress)
     except ValueError as exc:
         _fail(str(exc))
     if as_json:

@@ -29,6 +29,7 @@ the model-error grid of `mbfidelity run` and `mbfidelity power` are not run.
 from __future__ import annotations
 
 import os
+import resource
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
@@ -131,8 +132,10 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
     return d
 
 
-def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> PowerEntry:
-    """The out-of-the-box reading of one system on one engine (see the module doc)."""
+def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
+                   only: Iterable[str] | None = None) -> PowerEntry:
+    """The out-of-the-box reading of one system on one engine (see the module doc); with
+    `only`, just those of the engine's neutralised defaults, each alone (no "all")."""
     started = time.perf_counter()
     system = get_system(system_id)
     backend = get_backend(simulator)
@@ -145,6 +148,8 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> Po
         return entry
     entry.engine_version = backend.version()
     switched = engine_defaults(simulator, dt)
+    if only is not None:
+        switched = {k: v for k, v in switched.items() if k in set(only)}
     if not switched:  # nothing to switch on: no run
         return entry
     values = system.parameter_values(None, scenario=system.scenarios[0])
@@ -164,7 +169,7 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> Po
                                   if m.status not in ("pass", "xpass", "measured")]
     budget = max(RUN_BUDGET_FLOOR, RUN_BUDGET_FACTOR * (time.perf_counter() - started))
     chosen = [(key, {key: value}) for key, value in switched.items()]
-    if len(switched) > 1:
+    if len(switched) > 1 and only is None:
         chosen.append((ALL, dict(switched)))
     for key, settings in chosen:
         began = time.perf_counter()
@@ -191,15 +196,25 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> Po
     return entry
 
 
-def _system_job(system_id: str, sims: list[str], dt: float) -> list[PowerEntry]:
-    return [defaults_entry(system_id, sim, dt) for sim in sims]
+def _cpu_seconds() -> float:
+    """CPU seconds of this process and of its finished children (the forked runs)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
 
 
-def _isolated_entry(system_id: str, simulator: str, dt: float) -> PowerEntry:
+def _system_job(system_id: str, sims: list[str], dt: float, only
+                ) -> tuple[list[PowerEntry], float]:
+    """Every engine's reading of one system, and the job's CPU seconds."""
+    start = _cpu_seconds()
+    entries = [defaults_entry(system_id, sim, dt, only) for sim in sims]
+    return entries, _cpu_seconds() - start
+
+
+def _isolated_entry(system_id: str, simulator: str, dt: float, only) -> PowerEntry:
     """`defaults_entry` in a worker of its own: a process that dies gives an entry that
     says so, with every default unmeasured."""
     try:
-        return isolated(defaults_entry, system_id, simulator, dt, timeout=ENTRY_TIMEOUT)
+        return isolated(defaults_entry, system_id, simulator, dt, only, timeout=ENTRY_TIMEOUT)
     except (ValueError, KeyError):
         raise
     except Exception as exc:
@@ -214,6 +229,8 @@ class OutOfTheBoxStudy:
     provenance: dict = field(default_factory=dict)
     wall_time_s: float = 0.0
     workers: int = 1
+    #: system -> CPU seconds of its job (its forked runs included)
+    job_cpu_s: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """The document of the out-of-the-box page (`power.out_of_the_box_document`), with
@@ -222,6 +239,7 @@ class OutOfTheBoxStudy:
                                        "entries": [e.as_dict() for e in self.entries]})
         doc["cost"] = {"wall_time_s": self.wall_time_s, "workers": self.workers,
                        "comparisons": sum(e.comparisons for e in self.entries),
+                       "cpu_s": sum(self.job_cpu_s.values()), "job_cpu_s": self.job_cpu_s,
                        "per_entry_wall_time_s": {f"{e.system}/{e.simulator}": e.wall_time_s
                                                  for e in self.entries}}
         return doc
@@ -230,11 +248,13 @@ class OutOfTheBoxStudy:
 def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                          dt: float = DEFAULT_DT, workers: int | None = None,
                          order: Iterable[str] | None = None,
-                         progress: Callable[[PowerEntry], None] | None = None
-                         ) -> OutOfTheBoxStudy:
+                         progress: Callable[[PowerEntry], None] | None = None,
+                         only: Iterable[str] | None = None) -> OutOfTheBoxStudy:
     """`defaults_entry` for every system x engine, in `systems` x `sims` order; one job
     per system in a pool of `workers` processes (default: up to 2), dispatched in `order`
-    (default: `systems`; the longest first keeps the pool busy to the end)."""
+    (default: `systems`; the longest first keeps the pool busy to the end). `only`
+    names the defaults switched on (each engine those of them it neutralises)."""
+    only = None if only is None else tuple(only)
     from .runner import provenance
 
     started = time.perf_counter()
@@ -242,9 +262,11 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
     order = [s for s in (order or systems) if s in systems]
     workers = max(1, min(workers or min(2, os.cpu_count() or 1), len(systems)))
     found: dict[str, list[PowerEntry]] = {}
+    cpu: dict[str, float] = {}
 
-    def collect(system_id: str, entries: list[PowerEntry]) -> None:
-        found[system_id] = entries
+    def collect(system_id: str, job: tuple[list[PowerEntry], float]) -> None:
+        found[system_id], cpu[system_id] = job
+        entries = found[system_id]
         if progress is not None:
             for e in entries:
                 progress(e)
@@ -252,17 +274,25 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
     crashed = []
     if workers == 1:
         for s in order:
-            collect(s, _system_job(s, sims, dt))
+            collect(s, _system_job(s, sims, dt, only))
     else:
         with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
                                  initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(_system_job, s, sims, dt): s for s in order}
+            futures = {pool.submit(_system_job, s, sims, dt, only): s for s in order}
             for fut in as_completed(futures):
                 try:
                     collect(futures[fut], fut.result())
                 except BrokenProcessPool:
                     crashed.append(futures[fut])
+                except Exception as exc:  # the job could not come back: its entries say so
+                    collect(futures[fut], ([PowerEntry(
+                        futures[fut], sim, supported=False, dt=dt,
+                        reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
+                        for sim in sims], 0.0))
     for s in crashed:
-        collect(s, [_isolated_entry(s, sim, dt) for sim in sims])
+        start = _cpu_seconds()
+        entries = [_isolated_entry(s, sim, dt, only) for sim in sims]
+        collect(s, (entries, _cpu_seconds() - start))
     entries = [e for s in systems for e in found[s]]
-    return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers)
+    return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers,
+                            {s: cpu[s] for s in systems})
