@@ -34,10 +34,14 @@ WAIT_S = 1.0
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
-    """A site of one mechanism on two engines, with its errata page."""
+    """A site of one mechanism on two engines, with its errata page and its out-of-the-box
+    reading (Pymunk's error bias)."""
     out = tmp_path_factory.mktemp("site")
     res = CliRunner().invoke(app, ["run", "--systems", SYSTEM, "--sims", "mujoco,pymunk",
                                    "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(app, ["out-of-the-box", "--systems", SYSTEM, "--sims", "pymunk",
+                                   "--default", "error_bias", "--out", str(out)])
     assert res.exit_code == 0, res.output
     save_errata([e.as_dict() for e in errata(get_system(SYSTEM))], out)
     write_report(out, workers=1)
@@ -108,7 +112,8 @@ def _problems(driver, page: Path) -> list[str]:
 
 def test_every_page_opens_clean(browser, site):
     pages = sorted(site.glob("*.html"))
-    assert {p.name for p in pages} == {"index.html", f"{SYSTEM}.html", "errata.html"}
+    assert {p.name for p in pages} == {"index.html", f"{SYSTEM}.html", "errata.html",
+                                       "out_of_the_box.html"}
     for page in pages:
         assert _problems(browser, page) == [], page.name
 

@@ -909,7 +909,12 @@ def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--syst
             moved = (f"; motion change {change:.3g} (gate {d.motion['trajectory_gate']:.3g}, "
                      f"{d.motion['scenario']})" if change is not None
                      and "trajectory_gate" in d.motion else "")
-            typer.echo(f"    {d.setting} = {d.engine_value}: {verdict}{moved}")
+            drifts = [m for m in d.motion.get("scenarios", {}).values()
+                      if m.get("energy_drift_switched_on") is not None]
+            worst = max(drifts, key=lambda m: m["energy_drift_switched_on"], default=None)
+            drained = (f"; energy drift {worst['energy_drift_neutralised']:.3g} -> "
+                       f"{worst['energy_drift_switched_on']:.3g}" if worst else "")
+            typer.echo(f"    {d.setting} = {d.engine_value}: {verdict}{moved}{drained}")
 
     start = time.perf_counter()
     try:

@@ -42,8 +42,8 @@ from ..simulators import get_backend
 from ..systems import get_system
 from .budget import become_worker
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
-from .power import (DefaultPower, PowerEntry, _effect, _free, _metric, _same_metrics,
-                    out_of_the_box_document, rejecting_metrics)
+from .power import (DefaultPower, PowerEntry, effect_against, free_coordinates,
+                    metric_named, out_of_the_box_document, rejecting_metrics, same_metrics)
 from .runner import DEFAULT_DT, Comparison, compare, failed_comparison
 
 #: wall-clock budget of one default's run: this many times the neutralised run's wall
@@ -107,16 +107,16 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
     scenarios = {}
     for name in declared:
         m = dict(motion.get(name, {}))
-        gate = _metric(neutral, f"{name}.trajectory_max")
+        gate = metric_named(neutral, f"{name}.trajectory_max")
         if gate is not None and "trajectory_change" in m:
             m["trajectory_gate"] = gate.tolerance
             m["beyond_gate"] = bool(m["trajectory_change"] > gate.tolerance)
-        before, after = (_metric(c, f"{name}.energy_drift") for c in (neutral, run))
+        before, after = (metric_named(c, f"{name}.energy_drift") for c in (neutral, run))
         m["energy_drift_neutralised"] = before.value if before is not None else None
         m["energy_drift_switched_on"] = after.value if after is not None else None
         scenarios[name] = m
     d = DefaultPower(key, value, harness, bool(by), by, run.passed,
-                     acts=not _same_metrics(neutral, run), effect=_effect(neutral, run),
+                     acts=not same_metrics(neutral, run), effect=effect_against(neutral, run),
                      note=note, incidents=run.incidents, wall_time_s=wall_time)
     d.motion["scenarios"] = scenarios
     measured = {k: v for k, v in scenarios.items() if "trajectory_change" in v}
@@ -153,7 +153,7 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     if not switched:  # nothing to switch on: no run
         return entry
     values = system.parameter_values(None, scenario=system.scenarios[0])
-    free = _free(system.with_structure(values), values)
+    free = free_coordinates(system.with_structure(values), values)
     entry.comparisons += 1
     neutral = compare(system.id, simulator, dt=dt, scenarios=declared, keep_series=True)
     entry.engine_time_s += neutral.wall_time

@@ -189,13 +189,15 @@ def mutated_parameter(system, kind: str, values: Mapping[str, float]) -> str | N
     return None
 
 
-def _free(system, values) -> list[int]:
+def free_coordinates(system, values) -> list[int]:
+    """The coordinates the engine integrates (a driven system's prescribed ones aside)."""
     model = numeric_model(system.id, values)
     return (list(model.independent) if system.mechanism.prescribed
             else list(range(len(system.coordinates))))
 
 
-def _metric(c: Comparison, name: str):
+def metric_named(c: Comparison, name: str):
+    """The metric of `c` called `name`, or None."""
     return next((m for m in c.metrics if m.name == name), None)
 
 
@@ -208,13 +210,13 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
     ref = reference(system, scenario, values, dt)
     mutated = {**values, parameter: values[parameter] * (1 + PROBE)}
     other = reference(system, scenario, mutated, dt)
-    free = _free(system, values)
+    free = free_coordinates(system, values)
     eq = operating_equilibrium(system, values)
     scale = metrics.amplitude(ref.q[:, free], eq.q[free])
     n = min(len(ref.t), len(other.t))
     trajectory, _ = metrics.trajectory_errors(other.q[:n, free], ref.q[:n, free], scale)
     out: dict = {"eps": PROBE, "trajectory": trajectory}
-    gate = _metric(baseline, f"{scenario.name}.trajectory_max")
+    gate = metric_named(baseline, f"{scenario.name}.trajectory_max")
     if gate is not None:
         out["trajectory_gate"] = gate.tolerance
         out["trajectory_gate_status"] = gate.status
@@ -247,7 +249,9 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
     return out
 
 
-def _effect(baseline: Comparison, run: Comparison) -> dict:
+def effect_against(baseline: Comparison, run: Comparison) -> dict:
+    """Per metric of the out-of-the-box reading (`EFFECT_SUFFIXES`, `EFFECT_PREFIXES`):
+    its value in `baseline` and in `run`, the tolerance, unit and status."""
     before = {m.name: m for m in baseline.metrics}
     out = {}
     for m in run.metrics:
@@ -260,7 +264,8 @@ def _effect(baseline: Comparison, run: Comparison) -> dict:
     return out
 
 
-def _same_metrics(a: Comparison, b: Comparison) -> bool:
+def same_metrics(a: Comparison, b: Comparison) -> bool:
+    """Whether the two comparisons measured the same metrics with the same values."""
     va = {m.name: m.value for m in a.metrics}
     vb = {m.name: m.value for m in b.metrics}
     return va.keys() == vb.keys() and all(
@@ -378,7 +383,7 @@ def _defaults_power(system, backend, baseline: Comparison, dt: float, run,
     for scenario in system.scenarios:
         values = system.parameter_values(None, scenario=scenario)
         neutral = _scenario_run(system, backend, scenario, values, dt, {}, budget)
-        gate = _metric(baseline, f"{scenario.name}.trajectory_max")
+        gate = metric_named(baseline, f"{scenario.name}.trajectory_max")
         for d in out:
             chosen = switched if d.setting == "all" else {d.setting: switched[d.setting]}
             motion = _motion_against(neutral, _scenario_run(system, backend, scenario, values,
@@ -403,8 +408,8 @@ def _default_power(key, settings, harness, baseline, run, note) -> DefaultPower:
     c = run(settings=settings)
     by = rejecting_metrics(baseline, c)
     return DefaultPower(key, settings[key] if key in settings else settings, harness,
-                        bool(by), by, c.passed, acts=not _same_metrics(baseline, c),
-                        effect=_effect(baseline, c), note=note, incidents=c.incidents,
+                        bool(by), by, c.passed, acts=not same_metrics(baseline, c),
+                        effect=effect_against(baseline, c), note=note, incidents=c.incidents,
                         wall_time_s=time.perf_counter() - started)
 
 
@@ -415,7 +420,7 @@ def _simulate_scenario(system, backend, scenario, values, dt, settings) -> dict:
     mech = system.numeric_mechanism(values)
     run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt,
                            backend.resolve_settings(settings), ())
-    free = _free(system, values)
+    free = free_coordinates(system, values)
     eq = operating_equilibrium(system, values)
     scale = metrics.amplitude(ref.q[:, free], eq.q[free])
     n = min(len(ref.t), len(run.t))
