@@ -75,8 +75,10 @@ change of the exact model's energy along the run, relative to the largest kineti
 Damping ratio: what the free-vibration fit of mode 1 finds added to the exact one. Verdict:
 rejected when a gate that holds with the harness's setting fails with the default (a run that
 does not complete counts as rejected: timed out, crashed); "no effect" when no metric moved.</p>
-{% set left = doc.entries|rejectattr("supported")|list %}{% if left %}<h2>Left out</h2><ul>
-{% for e in left %}<li><a href="#{{ e.system }}-{{ e.simulator }}">{{ e.system }} · {{ e.simulator }}</a>: {{ e.reason }}</li>{% endfor %}</ul>{% endif %}
+{% if left %}<h2>Left out</h2><p>What the study could not measure, with the reason: an
+engine that cannot build the mechanism, a run with a default that did not complete (its
+verdict counts it as rejected; its effect is not measured).</p><ul>
+{% for anchor, what, why in left %}<li><a href="#{{ anchor }}">{{ what }}</a>: {{ why }}</li>{% endfor %}</ul>{% endif %}
 {% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{% if e.system in links.pages %}<a href="{{ links.pages[e.system] }}">{{ e.system }}</a>{% else %}{{ e.system }}{% endif %} · {{ e.simulator }} {{ e.engine_version }}</h2>
 {% if not e.supported %}<p>left out: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default declared by its backend (<code>Setting.engine_default</code>).</p>{% else %}
 <table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate)</th><th>energy drift: harness → default</th><th>damping ratio added (mode 1)</th><th>frequency error (mode 1)</th></tr>
@@ -106,6 +108,16 @@ def write_out_of_the_box_page(out: Path, pages: dict[str, str] | None = None) ->
     box = json.loads((out / OUT_OF_THE_BOX).read_text())
     links = {"index": (out / "index.html").exists() or bool(pages),
              "power": (out / "power.html").exists(), "pages": pages or {}}
+    left = []
+    for e in box["entries"]:
+        anchor = f"{e['system']}-{e['simulator']}"
+        if not e["supported"]:
+            left.append((anchor, f"{e['system']} · {e['simulator']}", e["reason"]))
+        for d in e["defaults"]:
+            for i in d.get("incidents", []):
+                left.append((anchor, f"{e['system']} · {e['simulator']} · {d['setting']}",
+                             f"{i['outcome']}: {i['message']}"))
     page = out / "out_of_the_box.html"
-    page.write_text(OUT_OF_THE_BOX_TEMPLATE.render(doc=box, style=STYLE, links=links))
+    page.write_text(OUT_OF_THE_BOX_TEMPLATE.render(doc=box, style=STYLE, links=links,
+                                                   left=left))
     return page
