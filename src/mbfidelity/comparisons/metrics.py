@@ -49,6 +49,12 @@ def relative_vector_error(f: np.ndarray, f_ref: np.ndarray, scale: float = 0.0) 
     return float(num / max(np.nanmax(np.linalg.norm(f_ref, axis=1)), scale, 1e-300))
 
 
+#: evaluations of the model one seed of the free-vibration fit may take (MINPACK's
+#: maxfev): a clean free vibration converges in a few tens, a record that is not one (a
+#: mode an engine default has reshaped) would otherwise search for minutes
+FIT_EVALUATIONS = 200
+
+
 def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess: float):
     """Least-squares fit of x = A exp(-sigma t) cos(wd t + phase) + offset.
     Returns (undamped angular frequency, damping ratio)."""
@@ -74,7 +80,8 @@ def fit_damped_sinusoid(t: np.ndarray, x: np.ndarray, w_guess: float, zeta_guess
             # the covariance is not used; an exact fit makes it inestimable
             warnings.simplefilter("ignore", scipy.optimize.OptimizeWarning)
             p, _ = scipy.optimize.curve_fit(model, t, x, p0=p0, jac=jacobian,
-                                            maxfev=20000, xtol=1e-14, ftol=1e-14)
+                                            maxfev=FIT_EVALUATIONS, xtol=1e-14,
+                                            ftol=1e-14)
         return float(np.sum((model(t, *p) - x) ** 2)), p
 
     # amplitude, phase and offset for the seeded (wd, sigma) by linear least squares, and
