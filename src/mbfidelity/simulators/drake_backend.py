@@ -263,22 +263,27 @@ class DrakeBackend(Backend):
     SETTINGS = {
         "integrator": Setting(
             "runge_kutta5", tuple(_ORDER),
-            "Drake's Simulator defaults to runge_kutta3 at accuracy 1e-2 (a few significant "
-            "digits); runge_kutta5 (Dormand-Prince, fifth order with a fourth-order error "
-            "estimate) is its most accurate explicit scheme. Also offered: runge_kutta3, "
-            "bogacki_shampine3, radau3, implicit_euler (integrator_order reports the order "
-            "of the one used)."),
+            "Drake's Simulator integrates with runge_kutta3; runge_kutta5 (Dormand-Prince, "
+            "fifth order with a fourth-order error estimate) is its most accurate explicit "
+            "scheme. Also offered: runge_kutta3, bogacki_shampine3, radau3, implicit_euler "
+            "(integrator_order reports the order of the one used). Engine default: Drake's "
+            "SimulatorConfig (systems/analysis/simulator_config.h), integration_scheme.",
+            engine_default="runge_kutta3"),
         "target_accuracy": Setting(
             1e-10, float,
-            "Drake's default target accuracy (1e-2 in the Simulator's flags) replaced by "
-            "1e-10: the local error the integrator keeps each step below (unit weights: "
-            "rad, m, rad/s, m/s); tight enough that Drake is the most accurate engine on "
-            "smooth trees. The run records it with the number of steps taken (the "
-            "error-controlled trajectory gate follows from both)."),
+            "Drake's default target accuracy replaced by 1e-10: the local error the "
+            "integrator keeps each step below (unit weights: rad, m, rad/s, m/s); tight "
+            "enough that Drake is the most accurate engine on smooth trees. The run records "
+            "it with the number of steps taken (the error-controlled trajectory gate follows "
+            "from both). Engine default: Drake's SimulatorConfig "
+            "(systems/analysis/simulator_config.h), accuracy 1e-4.",
+            engine_default=1e-4),
         "max_step": Setting(
             None, (float, type(None)),
-            "Drake's largest step (the Simulator's default 0.1 s) capped at the sampling "
-            "step dt (null); a number caps it further."),
+            "Drake's largest step capped at the sampling step dt (null); a number caps it "
+            "further. Engine default: Drake's SimulatorConfig "
+            "(systems/analysis/simulator_config.h), max_step_size 0.1 s.",
+            engine_default=0.1),
         "fixed_step": Setting(
             False, bool,
             "Drake default (error control) kept; True runs the integrator at the fixed "
