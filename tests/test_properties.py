@@ -48,6 +48,8 @@ FORMULAS = {
     "inertial_shaker": {"Omega": lambda v: v["ratio"] * (v["k"] / (v["M"] + v["m"])) ** 0.5},
     # the rotor symmetric about its axis but for I23 (I1 = I2; eq. 88)
     "dynamic_unbalance": {"I2": lambda v: v["I1"]},
+    # IFToMM A02: every link 1 kg and 1 m, couplers as cranks unless given
+    "iftomm_a02_four_bar": {"b": lambda v: v["L"], "mc": lambda v: v["m"]},
     # parametric resonance: the pumping at twice the small-swing frequency (Fig. 11)
     "variable_length_pendulum": {"Omega": lambda v: 2 * (v["g"] / v["l0"]) ** 0.5},
     # the preload that makes phi0 the lever's equilibrium (Fig. 10, eq. 12)

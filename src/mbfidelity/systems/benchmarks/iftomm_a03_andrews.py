@@ -196,7 +196,10 @@ SYSTEM = System(
                     "Exudyn's implicit scheme solves each step by Newton's method, which "
                     "does not converge when the crank turns about a radian within one "
                     "step: the solver stops (a step well below a millisecond runs)"),
-        Expectation("*", "*", "unresolved", _UNRESOLVED),
+        # Pymunk's and Exudyn's refinements reach their asymptotic range within the step
+        # budget and judge every metric; the others' do not
+        *(Expectation(engine, "*", "unresolved", _UNRESOLVED)
+          for engine in ("mujoco", "pybullet", "drake")),
     ),
     # releases near the other stable equilibria last as long as the published run
     near_equilibrium_t_end=0.03,
