@@ -208,7 +208,8 @@ def test_the_mechanism_page_shows_the_published_solutions():
     def page(published):
         return site.MECHANISM.render(
             style="", system=A03, title="", source="", drawing="", model={}, errata=[],
-            published=published, sections=[], errata_page=False, script="", convergence="")
+            published=published, sections=[], errata_page=False, script="", convergence="",
+            out_of_the_box=[])
 
     shown = page(entries)
     assert "<h2>Published solutions</h2>" in shown

@@ -130,3 +130,14 @@ def test_rolling_contact_variant_keeps_rolling(system_id, variant, simulator):
     assert normal["reference_min"] > 0
     assert normal["rms_error"] < 0.5
     assert all(m.status in ("pass", "measured") for m in result.metrics)
+
+
+@pytest.mark.xdist_group("grouping-check")
+def test_cases_of_one_system_share_a_worker(request):
+    """The cases of one system run on one worker so that its comparison is made once
+    (`_comparison` is cached per process): under `--dist loadgroup` pytest-xdist marks
+    each grouped case's id with its group. A pytest that xdist cannot rename (pytest 9
+    with xdist 3.8) silently spreads the cases and doubles the suite's time."""
+    if not getattr(request.config.option, "loadgroup", False):
+        pytest.skip("not run by a pytest-xdist worker with --dist loadgroup")
+    assert request.node.nodeid.endswith("@grouping-check")
