@@ -51,23 +51,14 @@ def _belongs(metric_name: str, check: str) -> bool:
         CHECKS["frequency"])
 
 
-#: the chain through singular positions: its rows cost several times the catalog's median;
-#: the default suite keeps PyBullet's (tests/test_drake.py gates Drake's closed loops on
-#: two other mechanisms), `make test-slow` runs the rest
-A02 = "iftomm_a02_four_bar"
-
-
 def _marks(system_id: str, simulator: str) -> list:
     """Its system's worker group. In `make test-slow`: Drake's driven rows (the actuator's
     inverse dynamics runs in Python at every integrator stage) and its rows on the discrete
     plant (closures, couplings, slots: the SAP solver's step and the Python force system
-    at every step), and the A02 chain's twenty-second published run on the engines whose
-    run it declares to fail or to drift."""
+    at every step; tests/test_drake.py gates its closed loops on two mechanisms)."""
     marks = [pytest.mark.xdist_group(system_id)]
     mechanism = all_systems()[system_id].mechanism
     if simulator == "drake" and (mechanism.prescribed or mechanism.constraints):
-        marks.append(pytest.mark.slow)
-    if system_id == A02 and simulator in ("mujoco", "exudyn", "pymunk"):
         marks.append(pytest.mark.slow)
     return marks
 
