@@ -42,8 +42,9 @@ from ..simulators import get_backend
 from ..systems import get_system
 from .budget import become_worker
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
-from .power import (DefaultPower, PowerEntry, effect_against, free_coordinates,
-                    metric_named, out_of_the_box_document, rejecting_metrics, same_metrics)
+from .power import (DefaultPower, PowerEntry, effect_against, engine_defaults,
+                    free_coordinates, metric_named, out_of_the_box_document,
+                    rejecting_metrics, same_metrics, worst_scenario)
 from .runner import DEFAULT_DT, Comparison, compare, failed_comparison
 
 #: wall-clock budget of one default's run: this many times the neutralised run's wall
@@ -57,17 +58,6 @@ RUN_BUDGET_FLOOR = 60.0
 ENTRY_TIMEOUT = 1800.0
 #: the name of every neutralised default switched on together
 ALL = "all"
-
-
-def engine_defaults(simulator: str, dt: float = DEFAULT_DT) -> dict[str, object]:
-    """setting -> the engine's own value at step `dt`, for each setting the harness
-    neutralises (its `engine_default` differs from the harness's value)."""
-    out = {}
-    for key, setting in get_backend(simulator).SETTINGS.items():
-        value = setting.out_of_the_box(dt)
-        if value is not None and value != setting.default:
-            out[key] = value
-    return out
 
 
 def _motion_change(neutral: Mapping[str, tuple], on: Comparison, free: list[int]) -> dict:
@@ -121,10 +111,8 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
     d.motion["scenarios"] = scenarios
     measured = {k: v for k, v in scenarios.items() if "trajectory_change" in v}
     if measured:
-        # the scenario where the default moves the motion most, against its gate
-        worst = max(measured.items(), key=lambda item: (
-            item[1]["trajectory_change"] / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
-        d.motion.update(worst[1], scenario=worst[0])
+        name, worst = worst_scenario(measured)
+        d.motion.update(worst, scenario=name)
     else:
         d.motion["error"] = "; ".join(f"{i['outcome']}: {i['message']}"
                                       for i in run.incidents) or "no motion recorded"

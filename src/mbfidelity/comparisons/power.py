@@ -367,15 +367,9 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
 
 def _defaults_power(system, backend, baseline: Comparison, dt: float, run,
                     budget: float) -> list[DefaultPower]:
-    out = []
-    switched = {}
-    for key, setting in backend.SETTINGS.items():
-        value = setting.out_of_the_box(dt)
-        if value is None or value == setting.default:
-            continue
-        switched[key] = value
-        out.append(_default_power(key, {key: value}, setting.default, baseline, run,
-                                  setting.note))
+    switched = engine_defaults(backend.id, dt)
+    out = [_default_power(key, {key: value}, backend.SETTINGS[key].default, baseline, run,
+                          backend.SETTINGS[key].note) for key, value in switched.items()]
     if len(switched) > 1:
         out.append(_default_power("all", switched, None, baseline, run,
                                   "every neutralised default switched back on together: "
@@ -393,14 +387,30 @@ def _defaults_power(system, backend, baseline: Comparison, dt: float, run,
                 motion["beyond_gate"] = bool(motion["trajectory_change"] > gate.tolerance)
             d.motion.setdefault("scenarios", {})[scenario.name] = motion
     for d in out:
-        # the scenario where the default moves the motion most, against its gate
-        worst = max(d.motion["scenarios"].items(), key=lambda item: (
-            item[1].get("trajectory_change", math.inf)
-            / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
-        d.motion.update(worst[1], scenario=worst[0],
+        name, worst = worst_scenario(d.motion["scenarios"])
+        d.motion.update(worst, scenario=name,
                         beyond_gate=any(m.get("beyond_gate", False)
                                         for m in d.motion["scenarios"].values()))
     return out
+
+
+def engine_defaults(simulator: str, dt: float = DEFAULT_DT) -> dict[str, object]:
+    """setting -> the engine's own value at step `dt`, for each setting the harness
+    neutralises (its `engine_default` differs from the harness's value)."""
+    out = {}
+    for key, setting in get_backend(simulator).SETTINGS.items():
+        value = setting.out_of_the_box(dt)
+        if value is not None and value != setting.default:
+            out[key] = value
+    return out
+
+
+def worst_scenario(scenarios: Mapping[str, dict]) -> tuple[str, dict]:
+    """The scenario where a default moves the motion most against its gate (one without a
+    measured change counts as infinitely moved)."""
+    return max(scenarios.items(), key=lambda item: (
+        item[1].get("trajectory_change", math.inf)
+        / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
 
 
 def _default_power(key, settings, harness, baseline, run, note) -> DefaultPower:
