@@ -46,6 +46,7 @@ from ..analytic.reference import LOOSE, TIGHT, reference
 from ..simulators import get_backend
 from ..systems import get_system
 from . import metrics, tolerances
+from .benchmark_error import benchmark_errors, declared_failure
 from .runner import Metric, _judge, expectation_for
 
 #: the steps of a study (s): halvings, each an integer multiple of the finest; scaled down
@@ -84,6 +85,9 @@ class ConvergencePoint:
     #: an accuracy study's target accuracy and the steps its integrator took (else None)
     accuracy: float | None = None
     integrator_steps: int | None = None
+    #: the benchmark's own error measure (`System.benchmark_error`, in its unit; NaN: the
+    #: run did not complete); None for a system without one
+    benchmark_error: float | None = None
 
 
 @dataclass
@@ -117,6 +121,13 @@ class ConvergenceStudy:
     judged_accuracies: list[float] = field(default_factory=list)
     worst_decrease: float | None = None
     accuracy_slope: float | None = None
+    #: the benchmark's error measure recorded at every point (`System.benchmark_error`):
+    #: what it measures and its unit ('' for a system without one)
+    benchmark_measure: str = ""
+    benchmark_unit: str = ""
+    #: why the engine does not complete the run, as the system declares it (its
+    #: `<scenario>.completed` expected failure), where a run failed or diverged
+    declared_failure: str = ""
 
     @property
     def order_matches(self) -> bool | None:
@@ -200,7 +211,7 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
         w = max([w] + excitation_frequencies(system, values))
     if by_accuracy:
         return _accuracy_study(system, sc.name, backend, mech, probe, free, eq.q[free], w,
-                               T, order, settings, accuracies or DEFAULT_ACCURACIES)
+                               T, order, settings, accuracies or DEFAULT_ACCURACIES, values)
     dts = tuple(sorted(dts if dts is not None else automatic_steps(w, max(order, 1)),
                        reverse=True))
     finest = min(dts)
@@ -218,6 +229,7 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
     points: list[ConvergencePoint] = []
     study = ConvergenceStudy(system.id, sc.name, simulator, backend.version(), order, points,
                              None, reference_error=reference_error, frequency=w)
+    _describe_benchmark(study, system)
     if not support.ok:
         study.unsupported = f"{simulator} cannot express {system.id}: {support.reason}"
         return study
@@ -227,11 +239,15 @@ def convergence(system_id: str, simulator: str, scenario: str | None = None,
             run = backend.simulate(mech, ref.q[0], ref.qd[0], T, dt, settings)
         except Exception as exc:  # an engine's failure is a result of the study
             study.failure = f"dt = {dt:g}: {type(exc).__name__}: {exc}"
+            study.declared_failure = declared_failure(system, simulator, sc.name)
             return study
         n = min(len(run.t), len(q_ref))
         err, _ = metrics.trajectory_errors(run.q[:n, free], q_ref[:n], scale)
-        points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1))
+        points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1,
+                                       benchmark_error=_benchmark_error(
+                                           system, values, mech, ref, run, k)))
         order = run.integrator_order
+    _declare_diverged(study, system, sc.name)
     study.integrator_order = order
     limit = tolerances.asymptotic_limit(order)
     asymptotic = [p for p in points if w * p.dt <= limit * (1 + 1e-9)]
@@ -262,9 +278,32 @@ def accuracy_sampling_step(w: float, t_end: float, finest: float) -> float:
     return max(1, int(wanted / finest + 1e-9)) * finest
 
 
+def _describe_benchmark(study: ConvergenceStudy, system) -> None:
+    """The study records the system's benchmark error measure, where it declares one."""
+    if system.benchmark_error is not None:
+        study.benchmark_measure = system.benchmark_error.description
+        study.benchmark_unit = system.benchmark_error.unit
+
+
+def _benchmark_error(system, values: Mapping[str, float], mech, ref, run,
+                     stride: int) -> float | None:
+    """The benchmark's error of `run`, sampled every `stride` samples of `ref` (None
+    without a benchmark measure)."""
+    if system.benchmark_error is None:
+        return None
+    return benchmark_errors(system, values, mech, ref, run.q, run.qd, stride)["error"]
+
+
+def _declare_diverged(study: ConvergenceStudy, system, scenario: str) -> None:
+    """A run that left the finite numbers: the system's declared reason, if any."""
+    if any(not np.isfinite(p.error) for p in study.points):
+        study.declared_failure = declared_failure(system, study.simulator, scenario)
+
+
 def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
                     q_eq: np.ndarray, w: float, T: float, order: int, settings: Mapping,
-                    accuracies: Sequence[float]) -> ConvergenceStudy:
+                    accuracies: Sequence[float], values: Mapping[str, float]
+                    ) -> ConvergenceStudy:
     """An error-controlled engine's study: its error at each target accuracy (loose to
     tight), sampled every `accuracy_sampling_step`, against the reference `ref` (sampled
     at DEFAULT_STEPS[2]), judged by the rule of tolerances.MIN_ACCURACY_DECREASE."""
@@ -279,6 +318,7 @@ def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
     study = ConvergenceStudy(system.id, scenario, backend.id, backend.version(), order, points,
                              None, reference_error=reference_error, frequency=w,
                              knob="accuracy")
+    _describe_benchmark(study, system)
     support = backend.support(mech)
     if not support.ok:
         study.unsupported = f"{backend.id} cannot express {system.id}: {support.reason}"
@@ -290,13 +330,16 @@ def _accuracy_study(system, scenario: str, backend, mech, ref, free: list[int],
                                    {**settings, backend.ACCURACY_SETTING: float(eps)})
         except Exception as exc:  # an engine's failure is a result of the study
             study.failure = f"accuracy {eps:g}: {type(exc).__name__}: {exc}"
+            study.declared_failure = declared_failure(system, backend.id, scenario)
             return study
         n = min(len(run.t), len(q_ref))
         err, _ = metrics.trajectory_errors(run.q[:n, free], q_ref[:n], scale)
         taken = run.error_control.steps if run.error_control else n - 1
         points.append(ConvergencePoint(dt, float(err), run.wall_time, run.cpu_time, n - 1,
-                                       float(eps), int(taken)))
+                                       float(eps), int(taken),
+                                       _benchmark_error(system, values, mech, ref, run, k)))
         study.integrator_order = run.integrator_order
+    _declare_diverged(study, system, scenario)
     _judge_accuracy_points(study, T)
     return study
 

@@ -216,6 +216,37 @@ class Published:
             raise ValueError(f"published {self.quantity}: a period names its coordinate")
 
 
+BENCHMARK_ERROR_AT = ("run", "end")
+
+
+@dataclass(frozen=True)
+class BenchmarkError:
+    """How a benchmark measures a solution's error, as its specification states it (the
+    accuracy that, with the CPU time, a code reports on the problem).
+
+    `quantities`: the published quantities, each a named point's component
+    (``"P1.x"``, ``"B0.vy"``: x, y, z for the position, vx, vy, vz for the velocity of a
+    `PointOutput`) or a coordinate's name (``"beta"``). `at` "run": the largest absolute
+    difference from the reference over every sample of the run; "end": the difference at
+    the run's last instant (a source that publishes the state at one time). The error is
+    the largest over the quantities, in their own unit (`unit`). `scenario`: the run it
+    measures (None: the first)."""
+
+    quantities: tuple[str, ...]
+    at: str
+    unit: str
+    source: str
+    description: str = ""
+    scenario: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.at not in BENCHMARK_ERROR_AT:
+            raise ValueError(f"benchmark error at {self.at!r} is not one of "
+                             f"{', '.join(BENCHMARK_ERROR_AT)}")
+        if not self.quantities:
+            raise ValueError("a benchmark error names at least one quantity")
+
+
 EXPECTATION_KINDS = ("xfail", "unsupported", "unresolved", "judged")
 
 
@@ -321,6 +352,9 @@ class System:
     #: values the sources publish for the motion (a benchmark's solution), a function of
     #: the parameter symbols like `printed`: `analyze` compares each with the reference
     published: Callable[[SimpleNamespace], tuple[Published, ...]] = lambda P: ()
+    #: how the benchmark measures a solution's error (the convergence study measures the
+    #: engines with it too, next to its own relative measure); None: no benchmark
+    benchmark_error: BenchmarkError | None = None
     notes: str = ""
     module_doc: str = field(default="", compare=False)
     #: the catalog group (set by the discovery): "monograph", a subpackage's name (the

@@ -30,7 +30,7 @@ import math
 
 import sympy as sp
 
-from .. import Expectation, PointOutput, Published, System
+from .. import BenchmarkError, Expectation, PointOutput, Published, System
 from ..model import Body, Mechanism, Parameter, Revolute, Scenario, Segment
 
 SOURCE = ("IFToMM benchmark A01 (González et al., Multibody System Dynamics 16, 2006); "
@@ -90,6 +90,16 @@ def published(P):
     )
 
 
+#: the specification's measure of a solution's error: its reference solution is the time
+#: history of P1's x and y, and it grades a solution by their largest error over the run
+#: (1e-1 m low, 1e-3 m high precision). The specification compares a fixed number of
+#: output steps; every sample of the run counts here, which bounds the value at any subset
+ERROR = BenchmarkError(
+    ("P1.x", "P1.y"), "run", "m",
+    "IFToMM benchmark A01 specification (lim.ii.udc.es/mbsbenchmark, dist/A01): the time "
+    "history of P1's x and y; high precision 1e-3",
+    "largest |P1 - P1_ref| component over the run")
+
 SYSTEM = System(
     id="iftomm_a01_pendulum",
     title="IFToMM A01: simple pendulum (point mass on a massless bar)",
@@ -103,6 +113,7 @@ SYSTEM = System(
     ),
     reaction_joints=("pivot",),
     published=published,
+    benchmark_error=ERROR,
     points=lambda P: (PointOutput("P1", "bob", (0, 0), "the point mass: the published "
                                   "trajectory"),),
     expectations=tuple(
