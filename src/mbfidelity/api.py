@@ -24,7 +24,7 @@ from .comparisons.diff import ResultsDiff, diff_runs, holds
 from .comparisons.runner import DEFAULT_DT, Comparison
 
 __all__ = ["list_systems", "analyze", "compare", "run", "errata", "strutt", "discretization",
-           "convergence", "beams", "check", "diff", "export", "power", "out_of_the_box",
+           "convergence", "benchmark_errors", "beams", "check", "diff", "export", "power", "out_of_the_box",
            "Verdict", "CheckResult", "DEFAULT_DT"]
 
 
@@ -553,6 +553,33 @@ def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None
         (out / CONVERGENCE).write_text(json.dumps(doc, indent=1, default=jsonable))
         write_convergence_page(out)
     return doc
+
+
+def benchmark_errors(systems: Iterable[str] | None = None,
+                     sims: Iterable[str] | None = None, dt: float = DEFAULT_DT) -> dict:
+    """Each engine's error as the benchmark defines it (`System.benchmark_error`) and its
+    CPU seconds of stepping, at its default settings and the step `dt`, over each
+    benchmark row's whole scenario (default: every row that declares a measure, every
+    installed engine); a run that does not complete is reported with its status and the
+    system's declared reason. `rows` lists them in system x engine order."""
+    import numpy as np
+
+    from .comparisons.benchmark_error import default_step_error
+    from .comparisons.runner import provenance
+    from .simulators import all_backends
+    from .systems import all_systems
+
+    sys_ids = list(systems) if systems else [
+        s for s in all_systems() if _system(s).benchmark_error is not None]
+    for s in sys_ids:
+        if _system(s).benchmark_error is None:
+            raise ValueError(f"{s} declares no benchmark error measure")
+    sim_ids = (checked_simulators(sims) if sims else
+               [e for e, b in all_backends().items() if b.available()[0]])
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"the step must be positive; got {dt}")
+    rows = [default_step_error(s, e, dt) for s in sys_ids for e in sim_ids]
+    return {"provenance": provenance(), "dt": dt, "rows": rows}
 
 
 def jsonable(x):

@@ -604,6 +604,14 @@ def convergence_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems
             order = (f"{s['observed_order']:.2f}" if s["observed_order"] is not None else "-")
             typer.echo(f"{s['system']:28s} {s['simulator']:9s} order {order:>5s} / "
                        f"{s['integrator_order']}  {s['metric']['status']}")
+        for s in studies:  # a benchmark row: its own error measure at every point
+            if s.get("benchmark_measure"):
+                typer.echo(f"{s['system']:28s} {s['simulator']:9s} benchmark error "
+                           f"[{s['benchmark_unit']}] / CPU s: " + ", ".join(
+                               f"{p['benchmark_error']:.3g} / {p['cpu_time']:.3g}"
+                               for p in s["points"])
+                           + (f"  (failed{', declared' if s['declared_failure'] else ''})"
+                              if s["failure"] or s["declared_failure"] else ""))
         if out is not None:
             typer.echo(f"page: {page.resolve()}")
     raise typer.Exit(1 if failed else 0)

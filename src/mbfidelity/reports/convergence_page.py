@@ -3,7 +3,10 @@ engines), against the target accuracy (error-controlled engines) and against the
 seconds of the stepping (work-precision, every engine) on one figure, and the table of
 fitted against declared orders (per decade of accuracy: the largest error ratio against
 its gate), rendered from the saved convergence.json (`mbfidelity convergence --out
-DIR`)."""
+DIR`). A benchmark row (`System.benchmark_error`) adds its own work-precision panel, the
+error as the benchmark defines it against the CPU seconds, and a table of it at every
+step; an engine whose run fails shows as failed there, with the system's declared
+reason."""
 from __future__ import annotations
 
 import json
@@ -41,15 +44,52 @@ reference's floor.</p>
 </table>
 {% for sys in systems %}<h2 id="{{ sys }}">{{ sys }}</h2>
 <ul>{% for sim in sims %}{% set s = by[sys].get(sim) %}{% if s and (s.metric.reason or s.flattened or s.failure) %}<li><b>{{ sim }}</b> ({{ s.metric.status }}): {{ s.failure or s.metric.reason or s.flattened }}</li>{% endif %}{% endfor %}</ul>
-<img src="{{ figures[sys] }}">{% endfor %}
+<img src="{{ figures[sys] }}">
+{% set bench = by[sys].values()|selectattr("benchmark_measure")|list %}{% if bench %}
+<p>Benchmark's error: {{ bench[0].benchmark_measure }} ({{ bench[0].benchmark_unit }}), over the study's run.</p>
+<table><tr><th>engine</th><th>step / target accuracy</th><th>benchmark error</th><th>CPU s</th></tr>
+{% for s in bench %}{% for p in s.points %}<tr><td>{{ s.simulator }}</td><td>{{ "accuracy %g"|format(p.accuracy) if p.accuracy is not none else "dt %g s"|format(p.dt) }}</td>
+<td{% if p.benchmark_error is none or p.benchmark_error != p.benchmark_error %} class="{{ 'xfail' if s.declared_failure else 'fail' }}" title="{{ s.declared_failure }}">did not complete{% if s.declared_failure %} (declared){% endif %}{% else %}>{{ "%.3g"|format(p.benchmark_error) }}{% endif %}</td>
+<td>{{ "%.3g"|format(p.cpu_time) }}</td></tr>{% endfor %}{% if s.failure or s.unsupported %}<tr><td>{{ s.simulator }}</td><td colspan="3" class="{{ 'unsupported' if s.unsupported else ('xfail' if s.declared_failure else 'fail') }}">{{ s.unsupported or s.failure }}{% if s.declared_failure %}; declared: {{ s.declared_failure }}{% endif %}</td></tr>{% endif %}{% endfor %}
+</table>{% endif %}{% endfor %}
 </body></html>""")
+
+
+def _completed(study: dict) -> bool:
+    """Whether every run of the study finished with finite numbers."""
+    return not study.get("failure") and all(
+        p.get("benchmark_error") is None or p["benchmark_error"] == p["benchmark_error"]
+        for p in study["points"])
+
+
+def _benchmark_panel(ax, studies: list[dict]) -> None:
+    """The benchmark's error against the CPU seconds, every engine; one that failed its
+    run is labelled failed (declared, where the system declares why)."""
+    for i, s in enumerate(studies):
+        points = [p for p in s["points"] if p.get("benchmark_error") is not None
+                  and p["benchmark_error"] == p["benchmark_error"] and p["benchmark_error"] > 0]
+        label = s["simulator"] + ("" if _completed(s) else
+                                  " (failed, declared)" if s.get("declared_failure")
+                                  else " (failed)")
+        ax.loglog([max(p["cpu_time"], 1e-6) for p in points],
+                  [p["benchmark_error"] for p in points],
+                  "s--" if s.get("knob") == "accuracy" else "o-", color=f"C{i}",
+                  mfc="none" if not _completed(s) else None, label=label)
+    unit = next((s["benchmark_unit"] for s in studies if s.get("benchmark_unit")), "")
+    ax.set_xlabel("CPU seconds of stepping")
+    ax.set_ylabel(f"benchmark error [{unit}]")
+    ax.set_title("work-precision, the benchmark's error")
 
 
 def _figure(system: str, studies: list[dict], out: Path) -> str:
     by_accuracy = any(s.get("knob") == "accuracy" and any(p["error"] > 0 for p in s["points"])
                       for s in studies)
-    fig, axes = plt.subplots(1, 3 if by_accuracy else 2, figsize=(16 if by_accuracy else 11, 4))
-    steps, work = axes[0], axes[-1]
+    benchmark = any(s.get("benchmark_measure") for s in studies)
+    panels = 2 + by_accuracy + benchmark
+    fig, axes = plt.subplots(1, panels, figsize=(5.5 * panels, 4))
+    steps, work = axes[0], axes[1 + by_accuracy]
+    if benchmark:
+        _benchmark_panel(axes[-1], studies)
     for i, s in enumerate(studies):
         points = [p for p in s["points"] if p["error"] > 0]
         if not points:
