@@ -33,7 +33,13 @@ fall with the accuracy until it reaches the reference's floor
 T/N within w h <= asymptotic_limit, ACCURACY_CONTROLLED_STEPS steps per sample at
 least). A model error stops the fall at its own floor, above the reference's, and fails
 it. The slope of log(error) against log(eps) over the judged points is reported
-(between q/(q+1) and 1 for an error estimate of order q)."""
+(between q/(q+1) and 1 for an error estimate of order q).
+
+A benchmark row (`System.benchmark_error`) is measured at every point in the benchmark's
+own measure too (comparisons/benchmark_error.py: the published quantities' largest
+absolute error, in their units, over the study's run): the work-precision figure the
+benchmark asks for. It is recorded, not judged; a run that fails or diverges carries the
+system's declared reason (`declared_failure`)."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
