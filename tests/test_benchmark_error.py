@@ -114,3 +114,18 @@ def test_a_declared_failure_shows_on_the_convergence_page(tmp_path):
     assert "did not complete (declared)" in page
     assert SINGULAR_MUJOCO in page
     assert (tmp_path / "convergence-iftomm_a02_four_bar.png").exists()
+
+
+def test_the_default_step_table_reports_each_quantity_and_refuses_other_rows():
+    """`api.benchmark_errors`: the largest of the quantities' errors, the CPU seconds of
+    the stepping, over the problem's whole run; a row without a measure is refused."""
+    from mbfidelity import api
+
+    doc = api.benchmark_errors([A01], ["mujoco"])
+    row, = doc["rows"]
+    assert row["status"] == "completed" and row["t_end"] == 10.0
+    assert set(row["errors"]) == {"P1.x", "P1.y"}
+    assert row["error"] == max(row["errors"].values())
+    assert row["cpu_time"] > 0
+    with pytest.raises(ValueError, match="no benchmark error"):
+        api.benchmark_errors(["compound_pendulum"], ["mujoco"])
