@@ -6,7 +6,8 @@ study of the benchmark rows over their whole runs (its page draws the benchmark'
 against the CPU seconds: `mbfidelity convergence --systems ... --t-end ... --out DIR`).
 
 Usage: .venv/bin/python benchmarks/benchmark_errors.py [--figure DIR]
-Writes benchmarks/records/benchmark_errors.json and benchmark_errors.md.
+Writes benchmarks/records/benchmark_errors.json and benchmark_errors.md (with --figure,
+also the study's JSON as benchmarks/records/benchmark_work_precision.json).
 """
 import argparse
 import json
@@ -53,6 +54,8 @@ def main() -> None:
         rows = [s for s, sys in all_systems().items() if sys.benchmark_error is not None]
         longest = max(sc.t_end for s in rows for sc in all_systems()[s].scenarios)
         study = api.convergence(rows, t_end=longest, out=args.figure)
+        (out / "benchmark_work_precision.json").write_text(
+            (args.figure / "convergence.json").read_text())
         print(f"page: {args.figure / 'convergence.html'}; failed gates: {study['failed']}")
 
 
