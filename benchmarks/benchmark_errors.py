@@ -29,8 +29,9 @@ def markdown(doc: dict) -> str:
              "|---|---|---|---|---|---|---|"]
     for r in doc["rows"]:
         status = r["status"] + (f": {r['message']}" if r["message"] else "")
-        if r["declared"] and r["status"] != "completed":
-            status += " (declared)"
+        if r["declared"]:
+            status += (" (declared)" if r["status"] != "completed" else
+                       f" (trajectory declared {r['declared'].split(':')[0]})")
         lines.append(f"| {r['system']} | {r['simulator']} | {r.get('scheme', '-')} | "
                      f"{_cell(r['error'], '.3g')} | {r['unit']} | "
                      f"{_cell(r['cpu_time'], '.3g')} | {status} |")

@@ -99,7 +99,9 @@ def default_step_error(system_id: str, simulator: str, dt: float = DEFAULT_DT) -
     the benchmark's whole scenario: the benchmark's error (each quantity's and the
     largest), the CPU and wall seconds of the stepping, and the run's status ("completed",
     "diverged": non-finite states, "crashed": the engine raised, "unsupported"), with the
-    system's declared reason for a run that does not complete."""
+    system's declared reason (`declared`) for a run that does not complete, or for a
+    completed run whose trajectory it declares an expected failure or unresolved at this
+    step."""
     system = get_system(system_id)
     measure = system.benchmark_error
     if measure is None:
@@ -130,5 +132,9 @@ def default_step_error(system_id: str, simulator: str, dt: float = DEFAULT_DT) -
     if not np.all(finite):
         k = int(np.argmin(finite))
         status, message = "diverged", f"non-finite state at t = {run.t[k]:.6g} s"
+    if status == "completed":  # what the system declares about the run's trajectory
+        exp = expectation_for(system, simulator, f"{sc.name}.trajectory_max")
+        if exp is not None and exp.kind in ("xfail", "unresolved"):
+            entry["declared"] = f"{exp.kind}: {exp.reason}"
     return {**entry, "status": status, "message": message, "error": errors.pop("error"),
             "errors": errors, "cpu_time": run.cpu_time, "wall_time": run.wall_time}
