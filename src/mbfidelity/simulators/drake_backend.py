@@ -30,8 +30,9 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
 - reactions: the plant's reaction forces output (the force on the child at its joint
   frame, in that frame) turned to world axes. Drake counts the generalized forces on a
   joint's own coordinate (springs, damping, applied generalized force) as transmitted
-  through the joint; along a prismatic joint's slide they are the coordinate's force
-  elements, which the contract's reaction excludes, so they are subtracted;
+  through the joint; along a prismatic joint's slide the coordinate's force elements,
+  which the contract's reaction excludes, are taken out (`reactions.joint_reaction`),
+  while a prescribed coordinate's actuator stays in, as in the derivation;
 - linearization: Drake's ``Linearize`` (automatic differentiation) of the plant when no
   Python force system is needed, otherwise central differences of the diagram's own time
   derivatives; the eigenvalues of the 2n x 2n state matrix.
@@ -71,7 +72,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointOnLine,
-                             PointOnPoint, PointToPoint, Prismatic, Revolute)
+                             PointOnPoint, PointToPoint, Revolute)
 from .base import (
     EXACT,
     RK3_STABILITY,
@@ -89,6 +90,7 @@ from .base import (
     Scheme,
     Setting,
 )
+from .reactions import joint_reactions
 from .plan import (
     BODY,
     COORDINATE_FORCE_CUSTOM,
@@ -251,7 +253,6 @@ class _Built:
     velocities: np.ndarray            # plant velocity index of each joint
     cmap: CoordinateMap
     python_forces: bool               # whether a Python LeafSystem computes forces
-    slide_laws: dict = field(default_factory=dict)  # prismatic joint -> its coordinate laws
     forces: object = None             # the Python force system, when there is one
     #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
     #: slot's unit direction), for the slider's initial state (`_place_slider`)
@@ -568,11 +569,8 @@ class DrakeBackend(Backend):
             builder.Connect(forces.get_output_port(0),
                             plant.get_applied_generalized_force_input_port())
             builder.Connect(forces.get_output_port(1), plant.get_applied_spatial_force_input_port())
-        slide_laws = {i: [(f.weights(mech.coordinates), ForceLaw.of(f)) for f in mech.forces
-                          if isinstance(f, CoordinateForce) and i in f.weights(mech.coordinates)]
-                      for i, j in enumerate(mech.joints) if isinstance(j, Prismatic)}
         return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
-                      python_forces, slide_laws, forces, slots)
+                      python_forces, forces, slots)
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -756,14 +754,18 @@ class DrakeBackend(Backend):
         q = built.cmap.coordinates(state[:, :n])
         qd = built.cmap.rates(state[:, n:])
         actuator_forces = {name: actuators[:, k] for k, name in enumerate(driven)}
-        reactions = {name: forces[name] - self._slide_force(mechanism, built, i, t, q, qd,
-                                                            actuator_forces)
-                     for name, i in wanted}
         control = None if cfg["fixed_step"] or discrete else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
         # Drake reports no constraint forces (`EXPRESSIONS`)
         closures = {c.name: np.full((steps + 1, 1 if isinstance(c, LinearCoupling) else 2),
                                     np.nan) for c in mechanism.constraints}
+        # Drake books the generalized forces on a joint's own coordinate (its laws, a
+        # coupler constraint: unknown, so NaN on a slide it involves) as transmitted
+        # through it; the ball constraints and point-to-point forces act on the bodies
+        couplings = {c.name: closures[c.name] for c in mechanism.constraints
+                     if isinstance(c, LinearCoupling)}
+        reactions = joint_reactions(mechanism, reaction_joints, forces, t, q, qd,
+                                    coupling_forces=couplings)
         return Samples(q, qd, clock, reactions, constraint_forces=closures,
                        actuator_forces=actuator_forces, error_control=control)
 
@@ -785,30 +787,6 @@ class DrakeBackend(Backend):
     def _state_index(built: _Built) -> np.ndarray:
         """Where the description's joints sit in the plant's state vector (q, then v)."""
         return np.concatenate([built.positions, built.plant.num_positions() + built.velocities])
-
-    @staticmethod
-    def _slide_force(mech: Mechanism, built: _Built, i: int, t: np.ndarray, q: np.ndarray,
-                     qd: np.ndarray, actuator_forces: Mapping[str, np.ndarray]) -> np.ndarray:
-        """World force on the child of prismatic joint i from the coordinate's force
-        elements (Drake books them as transmitted through the joint; the contract's
-        reaction excludes them): Q axis / |axis|^2, the axis turned with the parent."""
-        out = np.zeros((len(t), 2))
-        if i not in built.slide_laws:
-            return out
-        joint = mech.joints[i]
-        # an actuator on the joint's own slide acts between parent and child like a law
-        Q = sum((actuator_forces[p.name] for p in mech.prescribed
-                 if p.coordinate == joint.coordinate), np.zeros(len(t)))
-        for weights, law in built.slide_laws[i]:
-            x = sum(sign * q[:, k] for k, sign in weights.items())
-            xd = sum(sign * qd[:, k] for k, sign in weights.items())
-            Q += weights[i] * law.vector_law(x, xd, t)
-        axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
-        axis = axis / float(axis @ axis)
-        th = built.cmap.angle(joint.parent, q)
-        world = np.stack([np.cos(th) * axis[0] - np.sin(th) * axis[1],
-                          np.sin(th) * axis[0] + np.cos(th) * axis[1]], axis=1)
-        return Q[:, None] * world
 
     # --- linearization -------------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,

@@ -99,7 +99,6 @@ from ..systems.model import (
     PointOnLine,
     PointOnPoint,
     PointToPoint,
-    Prismatic,
     Revolute,
     inertia_matrix,
 )
@@ -122,6 +121,7 @@ from .base import (
     Setting,
     Stopwatch,
 )
+from .reactions import joint_reactions, subtree_force
 from .plan import (
     spatial_tree_reason,
     BODY,
@@ -985,12 +985,17 @@ class ExudynBackend(Backend):
             acc = {b: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3] for b, s in s_acc.items()}
             for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
                 acc[b][0] = a0
+            # Exudyn's connector force is the force on marker 0 (body_a)
             conn_force = {name: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3]
                           for name, s in s_conn.items()}
-            for name in reaction_joints:
-                reactions[name] = self._reaction(mechanism, geo, name, t, q, qd, u, acc,
-                                                 conn_force, constraint_forces,
-                                                 actuator_forces)
+            # Newton on each subtree: every element force from outside is taken out
+            newton = {name: subtree_force(mechanism, name, t, acc) for name in reaction_joints}
+            pairs = {**conn_force, **{c.name: constraint_forces[c.name] for c in closures
+                                      if c.kind != "coupling"}}
+            couplings = {c.name: constraint_forces[c.name] for c in closures
+                         if c.kind == "coupling"}
+            reactions = joint_reactions(mechanism, reaction_joints, newton, t, q, qd,
+                                        pair_forces=pairs, coupling_forces=couplings)
         return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
@@ -1097,73 +1102,6 @@ class ExudynBackend(Backend):
         mbs.systemData.SetODE2Coordinates_tt(a0.tolist(),
                                              configuration=exu.ConfigurationType.Current)
         return {b: np.asarray(mbs.GetSensorValues(s))[:2] for b, s in sensors.items()}
-
-    @staticmethod
-    def _reaction(mech: Mechanism, geo: _Geometry, joint_name: str, t: np.ndarray,
-                  q: np.ndarray, qd: np.ndarray, u: np.ndarray,
-                  acc: dict[str, np.ndarray], conn_force: dict[str, np.ndarray],
-                  constraint_forces: Mapping[str, np.ndarray] | None = None,
-                  actuator_forces: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
-        """Force parent -> child (world x, y): sum m (a - g) over the child's subtree minus
-        the element, closure-constraint and actuator forces entering the subtree from
-        outside (an actuator on the joint's own slide acts along it, like a coordinate
-        force; on a hinge it is a moment)."""
-        joint = mech.joint(joint_name)
-        subtree = set(mech.subtree(joint.child))
-        g_vec = np.array([0.0, -geo.gravity])
-        total = np.zeros((len(t), 2))
-        for b in subtree:
-            if geo.mass[b] != 0:
-                total += geo.mass[b] * (acc[b] - g_vec)
-        for f in mech.forces:
-            if isinstance(f, PointToPoint):
-                in_a, in_b = f.body_a in subtree, f.body_b in subtree
-                if in_a == in_b or f.name not in conn_force:
-                    continue
-                # Exudyn's connector force is the force on marker 0 (body_a)
-                on_a = conn_force[f.name]
-                total -= on_a if in_a else -on_a
-            elif isinstance(f, CoordinateForce):
-                i = mech.coordinates.index(f.coordinate)
-                if mech.joints[i] is not joint or isinstance(joint, Revolute) or f.relative_to:
-                    continue
-                law = ForceLaw.of(f).law
-                force = np.array([law(a, b, c) for a, b, c in zip(q[:, i], qd[:, i], t)])
-                total -= ExudynBackend._slide_force(geo, joint, u, force)
-        for c in mech.constraints:
-            if constraint_forces is None or c.name not in constraint_forces:
-                continue
-            f_c = constraint_forces[c.name]
-            if isinstance(c, (PointOnPoint, PointOnLine)):
-                # the first body feels f_c, the second -f_c
-                first, second = c.bodies
-                in_1, in_2 = first in subtree, second in subtree
-                if in_1 != in_2:
-                    total -= f_c if in_1 else -f_c
-            elif isinstance(c, LinearCoupling) and isinstance(joint, Prismatic):
-                # a generalized force on the joint's own slide acts between parent and child
-                coef = sum(num(v) for name, v in c.coefficients if name == joint.coordinate)
-                if coef:
-                    total -= ExudynBackend._slide_force(geo, joint, u, coef * f_c[:, 0])
-        for p in mech.prescribed:
-            if (isinstance(joint, Prismatic) and p.coordinate == joint.coordinate
-                    and actuator_forces is not None and p.name in actuator_forces):
-                total -= ExudynBackend._slide_force(geo, joint, u, actuator_forces[p.name])
-        return total
-
-    @staticmethod
-    def _slide_force(geo: _Geometry, joint: Prismatic, u: np.ndarray,
-                     force: np.ndarray) -> np.ndarray:
-        """World force on the child of a prismatic joint from a generalized force on its
-        coordinate (virtual power: F axis / |axis|^2, axis turned with the parent)."""
-        row, const = geo.angle_rows[joint.parent]
-        th_parent = u @ row + const
-        axis = np.array([num(v) for v in joint.axis])
-        axis = axis / float(axis @ axis)
-        ax_world = np.stack([np.cos(th_parent) * axis[0] - np.sin(th_parent) * axis[1],
-                             np.sin(th_parent) * axis[0] + np.cos(th_parent) * axis[1]],
-                            axis=1)
-        return force[:, None] * ax_world
 
     # --- linearization ---------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,

@@ -70,9 +70,10 @@ Translation (generic over the description, see `to_mjcf`):
 Reactions: ``mj_forward`` + ``mj_rnePostConstraint`` at each sampled state (after the
 stepping, outside the timed loop); ``cfrc_int[body, 3:6]`` is the force the parent exerts
 on the body (world axes). Forces MuJoCo books as joint-space passive forces (joint
-springs/dampers, the callback) are inside that number, so those acting on the child's
-subtree from outside are subtracted to give the description's joint reaction; native
-tendon forces are already outside it (MuJoCo puts them in ``cfrc_ext``).
+springs/dampers, the callback, tendon equalities) are inside that number, so those acting
+on the child's subtree from outside are taken out (`reactions.joint_reaction`) to give the
+description's joint reaction; native tendon forces are already outside it (MuJoCo puts
+them in ``cfrc_ext``).
 """
 from __future__ import annotations
 
@@ -91,7 +92,6 @@ from ..systems.model import (
     PointOnLine,
     PointOnPoint,
     PointToPoint,
-    Prismatic,
     Rectangle,
     Revolute,
     RollingContact,
@@ -118,6 +118,7 @@ from .base import (
     Setting,
 )
 from ..systems._continua import Beam
+from .reactions import joint_reactions
 from .plan import (
     spatial_tree_reason,
     BODY,
@@ -1504,10 +1505,16 @@ class MujocoBackend(Backend):
                     get_state(m, d, row, spec)
             qpos, qvel = states[:, :m.nq], states[:, m.nq:]
             t = dt * np.arange(steps + 1)
-            reactions = self._reactions(comp, qpos, qvel, t, reaction_joints)
+            transmitted, pairs = self._transmitted(comp, qpos, qvel, t, reaction_joints)
             forces, violation = self._closures(comp, qpos, qvel, t)
             actuators = self._actuators(comp, qpos, qvel, t)
         q, qd = self._coordinates(comp, qpos, qvel)
+        # a coupling's tendon equality acts in joint space: cfrc_int counts it as
+        # transmitted
+        couplings = {cl.element.name: forces[cl.element.name] for cl in comp.plan.closures
+                     if cl.kind == "tendon"}
+        reactions = joint_reactions(mechanism, reaction_joints, transmitted, t, q, qd,
+                                    pair_forces=pairs, coupling_forces=couplings)
         # the substitute's own error: each closure's violation at every sample
         return Samples(q, qd, clock, reactions, forces, actuators,
                        extras={"constraint_violation": violation})
@@ -1581,20 +1588,26 @@ class MujocoBackend(Backend):
             record(k)
         return samples.result()
 
-    def _reactions(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
-                   joints: Sequence[str]) -> dict[str, np.ndarray]:
-        """Force of the parent on the child at each joint, at each sampled state."""
+    def _transmitted(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
+                     t: np.ndarray, joints: Sequence[str]
+                     ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """At each sampled state, per joint the force MuJoCo books as passing from parent
+        to child (``cfrc_int`` of the child's MJCF body), and per point-to-point element
+        that the callback applies (joint-space forces, which ``cfrc_int`` counts as
+        transmitted) its force on body_a; native tendon forces are already external
+        (MuJoCo puts them in ``cfrc_ext``)."""
         if not joints:
-            return {}
+            return {}, {}
         import mujoco
 
         plan, m, d = comp.plan, comp.model, comp.data
         mech = plan.mech
         bodies = sorted({plan.carrier[mech.joint(j).child] for j in joints})
         bid = np.array([m.body(b).id for b in bodies])
-        tids = np.array([m.tendon(e.tendon).id for e in plan.p2p], dtype=int)
+        p2p = [e for e in plan.p2p if e.native is None]
+        tids = np.array([m.tendon(e.tendon).id for e in p2p], dtype=int)
         sid = np.array([[m.site(f"{e.element.name}:a").id, m.site(f"{e.element.name}:b").id]
-                        for e in plan.p2p], dtype=int).reshape(-1, 2)
+                        for e in p2p], dtype=int).reshape(-1, 2)
         # rolling by contact: the contact carries what the description's arm and coupling
         # carried, so it counts as transmitted through the joints (contract point 6)
         discs = [cl.contact for cl in plan.closures if cl.kind == "contact"]
@@ -1621,8 +1634,7 @@ class MujocoBackend(Backend):
                 ten[k, :, 0] = ten_length[tids]
                 ten[k, :, 1] = ten_velocity[tids]
                 spos[k] = site_xpos[sid][:, :, :2]
-        q, qd = self._coordinates(comp, qpos, qvel)
-        out: dict[str, np.ndarray] = {}
+        transmitted: dict[str, np.ndarray] = {}
         for name in joints:
             joint = mech.joint(name)
             inside = set(mech.subtree(joint.child))
@@ -1630,32 +1642,13 @@ class MujocoBackend(Backend):
             for i, g in enumerate(discs):
                 if g["disc"] in inside and g["track"] not in inside:
                     r += ext[:, i]
-            # callback forces are joint-space forces, so cfrc_int counts them as
-            # transmitted by the joint: take those from outside the subtree out. Native
-            # tendon forces are already external (MuJoCo puts them in cfrc_ext).
-            for i, e in enumerate(plan.p2p):
-                f = e.element
-                in_a, in_b = f.body_a in inside, f.body_b in inside
-                if in_a == in_b or e.native is not None:
-                    continue
-                tension = ForceLaw.of(f).vector_law(ten[:, i, 0], ten[:, i, 1], t)
-                ab = spos[:, i, 1] - spos[:, i, 0]
-                unit = ab / np.linalg.norm(ab, axis=1)[:, None]
-                on_inside = tension[:, None] * unit * (1.0 if in_a else -1.0)
-                r -= on_inside
-            if isinstance(joint, Prismatic):
-                ji = mech.joints.index(joint)
-                axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
-                th = q @ plan.angle_c[joint.parent] + plan.angle_d[joint.parent]
-                c, s_ = np.cos(th), np.sin(th)
-                axis_w = np.stack([c * axis[0] - s_ * axis[1], s_ * axis[0] + c * axis[1]], 1)
-                axis_w /= float(axis @ axis)  # force F on q is F axis/|axis|^2 in space
-                for e in plan.coord:
-                    if e.j == ji:
-                        F = ForceLaw.of(e.element).vector_law(q[:, ji], qd[:, ji], t)
-                        r -= F[:, None] * axis_w
-            out[name] = r
-        return out
+            transmitted[name] = r
+        pairs: dict[str, np.ndarray] = {}
+        for i, e in enumerate(p2p):
+            tension = ForceLaw.of(e.element).vector_law(ten[:, i, 0], ten[:, i, 1], t)
+            ab = spos[:, i, 1] - spos[:, i, 0]
+            pairs[e.element.name] = tension[:, None] * (ab / np.linalg.norm(ab, axis=1)[:, None])
+        return transmitted, pairs
 
     # --- linearization -------------------------------------------------------------------
     @staticmethod

@@ -120,6 +120,7 @@ from .base import (
     Stopwatch,
     Setting,
 )
+from .reactions import joint_reactions
 from .plan import (
     spatial_tree_reason,
     BODY,
@@ -1379,7 +1380,6 @@ class PyBulletBackend(Backend):
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
             n_pf = len(plan.point_forces)
             f_point = np.zeros((total + 1, n_pf, 2))  # force on point b (on a: opposite)
-            tau_applied = np.zeros((total + 1, n))  # engine joint forces of CoordinateForces
             CF = np.full((total + 1, len(closures), 6), np.nan)  # getConstraintState rows
             # contact variant: force of the track on the disc (x, y) and contact count
             FC = np.zeros((total + 1, 3))
@@ -1408,9 +1408,7 @@ class PyBulletBackend(Backend):
                     JV[k] = jv
                     JVD[k] = jvd
                     if apply is not None:
-                        tau, forces = apply(k, jv, jvd)
-                        if tau is not None:
-                            tau_applied[k] = tau
+                        _, forces = apply(k, jv, jvd)
                         if forces is not None:
                             f_point[k] = forces
                     if drive is not None:
@@ -1438,40 +1436,38 @@ class PyBulletBackend(Backend):
             JVD[total] = [s[1] for s in js]
 
             forces = self._constraint_forces(plan, CF[: steps + 1], JV[: steps + 1])
-            f_closure = {c.element.name: forces[c.element.name] for c in closures
-                         if c.kind != "gear"}
-            tau_gear = np.zeros((steps + 1, n))
-            for r, c in enumerate(closures):
-                if c.kind == "gear":
-                    g = CF[: steps + 1, r, 0]
-                    tau_gear[:, c.a] += g
-                    tau_gear[:, c.b] += c.ratio * g
-
+            q = plan.coordinates(JV[: steps + 1, :n])
+            qd = plan.rates(JVD[: steps + 1, :n])
             reactions: dict[str, np.ndarray] = {}
             if reaction_joints:
+                # a gear is a joint force: both routes see it
+                gears = {c.element.name: forces[c.element.name] for c in closures
+                         if c.kind == "gear"}
                 if use_sensor:
-                    for r, name in enumerate(reaction_joints):
-                        reactions[name] = sensor[: steps + 1, r].copy()
+                    transmitted = {name: sensor[: steps + 1, r].copy()
+                                   for r, name in enumerate(reaction_joints)}
+                    pairs: dict[str, np.ndarray] = {}
                 else:
-                    if contact is not None:
-                        # the contact force acts on the disc (and the track) from outside
-                        # the tree: handled like a closure force on the disc
-                        f_closure = dict(f_closure)
-                        f_closure["__contact__"] = FC[: steps + 1, :2]
                     jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
-                    reactions = self._reactions_by_inverse_dynamics(
+                    transmitted = self._inverse_dynamics_forces(
                         p, cid, plan, cfg, joint_ids, list(reaction_joints),
-                        JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1],
-                        f_point[: steps + 1], f_closure)
-                self._remove_coordinate_forces(plan, joint_ids, list(reaction_joints),
-                                               reactions, plan.coordinates(JV[: steps + 1, :n]),
-                                               tau_applied[: steps + 1] + tau_gear)
+                        JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
+                    # inverse dynamics applies no element: the point-to-point and the
+                    # closure forces across the cut are in its force (on body_a: minus
+                    # the force recorded on point b). Rolling by contact: the contact
+                    # carries what the description's arm and coupling carried, so it
+                    # counts as transmitted through the joints (contract point 6)
+                    pairs = {pf.name: -f_point[: steps + 1, e]
+                             for e, pf in enumerate(plan.point_forces)}
+                    pairs.update({c.element.name: forces[c.element.name] for c in closures
+                                  if c.kind != "gear"})
+                reactions = joint_reactions(mechanism, reaction_joints, transmitted,
+                                            dt * np.arange(steps + 1), q, qd,
+                                            pair_forces=pairs, coupling_forces=gears)
             violation = self._violations(p, cid, body, eidx, plan, JV[: steps + 1])
         finally:
             p.disconnect(physicsClientId=cid)
 
-        q = plan.coordinates(JV[: steps + 1, :n])
-        qd = plan.rates(JVD[: steps + 1, :n])
         contact_report = None
         if contact is not None:
             contact_report = self._contact_report(plan, coupling, q, qd,
@@ -1598,36 +1594,14 @@ class PyBulletBackend(Backend):
                 "friction": friction, "friction_ratio": ratio,
                 "contact_points": FC[:, 2]}
 
-    @staticmethod
-    def _remove_coordinate_forces(plan: _Plan, joint_ids: list[int], names: list[str],
-                                  reactions: dict[str, np.ndarray], q: np.ndarray,
-                                  tau: np.ndarray) -> None:
-        """Both routes see the force that the coordinate laws apply along a prismatic
-        joint; the description counts it as an applied load, not as part of the reaction
-        (derivation: `_external_force_on`), so it is taken out here."""
-        for i, name in zip(joint_ids, names):
-            lk = plan.links[i]
-            if lk.revolute or not tau[:, i].any():
-                continue
-            joint = plan.mech.joints[i]
-            th = q @ plan.ang_c[joint.parent] + plan.ang_d[joint.parent]
-            c, s = np.cos(th), np.sin(th)
-            ux, uy = lk.axis_parent
-            reactions[name] -= tau[:, i, None] * np.stack([c * ux - s * uy, s * ux + c * uy],
-                                                           axis=1)
-
-    def _reactions_by_inverse_dynamics(self, p, cid: int, plan: _Plan, cfg: dict,
-                                       joint_ids: list[int], names: list[str],
-                                       JV: np.ndarray, JVD: np.ndarray, JVDD: np.ndarray,
-                                       f_point: np.ndarray,
-                                       f_closure: Mapping[str, np.ndarray] | None = None
-                                       ) -> dict[str, np.ndarray]:
-        """Reaction = inverse-dynamics force on two massless prismatic joints (x, y of the
-        parent frame) inserted in front of the joint, minus the point-to-point forces and
-        the closure-constraint forces that reach the child's subtree from outside (they act
-        on the bodies, not through the joint). Gear (coupling) forces are joint forces: on
-        a revolute joint a couple, on a prismatic joint an axial force that
-        `_remove_coordinate_forces` takes out like the coordinate laws."""
+    def _inverse_dynamics_forces(self, p, cid: int, plan: _Plan, cfg: dict,
+                                 joint_ids: list[int], names: list[str], JV: np.ndarray,
+                                 JVD: np.ndarray, JVDD: np.ndarray) -> dict[str, np.ndarray]:
+        """The force from parent to child at each joint (world axes): the inverse-dynamics
+        force on two massless prismatic joints (x, y of the parent frame) inserted in front
+        of the joint. It applies no force element and no closure, so it holds every force
+        that reaches the child's subtree from outside (`reactions.joint_reaction` takes
+        them out)."""
         body, eidx, virtual = self._build(p, cid, plan, cfg, split=set(joint_ids))
         ndof = p.getNumJoints(body, physicsClientId=cid)
         slots = np.array(eidx)
@@ -1645,40 +1619,14 @@ class PyBulletBackend(Backend):
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
         q = plan.coordinates(JV[:, :plan.n])
-        reactions: dict[str, np.ndarray] = {}
-        f_closure = f_closure or {}
+        transmitted: dict[str, np.ndarray] = {}
         for r, (i, name) in enumerate(zip(joint_ids, names)):
             joint = plan.mech.joints[i]
             th = q @ plan.ang_c[joint.parent] + plan.ang_d[joint.parent]
             c, s = np.cos(th), np.sin(th)
             fx, fy = out[:, r, 0], out[:, r, 1]
-            R = np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
-            subtree = set(plan.mech.subtree(joint.child))
-            for e, pf in enumerate(plan.point_forces):
-                in_a, in_b = pf.body_a in subtree, pf.body_b in subtree
-                if in_b and not in_a:
-                    R -= f_point[:, e]
-                elif in_a and not in_b:
-                    R += f_point[:, e]
-            # rotor and slider links belong to the subtree of the body that carries them
-            inside = subtree | {lk.body for lk in plan.links[plan.n:]
-                                if lk.parent >= 0 and plan.links[lk.parent].body in subtree}
-            pairs = [(cl.force_links, cl.element.name) for cl in plan.closures
-                     if cl.kind != "gear" and cl.element.name in f_closure]
-            # rolling by contact: the contact carries what the description's arm and
-            # coupling carried, so it counts as transmitted through the joints (contract
-            # point 6) and is not taken out
-            for (la, lb), key in pairs:
-                # the force f_closure[key] acts on link la, its opposite on link lb
-                in_a = la >= 0 and plan.links[la].body in inside
-                in_b = lb >= 0 and plan.links[lb].body in inside
-                F = np.asarray(f_closure[key], dtype=float)  # NaN where not given
-                if in_a and not in_b:
-                    R -= F
-                elif in_b and not in_a:
-                    R += F
-            reactions[name] = R
-        return reactions
+            transmitted[name] = np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
+        return transmitted
 
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
