@@ -1,0 +1,137 @@
+"""The joint reaction's bookkeeping (simulators/reactions.py), written once for every
+engine: the slide direction by virtual power against the shared forward kinematics, the
+forces entering a subtree taken out with the contract's signs (checked on a frictionless
+guide, whose reaction has no component along its slide), and on every engine the
+reaction at a prescribed slide, which carries the actuator's force as in the derivation."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from mbfidelity.analytic.linear import operating_equilibrium
+from mbfidelity.analytic.reference import reference
+from mbfidelity.comparisons import metrics, tolerances
+from mbfidelity.comparisons.runner import characteristic_frequency
+from mbfidelity.simulators import all_backends
+from mbfidelity.simulators.plan import body_states
+from mbfidelity.simulators.reactions import (joint_reaction, slide_direction,
+                                             subtree_force)
+from mbfidelity.systems import get_system
+from mbfidelity.systems.model import (COORD, COORD_RATE, Body, CoordinateForce,
+                                      LinearCoupling, Mechanism, PointToPoint, Prismatic,
+                                      Revolute)
+
+INSTALLED = [b for b in all_backends().values() if b.available()[0]]
+
+M_BLOCK, G = 2.0, 9.81
+AXIS = (3.0, 4.0)  # |axis| = 5: the slide coordinate is not a length
+TH, S, SD = 0.7, 0.2, 0.3  # arm angle, slide value and rate of the state checked
+
+
+def _arm_and_block(cable_from_block: bool) -> Mechanism:
+    """A hinged arm carrying a block on a slide along (3, 4), with a linear law on the
+    slide, a cable of constant tension 5 N from the block to the world point (1, 2), a
+    spring between arm and world (outside the slide's subtree) and a coupling of the slide
+    with the arm's angle."""
+    block, world = ("block", (0, 0)), ("world", (1.0, 2.0))
+    a, b = (block, world) if cable_from_block else (world, block)
+    return Mechanism(
+        bodies=(Body("arm", 1.0, 0.1), Body("block", M_BLOCK, 0.01)),
+        joints=(Revolute("hinge", "world", "arm", "th"),
+                Prismatic("slide", "arm", "block", "s", axis=AXIS)),
+        forces=(CoordinateForce("law", "s", -10 * COORD - 2 * COORD_RATE + 1),
+                PointToPoint("cable", a[0], a[1], b[0], b[1], 5),
+                PointToPoint("stay", "arm", (0.5, 0), "world", (0, 1), 7)),
+        gravity=G,
+        constraints=(LinearCoupling("gear", (("s", 2), ("th", 1))),), independent=("th",))
+
+
+def _turn(th: float, v) -> np.ndarray:
+    return np.array([math.cos(th) * v[0] - math.sin(th) * v[1],
+                     math.sin(th) * v[0] + math.cos(th) * v[1]])
+
+
+def test_slide_direction_is_the_virtual_power_dual_of_the_slide():
+    """F . v = Q q': the world force per unit generalized force, dotted with the block's
+    velocity per unit slide rate (forward kinematics, the arm turned), is 1."""
+    mech = _arm_and_block(True)
+    q = np.array([[TH, S], [-2.1, -0.4]])
+    for row in q:
+        vx, vy = body_states(mech, row, (0.0, 1.0))["block"][3:5]
+        direction = slide_direction(mech, mech.joint("slide"), row[None, :])[0]
+        assert direction @ (vx, vy) == pytest.approx(1.0, rel=1e-14)
+
+
+@pytest.mark.parametrize("cable_from_block", [True, False])
+def test_a_frictionless_guide_pushes_across_its_slide(cable_from_block):
+    """Newton on the block with the weight, the cable, the slide's law and the coupling's
+    generalized force: whatever the block's acceleration across the slide, the guide's
+    force (the reaction) is normal to the slide, m a.n minus the other forces' normal
+    part. The cable's force is handed in on its first body, whichever end that is."""
+    mech = _arm_and_block(cable_from_block)
+    t, q, qd = np.zeros(1), np.array([[TH, S]]), np.array([[0.4, SD]])
+    u = _turn(TH, AXIS) / 5.0
+    n = np.array([-u[1], u[0]])
+    block = _turn(TH, (S * AXIS[0], S * AXIS[1]))
+    cable = 5.0 * (np.array([1.0, 2.0]) - block) / np.linalg.norm(np.array([1.0, 2.0]) - block)
+    coupling = 0.55  # the coupling's generalized force, on s times its coefficient 2
+    law = -10 * S - 2 * SD + 1
+    slide = (law + 2 * coupling) * _turn(TH, AXIS) / 25.0
+    applied = np.array([0.0, -M_BLOCK * G]) + cable + slide
+    across = 0.37  # a . n, free: the guide supplies it
+    a = (applied @ u / M_BLOCK) * u + across * n
+    transmitted = subtree_force(mech, "slide", t, {"block": a[None, :]})
+    pairs = {"cable": (cable if cable_from_block else -cable)[None, :],
+             "stay": np.array([[1e3, -1e3]])}  # both ends outside the subtree
+    got = joint_reaction(mech, "slide", transmitted, t, q, qd, pair_forces=pairs,
+                         coupling_forces={"gear": np.array([[coupling]])})[0]
+    expected = (M_BLOCK * across - applied @ n) * n
+    assert got == pytest.approx(expected, rel=1e-12, abs=1e-12)
+    assert abs(got @ u) <= 1e-12 * np.linalg.norm(got)
+
+
+def test_only_pair_elements_are_handed_in_as_pairs():
+    mech = _arm_and_block(True)
+    with pytest.raises(ValueError, match="law"):
+        joint_reaction(mech, "slide", np.zeros((1, 2)), np.zeros(1), np.zeros((1, 2)),
+                       np.zeros((1, 2)), pair_forces={"law": np.zeros((1, 2))})
+
+
+# --- every engine: a prescribed slide's reaction carries its actuator -------------------
+
+T, DT = 1.0, 1e-3
+PRESCRIBED_SLIDES = {
+    # the string's pull is the actuator's force: the reaction along the string is all of it
+    "variable_length_pendulum": "string",
+    # the road lifts the wheel through its prescribed guide
+    "suspension": "road",
+}
+
+
+@pytest.mark.parametrize("system_id", sorted(PRESCRIBED_SLIDES))
+@pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
+def test_reaction_at_a_prescribed_slide(backend, system_id):
+    """The derivation counts a prescribed coordinate's actuator as acting through its
+    joint, so the reaction there holds its force. Each engine is held to the trajectory
+    gate of its own scheme (the reaction follows from its accelerations); the reaction with
+    the actuator's force taken out along the slide, what a bookkeeping that counted the
+    actuator as an outside force would return, is rejected."""
+    system = get_system(system_id)
+    joint = PRESCRIBED_SLIDES[system_id]
+    sc = system.scenarios[0]
+    values = system.parameter_values(scenario=sc)
+    mech = system.numeric_mechanism(values)
+    if not backend.support(mech).ok:
+        pytest.skip(backend.support(mech).reason)
+    ref = reference(dataclasses.replace(system, reaction_joints=(joint,)), sc, values, DT, T)
+    run = backend.simulate(mech, ref.q[0], ref.qd[0], T, DT, None, (joint,))
+    eq = operating_equilibrium(system, values)
+    w = characteristic_frequency(eq.modes, ref.q, ref.qd, eq.q)
+    gate = tolerances.trajectory_tolerance(w, DT, run.integrator_order, T)
+    got = run.reactions[joint][1:]  # the first sample may precede the engine's solve
+    assert np.all(np.isfinite(got))
+    assert metrics.relative_vector_error(got, ref.reactions[joint][1:]) <= gate
+    (actuator,) = run.actuator_forces.values()
+    without = got - actuator[1:, None] * slide_direction(mech, mech.joint(joint), run.q[1:])
+    assert metrics.relative_vector_error(without, ref.reactions[joint][1:]) > gate
