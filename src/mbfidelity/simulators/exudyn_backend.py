@@ -138,6 +138,7 @@ from .plan import (
     REVOLUTE,
     ROLLING_CONTACT,
     TIME_LOAD,
+    CoordinateMap,
     ForceLaw,
     constrained_bodies,
     coordinate_map,
@@ -218,9 +219,11 @@ class _DrivenItem:
 
 @dataclass
 class _Geometry:
-    """Numeric tree data derived from a (numeric) mechanism."""
+    """The link frames of Exudyn's kinematic tree for a (numeric) mechanism: one link per
+    joint, its frame at the joint, turned to a prismatic joint's axis; the map between
+    the description's coordinates and the engine's joint values is the shared one."""
 
-    n: int
+    cmap: CoordinateMap
     link_of: dict[str, int]          # body name -> link index
     parents: list[int]
     types: list[str]                 # "R" or "P"
@@ -228,12 +231,10 @@ class _Geometry:
     rotations: list[float]           # joint frame rotation against the parent link frame
     beta: dict[str, float]           # link frame orientation minus body angle
     com: dict[str, np.ndarray]       # centre of mass in the link frame
-    mass: dict[str, float]
-    inertia: dict[str, float]
-    T: np.ndarray                    # q = T u + c
-    c: np.ndarray
-    angle_rows: dict[str, tuple[np.ndarray, float]]  # body angle = row . u + const
-    gravity: float
+
+    @property
+    def n(self) -> int:
+        return len(self.parents)
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
@@ -241,12 +242,12 @@ class _Geometry:
 
     def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
-        row, const = self.angle_rows[body]
-        return u @ row + const + self.beta[body]
+        return u @ self.cmap.angle_v[body] + self.cmap.angle_v0[body] + self.beta[body]
 
     def coordinates(self, u: np.ndarray, ut: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine values and rates (rows) -> the description's coordinates and rates."""
-        return u @ self.T.T + self.c, ut @ self.T.T
+        T = self.cmap.T
+        return u @ T.T + self.cmap.c, ut @ T.T
 
 
 _AXIS_JOINTS = {(1.0, 0.0, 0.0): "RevoluteX", (0.0, 1.0, 0.0): "RevoluteY",
@@ -292,7 +293,6 @@ def _spatial_tree(mech: Mechanism, exu) -> tuple[list, list, list, list, list]:
 
 
 def _geometry(mech: Mechanism) -> _Geometry:
-    n = len(mech.joints)
     link_of: dict[str, int] = {}
     parents: list[int] = []
     types: list[str] = []
@@ -322,11 +322,7 @@ def _geometry(mech: Mechanism) -> _Geometry:
             rotations.append(alpha - beta[p])
             beta[j.child] = alpha - offset
         com[j.child] = -rot(-beta[j.child]) @ child_anchor
-    mass = {b.name: num(b.mass) for b in mech.bodies}
-    inertia = {b.name: num(b.inertia) for b in mech.bodies}
-    angle_rows = {body: (cmap.angle_v[body], cmap.angle_v0[body]) for body in cmap.angle_v}
-    return _Geometry(n, link_of, parents, types, offsets, rotations, beta, com, mass, inertia,
-                     cmap.T, cmap.c, angle_rows, num(mech.gravity))
+    return _Geometry(cmap, link_of, parents, types, offsets, rotations, beta, com)
 
 
 class ExudynBackend(Backend):
@@ -537,8 +533,8 @@ class ExudynBackend(Backend):
 
         geo = _geometry(mech)
         n = geo.n
-        Tinv = np.linalg.inv(geo.T)
-        u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.c)
+        Tinv = np.linalg.inv(geo.cmap.T)
+        u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.cmap.c)
         ud0 = Tinv @ np.asarray(qd0, dtype=float)
 
         SC = exu.SystemContainer()
@@ -550,11 +546,11 @@ class ExudynBackend(Backend):
         bodies = [j.child for j in mech.joints]
         joint_types = [exu.JointType.RevoluteZ if t == "R" else exu.JointType.PrismaticX
                        for t in geo.types]
-        inertias = [np.diag([0.0, 0.0, geo.inertia[b]]) for b in bodies]
+        inertias = [np.diag([0.0, 0.0, num(mech.body(b).inertia)]) for b in bodies]
         coms = [[*geo.com[b], 0.0] for b in bodies]
         offsets = [[*o, 0.0] for o in geo.offsets]
         transformations = [_rot3(a) for a in geo.rotations]
-        gravity = [0.0, -geo.gravity, 0.0]
+        gravity = [0.0, -num(mech.gravity), 0.0]
         if mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
             joint_types, offsets, inertias, coms, gravity = _spatial_tree(mech, exu)
             transformations = [np.eye(3)] * n
@@ -575,16 +571,16 @@ class ExudynBackend(Backend):
             target = None
             if f.relative_to is None:
                 i = mech.coordinates.index(f.coordinate)
-                row = geo.T[i]
-                if np.count_nonzero(row) == 1 and row[i] != 0 and geo.c[i] == 0:
+                row = geo.cmap.T[i]
+                if np.count_nonzero(row) == 1 and row[i] != 0 and geo.cmap.c[i] == 0:
                     target = i, row[i]  # q_i = s u_i
             else:
                 # a couple: COORD = w . q = (w T) . u + w . c, one engine coordinate when
                 # w T = r_j e_j and w . c = 0 (a hinge's own value)
-                r = sum(sign * geo.T[i] for i, sign in weights.items())
+                r = sum(sign * geo.cmap.T[i] for i, sign in weights.items())
                 r[np.abs(r) < 1e-12] = 0.0
                 nz = np.flatnonzero(r)
-                offset = sum(sign * geo.c[i] for i, sign in weights.items())
+                offset = sum(sign * geo.cmap.c[i] for i, sign in weights.items())
                 if len(nz) == 1 and offset == 0:
                     target = int(nz[0]), float(r[nz[0]])
             if aff is not None and target is not None:
@@ -602,7 +598,7 @@ class ExudynBackend(Backend):
             jointTransformations=exu.Matrix3DList(transformations),
             jointOffsets=exu.Vector3DList(offsets),
             linkInertiasCOM=exu.Matrix3DList(inertias), linkCOMs=exu.Vector3DList(coms),
-            linkMasses=[geo.mass[b] for b in bodies],
+            linkMasses=[num(mech.body(b).mass) for b in bodies],
         )
         if np.any(P) or np.any(D):
             tree_args.update(jointPControlVector=P.tolist(), jointDControlVector=D.tolist(),
@@ -699,8 +695,8 @@ class ExudynBackend(Backend):
                 a = np.zeros(geo.n)
                 for name, coef in c.coefficients:
                     a[mech.coordinates.index(name)] += num(coef)
-                row = a @ geo.T                      # Phi = row . u + offset
-                offset = float(a @ geo.c) - num(c.constant)
+                row = a @ geo.cmap.T                      # Phi = row . u + offset
+                offset = float(a @ geo.cmap.c) - num(c.constant)
                 if node_marker is None:
                     node_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
                     ground_node = mbs.AddNode(NodePointGround())
@@ -729,7 +725,7 @@ class ExudynBackend(Backend):
         ground_marker = None
         for motion in motions(mech):
             p = motion.index
-            scale, shift = float(geo.T[p, p]), float(geo.c[p])
+            scale, shift = float(geo.cmap.T[p, p]), float(geo.cmap.c[p])
             if ground_marker is None:
                 ground_node = mbs.AddNode(NodePointGround())
                 ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground_node,
@@ -810,7 +806,7 @@ class ExudynBackend(Backend):
                                   laws: list[tuple[dict[int, int], Callable[..., float]]]):
         """Each law acts on COORD = sum(sign q_i) with force sign * F on each q_i
         (`CoordinateForce.weights`)."""
-        T, c, n = geo.T, geo.c, geo.n
+        T, c, n = geo.cmap.T, geo.cmap.c, geo.n
         laws = [(tuple(w.items()), law) for w, law in laws]
         if np.array_equal(T, np.eye(n)) and not np.any(c):
             def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
@@ -905,7 +901,7 @@ class ExudynBackend(Backend):
                    f"the initial state of scenario {name!r}, solver {solver}.\nBackend "
                    f"settings:\n" + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
             items=items, simulation=sim.GetDictionary(), solver=solver, node=int(node),
-            coordinates=coordinates, T=geo.T, c=geo.c, dt=dt, not_in_script=outside)
+            coordinates=coordinates, T=geo.cmap.T, c=geo.cmap.c, dt=dt, not_in_script=outside)
         return text, outside
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
@@ -936,7 +932,8 @@ class ExudynBackend(Backend):
         acc_bodies: set[str] = set()
         for name in reaction_joints:
             joint = mechanism.joint(name)
-            acc_bodies |= {b for b in mechanism.subtree(joint.child) if geo.mass[b] != 0}
+            acc_bodies |= {b for b in mechanism.subtree(joint.child)
+                           if num(mechanism.body(b).mass) != 0}
         s_acc = {b: mbs.AddSensor(SensorKinematicTree(
             objectNumber=tree, linkNumber=geo.link_of[b], localPosition=[*geo.com[b], 0.0],
             outputVariableType=ovt.Acceleration, **sens)) for b in sorted(acc_bodies)}
@@ -1164,7 +1161,7 @@ class ExudynBackend(Backend):
         self._add_closures(exu, mbs, mech, node, tree, geo)
         mbs.Assemble()
         n = geo.n
-        u_eq = np.linalg.solve(geo.T, q_eq - geo.c)
+        u_eq = np.linalg.solve(geo.cmap.T, q_eq - geo.cmap.c)
         eps = float(cfg["linearization_relative_epsilon"])
         M, K, D = self._tree_mkd(exu, mbs, cfg)
 
