@@ -360,12 +360,11 @@ class _Plan:
                  contact: _Contact | None = None) -> None:
         opts = dict(opts or {})
         self.mech = mech
-        self.coords = mech.coordinates
-        self.n = len(self.coords)
-        self.gravity = num(mech.gravity)
+        self.n = len(mech.joints)
+        gravity = num(mech.gravity)
         up = np.array([num(u) for u in mech.up], dtype=float)
-        self.gravity_vector = ((0.0, -self.gravity, 0.0) if not mech.spatial
-                               else tuple(-self.gravity * up / np.linalg.norm(up)))
+        self.gravity_vector = ((0.0, -gravity, 0.0) if not mech.spatial
+                               else tuple(-gravity * up / np.linalg.norm(up)))
         masses = [num(b.mass) for b in mech.bodies]
         inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
@@ -418,11 +417,6 @@ class _Plan:
             link_of[j.child] = i
             anchor_of[j.child] = ca
         self.link_of = link_of
-        self.ang_c, self.ang_d = cmap.angle_c, cmap.angle_d
-        self.A, self.b = cmap.A, cmap.b
-        self.Ainv = cmap.T
-        self.AinvT = self.Ainv.T
-        self.identity_map = cmap.identity
 
         # rolling contact variant: the disc's hub rides on a massless radial slider on the
         # arm, so that the contact, not the arm, carries the normal force
@@ -483,7 +477,7 @@ class _Plan:
                         c, "prismatic", k, (0.0, 0.0), lline, lp,
                         row_normal=_slider_row_normal(u), force_links=(k, lline), **geo))
             elif isinstance(c, LinearCoupling):
-                cvec, const, w, rhs = _gear_terms(c, self.coords, self.Ainv, self.b)
+                cvec, const, w, rhs = _gear_terms(c, mech.coordinates, cmap.T, cmap.b)
                 nz = np.flatnonzero(w)
                 if len(nz) != 2:  # guarded by support()
                     raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
@@ -501,7 +495,7 @@ class _Plan:
             law = ForceLaw.of(f)
             if isinstance(f, CoordinateForce):
                 self.coord_forces.append(_CoordForce(
-                    f.weights(self.coords), law.law, law.time_dependent))
+                    f.weights(mech.coordinates), law.law, law.time_dependent))
             else:
                 self.point_forces.append(_PointForce(
                     f.name, link_of[f.body_a],
@@ -523,17 +517,6 @@ class _Plan:
                     done.add(i)
         return order
 
-    # --- coordinate maps -------------------------------------------------------------
-    def joint_values(self, q: np.ndarray) -> np.ndarray:
-        return self.map.engine_values(q)
-
-    def coordinates(self, jv: np.ndarray) -> np.ndarray:
-        """Rows of engine joint values -> description coordinates."""
-        return self.map.coordinates(jv)
-
-    def rates(self, jvd: np.ndarray) -> np.ndarray:
-        return self.map.rates(jvd)
-
     def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
         """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
         Q = np.zeros(self.n)
@@ -545,7 +528,7 @@ class _Plan:
                            sum(s * qd[i] for i, s in w.items()), t)
             for i, s in w.items():
                 Q[i] += s * force
-        return self.AinvT @ Q
+        return self.map.T.T @ Q
 
 
 @dataclass
@@ -1047,14 +1030,14 @@ class PyBulletBackend(Backend):
         (f / w_a) w = A^-T c f / w_a: the coupling's generalized force is c f / w_a and
         -lambda = f / w_a."""
         out = {}
-        q = plan.coordinates(JV[:, :plan.n]) if plan.closures else None
+        q = plan.map.coordinates(JV[:, :plan.n]) if plan.closures else None
         for r, c in enumerate(plan.closures):
             if c.kind == "gear":
                 out[c.element.name] = CF[:, r, :1] / c.scale
             elif c.kind == "prismatic":
                 if c.line_link >= 0:
                     body = plan.links[c.line_link].body
-                    th = q @ plan.ang_c[body] + plan.ang_d[body]
+                    th = plan.map.angle(body, q)
                 else:
                     th = np.zeros(len(CF))
                 nx, ny = c.row_normal
@@ -1076,7 +1059,7 @@ class PyBulletBackend(Backend):
         N = len(JV)
         out = {c.element.name: np.empty(N) for c in plan.closures}
         geo = [c for c in plan.closures if c.kind != "gear"]
-        q = plan.coordinates(JV[:, :plan.n])
+        q = plan.map.coordinates(JV[:, :plan.n])
         for c in plan.closures:
             if c.kind == "gear":
                 out[c.element.name] = q @ c.weights - c.constant
@@ -1156,8 +1139,8 @@ class PyBulletBackend(Backend):
             shapes, ring = (self._contact_shapes(p, cid, plan, cfg) if contact is not None
                             else (None, None))
             body, eidx, _ = self._build(p, cid, plan, cfg, collision=shapes, fixed_shapes=ring)
-            jv0 = plan.joint_values(q0)
-            jvd0 = plan.A @ np.asarray(qd0, dtype=float)
+            jv0 = plan.map.engine_values(q0)
+            jvd0 = plan.map.A @ np.asarray(qd0, dtype=float)
             for i in range(n):
                 p.resetJointState(body, eidx[i], float(jv0[i]), float(jvd0[i]),
                                   physicsClientId=cid)
@@ -1200,8 +1183,8 @@ class PyBulletBackend(Backend):
         links = eidx[:n]
         point_links = [eidx[k] for k in plan.point_links]
         pos_of = {k: m for m, k in enumerate(plan.point_links)}
-        Ainv, bvec = plan.Ainv, plan.b
-        identity = plan.identity_map
+        Ainv, bvec = plan.map.T, plan.map.b
+        identity = plan.map.identity
         moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
                                if lk >= 0})
         moving_eidx = [eidx[lk] for lk in moving_links]
@@ -1306,8 +1289,8 @@ class PyBulletBackend(Backend):
                         step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
             plan = world.plan
-            return BareLoop(clock.cpu, plan.coordinates(np.array([[s[0] for s in js]]))[0],
-                            plan.rates(np.array([[s[1] for s in js]]))[0])
+            return BareLoop(clock.cpu, plan.map.coordinates(np.array([[s[0] for s in js]]))[0],
+                            plan.map.rates(np.array([[s[1] for s in js]]))[0])
         finally:
             p.disconnect(physicsClientId=world.cid)
 
@@ -1436,8 +1419,8 @@ class PyBulletBackend(Backend):
             JVD[total] = [s[1] for s in js]
 
             forces = self._constraint_forces(plan, CF[: steps + 1], JV[: steps + 1])
-            q = plan.coordinates(JV[: steps + 1, :n])
-            qd = plan.rates(JVD[: steps + 1, :n])
+            q = plan.map.coordinates(JV[: steps + 1, :n])
+            qd = plan.map.rates(JVD[: steps + 1, :n])
             reactions: dict[str, np.ndarray] = {}
             if reaction_joints:
                 # a gear is a joint force: both routes see it
@@ -1579,10 +1562,10 @@ class PyBulletBackend(Backend):
         ct = plan.contact
         cvec = np.zeros(plan.n)
         for name, coef in coupling.coefficients:
-            cvec[plan.coords.index(name)] += num(coef)
+            cvec[plan.mech.coordinates.index(name)] += num(coef)
         const = num(coupling.constant)
         arm = plan.mech.joints[ct.hub].parent
-        th = q @ plan.ang_c[arm] + plan.ang_d[arm]
+        th = plan.map.angle(arm, q)
         ux0, uy0 = ct.radial
         ux, uy = np.cos(th) * ux0 - np.sin(th) * uy0, np.sin(th) * ux0 + np.cos(th) * uy0
         normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
@@ -1618,11 +1601,11 @@ class PyBulletBackend(Backend):
                           physicsClientId=cid)
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
-        q = plan.coordinates(JV[:, :plan.n])
+        q = plan.map.coordinates(JV[:, :plan.n])
         transmitted: dict[str, np.ndarray] = {}
         for r, (i, name) in enumerate(zip(joint_ids, names)):
             joint = plan.mech.joints[i]
-            th = q @ plan.ang_c[joint.parent] + plan.ang_d[joint.parent]
+            th = plan.map.angle(joint.parent, q)
             c, s = np.cos(th), np.sin(th)
             fx, fy = out[:, r, 0], out[:, r, 1]
             transmitted[name] = np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
@@ -1667,7 +1650,7 @@ class PyBulletBackend(Backend):
         cid = self._connect(p, cfg, dt, plan.gravity_vector)
         try:
             body, eidx, _ = self._build(p, cid, plan, cfg)
-            jv_eq = plan.joint_values(np.asarray(q_eq, dtype=float))
+            jv_eq = plan.map.engine_values(np.asarray(q_eq, dtype=float))
             zeros = [0.0] * n
             perm = np.asarray(eidx[:n])  # engine (depth-first) index of each joint
 
@@ -1679,8 +1662,8 @@ class PyBulletBackend(Backend):
 
             def applied(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
                 """Engine joint forces of the autonomous force elements at (jv, jvd)."""
-                q = plan.coordinates(jv)
-                qd = plan.rates(jvd)
+                q = plan.map.coordinates(jv)
+                qd = plan.map.rates(jvd)
                 tau = plan.coordinate_torques(q, qd, 0.0, autonomous=True)
                 pfs = [pf for pf in plan.point_forces if not pf.time_dependent]
                 if not pfs:
