@@ -135,6 +135,7 @@ from .plan import (
     REVOLUTE,
     ROLLING_CONTACT,
     TIME_LOAD,
+    CoordinateMap,
     ForceLaw,
     coordinate_map,
     coupled,
@@ -248,12 +249,7 @@ class _Plan:
     """A numeric mechanism translated to MuJoCo terms."""
 
     mech: Mechanism
-    n: int
-    A: np.ndarray
-    Ainv: np.ndarray
-    b: np.ndarray
-    angle_c: dict[str, np.ndarray]
-    angle_d: dict[str, float]
+    cmap: CoordinateMap  # description coordinates q <-> engine joint values v
     carrier: dict[str, str]  # description body -> MJCF body carrying it
     chains: dict[str, list[int]]  # MJCF body -> description joint indices, in order
     mj_parent: dict[str, str]
@@ -267,8 +263,9 @@ class _Plan:
     opts: dict = field(default_factory=dict)
     xml: str = ""
 
-    def engine_values(self, q: np.ndarray) -> np.ndarray:
-        return self.A @ np.asarray(q, dtype=float) + self.b
+    @property
+    def n(self) -> int:
+        return len(self.mech.joints)
 
 
 def _point_loaded_bodies(mech: Mechanism) -> set[str]:
@@ -318,7 +315,6 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
     n = len(mech.joints)
     cmap = coordinate_map(mech)
     A, b, Ainv = cmap.A, cmap.b, cmap.T
-    angle_c, angle_d = cmap.angle_c, cmap.angle_d
 
     foldable = _foldable(mech)
     carrier: dict[str, str] = {}
@@ -336,7 +332,7 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
         parent = mech.joints[chain[0]].parent
         mj_parent[name] = WORLD if parent == WORLD else carrier[parent]
 
-    plan = _Plan(mech, n, A, Ainv, b, angle_c, angle_d, carrier, chains, mj_parent)
+    plan = _Plan(mech, cmap, carrier, chains, mj_parent)
     plan.opts = opts
     m_min = min(num(bd.mass) for bd in mech.bodies if not bd.massless)
     # massless bodies that cannot be folded: a pure kinematic link (several children, no
@@ -468,7 +464,7 @@ def _poses(plan: _Plan, q: np.ndarray) -> tuple[dict, dict]:
     for i, j in enumerate(mech.joints):
         pp, thp = poses[j.parent]
         Rp = rot(thp)
-        th = float(plan.angle_c[j.child] @ q + plan.angle_d[j.child])
+        th = float(plan.cmap.angle_c[j.child] @ q + plan.cmap.angle_d[j.child])
         pa = np.array([num(j.parent_anchor[0]), num(j.parent_anchor[1])])
         ca = np.array([num(j.child_anchor[0]), num(j.child_anchor[1])])
         if isinstance(j, Revolute):
@@ -552,7 +548,7 @@ def _spatial_reason(mech: Mechanism) -> str:
 
 def _mjcf(plan: _Plan, joint_native: dict[int, list[float]]) -> str:
     mech = plan.mech
-    q_ref = plan.Ainv @ (-plan.b)  # the configuration with every engine value 0
+    q_ref = plan.cmap.T @ (-plan.cmap.b)  # the configuration with every engine value 0
     poses, janchor = _poses(plan, q_ref)
     native_joint = {e.j for e in plan.coord if e.native is not None}
     sites: dict[str, list[str]] = {}
@@ -810,9 +806,9 @@ class _Compiled:
         coordinate over its coefficient; and the accumulated slip Phi = c.q - const."""
         d = self.data
         qfrc = self._contact_qfrc(self.disc_geom[k_contact])
-        Q = self.plan.A.T @ qfrc[self.vadr]
+        Q = self.plan.cmap.A.T @ qfrc[self.vadr]
         j = cl.contact["j"]
-        q = self.plan.Ainv @ (d.qpos[self.qadr] - self.plan.b)
+        q = self.plan.cmap.T @ (d.qpos[self.qadr] - self.plan.cmap.b)
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
@@ -822,10 +818,10 @@ class _Compiled:
         for e in plan.coord:
             if e.native is not None:
                 continue
-            row = plan.Ainv[e.j] if e.row is None else e.row
+            row = plan.cmap.T[e.j] if e.row is None else e.row
             nz = np.flatnonzero(row)
             ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
-            const = float(-row @ plan.b)
+            const = float(-row @ plan.cmap.b)
             # generalized force on the engine dofs: A^-T e_j F (row j of A^-1)
             outs = tuple((int(self.vadr[i]), float(row[i])) for i in nz)
             coord_terms.append((e.law, ins, const, outs))
@@ -884,10 +880,10 @@ class _Compiled:
             return None
         mujoco = self.mujoco
         nv, k = model.nv, len(moves)
-        rows = plan.Ainv[[mv.index for mv in moves]]  # q_p = rows (v - b)
+        rows = plan.cmap.T[[mv.index for mv in moves]]  # q_p = rows (v - b)
         Tp = np.zeros((k, nv))
         Tp[:, self.vadr] = rows
-        qadr, b = self.qadr, plan.b
+        qadr, b = self.qadr, plan.cmap.b
         stack = np.zeros((1 + k, nv))  # the free force and the actuators' columns
         stack[1:] = Tp
         solved = np.zeros_like(stack)
@@ -978,8 +974,8 @@ class _Compiled:
         value is (P - L) . u and its rate (v_P - v_L) . u, with v_L the velocity of the
         slot body's material point under the slider."""
         mujoco, m, d = self.mujoco, self.model, self.data
-        d.qpos[self.qadr] = self.plan.engine_values(q)
-        d.qvel[self.vadr] = self.plan.A @ np.asarray(qd, dtype=float)
+        d.qpos[self.qadr] = self.plan.cmap.engine_values(q)
+        d.qvel[self.vadr] = self.plan.cmap.A @ np.asarray(qd, dtype=float)
         d.time = t
         d.qpos[self.radial_qadr] = 0.0
         d.qvel[self.radial_vadr] = 0.0
@@ -1443,8 +1439,8 @@ class MujocoBackend(Backend):
                         f'qvel="{_fmt(*comp.data.qvel)}"/>')
         custom = (f'  <custom>\n'
                   f'    <numeric name="mbfidelity_qadr" data="{_fmt(*comp.qadr)}"/>\n'
-                  f'    <numeric name="mbfidelity_A" data="{_fmt(*plan.A.ravel())}"/>\n'
-                  f'    <numeric name="mbfidelity_b" data="{_fmt(*plan.b)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{_fmt(*plan.cmap.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{_fmt(*plan.cmap.b)}"/>\n'
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
@@ -1545,9 +1541,7 @@ class MujocoBackend(Backend):
                      qvel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine joint values (rows) -> the description's coordinates and rates."""
         plan = comp.plan
-        q = (qpos[:, comp.qadr] - plan.b) @ plan.Ainv.T
-        qd = qvel[:, comp.vadr] @ plan.Ainv.T
-        return q, qd
+        return plan.cmap.coordinates(qpos[:, comp.qadr]), plan.cmap.rates(qvel[:, comp.vadr])
 
     def _actuators(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
                    t: np.ndarray) -> dict[str, np.ndarray]:
@@ -1769,7 +1763,7 @@ class MujocoBackend(Backend):
             perm = comp.vadr
             K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
             eig = quadratic_eigenvalues(M, C, K)
-            A = plan.A  # v = A q + b: matrices in description coordinates are A^T X A
+            A = plan.cmap.A  # v = A q + b: matrices in description coordinates are A^T X A
             extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
             method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central differences "
                       f"of mj_inverse, eps={eps:g})")
