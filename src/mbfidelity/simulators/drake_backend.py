@@ -657,14 +657,10 @@ class DrakeBackend(Backend):
                 continue
             weights = f.weights(mech.coordinates)
             law = ForceLaw.of(f)
-            row = sum(sign * cmap.T[i] for i, sign in weights.items())
-            row = np.where(np.abs(row) < 1e-12, 0.0, row)
-            shift = sum(sign * cmap.c[i] for i, sign in weights.items())
-            target = np.flatnonzero(row)
+            target = cmap.law_target(weights)
             linear = law.linear if native else None
-            if linear is not None and len(target) == 1 and shift == 0:
-                j = int(target[0])
-                r = float(row[j])
+            if linear is not None and target is not None:
+                j, r = target
                 a, b, c = linear
                 k, d = -r * r * b, -r * r * c
                 if k >= 0 and d >= 0 and (k > 0 or a == 0):

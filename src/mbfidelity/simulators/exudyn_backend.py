@@ -568,21 +568,7 @@ class ExudynBackend(Backend):
             law = ForceLaw.of(f)
             aff = law.linear if settings["native_linear_laws"] else None
             # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
-            target = None
-            if f.relative_to is None:
-                i = mech.coordinates.index(f.coordinate)
-                row = geo.cmap.T[i]
-                if np.count_nonzero(row) == 1 and row[i] != 0 and geo.cmap.c[i] == 0:
-                    target = i, row[i]  # q_i = s u_i
-            else:
-                # a couple: COORD = w . q = (w T) . u + w . c, one engine coordinate when
-                # w T = r_j e_j and w . c = 0 (a hinge's own value)
-                r = sum(sign * geo.cmap.T[i] for i, sign in weights.items())
-                r[np.abs(r) < 1e-12] = 0.0
-                nz = np.flatnonzero(r)
-                offset = sum(sign * geo.cmap.c[i] for i, sign in weights.items())
-                if len(nz) == 1 and offset == 0:
-                    target = int(nz[0]), float(r[nz[0]])
+            target = geo.cmap.law_target(weights)
             if aff is not None and target is not None:
                 j, s = target
                 a0, ax, av = aff

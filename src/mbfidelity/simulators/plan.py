@@ -409,6 +409,19 @@ class CoordinateMap:
         """The body's angle at q (rows of q give one angle per row)."""
         return q @ self.angle_c[body] + self.angle_d[body]
 
+    def law_target(self, weights: dict[int, int]) -> tuple[int, float] | None:
+        """(j, r) when a coordinate law's argument COORD = sum sign q_i (`weights`, as in
+        `CoordinateForce.weights`) is r v_j, one engine joint value without offset (an
+        engine can then hold the law on its joint j: force r F(r v_j, r v_j') on v_j);
+        None otherwise. Weights below 1e-12 are round-off of T and set to zero."""
+        row = sum(sign * self.T[i] for i, sign in weights.items())
+        row = np.where(np.abs(row) < 1e-12, 0.0, row)
+        shift = sum(sign * self.c[i] for i, sign in weights.items())
+        target = np.flatnonzero(row)
+        if len(target) != 1 or shift != 0:
+            return None
+        return int(target[0]), float(row[target[0]])
+
     def on_engine_values(self, coefficients: np.ndarray, constant: float
                          ) -> tuple[np.ndarray, float]:
         """A linear relation sum a_k q_k = C on the coordinates written on the engine
