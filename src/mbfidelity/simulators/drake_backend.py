@@ -92,6 +92,8 @@ from .base import (
 )
 from .reactions import joint_reactions
 from .plan import (
+    CoordinateLaws,
+    driven_start,
     BODY,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
@@ -556,7 +558,7 @@ class DrakeBackend(Backend):
                     joints[i1], ratio, offset)
         rec.python_forces = [f.name for f in mech.forces
                              if any(f is w for w in python_p2p)
-                             or any(law.element is f for _, law in python_laws)]
+                             or any(f is g for g in python_laws)]
         plant.Finalize()
         python_forces = bool(python_laws or python_p2p or mech.prescribed)
         positions = np.array([j.position_start() for j in joints], dtype=int)
@@ -644,8 +646,8 @@ class DrakeBackend(Backend):
 
     @staticmethod
     def _coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool):
-        """(springs [(joint, stiffness, nominal value)], damping per joint, laws left to the
-        Python force system [(weights, law)]). A law goes to Drake's own elements when its
+        """(springs [(joint, stiffness, nominal value)], damping per joint, the laws
+        (CoordinateForce elements) left to the Python force system). A law goes to Drake's own elements when its
         coordinate is r v_j, one engine joint value (COORD = sum sign q_i = (sum sign T_i) v
         + sum sign c_i): then tau_j = r F(r v_j, r v_j') = r a + r^2 b v_j + r^2 c v_j', a
         spring of stiffness k = -r^2 b >= 0 and nominal value r a / k, and a damper
@@ -668,7 +670,7 @@ class DrakeBackend(Backend):
                         springs.append((j, k, r * a / k))
                     damping[j] += d
                     continue
-            python_laws.append((weights, law))
+            python_laws.append(f)
         return springs, damping, python_laws
 
     # --- running -----------------------------------------------------------------------------
@@ -701,7 +703,7 @@ class DrakeBackend(Backend):
                        steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
         built = self._build(mechanism, cfg, dt)
-        q0, qd0 = _driven_state(mechanism, q0, qd0)
+        q0, qd0 = driven_start(mechanism, q0, qd0)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
         n = len(mechanism.joints)
@@ -769,7 +771,7 @@ class DrakeBackend(Backend):
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The diagram of `simulate`, advanced to the same sample times, nothing read."""
         built = self._build(mechanism, cfg, dt)
-        q0, qd0 = _driven_state(mechanism, q0, qd0)
+        q0, qd0 = driven_start(mechanism, q0, qd0)
         simulator, _, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         with Stopwatch() as clock:
             for k in range(1, steps + 1):
@@ -847,16 +849,6 @@ def _place_slider(plant, context, slide, body, pin, line, axis) -> None:
     slide.set_translation_rate(context, float(J @ plant.GetVelocities(context) @ axis))
 
 
-def _driven_state(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """The initial state with each prescribed coordinate on its motion at t = 0
-    (convention 9); an undriven mechanism's state unchanged."""
-    q0, qd0 = np.array(q0, dtype=float), np.array(qd0, dtype=float)
-    for motion in motions(mech):
-        q0[motion.index], qd0[motion.index] = motion.position(0.0), motion.rate(0.0)
-    return q0, qd0
-
-
 class _Recorder:
     """Calls into pydrake, each also written as a line of Python (`export`): a call given
     a variable name becomes ``name = text(args)``, one given "" a statement, one given
@@ -927,7 +919,7 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
 
     nq, nv = plant.num_positions(), plant.num_velocities()
     n = len(mech.joints)
-    laws = [(tuple(w.items()), law.law) for w, law in coordinate_laws]
+    laws = CoordinateLaws(mech, coordinate_laws)
     points = [(f, ForceLaw.of(f).law, np.array([num(f.point_a[0]), num(f.point_a[1]), 0.0]),
                np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in point_laws]
     kinematics = plant.CreateDefaultContext()
@@ -950,13 +942,8 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
             """The coordinate laws' generalized force, in the plant's velocity order."""
             tau = np.zeros(nv)
             if laws:
-                q, qd = T @ x[positions] + c, T @ x[nq + velocities]
-                Q = np.zeros(n)
-                for w, law in laws:
-                    F = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
-                    for i, s in w:
-                        Q[i] += s * F
-                tau[velocities] = T.T @ Q
+                Q = laws.generalized(T @ x[positions] + c, T @ x[nq + velocities], t)
+                tau[velocities] = T.T @ np.asarray(Q)
             return tau
 
         def actuators(self, x: np.ndarray, t: float, tau_laws: np.ndarray) -> np.ndarray:

@@ -123,6 +123,8 @@ from .base import (
 )
 from .reactions import joint_reactions, subtree_force
 from .plan import (
+    CoordinateLaws,
+    driven_start,
     spatial_tree_reason,
     BODY,
     PRESCRIBED,
@@ -560,7 +562,7 @@ class ExudynBackend(Backend):
         P = np.zeros(n)
         D = np.zeros(n)
         f_const = np.zeros(n)
-        python_laws: list[tuple[dict[int, int], Callable[..., float]]] = []
+        python_laws: list[CoordinateForce] = []
         for f in mech.forces:
             if not isinstance(f, CoordinateForce):
                 continue
@@ -576,7 +578,7 @@ class ExudynBackend(Backend):
                 P[j] += -s * s * ax
                 D[j] += -s * s * av
             else:
-                python_laws.append((weights, law.law))
+                python_laws.append(f)
 
         tree_args = dict(
             nodeNumber=node, gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
@@ -593,7 +595,8 @@ class ExudynBackend(Backend):
         if np.any(f_const):
             tree_args.update(jointForceVector=f_const.tolist())
         if python_laws:
-            tree_args.update(forceUserFunction=self._coordinate_user_function(geo, python_laws))
+            tree_args.update(forceUserFunction=self._coordinate_user_function(
+                geo, CoordinateLaws(mech, python_laws)))
         tree = mbs.AddObject(ObjectKinematicTree(**tree_args))
 
         # point-to-point elements: spring-dampers between markers
@@ -730,21 +733,6 @@ class ExudynBackend(Backend):
             return (f(t) - shift) / scale
         return uf
 
-    @staticmethod
-    def _driven_state(mech: Mechanism, q0: np.ndarray,
-                      qd0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The initial state with each prescribed coordinate on its motion at t = 0
-        (convention 9: it follows q(t) for the whole run, so its start is not free).
-        Undriven mechanisms get their arguments back untouched."""
-        if not mech.prescribed:
-            return q0, qd0
-        q0 = np.array(q0, dtype=float)
-        qd0 = np.array(qd0, dtype=float)
-        for motion in motions(mech):
-            q0[motion.index] = motion.position(0.0)
-            qd0[motion.index] = motion.rate(0.0)
-        return q0, qd0
-
     def _consistent_start(self, exu, mbs, cfg: dict, mech: Mechanism,
                           driven: list[_DrivenItem]) -> np.ndarray:
         """Initial accelerations and multipliers that meet the prescribed accelerations
@@ -788,31 +776,17 @@ class ExudynBackend(Backend):
         return uf
 
     @staticmethod
-    def _coordinate_user_function(geo: _Geometry,
-                                  laws: list[tuple[dict[int, int], Callable[..., float]]]):
-        """Each law acts on COORD = sum(sign q_i) with force sign * F on each q_i
-        (`CoordinateForce.weights`)."""
+    def _coordinate_user_function(geo: _Geometry, laws: CoordinateLaws):
+        """The laws' generalized force on the engine coordinates (T^T Q)."""
         T, c, n = geo.cmap.T, geo.cmap.c, geo.n
-        laws = [(tuple(w.items()), law) for w, law in laws]
         if np.array_equal(T, np.eye(n)) and not np.any(c):
             def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
-                out = [0.0] * n
-                for w, law in laws:
-                    F = law(sum(s * u[i] for i, s in w), sum(s * u_t[i] for i, s in w), t)
-                    for i, s in w:
-                        out[i] += s * F
-                return out
+                return laws.generalized(u, u_t, t)
             return uf
 
         def uf_mapped(mbs, t, item, u, u_t):
-            q = T @ np.asarray(u) + c
-            qd = T @ np.asarray(u_t)
-            F = np.zeros(n)
-            for w, law in laws:
-                force = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
-                for i, s in w:
-                    F[i] += s * force
-            return (T.T @ F).tolist()
+            Q = laws.generalized(T @ np.asarray(u) + c, T @ np.asarray(u_t), t)
+            return (T.T @ np.asarray(Q)).tolist()
         return uf_mapped
 
     def _simulation_settings(self, exu, settings: dict, t_end: float, steps: int):
@@ -859,7 +833,7 @@ class ExudynBackend(Backend):
         if not support.ok:
             raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
         solver = self._solver_for(mechanism, cfg)
-        q0, qd0 = self._driven_state(mechanism, q0, qd0)
+        q0, qd0 = driven_start(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
         driven = self._add_prescribed(mbs, mechanism, node, geo)
@@ -903,7 +877,7 @@ class ExudynBackend(Backend):
                        reaction_joints: tuple[str, ...]) -> Samples:
         solver = self._solver_for(mechanism, cfg)
         t_run = steps * dt
-        q0, qd0 = self._driven_state(mechanism, q0, qd0)
+        q0, qd0 = driven_start(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
         driven = self._add_prescribed(mbs, mechanism, node, geo)
@@ -986,7 +960,7 @@ class ExudynBackend(Backend):
         """The system of `simulate` without its sensors, solved by the same solver."""
         solver = self._solver_for(mechanism, cfg)
         # SC owns mbs: it stays referenced until the solve returns
-        q0, qd0 = self._driven_state(mechanism, q0, qd0)
+        q0, qd0 = driven_start(mechanism, q0, qd0)
         exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
         closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
         driven = self._add_prescribed(mbs, mechanism, node, geo)

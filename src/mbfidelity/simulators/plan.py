@@ -242,6 +242,29 @@ class ForceLaw:
         return call
 
 
+class CoordinateLaws:
+    """Coordinate laws (`CoordinateForce`) evaluated together, as an engine's force
+    callback evaluates them at each stage: `generalized(q, qd, t)` is their generalized
+    force on the description coordinates (each law F(COORD, COORD', t) acts with
+    sign * F on each coordinate of its `weights`), as a list (q, qd: sequences)."""
+
+    def __init__(self, mech: Mechanism, forces) -> None:
+        self.n = len(mech.joints)
+        self.terms = tuple((tuple(f.weights(mech.coordinates).items()), ForceLaw.of(f).law)
+                           for f in forces)
+
+    def __bool__(self) -> bool:
+        return bool(self.terms)
+
+    def generalized(self, q, qd, t: float) -> list[float]:
+        Q = [0.0] * self.n
+        for w, law in self.terms:
+            F = law(sum(s * q[i] for i, s in w), sum(s * qd[i] for i, s in w), t)
+            for i, s in w:
+                Q[i] += s * F
+        return Q
+
+
 _LAWS: dict[object, ForceLaw] = {}
 
 
@@ -288,6 +311,15 @@ class Motion:
 def motions(mech: Mechanism) -> list[Motion]:
     """The prescribed motions of a numeric mechanism, in description order."""
     return [Motion(p, mech.coordinates.index(p.coordinate)) for p in mech.prescribed]
+
+
+def driven_start(mech: Mechanism, q0, qd0) -> tuple[np.ndarray, np.ndarray]:
+    """The initial state (copies) with each prescribed coordinate on its motion at t = 0
+    (convention 9: it follows q(t) for the whole run, so its start is not free)."""
+    q0, qd0 = np.array(q0, dtype=float), np.array(qd0, dtype=float)
+    for motion in motions(mech):
+        q0[motion.index], qd0[motion.index] = motion.position(0.0), motion.rate(0.0)
+    return q0, qd0
 
 
 def coupled(mech: Mechanism) -> Mechanism:

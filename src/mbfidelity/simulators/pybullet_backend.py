@@ -122,6 +122,7 @@ from .base import (
 )
 from .reactions import joint_reactions
 from .plan import (
+    CoordinateLaws,
     spatial_tree_reason,
     BODY,
     PRESCRIBED,
@@ -190,13 +191,6 @@ class _PointForce:
     body_b: str
     time_dependent: bool
 
-
-@dataclass
-class _CoordForce:
-    #: {coordinate index: sign} (`CoordinateForce.weights`)
-    weights: dict[int, int]
-    law: Callable[[float, float, float], float]
-    time_dependent: bool
 
 
 @dataclass
@@ -489,14 +483,14 @@ class _Plan:
             else:  # guarded by support()
                 raise TypeError(f"unsupported constraint {c!r}")
 
-        self.coord_forces: list[_CoordForce] = []
+        coordinate = [f for f in mech.forces if isinstance(f, CoordinateForce)]
+        self.coordinate_laws = CoordinateLaws(mech, coordinate)
+        self.autonomous_laws = CoordinateLaws(
+            mech, [f for f in coordinate if not ForceLaw.of(f).time_dependent])
         self.point_forces: list[_PointForce] = []
         for f in mech.forces:
             law = ForceLaw.of(f)
-            if isinstance(f, CoordinateForce):
-                self.coord_forces.append(_CoordForce(
-                    f.weights(mech.coordinates), law.law, law.time_dependent))
-            else:
+            if not isinstance(f, CoordinateForce):
                 self.point_forces.append(_PointForce(
                     f.name, link_of[f.body_a],
                     (num(f.point_a[0]), num(f.point_a[1])),
@@ -519,16 +513,8 @@ class _Plan:
 
     def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
         """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
-        Q = np.zeros(self.n)
-        for cf in self.coord_forces:
-            if autonomous and cf.time_dependent:
-                continue
-            w = cf.weights
-            force = cf.law(sum(s * q[i] for i, s in w.items()),
-                           sum(s * qd[i] for i, s in w.items()), t)
-            for i, s in w.items():
-                Q[i] += s * force
-        return self.map.T.T @ Q
+        laws = self.autonomous_laws if autonomous else self.coordinate_laws
+        return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))
 
 
 @dataclass
@@ -1169,7 +1155,7 @@ class PyBulletBackend(Backend):
         `jv` and `jvd`."""
         plan, cid, body, eidx = world.plan, world.cid, world.body, world.eidx
         n = plan.n
-        has_cf = bool(plan.coord_forces)
+        has_cf = bool(plan.coordinate_laws)
         n_pf = len(plan.point_forces)
         moving = [(world.cids[r], c) for r, c in enumerate(plan.closures)
                   if c.kind == "prismatic"]
