@@ -11,12 +11,16 @@ them and lives here:
   entry numeric, no zero axis, slot direction or coupling);
 - the force laws, compiled once, with their classification (`ForceLaw`): linear (a
   spring of stiffness -b and free length -a/b, a damper of coefficient c, or a constant
-  force, ``a + b x + c x'`` with no TIME) or custom;
+  force, ``a + b x + c x'`` with no TIME) or custom; the coordinate laws' generalized
+  force, as an engine's force callback evaluates it (`CoordinateLaws`);
+- the prescribed motions (`Motion`, `motions`) and the start state they impose
+  (`driven_start`);
 - the map between the description coordinates q and the engine joint values v
   (`CoordinateMap`): every engine joint is relative (v = theta_child - theta_parent -
   angle_offset for a hinge, the slide along the unit axis for a prismatic joint), so
   ``v = A q + b`` with the inverse ``q = T v + c``, and the body angles are affine in
-  both.
+  both; a coordinate law whose argument is one engine joint value can sit on that joint
+  (`CoordinateMap.law_target`).
 """
 from __future__ import annotations
 
