@@ -32,7 +32,8 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   joint's own coordinate (springs, damping, applied generalized force) as transmitted
   through the joint; along a prismatic joint's slide the coordinate's force elements,
   which the contract's reaction excludes, are taken out (`reactions.joint_reaction`),
-  while a prescribed coordinate's actuator stays in, as in the derivation;
+  while a prescribed coordinate's actuator stays in, as in the derivation (a coupler
+  constraint on a slide, whose force Drake does not report, leaves its reaction NaN);
 - linearization: Drake's ``Linearize`` (automatic differentiation) of the plant when no
   Python force system is needed, otherwise central differences of the diagram's own time
   derivatives; the eigenvalues of the 2n x 2n state matrix.
