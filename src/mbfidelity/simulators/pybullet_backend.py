@@ -483,19 +483,21 @@ class _Plan:
             else:  # guarded by support()
                 raise TypeError(f"unsupported constraint {c!r}")
 
-        coordinate = [f for f in mech.forces if isinstance(f, CoordinateForce)]
-        self.coordinate_laws = CoordinateLaws(mech, coordinate)
-        self.autonomous_laws = CoordinateLaws(
-            mech, [f for f in coordinate if not ForceLaw.of(f).time_dependent])
+        coordinate: list[CoordinateForce] = []
         self.point_forces: list[_PointForce] = []
         for f in mech.forces:
             law = ForceLaw.of(f)
-            if not isinstance(f, CoordinateForce):
-                self.point_forces.append(_PointForce(
-                    f.name, link_of[f.body_a],
-                    (num(f.point_a[0]), num(f.point_a[1])),
-                    link_of[f.body_b], (num(f.point_b[0]), num(f.point_b[1])),
-                    law.law, f.body_a, f.body_b, law.time_dependent))
+            if isinstance(f, CoordinateForce):
+                coordinate.append(f)
+                continue
+            self.point_forces.append(_PointForce(
+                f.name, link_of[f.body_a],
+                (num(f.point_a[0]), num(f.point_a[1])),
+                link_of[f.body_b], (num(f.point_b[0]), num(f.point_b[1])),
+                law.law, f.body_a, f.body_b, law.time_dependent))
+        self.coordinate_laws = CoordinateLaws(mech, coordinate)
+        self.autonomous_laws = CoordinateLaws(
+            mech, [f for f in coordinate if not ForceLaw.of(f).time_dependent])
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
