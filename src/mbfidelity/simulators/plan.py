@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property, singledispatch
-from typing import Callable, Iterator
+from typing import Callable, Iterator, Sequence
 
 import numpy as np
 import sympy as sp
@@ -569,3 +569,119 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str
     if any(isinstance(f, PointToPoint) for f in mech.forces):
         return "a point-to-point element in a spatial mechanism (the spatial build has none)"
     return ""
+
+
+# --- planar kinematics on numbers or on arrays of samples ------------------------------
+
+
+# The functions below take numbers (one step), arrays of samples (a run's read-out) or
+# SymPy expressions (`traced`: a step's function compiled to straight-line code).
+
+
+def _module(*values):
+    """The functions for the kind of the values: NumPy, SymPy or `math`."""
+    if any(isinstance(v, np.ndarray) for v in values):
+        return np
+    if any(isinstance(v, sp.Basic) for v in values):
+        return sp
+    return math
+
+
+def cos_sin(theta):
+    """(cos, sin) of an angle."""
+    m = _module(theta)
+    return m.cos(theta), m.sin(theta)
+
+
+def sqrt(x):
+    return _module(x).sqrt(x)
+
+
+def atan2(y, x):
+    m = _module(y, x)
+    return m.atan2(y, x)
+
+
+def law_value(law: ForceLaw, x, xd, t):
+    """A force law at (x, x', t): compiled for numbers, vectorised for arrays, its
+    expression for SymPy arguments."""
+    m = _module(x, xd, t)
+    if m is sp:
+        return law.expr.xreplace(dict(zip(law.args, map(sp.sympify, (x, xd, t)))))
+    return (law.vector_law if m is np else law.law)(x, xd, t)
+
+
+def linear_solver(A: list[list]) -> Callable[[list], list]:
+    """Solving A x = b for a small square A (nested lists) whose entries are numbers,
+    arrays of samples (one matrix per sample) or SymPy expressions; the solver takes
+    and gives lists of the same kind (b's entries may also be arrays over other
+    right-hand sides when A's are numbers)."""
+    flat = [e for row in A for e in row]
+    m = len(A)
+    if _module(*flat) is sp:
+        M = sp.Matrix(A)
+        return lambda b: list(M.LUsolve(sp.Matrix([sp.sympify(v) for v in b])))
+    arrays = np.broadcast_arrays(*[np.asarray(e, dtype=float) for e in flat])
+    M = np.array(arrays).reshape(m, m, *arrays[0].shape)
+    if M.ndim == 2:
+        inv = np.linalg.inv(M).tolist()
+    else:
+        full = np.linalg.inv(np.moveaxis(M, (0, 1), (-2, -1)))
+        inv = [[full[..., i, j] for j in range(m)] for i in range(m)]
+    return lambda b: [sum(inv[i][j] * b[j] for j in range(m)) for i in range(m)]
+
+
+def traced(fn: Callable[..., Sequence], n_args: int) -> Callable[..., list]:
+    """A numeric function of `n_args` numbers made of arithmetic and this module's
+    functions, compiled to straight-line code: evaluated once on symbols and lambdified
+    with its common subexpressions computed once (what a step's loads cost)."""
+    # names unlike lambdify's common-subexpression temporaries (x0, x1, ...)
+    args = sp.symbols(f"arg_0:{n_args}", real=True)
+    return sp.lambdify(args, [sp.sympify(v) for v in fn(*args)], modules="math", cse=True)
+
+
+def moving_point(state, local) -> tuple:
+    """World position and velocity (x, y, vx, vy) of a body point from the body frame's
+    state (x, y, theta, vx, vy, omega), whose entries are numbers or arrays of samples."""
+    x, y, th, vx, vy, w = state
+    c, s = cos_sin(th)
+    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
+    return x + rx, y + ry, vx - w * ry, vy + w * rx
+
+
+def coordinate_reader(joint: Revolute | Prismatic) -> Callable[[tuple, tuple], tuple]:
+    """A function giving a joint's coordinate and rate (q, qd) from the frame states
+    (x, y, theta, vx, vy, omega) of its parent and its child, numbers or arrays of
+    samples: the inverse of `body_states` for that joint. A hinge's coordinate is the
+    relative angle, a slide's the travel of the child's anchor along the parent's axis
+    (over the axis length). The joint's numbers are read once."""
+    off = num(joint.angle_offset)
+    if isinstance(joint, Revolute):
+        sign = -1.0 if joint.clockwise else 1.0
+        if joint.absolute:
+            return lambda parent, child: (sign * (child[2] - off), sign * child[5])
+        return lambda parent, child: (sign * (child[2] - parent[2] - off),
+                                      sign * (child[5] - parent[5]))
+    pa = (num(joint.parent_anchor[0]), num(joint.parent_anchor[1]))
+    ca = (num(joint.child_anchor[0]), num(joint.child_anchor[1]))
+    a = (num(joint.axis[0]), num(joint.axis[1]))
+    norm2 = a[0] * a[0] + a[1] * a[1]
+
+    def read(parent: tuple, child: tuple) -> tuple:
+        xa, ya, vxa, vya = moving_point(parent, pa)
+        xb, yb, vxb, vyb = moving_point(child, ca)
+        c, s = cos_sin(parent[2])
+        ax, ay = c * a[0] - s * a[1], s * a[0] + c * a[1]  # the axis in world axes
+        dx, dy = xb - xa, yb - ya
+        # d/dt (R a . d) = R a . d' + omega (perp R a) . d
+        return ((ax * dx + ay * dy) / norm2,
+                (ax * (vxb - vxa) + ay * (vyb - vya) + parent[5] * (ax * dy - ay * dx)) / norm2)
+
+    return read
+
+
+def joint_coordinates(mech: Mechanism, states) -> tuple[list, list]:
+    """The coordinates and rates (q, qd) from the frame states of the description's
+    bodies (a mapping from body name, the world included; numbers or arrays of samples)."""
+    pairs = [coordinate_reader(j)(states[j.parent], states[j.child]) for j in mech.joints]
+    return [p[0] for p in pairs], [p[1] for p in pairs]

@@ -99,18 +99,14 @@ from __future__ import annotations
 import math
 from types import SimpleNamespace
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
-import sympy as sp
 
 from ..systems.model import (
-    COORD,
-    COORD_RATE,
-    LENGTH,
-    LENGTH_RATE,
-    TIME,
     WORLD,
+    CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -119,8 +115,6 @@ from ..systems.model import (
     Prismatic,
     Revolute,
     RollingContact,
-    as_column,
-    rotation,
 )
 from .base import (
     SEMI_IMPLICIT_EULER_STABILITY,
@@ -153,8 +147,18 @@ from .plan import (
     REVOLUTE,
     ROLLING_CONTACT,
     TIME_LOAD,
+    ForceLaw,
+    atan2,
     body_states,
+    cos_sin,
+    law_value,
+    linear_solver,
+    sqrt,
+    traced,
     coupled,
+    coordinate_reader,
+    joint_coordinates,
+    moving_point,
     motions,
     description_reason,
     num,
@@ -299,29 +303,6 @@ class _Layout:
     @property
     def engine(self) -> list[str]:
         return self.dynamic + [c.name for c in self.carriers]
-
-
-@dataclass
-class _Compiled:
-    """Everything derived once per mechanism (symbolic, then compiled). The engine state
-    is, per engine body, (x, y, theta, vx, vy, omega) of its centre of mass."""
-
-    layout: _Layout
-    kin: "_Kinematics"
-    loads: list  # element loads on description bodies (symbolic)
-    loaded: list[int]  # indices of engine bodies that receive element loads
-    loads_math: Callable | None  # (*state, H, t) -> flat (fx, fy, tau) for `loaded`
-    external_np: dict[str, Callable]  # joint -> (*state, H, t) -> (fx, fy) from elements
-    coords_np: Callable  # (*state) -> (q..., qd...)
-    masses: dict[str, float]
-    pitch_phi: list[Callable]  # per pitch coupling: (*positions) -> Phi
-    balance: object = None  # lazily built momentum-balance solver
-    #: per prescribed coordinate, the read-out of its actuator force (`_DriveBalance`)
-    drives: dict[str, "_DriveBalance"] = field(default_factory=dict)
-
-
-def _cross(r: sp.Matrix, f: sp.Matrix) -> sp.Expr:
-    return r[0] * f[1] - r[1] * f[0]
 
 
 def _vec(v) -> np.ndarray:
@@ -796,273 +777,503 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
 
-class _Kinematics:
-    """Description-level poses as expressions of the engine bodies' states (centre of
-    mass position, angle, and their rates)."""
+def _turn(th, v) -> tuple:
+    """R(th) v."""
+    c, s = cos_sin(th)
+    return c * v[0] - s * v[1], s * v[0] + c * v[1]
+
+
+def _posed(x, y, th) -> tuple:
+    """A body's pose (x, y, theta, cos theta, sin theta)."""
+    return (x, y, th, *cos_sin(th))
+
+
+def _rot(pose: tuple, v) -> tuple:
+    """A body-frame vector in world axes, from the body's pose."""
+    c, s = pose[3], pose[4]
+    return c * v[0] - s * v[1], s * v[0] + c * v[1]
+
+
+def _place(pose: tuple, local) -> tuple:
+    """World position of a body point from the body's pose."""
+    rx, ry = _rot(pose, local)
+    return pose[0] + rx, pose[1] + ry
+
+
+def _swing(pose: tuple, rate: tuple, local) -> tuple:
+    """World velocity of a body point from the body's pose and rates (vx, vy, omega)."""
+    rx, ry = _rot(pose, local)
+    return rate[0] - rate[2] * ry, rate[1] + rate[2] * rx
+
+
+def _pt(v) -> tuple[float, float]:
+    return (num(v[0]), num(v[1]))
+
+
+@dataclass(frozen=True)
+class _Group:
+    """A free massless group's joint equations, read once: per equation pair the points
+    (sign, body, local) whose sum vanishes, and the travel along a direction of a body
+    (column, body, direction, sign) of a slide or a slot, if any."""
+
+    bodies: tuple[str, ...]
+    column: dict  # body -> column of its x (y follows)
+    size: int
+    angles: tuple[tuple[str, str, float], ...]
+    equations: tuple
+
+
+def _group(comp: _Component) -> _Group:
+    column = {body: 2 * i for i, body in enumerate(comp.bodies)}
+    extra, equations = 2 * len(comp.bodies), []
+    for j in comp.joints:
+        slide = None
+        if isinstance(j, Prismatic):
+            slide, extra = (extra, j.parent, _pt(j.axis), 1.0), extra + 1
+        equations.append((((1.0, j.parent, _pt(j.parent_anchor)),
+                           (-1.0, j.child, _pt(j.child_anchor))), slide))
+    for c in comp.closures:
+        if isinstance(c, PointOnPoint):
+            equations.append((((1.0, c.body_a, _pt(c.point_a)),
+                               (-1.0, c.body_b, _pt(c.point_b))), None))
+        else:
+            equations.append((((1.0, c.body, _pt(c.point)),
+                               (-1.0, c.line_body, _pt(c.line_point))),
+                              (extra, c.line_body, _pt(c.direction), -1.0)))
+            extra += 1
+    return _Group(comp.bodies, column, extra, comp.angles, tuple(equations))
+
+
+class _States:
+    """How every description body's frame follows from the engine bodies' states
+    (centre of gravity, angle and their rates), read once per mechanism: a body with
+    mass is an engine body (its frame placed from the centre of gravity); a folded link
+    turns with its partner about its pin; an arm points from its end at alpha to its end
+    at beta; a free massless group solves its joint equations, linear once its angles
+    are known, and their time derivative for the rates. `frames` gives the states."""
 
     def __init__(self, mech: Mechanism, layout: _Layout):
-        self.mech, self.layout, self.folds = mech, layout, layout.folds
-        self.P: list[sp.Symbol] = []
-        self.V: list[sp.Symbol] = []
-        self.sym: dict[str, tuple[sp.Matrix, sp.Expr]] = {}
-        self.com: dict[str, sp.Matrix] = {}
-        self.index: dict[str, int] = {}
-        for k, name in enumerate(layout.engine):
-            # names unlike lambdify's common-subexpression temporaries (x0, x1, ...)
-            x, y, th = sp.symbols(f"bx_{k} by_{k} bth_{k}", real=True)
-            vx, vy, w = sp.symbols(f"bvx_{k} bvy_{k} bw_{k}", real=True)
-            self.P += [x, y, th]
-            self.V += [vx, vy, w]
-            self.index[name] = k
-            self.com[name] = sp.Matrix([x, y])
-            if name in layout.dynamic:
-                cog = layout.cog.get(name)
-                p = self.com[name] - rotation(th) * sp.Matrix(cog) if cog else self.com[name]
-                self.sym[name] = (p, th)
-        self.sym[WORLD] = (sp.zeros(2, 1), sp.Integer(0))
+        self.index = {name: k for k, name in enumerate(layout.engine)}
+        self.n = len(layout.engine)
+        self.kind: dict[str, tuple] = {}
+        #: per eliminated body, the engine bodies it follows
+        self.follows: dict[str, tuple[int, ...]] = {}
+        for name in layout.dynamic:
+            cog = layout.cog.get(name)
+            self.kind[name] = ("body", self.index[name], tuple(map(float, cog)) if cog else None)
+        for name, fold in layout.folds.items():
+            if isinstance(fold.inner, Revolute):  # turns with its child, pin on the parent
+                turner, off = fold.outer.child, -num(fold.outer.angle_offset)
+                pin, pin_local, local = (fold.inner.parent, fold.inner.parent_anchor,
+                                         fold.inner.child_anchor)
+            else:  # turns with its parent, pin on the child
+                turner, off = fold.inner.parent, num(fold.inner.angle_offset)
+                pin, pin_local, local = (fold.outer.child, fold.outer.child_anchor,
+                                         fold.outer.parent_anchor)
+            self.kind[name] = ("fold", turner, off, pin, _pt(pin_local), _pt(local))
+            self._follow(name, (turner, pin))
+        for name, link in layout.links.items():
+            (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
+            ell = (link.beta[0] - link.alpha[0], link.beta[1] - link.alpha[1])
+            self.kind[name] = ("link", ra, pa, rb, pb, ell, link.alpha)
+            self._follow(name, (ra, rb))
+        self.groups = [_group(comp) for comp in layout.components]
+        for i, (comp, group) in enumerate(zip(layout.components, self.groups)):
+            ends = {b for _, points_slide in enumerate(group.equations)
+                    for b in [p[1] for p in points_slide[0]]} - set(comp.bodies)
+            for name in comp.bodies:
+                self.kind[name] = ("group", i)
+                self._follow(name, ends)
 
-    def pose(self, name: str) -> tuple[sp.Matrix, sp.Expr]:
-        if name in self.sym:
-            return self.sym[name]
-        if name in self.folds:
-            fold = self.folds[name]
-            if isinstance(fold.inner, Revolute):  # link turns with its child, pin on the parent
-                _, th_c = self.pose(fold.outer.child)
-                th = th_c - fold.outer.angle_offset
-                pin = self.point(fold.inner.parent, fold.inner.parent_anchor)
-                p = pin - rotation(th) * as_column(fold.inner.child_anchor)
-            else:  # link turns with its parent, pin on the child
-                _, th_p = self.pose(fold.inner.parent)
-                th = th_p + fold.inner.angle_offset
-                pin = self.point(fold.outer.child, fold.outer.child_anchor)
-                p = pin - rotation(th) * as_column(fold.outer.parent_anchor)
-            self.sym[name] = (p, th)
-        elif name in self.layout.links:
-            link = self.layout.links[name]
-            wa = self.point(*link.at_alpha[0])
-            wb = self.point(*link.at_beta[0])
-            ell = sp.Matrix(np.subtract(link.beta, link.alpha).tolist())
-            w = wb - wa
-            th = sp.atan2(ell[0] * w[1] - ell[1] * w[0], ell[0] * w[0] + ell[1] * w[1])
-            self.sym[name] = (wa - rotation(th) * sp.Matrix(link.alpha), th)
+    def _follow(self, name: str, bodies) -> None:
+        self.follows[name] = tuple(sorted(self.index[b] for b in set(bodies) if b in self.index))
+
+    def frames(self, P: Sequence, V: Sequence) -> "_Frames":
+        """The description bodies' frames at engine positions P and rates V (per engine
+        body, (x, y, theta) of its centre of gravity and their rates)."""
+        return _Frames(self, P, V)
+
+
+_ZERO = (0.0, 0.0, 0.0)
+_AT_REST = (0.0, 0.0, 0.0, 1.0, 0.0)
+_UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+class _Frames:
+    """The frame state (x, y, theta, vx, vy, omega) of each description body, computed
+    when asked (`frames[body]`); `rates` gives the frames at other engine rates on the
+    same positions (the columns of a velocity Jacobian)."""
+
+    def __init__(self, states: _States, P: Sequence, V: Sequence, pose: dict | None = None,
+                 solved: dict | None = None):
+        self.states, self.P, self.V = states, P, V
+        self.pose = {WORLD: _AT_REST} if pose is None else pose
+        self.solved = {} if solved is None else solved
+        self.rate: dict[str, tuple] = {WORLD: _ZERO}
+
+    def rates(self, V: Sequence) -> "_Frames":
+        return _Frames(self.states, self.P, V, self.pose, self.solved)
+
+    def __getitem__(self, body: str) -> tuple:
+        """The body's frame state (x, y, theta, vx, vy, omega)."""
+        return self.position(body)[:3] + self.velocity(body)
+
+    def point(self, body: str, local) -> tuple:
+        """World position and velocity (x, y, vx, vy) of a body point."""
+        pose = self.position(body)
+        return (*_place(pose, local), *_swing(pose, self.velocity(body), local))
+
+    def position(self, body: str) -> tuple:
+        pose = self.pose.get(body)
+        if pose is not None:
+            return pose
+        kind = self.states.kind[body]
+        if kind[0] == "body":
+            _, k, cog = kind
+            x, y, th = self.P[k]
+            pose = _posed(x, y, th)
+            if cog:  # the frame origin from the centre of gravity
+                rx, ry = _rot(pose, cog)
+                pose = (x - rx, y - ry, *pose[2:])
+        elif kind[0] == "fold":
+            _, turner, off, pin, pin_local, local = kind
+            pose = _posed(0.0, 0.0, self.position(turner)[2] + off)
+            (px, py), (rx, ry) = _place(self.position(pin), pin_local), _rot(pose, local)
+            pose = (px - rx, py - ry, *pose[2:])
+        elif kind[0] == "link":
+            _, ra, pa, rb, pb, ell, alpha = kind
+            (ax, ay), (bx, by) = _place(self.position(ra), pa), _place(self.position(rb), pb)
+            wx, wy = bx - ax, by - ay
+            pose = _posed(0.0, 0.0, atan2(ell[0] * wy - ell[1] * wx, ell[0] * wx + ell[1] * wy))
+            rx, ry = _rot(pose, alpha)
+            pose = (ax - rx, ay - ry, *pose[2:])
         else:
-            for comp in self.layout.components:
-                if name in comp.bodies:
-                    self._solve(comp)
-                    break
-            else:
-                raise KeyError(name)
-        return self.sym[name]
+            self._solve(kind[1])
+            return self.pose[body]
+        self.pose[body] = pose
+        return pose
 
-    def _solve(self, comp: _Component) -> None:
-        """Positions of a free massless group: the joint equations are linear in them
-        once the angles (fixed by prismatic joints) are known."""
-        theta: dict[str, sp.Expr] = {}
-        for body, known, off in comp.angles:
-            theta[body] = (theta[known] if known in theta else self.pose(known)[1]) + off
-        unknown: list[sp.Symbol] = []
-        pos: dict[str, sp.Matrix] = {}
-        for i, body in enumerate(comp.bodies):
-            px, py = sp.symbols(f"_mlx{i} _mly{i}", real=True)
-            unknown += [px, py]
-            pos[body] = sp.Matrix([px, py])
+    def velocity(self, body: str) -> tuple:
+        rate = self.rate.get(body)
+        if rate is not None:
+            return rate
+        kind = self.states.kind[body]
+        if kind[0] == "body":
+            _, k, cog = kind
+            vx, vy, w = self.V[k]
+            if cog:
+                rx, ry = _rot(self.position(body), cog)
+                vx, vy = vx + w * ry, vy - w * rx
+            rate = (vx, vy, w)
+        elif kind[0] == "fold":
+            _, turner, _, pin, pin_local, local = kind
+            w = self.velocity(turner)[2]
+            px, py = _swing(self.position(pin), self.velocity(pin), pin_local)
+            rx, ry = _rot(self.position(body), local)
+            rate = (px + w * ry, py - w * rx, w)
+        elif kind[0] == "link":
+            _, ra, pa, rb, pb, _, alpha = kind
+            (ax, ay), (bx, by) = _place(self.position(ra), pa), _place(self.position(rb), pb)
+            (vax, vay) = _swing(self.position(ra), self.velocity(ra), pa)
+            (vbx, vby) = _swing(self.position(rb), self.velocity(rb), pb)
+            wx, wy = bx - ax, by - ay
+            w = (wx * (vby - vay) - wy * (vbx - vax)) / (wx * wx + wy * wy)
+            rx, ry = _rot(self.position(body), alpha)
+            rate = (vax + w * ry, vay - w * rx, w)
+        else:
+            self.position(body)
+            self._solve_rates(kind[1])
+            return self.rate[body]
+        self.rate[body] = rate
+        return rate
 
-        def angle(body):
-            return theta[body] if body in theta else self.pose(body)[1]
+    def _solve(self, i: int) -> None:
+        """A free group's positions (and the travels of its slides and slots)."""
+        group = self.states.groups[i]
+        angle: dict[str, object] = {}
+        for body, known, off in group.angles:
+            angle[body] = (angle[known] if known in angle else self.position(known)[2]) + off
+        m, column = group.size, group.column
+        A = [[0.0] * m for _ in range(m)]
+        known: list = []
+        for r, (points, slide) in enumerate(group.equations):
+            gx = gy = 0.0
+            for sign, body, local in points:
+                if body in column:
+                    A[2 * r][column[body]] += sign
+                    A[2 * r + 1][column[body] + 1] += sign
+                    rx, ry = _turn(angle[body], local)
+                else:
+                    rx, ry = _place(self.position(body), local)
+                gx, gy = gx + sign * rx, gy + sign * ry
+            if slide is not None:
+                k, body, d, sign = slide
+                dx, dy = _turn(angle[body] if body in angle else self.position(body)[2], d)
+                A[2 * r][k], A[2 * r + 1][k] = sign * dx, sign * dy
+            known += [gx, gy]
+        solve = linear_solver(A)
+        x = solve([-v for v in known])
+        self.solved[i] = (angle, A, solve, x)
+        for body, c in column.items():
+            self.pose[body] = _posed(x[c], x[c + 1], angle[body])
 
-        def point(body, local):
-            if body in pos:
-                return pos[body] + rotation(theta[body]) * as_column(local)
-            return self.point(body, local)
-
-        eqs: list[sp.Expr] = []
-        for n, j in enumerate(comp.joints):
-            gap = point(j.parent, j.parent_anchor) - point(j.child, j.child_anchor)
-            if isinstance(j, Prismatic):
-                q = sp.Symbol(f"_mlq{n}", real=True)
-                unknown.append(q)
-                gap += q * rotation(angle(j.parent)) * as_column(j.axis)
-            eqs += list(gap)
-        for n, c in enumerate(comp.closures):
-            if isinstance(c, PointOnPoint):
-                gap = point(c.body_a, c.point_a) - point(c.body_b, c.point_b)
-            else:
-                u = sp.Symbol(f"_mlu{n}", real=True)
-                unknown.append(u)
-                gap = (point(c.body, c.point) - point(c.line_body, c.line_point)
-                       - u * rotation(angle(c.line_body)) * as_column(c.direction))
-            eqs += list(gap)
-        A, rhs = sp.linear_eq_to_matrix(eqs, unknown)
-        sol = A.LUsolve(rhs)
-        values = dict(zip(unknown, sol))
-        for body in comp.bodies:
-            self.sym[body] = (pos[body].xreplace(values), theta[body])
-
-    def point(self, body: str, local) -> sp.Matrix:
-        p, th = self.pose(body)
-        return p + rotation(th) * as_column(local)
-
-    def pin(self, fold: _Fold) -> sp.Matrix:
-        if isinstance(fold.inner, Revolute):
-            return self.point(fold.inner.parent, fold.inner.parent_anchor)
-        return self.point(fold.outer.child, fold.outer.child_anchor)
-
-    def rate(self, expr: sp.Expr) -> sp.Expr:
-        return sum((sp.diff(expr, p) * v for p, v in zip(self.P, self.V)), sp.Integer(0))
-
-    def coordinate(self, j: Revolute | Prismatic) -> sp.Expr:
-        p_p, th_p = self.pose(j.parent)
-        p_c, th_c = self.pose(j.child)
-        if isinstance(j, Revolute):
-            value = th_c - (0 if j.absolute else th_p) - j.angle_offset
-            return -value if j.clockwise else value
-        axis = as_column(j.axis)
-        d = p_c + rotation(th_c) * as_column(j.child_anchor) - p_p \
-            - rotation(th_p) * as_column(j.parent_anchor)
-        return (axis.T * rotation(th_p).T * d)[0] / (axis.T * axis)[0]
+    def _solve_rates(self, i: int) -> None:
+        """A free group's rates: its equations differentiated in time."""
+        group = self.states.groups[i]
+        angle, A, solve, x = self.solved[i]
+        omega: dict[str, object] = {}
+        for body, known, _ in group.angles:
+            omega[body] = omega[known] if known in omega else self.velocity(known)[2]
+        m, column = group.size, group.column
+        known_rates: list = []
+        for r, (points, slide) in enumerate(group.equations):
+            gx = gy = 0.0
+            for sign, body, local in points:
+                if body in column:
+                    rx, ry = _turn(angle[body], local)
+                    vx, vy = -omega[body] * ry, omega[body] * rx
+                else:
+                    vx, vy = _swing(self.position(body), self.velocity(body), local)
+                gx, gy = gx + sign * vx, gy + sign * vy
+            if slide is not None:  # d/dt (u sign R d) = u' sign R d + u omega perp(sign R d)
+                k, body = slide[:2]
+                w = omega[body] if body in omega else self.velocity(body)[2]
+                gx, gy = gx - w * A[2 * r + 1][k] * x[k], gy + w * A[2 * r][k] * x[k]
+            known_rates += [gx, gy]
+        v = solve([-v for v in known_rates])
+        for body, c in column.items():
+            self.rate[body] = (v[c], v[c + 1], omega[body])
 
 
-def _coordinate_loads(j: Revolute | Prismatic, value: sp.Expr, kin: _Kinematics):
-    """Loads (body, force, point, torque) of a generalized force `value` on the
-    coordinate of joint j (virtual power)."""
+#: a load on a description body: (body, force (fx, fy) or None, its world point, torque)
+_Load = tuple
+
+
+def _coordinate_load(j: Revolute | Prismatic) -> Callable[["_Frames", object], list]:
+    """The loads of a generalized force Q on the coordinate of joint j (virtual power),
+    as a function of (frames, Q): torques s Q on a hinge's child and -s Q on its parent
+    (none for an absolute angle); a slide's force Q R a / |a|^2 on the child at its
+    anchor, opposite on the parent."""
     if isinstance(j, Revolute):
-        s = -1 if j.clockwise else 1
-        out = [(j.child, None, None, s * value)]
-        if not j.absolute:
-            out.append((j.parent, None, None, -s * value))
-        return out
-    _, th_p = kin.pose(j.parent)
-    axis = as_column(j.axis)
-    force = value * rotation(th_p) * axis / (axis.T * axis)[0]
-    w = kin.point(j.child, j.child_anchor)
-    return [(j.child, force, w, 0), (j.parent, -force, w, 0)]
+        s = -1.0 if j.clockwise else 1.0
+        if j.absolute:
+            return lambda frames, value: [(j.child, None, None, s * value)]
+        return lambda frames, value: [(j.child, None, None, s * value),
+                                      (j.parent, None, None, -s * value)]
+    a, anchor = _pt(j.axis), _pt(j.child_anchor)
+    norm2 = a[0] * a[0] + a[1] * a[1]
 
+    def loads(frames: _Frames, value) -> list:
+        ax, ay = _rot(frames.position(j.parent), a)
+        force = (value * ax / norm2, value * ay / norm2)
+        w = _place(frames.position(j.child), anchor)
+        return [(j.child, force, w, 0.0), (j.parent, (-force[0], -force[1]), w, 0.0)]
 
-def _element_loads(mech: Mechanism, kin: _Kinematics):
-    """Per element, the loads on description bodies: (body, force or None, world point,
-    torque). Forces in a pair act at a common world point."""
-    coords = [kin.coordinate(j) for j in mech.joints]
-    loads: list[tuple[str, sp.Matrix | None, sp.Matrix | None, sp.Expr]] = []
-    for f in mech.forces:
-        if isinstance(f, PointToPoint):
-            pa, pb = kin.point(f.body_a, f.point_a), kin.point(f.body_b, f.point_b)
-            d = pb - pa
-            length = sp.sqrt(d[0] ** 2 + d[1] ** 2)
-            tension = sp.sympify(f.tension).xreplace(
-                {LENGTH: length, LENGTH_RATE: kin.rate(length)})
-            u = d / length
-            loads.append((f.body_b, -tension * u, pb, 0))
-            loads.append((f.body_a, tension * u, pa, 0))
-        elif f.relative_to is not None:  # a couple: +F on one coordinate, -F on the other
-            weights = f.weights(mech.coordinates)
-            x = sum(sign * coords[i] for i, sign in weights.items())
-            value = sp.sympify(f.force).xreplace({COORD: x, COORD_RATE: kin.rate(x)})
-            for i, sign in weights.items():
-                loads += _coordinate_loads(mech.joints[i], sign * value, kin)
-        else:
-            i = mech.coordinates.index(f.coordinate)
-            j = mech.joints[i]
-            value = sp.sympify(f.force).xreplace({COORD: coords[i], COORD_RATE: kin.rate(coords[i])})
-            loads += _coordinate_loads(j, value, kin)
     return loads
 
 
-def _engine_loads(loads, kin: _Kinematics, dynamic: list[str]) -> dict[int, list[sp.Expr]]:
-    """Body loads (fx, fy at the centre of mass, tau about it) on the engine bodies."""
-    out: dict[int, list[sp.Expr]] = {}
+def _element(mech: Mechanism, f: PointToPoint | CoordinateForce) -> Callable:
+    """A force element's loads on the description bodies as a function of (frames, t),
+    numbers or arrays of samples (the law compiled for each)."""
+    law = ForceLaw.of(f)
+    if isinstance(f, PointToPoint):
+        pa, pb = _pt(f.point_a), _pt(f.point_b)
 
-    def add(body: str, force, point, torque) -> None:
-        if body == WORLD:
-            return
-        if body in kin.folds:  # virtual power through the massless link
-            fold = kin.folds[body]
-            if force is not None:
-                pin = kin.pin(fold)
-                add(fold.pin_body, force, pin, 0)
-                torque = torque + _cross(point - pin, force)
-            add(fold.partner, None, None, torque)
-            return
-        if body not in kin.index:  # eliminated massless body: virtual power, J^T f
-            _, th = kin.pose(body)
-            for name, k in kin.index.items():
-                gen = []
-                for s in kin.P[3 * k:3 * k + 3]:
-                    g = sp.diff(th, s) * torque if torque != 0 else sp.Integer(0)
+        def point_to_point(frames: _Frames, t) -> list:
+            a, b = frames.point(f.body_a, pa), frames.point(f.body_b, pb)
+            dx, dy = b[0] - a[0], b[1] - a[1]
+            length = sqrt(dx * dx + dy * dy)
+            rate = (dx * (b[2] - a[2]) + dy * (b[3] - a[3])) / length
+            tension = law_value(law, length, rate, t)
+            ux, uy = dx / length, dy / length
+            return [(f.body_b, (-tension * ux, -tension * uy), b[:2], 0.0),
+                    (f.body_a, (tension * ux, tension * uy), a[:2], 0.0)]
+
+        return point_to_point
+    terms = [(sign, mech.joints[i], coordinate_reader(mech.joints[i]),
+              _coordinate_load(mech.joints[i]))
+             for i, sign in f.weights(mech.coordinates).items()]
+
+    def coordinate_force(frames: _Frames, t) -> list:
+        x = xd = 0.0
+        for sign, j, read, _ in terms:
+            q, qd = read(frames[j.parent], frames[j.child])
+            x, xd = x + sign * q, xd + sign * qd
+        value = law_value(law, x, xd, t)
+        # a couple (relative_to): +F on one coordinate, -F on the other
+        return [load for sign, _, _, apply in terms for load in apply(frames, sign * value)]
+
+    return coordinate_force
+
+
+def _transmit(kind: tuple, load: _Load, frames: _Frames) -> list[_Load]:
+    """A load on a folded link or an arm as the loads on the bodies it follows that have
+    the same virtual power: on a folded link, the force at the pin on the pin's body and
+    the moment about the pin on the body it turns with; on an arm from a to b, whose
+    angle is that of w = b - a, a moment M about a is the force M perp(w) / |w|^2 at b
+    (and its opposite at a)."""
+    body, force, point, torque = load
+    if kind[0] == "fold":
+        _, turner, _, pin, pin_local, _ = kind
+        if force is None:
+            return [(turner, None, None, torque)]
+        px, py = _place(frames.position(pin), pin_local)
+        moment = (point[0] - px) * force[1] - (point[1] - py) * force[0] + torque
+        return [(pin, force, (px, py), 0.0), (turner, None, None, moment)]
+    _, ra, pa, rb, pb, _, _ = kind
+    (ax, ay), (bx, by) = _place(frames.position(ra), pa), _place(frames.position(rb), pb)
+    wx, wy = bx - ax, by - ay
+    moment = torque if force is None else \
+        (point[0] - ax) * force[1] - (point[1] - ay) * force[0] + torque
+    scale = moment / (wx * wx + wy * wy)
+    fb = (-scale * wy, scale * wx)
+    fa = (-fb[0], -fb[1]) if force is None else (force[0] - fb[0], force[1] - fb[1])
+    return [(ra, fa, (ax, ay), 0.0), (rb, fb, (bx, by), 0.0)]
+
+
+def _wrench(load: _Load, centre: tuple) -> tuple:
+    """(fx, fy, moment about `centre`) of a load."""
+    _, force, point, torque = load
+    if force is None:
+        return 0.0, 0.0, torque
+    return (force[0], force[1],
+            (point[0] - centre[0]) * force[1] - (point[1] - centre[1]) * force[0] + torque)
+
+
+def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
+    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from
+    state rows (columns of samples)."""
+    S = np.asarray(S, dtype=float).T
+    P = [tuple(S[k + i] + H * S[k + 3 + i] for i in range(3)) for k in range(0, len(S), 6)]
+    V = [tuple(S[k + 3 + i] for i in range(3)) for k in range(0, len(S), 6)]
+    return P, V
+
+
+@dataclass
+class _Compiled:
+    """What the runs of one mechanism use, read once: the description bodies' frames
+    from the engine's state (`states`), the force elements' loads and the engine bodies
+    they reach. The engine state is, per engine body, (x, y, theta, vx, vy, omega) of its
+    centre of gravity."""
+
+    mech: Mechanism
+    layout: _Layout
+    states: _States
+    elements: list[Callable]  # per force element: (frames, t) -> loads
+    loaded: list[int]  # indices of engine bodies that receive element loads
+    masses: dict[str, float]
+    #: per prescribed coordinate, the read-out of its actuator force (`_DriveBalance`)
+    drives: dict[str, "_DriveBalance"] = field(default_factory=dict)
+    balance: "_Balance | None" = None  # built on the first constrained read-out
+    phis: dict[str, Callable] = field(default_factory=dict)  # compiled `pitch_phi`s
+
+    def frames(self, S: np.ndarray, H: float = 0.0) -> _Frames:
+        """The frames over state rows S (one sample per row) at x + H v."""
+        return self.states.frames(*_rows(S, H))
+
+    def body_loads(self, frames: _Frames, t) -> list[_Load]:
+        """The element loads on the description bodies."""
+        return [load for element in self.elements for load in element(frames, t)]
+
+    def pitch_phi(self, pitch: _Pitch) -> Callable[..., float]:
+        """The residual Phi = sum k q - const of a pitch pair's coupling, as a compiled
+        function of the engine bodies' positions (x, y, theta each)."""
+        if pitch.name in self.phis:
+            return self.phis[pitch.name]
+        c = next(c for c in self.mech.constraints if c.name == pitch.name)
+        terms = [(num(coef), coordinate_reader(self.mech.joints[i]), self.mech.joints[i])
+                 for name, coef in c.coefficients
+                 for i in [self.mech.coordinates.index(name)]]
+        constant, n = num(c.constant), self.states.n
+
+        def phi(*pos: float) -> float:
+            frames = self.states.frames([pos[3 * k:3 * k + 3] for k in range(n)], [_ZERO] * n)
+            return sum(coef * read(frames[j.parent], frames[j.child])[0]
+                       for coef, read, j in terms) - constant
+
+        compiled = traced(lambda *pos: [phi(*pos)], 3 * n)
+        self.phis[pitch.name] = lambda *pos: compiled(*pos)[0]
+        return self.phis[pitch.name]
+
+    @cached_property
+    def loads_math(self) -> Callable | None:
+        """`engine_loads` compiled: (*state row, H, t) -> flat (fx, fy, tau) of the
+        `loaded` engine bodies (None without force elements)."""
+        if not self.elements:
+            return None
+        return traced(lambda *args: self.engine_loads(args[:-2], args[-2], args[-1]),
+                      6 * self.states.n + 2)
+
+    def engine_loads(self, row: Sequence[float], H: float, t: float) -> list[float]:
+        """The element loads (fx, fy at the centre of gravity, tau) on the `loaded`
+        engine bodies at the position-updated state x + H v of one state row. A load on
+        an eliminated massless body reaches the engine bodies it follows by virtual
+        power, J^T f, J's columns its velocities for a unit rate of each engine state."""
+        P, V = [], []
+        for k in range(0, len(row), 6):
+            vx, vy, w = row[k + 3:k + 6]
+            P.append((row[k] + H * vx, row[k + 1] + H * vy, row[k + 2] + H * w))
+            V.append((vx, vy, w))
+        frames = self.states.frames(P, V)
+        kind, follows = self.states.kind, self.states.follows
+        out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
+        pending = self.body_loads(frames, t)
+        while pending:
+            load = pending.pop()
+            body, force, point, torque = load
+            if body == WORLD:
+                continue
+            if kind[body][0] == "body":
+                k = kind[body][1]
+                fx, fy, tau = _wrench(load, P[k][:2])
+                acc = out[k]
+                acc[0] += fx
+                acc[1] += fy
+                acc[2] += tau
+                continue
+            if kind[body][0] != "group":
+                pending.extend(_transmit(kind[body], load, frames))
+                continue
+            x, y = frames.position(body)[:2]
+            for k in follows[body]:
+                acc = out[k]
+                for i, unit in enumerate(_UNITS):
+                    rates = [_ZERO] * len(P)
+                    rates[k] = unit
+                    vx, vy, w = frames.rates(rates).velocity(body)
+                    gen = torque * w
                     if force is not None:
-                        g += force[0] * sp.diff(point[0], s) + force[1] * sp.diff(point[1], s)
-                    gen.append(g)
-                if any(g != 0 for g in gen):
-                    acc = out.setdefault(k, [sp.Integer(0)] * 3)
-                    for i in range(3):
-                        acc[i] += gen[i]
-            return
-        acc = out.setdefault(kin.index[body], [sp.Integer(0)] * 3)
-        if force is not None:
-            p = kin.com[body]
-            acc[0] += force[0]
-            acc[1] += force[1]
-            acc[2] += _cross(point - p, force)
-        acc[2] += torque
-
-    for body, force, point, torque in loads:
-        add(body, force, point, torque)
-    return out
+                        gen += force[0] * (vx - w * (point[1] - y)) \
+                            + force[1] * (vy + w * (point[0] - x))
+                    acc[i] += gen
+        return [v for k in self.loaded for v in out[k]]
 
 
 _CACHE: dict[tuple, _Compiled] = {}
 
 
-def _layout_key(layout: _Layout) -> tuple:
-    return (tuple(layout.engine), tuple(sorted(layout.cog.items())),
-            tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
-
-
 def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
-    key = (mech, _layout_key(layout))
+    """The mechanism's `_Compiled`, reused by every run on the same layout."""
+    key = (mech, tuple(layout.engine), tuple(sorted(layout.cog.items())),
+           tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
     if key in _CACHE:
         return _CACHE[key]
-    kin = _Kinematics(mech, layout)
-    H = sp.Symbol("H", real=True)
-    # loads are evaluated at the position-updated state x + H v (H = dt or 0)
-    predicted = {p: p + H * v for p, v in zip(kin.P, kin.V)}
-    n_engine = len(layout.engine)
-    state = [s for k in range(n_engine) for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
-    args = [*state, H, TIME]
-    loads = _element_loads(mech, kin)
-    per_body = _engine_loads(loads, kin, layout.dynamic)
-    loaded = sorted(per_body)
-    loads_math = None
-    if loaded:
-        flat = [e.xreplace(predicted) for k in loaded for e in per_body[k]]
-        loads_math = sp.lambdify(args, flat, modules="math", cse=True)
-    external_np: dict[str, Callable] = {}
-    if not mech.constraints:
-        for j in mech.joints:
-            subtree = set(mech.subtree(j.child))
-            total = sp.zeros(2, 1)
-            for body, force, _, _ in loads:
-                if force is not None and body in subtree:
-                    total += force
-            external_np[j.name] = sp.lambdify(args, list(total.xreplace(predicted)),
-                                              modules="numpy", cse=True)
-    coords = [kin.coordinate(j) for j in mech.joints]
-    coords_np = sp.lambdify(state, coords + [kin.rate(c) for c in coords],
-                            modules="numpy", cse=True)
-    masses = {b.name: num(b.mass) for b in mech.bodies}
-    pitch_phi = []
-    for pitch in layout.pitches:
-        c = next(c for c in mech.constraints if c.name == pitch.name)
-        phi = sum((num(coef) * coords[mech.coordinates.index(name)]
-                   for name, coef in c.coefficients), sp.Integer(0)) - num(c.constant)
-        pitch_phi.append(sp.lambdify(kin.P, phi, modules="math", cse=True))
-    drives = {d.name: _DriveBalance.of(mech, layout, kin, loads, d, args, predicted)
-              for d in layout.drives}
-    compiled = _Compiled(layout, kin, loads, loaded, loads_math, external_np, coords_np, masses,
-                         pitch_phi, drives=drives)
+    states = _States(mech, layout)
+    loaded: set[int] = set()
+    for f in mech.forces:
+        bodies = ((f.body_a, f.body_b) if isinstance(f, PointToPoint) else
+                  [b for i in f.weights(mech.coordinates)
+                   for b in (mech.joints[i].parent, mech.joints[i].child)])
+        for body in set(bodies) - {WORLD}:
+            kind = states.kind[body]
+            loaded |= {kind[1]} if kind[0] == "body" else set(states.follows[body])
+    comp = _Compiled(mech, layout, states, [_element(mech, f) for f in mech.forces],
+                     sorted(loaded), {b.name: num(b.mass) for b in mech.bodies})
+    comp.drives = {d.name: _DriveBalance.of(mech, comp, d) for d in layout.drives}
     if len(_CACHE) > 64:
         _CACHE.clear()
-    _CACHE[key] = compiled
-    return compiled
+    _CACHE[key] = comp
+    return comp
 
 
 @dataclass(frozen=True)
@@ -1075,56 +1286,41 @@ class _DriveBalance:
     on the subtree as applied in that step. d is the slide's axis in world axes (dq = 1
     moves the child by d)."""
 
+    comp: _Compiled
+    joint: Revolute | Prismatic
     engine: tuple[int, ...]  # engine bodies of the subtree
     mass: tuple[float, ...]
     inertia: tuple[float, ...]
     cog: tuple[tuple[float, float], ...]  # engine centre of gravity in the body frame
-    slide: bool
     sign: float
-    geometry: Callable  # (*positions) -> (d_x, d_y) for a slide, (A_x, A_y) for a hinge
-    external: Callable  # (*state, H, t) -> generalized force of the element loads
 
     @staticmethod
-    def of(mech: Mechanism, layout: _Layout, kin: "_Kinematics", loads, drive: _Drive,
-           args: list, predicted: dict) -> "_DriveBalance":
+    def of(mech: Mechanism, comp: _Compiled, drive: _Drive) -> "_DriveBalance":
         j = drive.joint
         subtree = set(mech.subtree(j.child))
-        members = [name for name in layout.dynamic if name in subtree]
-        slide = isinstance(j, Prismatic)
-        if slide:
-            _, th_p = kin.pose(j.parent)
-            geometry = rotation(th_p) * as_column(j.axis)
-        else:
-            geometry = kin.point(j.child, j.child_anchor)
-        sign = -1.0 if isinstance(j, Revolute) and j.clockwise else 1.0
-        total = sp.Integer(0)
-        for body, force, point, torque in loads:
-            if body not in subtree:
-                continue
-            if slide:
-                if force is not None:
-                    total += (geometry.T * force)[0]
-            else:
-                total += torque
-                if force is not None:
-                    total += _cross(point - geometry, force)
-        external = sp.lambdify(args, sign * sp.sympify(total).xreplace(predicted),
-                               modules="numpy", cse=True)
+        members = [name for name in comp.layout.dynamic if name in subtree]
         return _DriveBalance(
-            tuple(kin.index[n] for n in members),
+            comp, j, tuple(comp.states.index[n] for n in members),
             tuple(num(mech.body(n).mass) for n in members),
             tuple(num(mech.body(n).inertia) for n in members),
-            tuple(layout.cog.get(n, (0.0, 0.0)) for n in members),
-            slide, sign, sp.lambdify(kin.P, list(geometry), modules="numpy", cse=True),
-            external)
+            tuple(comp.layout.cog.get(n, (0.0, 0.0)) for n in members),
+            -1.0 if isinstance(j, Revolute) and j.clockwise else 1.0)
+
+    def geometry(self, frames: _Frames) -> tuple:
+        """The slide's axis in world axes, or the hinge point."""
+        j = self.joint
+        if isinstance(j, Prismatic):
+            return _rot(frames.position(j.parent), _pt(j.axis))
+        return _place(frames.position(j.child), _pt(j.child_anchor))
 
     def force(self, S: np.ndarray, h: float, g: float, H: float, shift: int,
               t: np.ndarray) -> np.ndarray:
         """Shape (N+1,): the actuator force over step n -> n+1 at sample n+1 (where
         Chipmunk computed the impulses, as the reactions); sample 0 is NaN."""
         n = len(t) - 1
-        pos = [S[1:, 6 * k + i] for k in range(S.shape[1] // 6) for i in range(3)]
-        gx, gy = (np.broadcast_to(np.asarray(v, float), (n,)) for v in self.geometry(*pos))
+        slide = isinstance(self.joint, Prismatic)
+        gx, gy = (np.broadcast_to(np.asarray(v, float), (n,))
+                  for v in self.geometry(self.comp.frames(S[1:])))
         total = np.zeros(n)
         for k, m, inertia, (cx, cy) in zip(self.engine, self.mass, self.inertia, self.cog):
             # the centre of mass from the engine's centre of gravity (a kinematic driver
@@ -1134,97 +1330,111 @@ class _DriveBalance:
             dy = -(np.sin(th) * cx + np.cos(th) * cy)
             fx = m * np.diff(S[:, 6 * k + 3] - w * dy) / h
             fy = m * (np.diff(S[:, 6 * k + 4] + w * dx) / h + g)
-            if self.slide:
+            if slide:
                 total += gx * fx + gy * fy
             else:
                 rx = S[1:, 6 * k] + dx[1:] - gx
                 ry = S[1:, 6 * k + 1] + dy[1:] - gy
                 total += self.sign * (inertia * np.diff(S[:, 6 * k + 5]) / h
                                       + rx * fy - ry * fx)
-        total -= np.broadcast_to(np.asarray(
-            self.external(*S[:-1].T, H, t[:-1] + shift * h), float), (n,))
+        # the element loads on the subtree as applied in the step (position-updated)
+        ahead = self.comp.frames(S[:-1], H)
+        ax, ay = self.geometry(ahead)
+        subtree = set(self.comp.mech.subtree(self.joint.child))
+        external = np.zeros(n)
+        for load in self.comp.body_loads(ahead, t[:-1] + shift * h):
+            if load[0] not in subtree:
+                continue
+            if slide:
+                if load[1] is not None:
+                    external = external + ax * load[1][0] + ay * load[1][1]
+            else:
+                external = external + _wrench(load, (ax, ay))[2]
         out = np.full(len(t), np.nan)
-        out[1:] = total
+        out[1:] = total - self.sign * external
         return out
 
 
 class _Balance:
     """Momentum balance of every description body over a step, solved in least squares
-    for the joint reactions and the closure multipliers (see `PymunkBackend._forces`)."""
+    for the joint reactions and the closure multipliers (see `PymunkBackend._forces`):
+    per column (a joint's or closure's unknown force component), its loads on the
+    description bodies and its unit direction (zero for a moment or a coupling)."""
 
-    def __init__(self, mech: Mechanism, comp: _Compiled):
-        kin = comp.kin
+    def __init__(self, mech: Mechanism):
+        self.mech = mech
         self.bodies = [b.name for b in mech.bodies]
-        self.columns: list[tuple[str, str]] = []  # (kind, name)
-        cols: list[dict[str, list]] = []
-        vectors: list[sp.Matrix] = []  # per column, the unit force direction (or zeros)
+        self.columns = [(kind, name) for kind, name, _, _ in self._columns(None)]
+        self.shape = (3 * len(self.bodies), len(self.columns))
 
-        def add(col, body, force, point, torque):
-            if body == WORLD:
-                return
-            c, _ = kin.pose(body)
-            entry = col.setdefault(body, [sp.Integer(0)] * 3)
-            if force is not None:
-                entry[0] += force[0]
-                entry[1] += force[1]
-                entry[2] += _cross(point - c, force)
-            entry[2] += torque
+    def _columns(self, frames: _Frames | None) -> list[tuple[str, str, list, tuple]]:
+        """(kind, name, loads, direction) per column at the frames (None: only the kinds
+        and names)."""
+        mech, out = self.mech, []
 
-        def column(kind, name, pairs, vector):
-            col: dict[str, list] = {}
-            for body, force, point, torque in pairs:
-                add(col, body, force, point, torque)
-            cols.append(col)
-            self.columns.append((kind, name))
-            vectors.append(vector)
+        def point(body, local):
+            return _place(frames.position(body), _pt(local)) if frames else None
 
-        ex, ey, zero = sp.Matrix([1, 0]), sp.Matrix([0, 1]), sp.zeros(2, 1)
+        def normal(body, d):  # the unit normal of direction d of `body`, in world axes
+            if not frames:
+                return None
+            d = np.array(_pt(d)) / float(np.linalg.norm(_pt(d)))
+            dx, dy = _rot(frames.position(body), d)
+            return -dy, dx
+
+        def pair(kind, name, a, b, force, w):
+            minus = None if force is None else (-force[0], -force[1])
+            out.append((kind, name, [(a, force, w, 0.0), (b, minus, w, 0.0)], force))
+
         for j in mech.joints:
-            w = kin.point(j.child, j.child_anchor)
+            w = point(j.child, j.child_anchor)
             if isinstance(j, Revolute):
-                for e in (ex, ey):
-                    column("joint", j.name, [(j.child, e, w, 0), (j.parent, -e, w, 0)], e)
+                for e in ((1.0, 0.0), (0.0, 1.0)):
+                    pair("joint", j.name, j.child, j.parent, e, w)
             else:
-                _, th_p = kin.pose(j.parent)
-                axis = as_column(j.axis)
-                n = rotation(th_p) * sp.Matrix([-axis[1], axis[0]]) / sp.sqrt((axis.T * axis)[0])
-                column("joint", j.name, [(j.child, n, w, 0), (j.parent, -n, w, 0)], n)
-                column("moment", j.name, [(j.child, None, None, 1), (j.parent, None, None, -1)],
-                       zero)
+                pair("joint", j.name, j.child, j.parent, normal(j.parent, j.axis), w)
+                out.append(("moment", j.name, [(j.child, None, None, 1.0),
+                                               (j.parent, None, None, -1.0)], (0.0, 0.0)))
         for c in mech.constraints:
             if isinstance(c, PointOnPoint):
-                w = kin.point(c.body_a, c.point_a)
-                for e in (ex, ey):
-                    column("closure", c.name, [(c.body_a, e, w, 0), (c.body_b, -e, w, 0)], e)
+                w = point(c.body_a, c.point_a)
+                for e in ((1.0, 0.0), (0.0, 1.0)):
+                    pair("closure", c.name, c.body_a, c.body_b, e, w)
             elif isinstance(c, PointOnLine):
-                _, th = kin.pose(c.line_body)
-                d = as_column(c.direction)
-                n = rotation(th) * sp.Matrix([-d[1], d[0]]) / sp.sqrt((d.T * d)[0])
-                w = kin.point(c.body, c.point)
-                column("closure", c.name, [(c.body, n, w, 0), (c.line_body, -n, w, 0)], n)
+                pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
+                     point(c.body, c.point))
             else:
-                pairs = []
-                for name, coef in c.coefficients:
-                    j = mech.joints[mech.coordinates.index(name)]
-                    pairs += _coordinate_loads(j, sp.sympify(coef), kin)
-                column("closure", c.name, pairs, zero)
-        entries = [col.get(b, [0, 0, 0])[r] for b in self.bodies for r in range(3) for col in cols]
-        self.shape = (3 * len(self.bodies), len(cols))
-        self.A = sp.lambdify(kin.P, entries, modules="numpy", cse=True)
-        self.vectors = sp.lambdify(kin.P, [e for v in vectors for e in v], modules="numpy",
-                                   cse=True)
-        self.centres = sp.lambdify(kin.P, [e for b in self.bodies for e in kin.pose(b)[0]],
-                                   modules="numpy", cse=True)
-        H = sp.Symbol("H", real=True)
-        predicted = {p: p + H * v for p, v in zip(kin.P, kin.V)}
-        ext: dict[str, list] = {}
-        for body, force, point, torque in comp.loads:
-            add(ext, body, force, point, torque)
-        flat = [sp.sympify(ext.get(b, [0, 0, 0])[r]).xreplace(predicted)
-                for b in self.bodies for r in range(3)]
-        state = [s for k in range(len(kin.index))
-                 for s in (*kin.P[3 * k:3 * k + 3], *kin.V[3 * k:3 * k + 3])]
-        self.external = sp.lambdify([*state, H, TIME], flat, modules="numpy", cse=True)
+                loads = [] if not frames else [
+                    load for name, coef in c.coefficients for load in _coordinate_load(
+                        mech.joints[mech.coordinates.index(name)])(frames, num(coef))]
+                out.append(("closure", c.name, loads, (0.0, 0.0)))
+        return out
+
+    def centres(self, frames: _Frames) -> list:
+        """The description bodies' frame origins, x and y per body."""
+        return [v for b in self.bodies for v in frames.position(b)[:2]]
+
+    def matrix(self, frames: _Frames, n: int) -> tuple[np.ndarray, list]:
+        """(A of shape (n, rows, columns), the columns' directions)."""
+        A = np.zeros((n, *self.shape))
+        directions = []
+        for col, (_, _, loads, direction) in enumerate(self._columns(frames)):
+            A[:, :, col] = self.wrenches(loads, frames, n)
+            directions.append(direction)
+        return A, directions
+
+    def wrenches(self, loads: list[_Load], frames: _Frames, n: int) -> np.ndarray:
+        """(n, rows): the loads' wrenches on every description body about its frame
+        origin."""
+        out = np.zeros((n, self.shape[0]))
+        for load in loads:
+            if load[0] == WORLD:
+                continue
+            i = self.bodies.index(load[0])
+            wrench = np.broadcast_arrays(*_wrench(load, frames.position(load[0])[:2]),
+                                         np.zeros(n))[:3]
+            out[:, 3 * i:3 * i + 3] += np.column_stack(wrench)
+        return out
 
 
 def _default_layout(mech: Mechanism) -> _Layout | None:
@@ -1531,11 +1741,12 @@ class PymunkBackend(Backend):
                 constraints.append(pymunk.GearJoint(a, b, g.phase, 1.0))
         for a, b, phase, ratio in layout.gears:
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
-        for i, (pitch, phi) in enumerate(zip(layout.pitches, comp.pitch_phi)):
+        for i, pitch in enumerate(layout.pitches):
             if pitch.contact is not None:
                 PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
             else:
-                constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch, phi))
+                constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch,
+                                                              comp.pitch_phi(pitch)))
         for c in constraints:
             c.error_bias = float(cfg["error_bias"])
         space.add(*constraints)
@@ -1888,9 +2099,8 @@ class PymunkBackend(Backend):
                      t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine body states (rows of `S`) -> the description's coordinates and rates;
         the angles of eliminated links, which come from atan2, continued from q0."""
-        n = len(mechanism.joints)
-        cols = [np.broadcast_to(np.asarray(c, float), t.shape) for c in comp.coords_np(*S.T)]
-        q, qd = np.column_stack(cols[:n]), np.column_stack(cols[n:])
+        q, qd = (np.column_stack([np.broadcast_to(np.asarray(c, float), t.shape) for c in cols])
+                 for cols in joint_coordinates(mechanism, comp.frames(S)))
         for i, j in enumerate(mechanism.joints):
             if isinstance(j, Revolute):
                 col = np.unwrap(q[:, i])
@@ -1919,9 +2129,11 @@ class PymunkBackend(Backend):
             m = comp.masses[name]
             total[:, 0] += m * np.diff(S[:, 6 * k + 3]) / h
             total[:, 1] += m * (np.diff(S[:, 6 * k + 4]) / h + g)
-        ext = comp.external_np[joint](*S[:-1].T, H, t[:-1] + shift * h)
-        for i in range(2):
-            total[:, i] -= np.broadcast_to(np.asarray(ext[i], float), (len(t) - 1,))
+        subtree = set(mech.subtree(j.child))
+        for body, force, _, _ in comp.body_loads(comp.frames(S[:-1], H), t[:-1] + shift * h):
+            if force is not None and body in subtree:
+                for i in range(2):
+                    total[:, i] -= force[i]
         out = np.full((len(t), 2), np.nan)
         out[1:] = total
         return out
@@ -1942,17 +2154,17 @@ class PymunkBackend(Backend):
         the force in a joint of an eliminated link is its static balance."""
         layout = comp.layout
         if comp.balance is None:
-            comp.balance = _Balance(mech, comp)
+            comp.balance = _Balance(mech)
         bal: _Balance = comp.balance
         m_steps = len(t) - 1
         nrow, ncol = bal.shape
-        pos = [S[1:, 6 * k + i] for k in range(len(layout.engine)) for i in range(3)]
 
         def arrays(values) -> list[np.ndarray]:
             return [np.broadcast_to(np.asarray(v, float), (m_steps,)) for v in values]
 
-        A = np.stack(arrays(bal.A(*pos)), axis=-1).reshape(m_steps, nrow, ncol)
-        centres = arrays(bal.centres(*pos))
+        frames = comp.frames(S[1:])
+        A, directions = bal.matrix(frames, m_steps)
+        centres = arrays(bal.centres(frames))
         rhs = np.zeros((m_steps, nrow))
         g = num(mech.gravity)
         carriers = {c.name: c for c in layout.carriers}
@@ -1969,15 +2181,14 @@ class PymunkBackend(Backend):
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
             rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
-        ext = arrays(bal.external(*S[:-1].T, H, t[:-1] + shift * h))
-        rhs -= np.column_stack(ext)
+        ahead = comp.frames(S[:-1], H)
+        rhs -= bal.wrenches(comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
         x = (np.linalg.pinv(A) @ rhs[..., None])[..., 0]
         resid = np.linalg.norm(np.einsum("nij,nj->ni", A, x) - rhs, axis=1)
         self.diagnostics = {
             "balance_residual": float(np.max(resid) / max(float(np.max(np.abs(rhs))), 1e-300)),
             "notes": list(layout.notes),
         }
-        vec = arrays(bal.vectors(*pos))
         joints: dict[str, list] = {}
         closures: dict[str, list] = {}
         for i, (kind, name) in enumerate(bal.columns):
@@ -1991,7 +2202,7 @@ class PymunkBackend(Backend):
                 val = x[:, indices]
             elif scalar_vector:  # force magnitude along its known direction
                 i = indices[0]
-                val = x[:, [i]] * np.column_stack([vec[2 * i], vec[2 * i + 1]])
+                val = x[:, [i]] * np.column_stack(arrays(directions[i]))
             else:
                 val = x[:, indices]
             out = np.full((len(t), val.shape[1]), np.nan)
