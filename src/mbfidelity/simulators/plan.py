@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property, singledispatch
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import sympy as sp
@@ -685,3 +685,81 @@ def joint_coordinates(mech: Mechanism, states) -> tuple[list, list]:
     bodies (a mapping from body name, the world included; numbers or arrays of samples)."""
     pairs = [coordinate_reader(j)(states[j.parent], states[j.child]) for j in mech.joints]
     return [p[0] for p in pairs], [p[1] for p in pairs]
+
+
+# --- the loads of the force elements on the bodies --------------------------------------
+
+#: a load on a body: (body, force (fx, fy) or None, its world point or None, torque)
+Load = tuple
+
+
+def wrench(load: Load, centre) -> tuple:
+    """(fx, fy, moment about `centre`) of a load."""
+    _, force, point, torque = load
+    if force is None:
+        return 0.0, 0.0, torque
+    return (force[0], force[1],
+            (point[0] - centre[0]) * force[1] - (point[1] - centre[1]) * force[0] + torque)
+
+
+def coordinate_load(joint: Revolute | Prismatic) -> Callable[[Mapping, object], list[Load]]:
+    """The loads of a generalized force Q on a joint's coordinate (virtual power of
+    Q q'), as a function of (the bodies' frame states, Q): torques s Q on a hinge's child
+    and -s Q on its parent (none for an absolute angle; s = -1 for a clockwise
+    coordinate); a slide's force Q R a / |a|^2 on the child at its anchor, opposite on
+    the parent."""
+    if isinstance(joint, Revolute):
+        s = -1.0 if joint.clockwise else 1.0
+        if joint.absolute:
+            return lambda states, value: [(joint.child, None, None, s * value)]
+        return lambda states, value: [(joint.child, None, None, s * value),
+                                      (joint.parent, None, None, -s * value)]
+    a = (num(joint.axis[0]), num(joint.axis[1]))
+    anchor = (num(joint.child_anchor[0]), num(joint.child_anchor[1]))
+    norm2 = a[0] * a[0] + a[1] * a[1]
+
+    def loads(states: Mapping, value) -> list[Load]:
+        c, s = cos_sin(states[joint.parent][2])
+        force = (value * (c * a[0] - s * a[1]) / norm2, value * (s * a[0] + c * a[1]) / norm2)
+        w = moving_point(states[joint.child], anchor)[:2]
+        return [(joint.child, force, w, 0.0), (joint.parent, (-force[0], -force[1]), w, 0.0)]
+
+    return loads
+
+
+def element_loads(mech: Mechanism, element: PointToPoint | CoordinateForce
+                  ) -> Callable[[Mapping, object], list[Load]]:
+    """A force element's loads on the bodies as a function of (the bodies' frame states,
+    t): a PointToPoint's tension along the line of its points (on body b, opposite on
+    body a); a CoordinateForce's generalized force by `coordinate_load` (a couple, +F on
+    one coordinate and -F on the other, with relative_to)."""
+    law = ForceLaw.of(element)
+    if isinstance(element, PointToPoint):
+        f = element
+        pa = (num(f.point_a[0]), num(f.point_a[1]))
+        pb = (num(f.point_b[0]), num(f.point_b[1]))
+
+        def point_to_point(states: Mapping, t) -> list[Load]:
+            a, b = moving_point(states[f.body_a], pa), moving_point(states[f.body_b], pb)
+            dx, dy = b[0] - a[0], b[1] - a[1]
+            length = sqrt(dx * dx + dy * dy)
+            rate = (dx * (b[2] - a[2]) + dy * (b[3] - a[3])) / length
+            tension = law_value(law, length, rate, t)
+            ux, uy = dx / length, dy / length
+            return [(f.body_b, (-tension * ux, -tension * uy), b[:2], 0.0),
+                    (f.body_a, (tension * ux, tension * uy), a[:2], 0.0)]
+
+        return point_to_point
+    terms = [(sign, mech.joints[i], coordinate_reader(mech.joints[i]),
+              coordinate_load(mech.joints[i]))
+             for i, sign in element.weights(mech.coordinates).items()]
+
+    def coordinate_force(states: Mapping, t) -> list[Load]:
+        x = xd = 0.0
+        for sign, j, read, _ in terms:
+            q, qd = read(states[j.parent], states[j.child])
+            x, xd = x + sign * q, xd + sign * qd
+        value = law_value(law, x, xd, t)
+        return [load for sign, _, _, apply in terms for load in apply(states, sign * value)]
+
+    return coordinate_force

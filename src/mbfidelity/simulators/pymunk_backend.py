@@ -106,7 +106,6 @@ import numpy as np
 
 from ..systems.model import (
     WORLD,
-    CoordinateForce,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -147,18 +146,18 @@ from .plan import (
     REVOLUTE,
     ROLLING_CONTACT,
     TIME_LOAD,
-    ForceLaw,
+    Load,
     atan2,
     body_states,
     cos_sin,
-    law_value,
     linear_solver,
-    sqrt,
     traced,
+    wrench,
     coupled,
+    coordinate_load,
     coordinate_reader,
+    element_loads,
     joint_coordinates,
-    moving_point,
     motions,
     description_reason,
     num,
@@ -1045,68 +1044,7 @@ class _Frames:
             self.rate[body] = (v[c], v[c + 1], omega[body])
 
 
-#: a load on a description body: (body, force (fx, fy) or None, its world point, torque)
-_Load = tuple
-
-
-def _coordinate_load(j: Revolute | Prismatic) -> Callable[["_Frames", object], list]:
-    """The loads of a generalized force Q on the coordinate of joint j (virtual power),
-    as a function of (frames, Q): torques s Q on a hinge's child and -s Q on its parent
-    (none for an absolute angle); a slide's force Q R a / |a|^2 on the child at its
-    anchor, opposite on the parent."""
-    if isinstance(j, Revolute):
-        s = -1.0 if j.clockwise else 1.0
-        if j.absolute:
-            return lambda frames, value: [(j.child, None, None, s * value)]
-        return lambda frames, value: [(j.child, None, None, s * value),
-                                      (j.parent, None, None, -s * value)]
-    a, anchor = _pt(j.axis), _pt(j.child_anchor)
-    norm2 = a[0] * a[0] + a[1] * a[1]
-
-    def loads(frames: _Frames, value) -> list:
-        ax, ay = _rot(frames.position(j.parent), a)
-        force = (value * ax / norm2, value * ay / norm2)
-        w = _place(frames.position(j.child), anchor)
-        return [(j.child, force, w, 0.0), (j.parent, (-force[0], -force[1]), w, 0.0)]
-
-    return loads
-
-
-def _element(mech: Mechanism, f: PointToPoint | CoordinateForce) -> Callable:
-    """A force element's loads on the description bodies as a function of (frames, t),
-    numbers or arrays of samples (the law compiled for each)."""
-    law = ForceLaw.of(f)
-    if isinstance(f, PointToPoint):
-        pa, pb = _pt(f.point_a), _pt(f.point_b)
-
-        def point_to_point(frames: _Frames, t) -> list:
-            a, b = frames.point(f.body_a, pa), frames.point(f.body_b, pb)
-            dx, dy = b[0] - a[0], b[1] - a[1]
-            length = sqrt(dx * dx + dy * dy)
-            rate = (dx * (b[2] - a[2]) + dy * (b[3] - a[3])) / length
-            tension = law_value(law, length, rate, t)
-            ux, uy = dx / length, dy / length
-            return [(f.body_b, (-tension * ux, -tension * uy), b[:2], 0.0),
-                    (f.body_a, (tension * ux, tension * uy), a[:2], 0.0)]
-
-        return point_to_point
-    terms = [(sign, mech.joints[i], coordinate_reader(mech.joints[i]),
-              _coordinate_load(mech.joints[i]))
-             for i, sign in f.weights(mech.coordinates).items()]
-
-    def coordinate_force(frames: _Frames, t) -> list:
-        x = xd = 0.0
-        for sign, j, read, _ in terms:
-            q, qd = read(frames[j.parent], frames[j.child])
-            x, xd = x + sign * q, xd + sign * qd
-        value = law_value(law, x, xd, t)
-        # a couple (relative_to): +F on one coordinate, -F on the other
-        return [load for sign, _, _, apply in terms for load in apply(frames, sign * value)]
-
-    return coordinate_force
-
-
-def _transmit(kind: tuple, load: _Load, frames: _Frames) -> list[_Load]:
+def _transmit(kind: tuple, load: Load, frames: _Frames) -> list[Load]:
     """A load on a folded link or an arm as the loads on the bodies it follows that have
     the same virtual power: on a folded link, the force at the pin on the pin's body and
     the moment about the pin on the body it turns with; on an arm from a to b, whose
@@ -1129,15 +1067,6 @@ def _transmit(kind: tuple, load: _Load, frames: _Frames) -> list[_Load]:
     fb = (-scale * wy, scale * wx)
     fa = (-fb[0], -fb[1]) if force is None else (force[0] - fb[0], force[1] - fb[1])
     return [(ra, fa, (ax, ay), 0.0), (rb, fb, (bx, by), 0.0)]
-
-
-def _wrench(load: _Load, centre: tuple) -> tuple:
-    """(fx, fy, moment about `centre`) of a load."""
-    _, force, point, torque = load
-    if force is None:
-        return 0.0, 0.0, torque
-    return (force[0], force[1],
-            (point[0] - centre[0]) * force[1] - (point[1] - centre[1]) * force[0] + torque)
 
 
 def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
@@ -1164,14 +1093,13 @@ class _Compiled:
     masses: dict[str, float]
     #: per prescribed coordinate, the read-out of its actuator force (`_DriveBalance`)
     drives: dict[str, "_DriveBalance"] = field(default_factory=dict)
-    balance: "_Balance | None" = None  # built on the first constrained read-out
     phis: dict[str, Callable] = field(default_factory=dict)  # compiled `pitch_phi`s
 
     def frames(self, S: np.ndarray, H: float = 0.0) -> _Frames:
         """The frames over state rows S (one sample per row) at x + H v."""
         return self.states.frames(*_rows(S, H))
 
-    def body_loads(self, frames: _Frames, t) -> list[_Load]:
+    def body_loads(self, frames: _Frames, t) -> list[Load]:
         """The element loads on the description bodies."""
         return [load for element in self.elements for load in element(frames, t)]
 
@@ -1225,7 +1153,7 @@ class _Compiled:
                 continue
             if kind[body][0] == "body":
                 k = kind[body][1]
-                fx, fy, tau = _wrench(load, P[k][:2])
+                fx, fy, tau = wrench(load, P[k][:2])
                 acc = out[k]
                 acc[0] += fx
                 acc[1] += fy
@@ -1267,7 +1195,7 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
         for body in set(bodies) - {WORLD}:
             kind = states.kind[body]
             loaded |= {kind[1]} if kind[0] == "body" else set(states.follows[body])
-    comp = _Compiled(mech, layout, states, [_element(mech, f) for f in mech.forces],
+    comp = _Compiled(mech, layout, states, [element_loads(mech, f) for f in mech.forces],
                      sorted(loaded), {b.name: num(b.mass) for b in mech.bodies})
     comp.drives = {d.name: _DriveBalance.of(mech, comp, d) for d in layout.drives}
     if len(_CACHE) > 64:
@@ -1349,92 +1277,61 @@ class _DriveBalance:
                 if load[1] is not None:
                     external = external + ax * load[1][0] + ay * load[1][1]
             else:
-                external = external + _wrench(load, (ax, ay))[2]
+                external = external + wrench(load, (ax, ay))[2]
         out = np.full(len(t), np.nan)
         out[1:] = total - self.sign * external
         return out
 
 
-class _Balance:
-    """Momentum balance of every description body over a step, solved in least squares
-    for the joint reactions and the closure multipliers (see `PymunkBackend._forces`):
-    per column (a joint's or closure's unknown force component), its loads on the
-    description bodies and its unit direction (zero for a moment or a coupling)."""
+def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
+    """The unknowns of the momentum balance (see `PymunkBackend._forces`), one column
+    each: (kind, name, its loads on the description bodies at unit value, its direction
+    in world axes or None): two force components of a hinge or a point-on-point
+    closure; the normal force and the moment of a slide; the normal force of a slot;
+    the generalized force of a coupling."""
+    out = []
 
-    def __init__(self, mech: Mechanism):
-        self.mech = mech
-        self.bodies = [b.name for b in mech.bodies]
-        self.columns = [(kind, name) for kind, name, _, _ in self._columns(None)]
-        self.shape = (3 * len(self.bodies), len(self.columns))
+    def pair(kind, name, a, b, force, w):
+        out.append((kind, name, [(a, force, w, 0.0), (b, (-force[0], -force[1]), w, 0.0)],
+                    force))
 
-    def _columns(self, frames: _Frames | None) -> list[tuple[str, str, list, tuple]]:
-        """(kind, name, loads, direction) per column at the frames (None: only the kinds
-        and names)."""
-        mech, out = self.mech, []
+    def normal(body, d):  # the unit normal of direction d of `body`, in world axes
+        dx, dy = _rot(frames.position(body), np.array(_pt(d)) / float(np.linalg.norm(_pt(d))))
+        return -dy, dx
 
-        def point(body, local):
-            return _place(frames.position(body), _pt(local)) if frames else None
+    for j in mech.joints:
+        w = _place(frames.position(j.child), _pt(j.child_anchor))
+        if isinstance(j, Revolute):
+            for e in ((1.0, 0.0), (0.0, 1.0)):
+                pair("joint", j.name, j.child, j.parent, e, w)
+        else:
+            pair("joint", j.name, j.child, j.parent, normal(j.parent, j.axis), w)
+            out.append(("moment", j.name, [(j.child, None, None, 1.0),
+                                           (j.parent, None, None, -1.0)], None))
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            w = _place(frames.position(c.body_a), _pt(c.point_a))
+            for e in ((1.0, 0.0), (0.0, 1.0)):
+                pair("closure", c.name, c.body_a, c.body_b, e, w)
+        elif isinstance(c, PointOnLine):
+            pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
+                 _place(frames.position(c.body), _pt(c.point)))
+        else:
+            out.append(("closure", c.name, [
+                load for name, coef in c.coefficients for load in coordinate_load(
+                    mech.joints[mech.coordinates.index(name)])(frames, num(coef))], None))
+    return out
 
-        def normal(body, d):  # the unit normal of direction d of `body`, in world axes
-            if not frames:
-                return None
-            d = np.array(_pt(d)) / float(np.linalg.norm(_pt(d)))
-            dx, dy = _rot(frames.position(body), d)
-            return -dy, dx
 
-        def pair(kind, name, a, b, force, w):
-            minus = None if force is None else (-force[0], -force[1])
-            out.append((kind, name, [(a, force, w, 0.0), (b, minus, w, 0.0)], force))
-
-        for j in mech.joints:
-            w = point(j.child, j.child_anchor)
-            if isinstance(j, Revolute):
-                for e in ((1.0, 0.0), (0.0, 1.0)):
-                    pair("joint", j.name, j.child, j.parent, e, w)
-            else:
-                pair("joint", j.name, j.child, j.parent, normal(j.parent, j.axis), w)
-                out.append(("moment", j.name, [(j.child, None, None, 1.0),
-                                               (j.parent, None, None, -1.0)], (0.0, 0.0)))
-        for c in mech.constraints:
-            if isinstance(c, PointOnPoint):
-                w = point(c.body_a, c.point_a)
-                for e in ((1.0, 0.0), (0.0, 1.0)):
-                    pair("closure", c.name, c.body_a, c.body_b, e, w)
-            elif isinstance(c, PointOnLine):
-                pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
-                     point(c.body, c.point))
-            else:
-                loads = [] if not frames else [
-                    load for name, coef in c.coefficients for load in _coordinate_load(
-                        mech.joints[mech.coordinates.index(name)])(frames, num(coef))]
-                out.append(("closure", c.name, loads, (0.0, 0.0)))
-        return out
-
-    def centres(self, frames: _Frames) -> list:
-        """The description bodies' frame origins, x and y per body."""
-        return [v for b in self.bodies for v in frames.position(b)[:2]]
-
-    def matrix(self, frames: _Frames, n: int) -> tuple[np.ndarray, list]:
-        """(A of shape (n, rows, columns), the columns' directions)."""
-        A = np.zeros((n, *self.shape))
-        directions = []
-        for col, (_, _, loads, direction) in enumerate(self._columns(frames)):
-            A[:, :, col] = self.wrenches(loads, frames, n)
-            directions.append(direction)
-        return A, directions
-
-    def wrenches(self, loads: list[_Load], frames: _Frames, n: int) -> np.ndarray:
-        """(n, rows): the loads' wrenches on every description body about its frame
-        origin."""
-        out = np.zeros((n, self.shape[0]))
-        for load in loads:
-            if load[0] == WORLD:
-                continue
-            i = self.bodies.index(load[0])
-            wrench = np.broadcast_arrays(*_wrench(load, frames.position(load[0])[:2]),
-                                         np.zeros(n))[:3]
-            out[:, 3 * i:3 * i + 3] += np.column_stack(wrench)
-        return out
+def _wrenches(bodies: list[str], loads: list[Load], frames: _Frames, n: int) -> np.ndarray:
+    """(n, 3 per body): the loads' wrenches on every body about its frame origin."""
+    out = np.zeros((n, 3 * len(bodies)))
+    for load in loads:
+        if load[0] != WORLD:
+            i = bodies.index(load[0])
+            out[:, 3 * i:3 * i + 3] += np.column_stack(np.broadcast_arrays(
+                *wrench(load, frames.position(load[0])[:2]), np.zeros(n))[:3])
+    return out
 
 
 def _default_layout(mech: Mechanism) -> _Layout | None:
@@ -2153,66 +2050,60 @@ class PymunkBackend(Backend):
         as the reactions (n+1; sample 0 NaN). Massless bodies enter with zero inertia, so
         the force in a joint of an eliminated link is its static balance."""
         layout = comp.layout
-        if comp.balance is None:
-            comp.balance = _Balance(mech)
-        bal: _Balance = comp.balance
         m_steps = len(t) - 1
-        nrow, ncol = bal.shape
+        bodies = [b.name for b in mech.bodies]
 
         def arrays(values) -> list[np.ndarray]:
             return [np.broadcast_to(np.asarray(v, float), (m_steps,)) for v in values]
 
         frames = comp.frames(S[1:])
-        A, directions = bal.matrix(frames, m_steps)
-        centres = arrays(bal.centres(frames))
-        rhs = np.zeros((m_steps, nrow))
+        columns = _balance_columns(mech, frames)
+        A = np.stack([_wrenches(bodies, loads, frames, m_steps) for _, _, loads, _ in columns],
+                     axis=-1)
+        rhs = np.zeros(A.shape[:2])
         g = num(mech.gravity)
         carriers = {c.name: c for c in layout.carriers}
         for k, name in enumerate(layout.engine):
             host = name if name in layout.dynamic else carriers[name].host
-            i = bal.bodies.index(host)
+            i = bodies.index(host)
             m, inertia = layout.engine_mass[name]
             fx = m * np.diff(S[:, 6 * k + 3]) / h
             fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
                 inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
-            rx, ry = S[1:, 6 * k] - centres[2 * i], S[1:, 6 * k + 1] - centres[2 * i + 1]
+            cx, cy = arrays(frames.position(host)[:2])
+            rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
             rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
         ahead = comp.frames(S[:-1], H)
-        rhs -= bal.wrenches(comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
+        rhs -= _wrenches(bodies, comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
         x = (np.linalg.pinv(A) @ rhs[..., None])[..., 0]
         resid = np.linalg.norm(np.einsum("nij,nj->ni", A, x) - rhs, axis=1)
         self.diagnostics = {
             "balance_residual": float(np.max(resid) / max(float(np.max(np.abs(rhs))), 1e-300)),
             "notes": list(layout.notes),
         }
-        joints: dict[str, list] = {}
-        closures: dict[str, list] = {}
-        for i, (kind, name) in enumerate(bal.columns):
-            if kind == "moment":
-                continue
-            target = joints if kind == "joint" else closures
-            target.setdefault(name, []).append(i)
+        grouped: dict[tuple[str, str], list[int]] = {}
+        for i, (kind, name, _, _) in enumerate(columns):
+            if kind != "moment":
+                grouped.setdefault((kind, name), []).append(i)
 
-        def assemble(indices: list[int], scalar_vector: bool) -> np.ndarray:
-            if len(indices) == 2:
-                val = x[:, indices]
-            elif scalar_vector:  # force magnitude along its known direction
-                i = indices[0]
-                val = x[:, [i]] * np.column_stack(arrays(directions[i]))
+        def assemble(indices: list[int]) -> np.ndarray:
+            direction = columns[indices[0]][3]
+            if len(indices) == 1 and direction is not None:  # magnitude along its direction
+                val = x[:, indices] * np.column_stack(arrays(direction))
             else:
                 val = x[:, indices]
             out = np.full((len(t), val.shape[1]), np.nan)
             out[1:] = val
             return out
 
-        joint_forces = {name: assemble(ix, True) for name, ix in joints.items()}
-        constraint_forces = {
-            c.name: assemble(closures[c.name], not isinstance(c, LinearCoupling))
-            for c in mech.constraints}
+        joint_forces = {name: assemble(ix) for (kind, name), ix in grouped.items()
+                        if kind == "joint"}
+        constraint_forces = {c.name: assemble(grouped["closure", c.name])
+                             for c in mech.constraints}
         return joint_forces, constraint_forces
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
