@@ -147,6 +147,7 @@ from .plan import (
     ROLLING_CONTACT,
     TIME_LOAD,
     Load,
+    element_kind,
     atan2,
     body_states,
     cos_sin,
@@ -542,6 +543,120 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             "belt, rolling: a pivot at the pitch point)")
 
 
+#: closure kind -> (its builder: (plan context, constraint) -> why it cannot be built or
+#: "", the expressions it declares)
+_CLOSURES: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
+
+
+def _closure(kind: str, *expressions: Expression) -> Callable:
+    """Register the builder of a closure kind with the expressions it declares."""
+    def register(build: Callable) -> Callable:
+        _CLOSURES[kind] = (build, expressions)
+        return build
+    return register
+
+
+def _massless_end(ctx, c, bodies) -> str:
+    bad = [b for b in bodies if not ctx.engine_ok(b)]
+    return (f"constraint {c.name}: on massless body {bad[0]} that cannot be eliminated "
+            "with it") if bad else ""
+
+
+@_closure(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
+def _pivot(ctx, c: PointOnPoint) -> str:
+    reason = _massless_end(ctx, c, (c.body_a, c.body_b))
+    if not reason:
+        ctx.layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
+                                  tuple(_vec(c.point_b))))
+    return reason
+
+
+@_closure(
+    POINT_ON_LINE,
+    Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot body's "
+                                           "centre of mass (or the slot is on the world or a "
+                                           "body whose rotation is fixed) and the pin is the "
+                                           "pin body's",
+               applies=lambda mech, slot: not _carried(mech, slot)),
+    Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
+                           "carrier (glued to the slot body, centred on the line) in an exact "
+                           "GrooveJoint, their mass taken out of the host "
+                           "(slider_compensation). " + _GROOVE_LIMIT,
+               when="otherwise"))
+def _slot(ctx, c: PointOnLine) -> str:
+    reason = _massless_end(ctx, c, (c.body, c.line_body))
+    if reason:
+        return reason
+    layout = ctx.layout
+    point, base = _vec(c.point), _vec(c.line_point)
+    direction = _vec(c.direction) / float(np.linalg.norm(_vec(c.direction)))
+
+    def substitute(kind: str, host: str, at: np.ndarray) -> str:
+        """A carrier of `host` at its point `at`: a glued slot carrier (kind "slot") or
+        a point-mass pin slider (kind "pin"), pinned there."""
+        m, inertia = num(ctx.mech.body(host).mass), num(ctx.mech.body(host).inertia)
+        mass = ctx.fraction * _effective_mass(m, inertia, float(np.linalg.norm(at)))
+        name = f"_{kind}_{'carrier' if kind == 'slot' else 'slider'}_{c.name}"
+        layout.carriers.append(_Carrier(name, host, kind, tuple(at), mass,
+                                        mass * inertia / m if kind == "slot" else math.inf,
+                                        c.name))
+        layout.pivots.append((host, name, tuple(at), (0.0, 0.0)))
+        return name
+
+    slot, pin, anchor = c.line_body, c.body, point
+    if slot != WORLD and not _through_origin(base, direction):
+        if _rotation_fixed(ctx.mech, slot):
+            layout.infinite.add(slot)
+        else:  # slot carrier glued to the slot body, its centre on the line
+            foot = base - float(base @ direction) * direction
+            slot, base = substitute("slot", slot, foot), base - foot
+            layout.gears.append((c.line_body, slot, 0.0, 1.0))
+    if pin != WORLD and point.any():
+        if _rotation_fixed(ctx.mech, pin):
+            layout.infinite.add(pin)
+        else:  # pin slider: a point mass pinned to the pin point
+            pin, anchor = substitute("pin", pin, point), np.zeros(2)
+    layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -ctx.half, ctx.half,
+                                  tuple(anchor), None))
+    return ""
+
+
+@_closure(ROLLING_CONTACT, Expression(
+    SUBSTITUTE, "the pitch circles collide (a Circle inside a ring of contact_segments "
+                "Segments) with Coulomb friction, the carrier arm removed: what a "
+                "game-physics user would build. Measured on the disc of Fig. 39: trajectory "
+                "error 2-10 % of the amplitude (coupling 2-2.6e-3), slip up to 3e-4 m, "
+                "single-step losses of contact from one chord to the next"))
+def _contact(ctx, c: RollingContact) -> str:
+    out = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
+    if isinstance(out, str):
+        return out
+    if out[0] == "gear":
+        return (f"contact {c.name}: the disc and the track must be hinged on a massless "
+                "carrier arm, which the contact replaces")
+    ctx.layout.pitches.append(out[1])
+    return ""
+
+
+@_closure(
+    LINEAR_COUPLING,
+    Expression(EXACT, "GearJoint on the absolute angles of two bodies",
+               when="two body angles",
+               applies=lambda mech, coupling: not _pitched(mech, coupling)),
+    Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
+                      "moved to the pitch point before every solve: its tangential row is "
+                      "the coupling (gear pair, belt, rolling); other couplings are refused "
+                      "(support)",
+               when="three body angles, two hinged on a carrier"))
+def _gear(ctx, c: LinearCoupling) -> str:
+    out = _coupling(ctx.mech, c, ctx.engine_ok, ctx.massless)
+    if isinstance(out, str):
+        return out
+    kind, value = out
+    (ctx.layout.gears if kind == "gear" else ctx.layout.pitches).append(value)
+    return ""
+
+
 def _moment(body, cfg: Mapping) -> float:
     """The engine moment of a body: its central inertia, or for a point mass (inertia 0,
     which Chipmunk inverts to an infinite angular response) m r^2 with r the setting
@@ -661,68 +776,15 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
         length = float(np.linalg.norm(np.subtract(link.beta, link.alpha)))
         layout.pins.append((ra, rb, pa, pb, length, link.link))
 
-    # --- closure constraints ------------------------------------------------------------
-    def engine_ok(b: str) -> bool:
-        return b == WORLD or b in dynamic
-
-    half = float(cfg.get("groove_half_length", 1000.0))
-    fraction = float(cfg.get("slider_mass_fraction", 0.5))
+    # --- closure constraints: each kind's registered builder ---------------------------
+    ctx = SimpleNamespace(mech=mech, layout=layout, massless=mset,
+                          engine_ok=lambda b: b == WORLD or b in dynamic,
+                          half=float(cfg.get("groove_half_length", 1000.0)),
+                          fraction=float(cfg.get("slider_mass_fraction", 0.5)))
     for c in constraints:
-        if id(c) in consumed:
-            continue
-        if isinstance(c, PointOnPoint):
-            bad = [b for b in (c.body_a, c.body_b) if not engine_ok(b)]
-            if bad:
-                return (f"constraint {c.name}: on massless body {bad[0]} that cannot be "
-                        "eliminated with it")
-            layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
-                                  tuple(_vec(c.point_b))))
-        elif isinstance(c, PointOnLine):
-            bad = [b for b in (c.body, c.line_body) if not engine_ok(b)]
-            if bad:
-                return (f"constraint {c.name}: on massless body {bad[0]} that cannot be "
-                        "eliminated with it")
-            point, base = _vec(c.point), _vec(c.line_point)
-            direction = _vec(c.direction) / float(np.linalg.norm(_vec(c.direction)))
-            slot, pin, anchor = c.line_body, c.body, point
-            if slot != WORLD and not _through_origin(base, direction):
-                if _rotation_fixed(mech, slot):
-                    layout.infinite.add(slot)
-                else:  # slot carrier glued to the slot body, its centre on the line
-                    foot = base - float(base @ direction) * direction
-                    host = mech.body(slot)
-                    m, inertia = num(host.mass), num(host.inertia)
-                    mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(foot)))
-                    name = f"_slot_carrier_{c.name}"
-                    layout.carriers.append(_Carrier(name, slot, "slot", tuple(foot), mass,
-                                                    mass * inertia / m, c.name))
-                    layout.pivots.append((slot, name, tuple(foot), (0.0, 0.0)))
-                    layout.gears.append((slot, name, 0.0, 1.0))
-                    slot, base = name, base - foot
-            if pin != WORLD and point.any():
-                if _rotation_fixed(mech, pin):
-                    layout.infinite.add(pin)
-                else:  # pin slider: a point mass pinned to the pin point
-                    host = mech.body(pin)
-                    m, inertia = num(host.mass), num(host.inertia)
-                    mass = fraction * _effective_mass(m, inertia, float(np.linalg.norm(point)))
-                    name = f"_pin_slider_{c.name}"
-                    layout.carriers.append(_Carrier(name, pin, "pin", tuple(point), mass,
-                                                    math.inf, c.name))
-                    layout.pivots.append((pin, name, tuple(point), (0.0, 0.0)))
-                    pin, anchor = name, np.zeros(2)
-            layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -half, half,
-                                          tuple(anchor), None))
-        else:
-            rolling = isinstance(c, RollingContact)
-            out = _coupling(mech, c.coupling if rolling else c, engine_ok, mset, rolling)
-            if isinstance(out, str):
-                return out
-            kind, value = out
-            if kind == "gear" and rolling:
-                return (f"contact {c.name}: the disc and the track must be hinged on a "
-                        "massless carrier arm, which the contact replaces")
-            (layout.gears if kind == "gear" else layout.pitches).append(value)
+        reason = "" if id(c) in consumed else _CLOSURES[element_kind(c)][0](ctx, c)
+        if reason:
+            return reason
 
     # --- engine masses; compensation of the slider substitutes -------------------------
     for name in dynamic:
@@ -1523,38 +1585,7 @@ class PymunkBackend(Backend):
         COORDINATE_FORCE_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
         COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
         TIME_LOAD: (Expression(EXACT, _ELEMENT_FORCE + ", at t + h"),),
-        POINT_ON_POINT: (Expression(EXACT, "PivotJoint"),),
-        POINT_ON_LINE: (
-            Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot "
-                                                  "body's centre of mass (or the slot is on "
-                                                  "the world or a body whose rotation is "
-                                                  "fixed) and the pin is the pin body's",
-                       applies=lambda mech, slot: not _carried(mech, slot)),
-            Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
-                                   "carrier (glued to the slot body, centred on the line) in "
-                                   "an exact GrooveJoint, their mass taken out of the host "
-                                   "(slider_compensation). " + _GROOVE_LIMIT,
-                       when="otherwise"),
-        ),
-        ROLLING_CONTACT: (Expression(SUBSTITUTE, "the pitch circles collide (a Circle "
-                                                 "inside a ring of contact_segments Segments) "
-                                                 "with Coulomb friction, the carrier arm "
-                                                 "removed: what a game-physics user would "
-                                                 "build. Measured on the disc of Fig. 39: "
-                                                 "trajectory error 2-10 % of the amplitude "
-                                                 "(coupling 2-2.6e-3), slip up to 3e-4 m, "
-                                                 "single-step losses of contact from one "
-                                                 "chord to the next"),),
-        LINEAR_COUPLING: (
-            Expression(EXACT, "GearJoint on the absolute angles of two bodies",
-                       when="two body angles",
-                       applies=lambda mech, coupling: not _pitched(mech, coupling)),
-            Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
-                              "moved to the pitch point before every solve: its tangential "
-                              "row is the coupling (gear pair, belt, rolling); other "
-                              "couplings are refused (support)",
-                       when="three body angles, two hinged on a carrier"),
-        ),
+        **{kind: expressions for kind, (_, expressions) in _CLOSURES.items()},
         PRESCRIBED: (Expression(EXACT, "on the world: a Body.KINEMATIC child whose velocity "
                                        "is set every step to (q(t + 2h) - q(t + h))/h after "
                                        "the position update; on a free body: a constraint "
