@@ -871,20 +871,11 @@ def _pt(v) -> tuple[float, float]:
     return (num(v[0]), num(v[1]))
 
 
-@dataclass(frozen=True)
-class _Group:
-    """A free massless group's joint equations, read once: per equation pair the points
-    (sign, body, local) whose sum vanishes, and the travel along a direction of a body
-    (column, body, direction, sign) of a slide or a slot, if any."""
-
-    bodies: tuple[str, ...]
-    column: dict  # body -> column of its x (y follows)
-    size: int
-    angles: tuple[tuple[str, str, float], ...]
-    equations: tuple
-
-
-def _group(comp: _Component) -> _Group:
+def _group(comp: _Component) -> tuple:
+    """A free massless group's joint equations, read once: (column of each body's x,
+    the number of unknowns, the angles (body, known body, offset), per equation pair the
+    points (sign, body, local) whose sum vanishes and the travel (column, body,
+    direction, sign) of a slide or a slot along a direction of a body, if any)."""
     column = {body: 2 * i for i, body in enumerate(comp.bodies)}
     extra, equations = 2 * len(comp.bodies), []
     for j in comp.joints:
@@ -902,57 +893,7 @@ def _group(comp: _Component) -> _Group:
                                (-1.0, c.line_body, _pt(c.line_point))),
                               (extra, c.line_body, _pt(c.direction), -1.0)))
             extra += 1
-    return _Group(comp.bodies, column, extra, comp.angles, tuple(equations))
-
-
-class _States:
-    """How every description body's frame follows from the engine bodies' states
-    (centre of gravity, angle and their rates), read once per mechanism: a body with
-    mass is an engine body (its frame placed from the centre of gravity); a folded link
-    turns with its partner about its pin; an arm points from its end at alpha to its end
-    at beta; a free massless group solves its joint equations, linear once its angles
-    are known, and their time derivative for the rates. `frames` gives the states."""
-
-    def __init__(self, mech: Mechanism, layout: _Layout):
-        self.index = {name: k for k, name in enumerate(layout.engine)}
-        self.n = len(layout.engine)
-        self.kind: dict[str, tuple] = {}
-        #: per eliminated body, the engine bodies it follows
-        self.follows: dict[str, tuple[int, ...]] = {}
-        for name in layout.dynamic:
-            cog = layout.cog.get(name)
-            self.kind[name] = ("body", self.index[name], tuple(map(float, cog)) if cog else None)
-        for name, fold in layout.folds.items():
-            if isinstance(fold.inner, Revolute):  # turns with its child, pin on the parent
-                turner, off = fold.outer.child, -num(fold.outer.angle_offset)
-                pin, pin_local, local = (fold.inner.parent, fold.inner.parent_anchor,
-                                         fold.inner.child_anchor)
-            else:  # turns with its parent, pin on the child
-                turner, off = fold.inner.parent, num(fold.inner.angle_offset)
-                pin, pin_local, local = (fold.outer.child, fold.outer.child_anchor,
-                                         fold.outer.parent_anchor)
-            self.kind[name] = ("fold", turner, off, pin, _pt(pin_local), _pt(local))
-            self._follow(name, (turner, pin))
-        for name, link in layout.links.items():
-            (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
-            ell = (link.beta[0] - link.alpha[0], link.beta[1] - link.alpha[1])
-            self.kind[name] = ("link", ra, pa, rb, pb, ell, link.alpha)
-            self._follow(name, (ra, rb))
-        self.groups = [_group(comp) for comp in layout.components]
-        for i, (comp, group) in enumerate(zip(layout.components, self.groups)):
-            ends = {b for _, points_slide in enumerate(group.equations)
-                    for b in [p[1] for p in points_slide[0]]} - set(comp.bodies)
-            for name in comp.bodies:
-                self.kind[name] = ("group", i)
-                self._follow(name, ends)
-
-    def _follow(self, name: str, bodies) -> None:
-        self.follows[name] = tuple(sorted(self.index[b] for b in set(bodies) if b in self.index))
-
-    def frames(self, P: Sequence, V: Sequence) -> "_Frames":
-        """The description bodies' frames at engine positions P and rates V (per engine
-        body, (x, y, theta) of its centre of gravity and their rates)."""
-        return _Frames(self, P, V)
+    return column, extra, comp.angles, tuple(equations)
 
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -965,15 +906,15 @@ class _Frames:
     when asked (`frames[body]`); `rates` gives the frames at other engine rates on the
     same positions (the columns of a velocity Jacobian)."""
 
-    def __init__(self, states: _States, P: Sequence, V: Sequence, pose: dict | None = None,
+    def __init__(self, comp: "_Compiled", P: Sequence, V: Sequence, pose: dict | None = None,
                  solved: dict | None = None):
-        self.states, self.P, self.V = states, P, V
+        self.comp, self.P, self.V = comp, P, V
         self.pose = {WORLD: _AT_REST} if pose is None else pose
         self.solved = {} if solved is None else solved
         self.rate: dict[str, tuple] = {WORLD: _ZERO}
 
     def rates(self, V: Sequence) -> "_Frames":
-        return _Frames(self.states, self.P, V, self.pose, self.solved)
+        return _Frames(self.comp, self.P, V, self.pose, self.solved)
 
     def __getitem__(self, body: str) -> tuple:
         """The body's frame state (x, y, theta, vx, vy, omega)."""
@@ -988,7 +929,7 @@ class _Frames:
         pose = self.pose.get(body)
         if pose is not None:
             return pose
-        kind = self.states.kind[body]
+        kind = self.comp.kind[body]
         if kind[0] == "body":
             _, k, cog = kind
             x, y, th = self.P[k]
@@ -1018,7 +959,7 @@ class _Frames:
         rate = self.rate.get(body)
         if rate is not None:
             return rate
-        kind = self.states.kind[body]
+        kind = self.comp.kind[body]
         if kind[0] == "body":
             _, k, cog = kind
             vx, vy, w = self.V[k]
@@ -1050,14 +991,13 @@ class _Frames:
 
     def _solve(self, i: int) -> None:
         """A free group's positions (and the travels of its slides and slots)."""
-        group = self.states.groups[i]
+        column, m, angles, equations = self.comp.groups[i]
         angle: dict[str, object] = {}
-        for body, known, off in group.angles:
+        for body, known, off in angles:
             angle[body] = (angle[known] if known in angle else self.position(known)[2]) + off
-        m, column = group.size, group.column
         A = [[0.0] * m for _ in range(m)]
         known: list = []
-        for r, (points, slide) in enumerate(group.equations):
+        for r, (points, slide) in enumerate(equations):
             gx = gy = 0.0
             for sign, body, local in points:
                 if body in column:
@@ -1080,14 +1020,13 @@ class _Frames:
 
     def _solve_rates(self, i: int) -> None:
         """A free group's rates: its equations differentiated in time."""
-        group = self.states.groups[i]
+        column, m, angles, equations = self.comp.groups[i]
         angle, A, solve, x = self.solved[i]
         omega: dict[str, object] = {}
-        for body, known, _ in group.angles:
+        for body, known, _ in angles:
             omega[body] = omega[known] if known in omega else self.velocity(known)[2]
-        m, column = group.size, group.column
         known_rates: list = []
-        for r, (points, slide) in enumerate(group.equations):
+        for r, (points, slide) in enumerate(equations):
             gx = gy = 0.0
             for sign, body, local in points:
                 if body in column:
@@ -1106,31 +1045,6 @@ class _Frames:
             self.rate[body] = (v[c], v[c + 1], omega[body])
 
 
-def _transmit(kind: tuple, load: Load, frames: _Frames) -> list[Load]:
-    """A load on a folded link or an arm as the loads on the bodies it follows that have
-    the same virtual power: on a folded link, the force at the pin on the pin's body and
-    the moment about the pin on the body it turns with; on an arm from a to b, whose
-    angle is that of w = b - a, a moment M about a is the force M perp(w) / |w|^2 at b
-    (and its opposite at a)."""
-    body, force, point, torque = load
-    if kind[0] == "fold":
-        _, turner, _, pin, pin_local, _ = kind
-        if force is None:
-            return [(turner, None, None, torque)]
-        px, py = _place(frames.position(pin), pin_local)
-        moment = (point[0] - px) * force[1] - (point[1] - py) * force[0] + torque
-        return [(pin, force, (px, py), 0.0), (turner, None, None, moment)]
-    _, ra, pa, rb, pb, _, _ = kind
-    (ax, ay), (bx, by) = _place(frames.position(ra), pa), _place(frames.position(rb), pb)
-    wx, wy = bx - ax, by - ay
-    moment = torque if force is None else \
-        (point[0] - ax) * force[1] - (point[1] - ay) * force[0] + torque
-    scale = moment / (wx * wx + wy * wy)
-    fb = (-scale * wy, scale * wx)
-    fa = (-fb[0], -fb[1]) if force is None else (force[0] - fb[0], force[1] - fb[1])
-    return [(ra, fa, (ax, ay), 0.0), (rb, fb, (bx, by), 0.0)]
-
-
 def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
     """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from
     state rows (columns of samples)."""
@@ -1140,26 +1054,65 @@ def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
     return P, V
 
 
-@dataclass
 class _Compiled:
-    """What the runs of one mechanism use, read once: the description bodies' frames
-    from the engine's state (`states`), the force elements' loads and the engine bodies
-    they reach. The engine state is, per engine body, (x, y, theta, vx, vy, omega) of its
-    centre of gravity."""
+    """What the runs of one mechanism on one layout use, read once. How every description
+    body's frame follows from the engine bodies' states (centre of gravity, angle and
+    their rates; `frames`): a body with mass is an engine body (its frame placed from the
+    centre of gravity); a folded link turns with its partner about its pin; an arm points
+    from its end at alpha to its end at beta; a free massless group solves its joint
+    equations, linear once its angles are known, and their time derivative for the
+    rates. And the force elements' loads, and the engine bodies they reach (`loaded`)."""
 
-    mech: Mechanism
-    layout: _Layout
-    states: _States
-    elements: list[Callable]  # per force element: (frames, t) -> loads
-    loaded: list[int]  # indices of engine bodies that receive element loads
-    masses: dict[str, float]
-    #: per prescribed coordinate, the read-out of its actuator force (`_DriveBalance`)
-    drives: dict[str, "_DriveBalance"] = field(default_factory=dict)
-    phis: dict[str, Callable] = field(default_factory=dict)  # compiled `pitch_phi`s
+    def __init__(self, mech: Mechanism, layout: _Layout):
+        self.mech, self.layout = mech, layout
+        self.index = {name: k for k, name in enumerate(layout.engine)}
+        self.n = len(layout.engine)
+        self.kind: dict[str, tuple] = {}
+        #: per eliminated body, the engine bodies it follows
+        self.follows: dict[str, tuple[int, ...]] = {}
+        for name in layout.dynamic:
+            cog = layout.cog.get(name)
+            self.kind[name] = ("body", self.index[name], tuple(map(float, cog)) if cog else None)
+        for name, fold in layout.folds.items():
+            if isinstance(fold.inner, Revolute):  # turns with its child, pin on the parent
+                turner, off = fold.outer.child, -num(fold.outer.angle_offset)
+                pin, pin_local, local = (fold.inner.parent, fold.inner.parent_anchor,
+                                         fold.inner.child_anchor)
+            else:  # turns with its parent, pin on the child
+                turner, off = fold.inner.parent, num(fold.inner.angle_offset)
+                pin, pin_local, local = (fold.outer.child, fold.outer.child_anchor,
+                                         fold.outer.parent_anchor)
+            self.kind[name] = ("fold", turner, off, pin, _pt(pin_local), _pt(local))
+            self._follow(name, (turner, pin))
+        for name, link in layout.links.items():
+            (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
+            ell = (link.beta[0] - link.alpha[0], link.beta[1] - link.alpha[1])
+            self.kind[name] = ("link", ra, pa, rb, pb, ell, link.alpha)
+            self._follow(name, (ra, rb))
+        self.groups = [_group(comp) for comp in layout.components]
+        for i, group in enumerate(self.groups):
+            bodies = group[0].keys()
+            for name in bodies:
+                self.kind[name] = ("group", i)
+                self._follow(name, {p[1] for points, _ in group[3] for p in points} - bodies)
+        self.elements = [element_loads(mech, f) for f in mech.forces]
+        loaded: set[int] = set()
+        for f in mech.forces:
+            ends = ((f.body_a, f.body_b) if isinstance(f, PointToPoint) else
+                    [b for i in f.weights(mech.coordinates)
+                     for b in (mech.joints[i].parent, mech.joints[i].child)])
+            for body in set(ends) - {WORLD}:
+                kind = self.kind[body]
+                loaded |= {kind[1]} if kind[0] == "body" else set(self.follows[body])
+        self.loaded = sorted(loaded)  # engine bodies that receive element loads
+        self.phis: dict[str, Callable] = {}  # compiled `pitch_phi`s
+
+    def _follow(self, name: str, bodies) -> None:
+        self.follows[name] = tuple(sorted(self.index[b] for b in set(bodies) if b in self.index))
 
     def frames(self, S: np.ndarray, H: float = 0.0) -> _Frames:
         """The frames over state rows S (one sample per row) at x + H v."""
-        return self.states.frames(*_rows(S, H))
+        return _Frames(self, *_rows(S, H))
 
     def body_loads(self, frames: _Frames, t) -> list[Load]:
         """The element loads on the description bodies."""
@@ -1174,14 +1127,14 @@ class _Compiled:
         terms = [(num(coef), coordinate_reader(self.mech.joints[i]), self.mech.joints[i])
                  for name, coef in c.coefficients
                  for i in [self.mech.coordinates.index(name)]]
-        constant, n = num(c.constant), self.states.n
 
-        def phi(*pos: float) -> float:
-            frames = self.states.frames([pos[3 * k:3 * k + 3] for k in range(n)], [_ZERO] * n)
-            return sum(coef * read(frames[j.parent], frames[j.child])[0]
-                       for coef, read, j in terms) - constant
+        def phi(*pos: float) -> list:
+            frames = _Frames(self, [pos[k:k + 3] for k in range(0, len(pos), 3)],
+                             [_ZERO] * self.n)
+            return [sum(coef * read(frames[j.parent], frames[j.child])[0]
+                        for coef, read, j in terms) - num(c.constant)]
 
-        compiled = traced(lambda *pos: [phi(*pos)], 3 * n)
+        compiled = traced(phi, 3 * self.n)
         self.phis[pitch.name] = lambda *pos: compiled(*pos)[0]
         return self.phis[pitch.name]
 
@@ -1192,50 +1145,35 @@ class _Compiled:
         if not self.elements:
             return None
         return traced(lambda *args: self.engine_loads(args[:-2], args[-2], args[-1]),
-                      6 * self.states.n + 2)
+                      6 * self.n + 2)
 
-    def engine_loads(self, row: Sequence[float], H: float, t: float) -> list[float]:
+    def engine_loads(self, row: Sequence, H, t) -> list:
         """The element loads (fx, fy at the centre of gravity, tau) on the `loaded`
         engine bodies at the position-updated state x + H v of one state row. A load on
         an eliminated massless body reaches the engine bodies it follows by virtual
         power, J^T f, J's columns its velocities for a unit rate of each engine state."""
-        P, V = [], []
-        for k in range(0, len(row), 6):
-            vx, vy, w = row[k + 3:k + 6]
-            P.append((row[k] + H * vx, row[k + 1] + H * vy, row[k + 2] + H * w))
-            V.append((vx, vy, w))
-        frames = self.states.frames(P, V)
-        kind, follows = self.states.kind, self.states.follows
+        P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3))
+             for k in range(0, len(row), 6)]
+        V = [tuple(row[k + 3:k + 6]) for k in range(0, len(row), 6)]
+        frames = _Frames(self, P, V)
         out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
-        pending = self.body_loads(frames, t)
-        while pending:
-            load = pending.pop()
+        for load in self.body_loads(frames, t):
             body, force, point, torque = load
             if body == WORLD:
                 continue
-            if kind[body][0] == "body":
-                k = kind[body][1]
-                fx, fy, tau = wrench(load, P[k][:2])
-                acc = out[k]
-                acc[0] += fx
-                acc[1] += fy
-                acc[2] += tau
-                continue
-            if kind[body][0] != "group":
-                pending.extend(_transmit(kind[body], load, frames))
+            if self.kind[body][0] == "body":
+                k = self.kind[body][1]
+                out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
                 continue
             x, y = frames.position(body)[:2]
-            for k in follows[body]:
-                acc = out[k]
+            for k in self.follows[body]:
                 for i, unit in enumerate(_UNITS):
                     rates = [_ZERO] * len(P)
                     rates[k] = unit
                     vx, vy, w = frames.rates(rates).velocity(body)
-                    gen = torque * w
-                    if force is not None:
-                        gen += force[0] * (vx - w * (point[1] - y)) \
-                            + force[1] * (vy + w * (point[0] - x))
-                    acc[i] += gen
+                    out[k][i] += torque * w if force is None else (
+                        torque * w + force[0] * (vx - w * (point[1] - y))
+                        + force[1] * (vy + w * (point[0] - x)))
         return [v for k in self.loaded for v in out[k]]
 
 
@@ -1246,103 +1184,62 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
     """The mechanism's `_Compiled`, reused by every run on the same layout."""
     key = (mech, tuple(layout.engine), tuple(sorted(layout.cog.items())),
            tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
-    if key in _CACHE:
-        return _CACHE[key]
-    states = _States(mech, layout)
-    loaded: set[int] = set()
-    for f in mech.forces:
-        bodies = ((f.body_a, f.body_b) if isinstance(f, PointToPoint) else
-                  [b for i in f.weights(mech.coordinates)
-                   for b in (mech.joints[i].parent, mech.joints[i].child)])
-        for body in set(bodies) - {WORLD}:
-            kind = states.kind[body]
-            loaded |= {kind[1]} if kind[0] == "body" else set(states.follows[body])
-    comp = _Compiled(mech, layout, states, [element_loads(mech, f) for f in mech.forces],
-                     sorted(loaded), {b.name: num(b.mass) for b in mech.bodies})
-    comp.drives = {d.name: _DriveBalance.of(mech, comp, d) for d in layout.drives}
-    if len(_CACHE) > 64:
-        _CACHE.clear()
-    _CACHE[key] = comp
-    return comp
+    if key not in _CACHE:
+        if len(_CACHE) > 64:
+            _CACHE.clear()
+        _CACHE[key] = _Compiled(mech, layout)
+    return _CACHE[key]
 
 
-@dataclass(frozen=True)
-class _DriveBalance:
-    """The actuator force of a prescribed coordinate from Newton-Euler on the joint's
-    child subtree over a step: the joint's reaction has no component along a slide and no
-    moment about a hinge's point, so the actuator's generalized force is, for a slide,
-    d . sum m (a - g) and, for a hinge, s sum (I alpha + (r - A) x m (a - g)) (A the
-    hinge point, s = -1 for a clockwise coordinate), minus the same of the element loads
-    on the subtree as applied in that step. d is the slide's axis in world axes (dq = 1
-    moves the child by d)."""
+def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, h: float,
+                    H: float, shift: int, t: np.ndarray) -> np.ndarray:
+    """Shape (N+1,): a prescribed coordinate's actuator force over step n -> n+1 at sample
+    n+1 (where Chipmunk computed the impulses, as the reactions; sample 0 is NaN), from
+    Newton-Euler on the joint's child subtree: the joint's reaction has no component
+    along a slide and no moment about a hinge's point, so the actuator's generalized
+    force is, for a slide, d . sum m (a - g) and, for a hinge, s sum (I alpha + (r - A) x
+    m (a - g)) (A the hinge point, s = -1 for a clockwise coordinate), minus the same of
+    the element loads on the subtree as applied in that step. d is the slide's axis in
+    world axes (dq = 1 moves the child by d)."""
+    mech, n = comp.mech, len(t) - 1
+    slide = isinstance(joint, Prismatic)
+    sign = -1.0 if not slide and joint.clockwise else 1.0
+    subtree = set(mech.subtree(joint.child))
 
-    comp: _Compiled
-    joint: Revolute | Prismatic
-    engine: tuple[int, ...]  # engine bodies of the subtree
-    mass: tuple[float, ...]
-    inertia: tuple[float, ...]
-    cog: tuple[tuple[float, float], ...]  # engine centre of gravity in the body frame
-    sign: float
+    def geometry(frames: _Frames) -> tuple:  # the slide's axis in world axes, or the hinge
+        if slide:
+            return _rot(frames.position(joint.parent), _pt(joint.axis))
+        return _place(frames.position(joint.child), _pt(joint.child_anchor))
 
-    @staticmethod
-    def of(mech: Mechanism, comp: _Compiled, drive: _Drive) -> "_DriveBalance":
-        j = drive.joint
-        subtree = set(mech.subtree(j.child))
-        members = [name for name in comp.layout.dynamic if name in subtree]
-        return _DriveBalance(
-            comp, j, tuple(comp.states.index[n] for n in members),
-            tuple(num(mech.body(n).mass) for n in members),
-            tuple(num(mech.body(n).inertia) for n in members),
-            tuple(comp.layout.cog.get(n, (0.0, 0.0)) for n in members),
-            -1.0 if isinstance(j, Revolute) and j.clockwise else 1.0)
-
-    def geometry(self, frames: _Frames) -> tuple:
-        """The slide's axis in world axes, or the hinge point."""
-        j = self.joint
-        if isinstance(j, Prismatic):
-            return _rot(frames.position(j.parent), _pt(j.axis))
-        return _place(frames.position(j.child), _pt(j.child_anchor))
-
-    def force(self, S: np.ndarray, h: float, g: float, H: float, shift: int,
-              t: np.ndarray) -> np.ndarray:
-        """Shape (N+1,): the actuator force over step n -> n+1 at sample n+1 (where
-        Chipmunk computed the impulses, as the reactions); sample 0 is NaN."""
-        n = len(t) - 1
-        slide = isinstance(self.joint, Prismatic)
-        gx, gy = (np.broadcast_to(np.asarray(v, float), (n,))
-                  for v in self.geometry(self.comp.frames(S[1:])))
-        total = np.zeros(n)
-        for k, m, inertia, (cx, cy) in zip(self.engine, self.mass, self.inertia, self.cog):
-            # the centre of mass from the engine's centre of gravity (a kinematic driver
-            # turns about its hinge point)
-            th, w = S[:, 6 * k + 2], S[:, 6 * k + 5]
-            dx = -(np.cos(th) * cx - np.sin(th) * cy)
-            dy = -(np.sin(th) * cx + np.cos(th) * cy)
-            fx = m * np.diff(S[:, 6 * k + 3] - w * dy) / h
-            fy = m * (np.diff(S[:, 6 * k + 4] + w * dx) / h + g)
-            if slide:
-                total += gx * fx + gy * fy
-            else:
-                rx = S[1:, 6 * k] + dx[1:] - gx
-                ry = S[1:, 6 * k + 1] + dy[1:] - gy
-                total += self.sign * (inertia * np.diff(S[:, 6 * k + 5]) / h
-                                      + rx * fy - ry * fx)
-        # the element loads on the subtree as applied in the step (position-updated)
-        ahead = self.comp.frames(S[:-1], H)
-        ax, ay = self.geometry(ahead)
-        subtree = set(self.comp.mech.subtree(self.joint.child))
-        external = np.zeros(n)
-        for load in self.comp.body_loads(ahead, t[:-1] + shift * h):
-            if load[0] not in subtree:
-                continue
-            if slide:
-                if load[1] is not None:
-                    external = external + ax * load[1][0] + ay * load[1][1]
-            else:
+    gx, gy = (np.broadcast_to(np.asarray(v, float), (n,)) for v in geometry(comp.frames(S[1:])))
+    frames, g = comp.frames(S), num(mech.gravity)
+    total = np.zeros(n)
+    for name in comp.layout.dynamic:
+        if name not in subtree:
+            continue
+        # the body's centre of mass is its frame's origin (a kinematic driver's engine
+        # centre of gravity is its hinge point)
+        x, y, _, vx, vy, w = frames[name]
+        m = num(mech.body(name).mass)
+        fx, fy = m * np.diff(vx) / h, m * (np.diff(vy) / h + g)
+        if slide:
+            total += gx * fx + gy * fy
+        else:
+            total += sign * (num(mech.body(name).inertia) * np.diff(w) / h
+                             + (x[1:] - gx) * fy - (y[1:] - gy) * fx)
+    # the element loads on the subtree as applied in the step (position-updated)
+    ahead = comp.frames(S[:-1], H)
+    ax, ay = geometry(ahead)
+    external = np.zeros(n)
+    for load in comp.body_loads(ahead, t[:-1] + shift * h):
+        if load[0] in subtree:
+            if not slide:
                 external = external + wrench(load, (ax, ay))[2]
-        out = np.full(len(t), np.nan)
-        out[1:] = total - self.sign * external
-        return out
+            elif load[1] is not None:
+                external = external + ax * load[1][0] + ay * load[1][1]
+    out = np.full(len(t), np.nan)
+    out[1:] = total - sign * external
+    return out
 
 
 def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
@@ -2017,9 +1914,8 @@ class PymunkBackend(Backend):
         else:
             reactions = {j: self._reaction(mechanism, comp, j, S, H, shift, h, t)
                          for j in reaction_joints}
-        g = num(mechanism.gravity)
-        actuator_forces = {name: drive.force(S, h, g, H, shift, t)
-                           for name, drive in comp.drives.items()}
+        actuator_forces = {d.name: _actuator_force(comp, d.joint, S, h, H, shift, t)
+                           for d in comp.layout.drives}
         return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
 
     @staticmethod
@@ -2054,7 +1950,7 @@ class PymunkBackend(Backend):
             if name not in dynamic:
                 continue  # massless link
             k = dynamic.index(name)
-            m = comp.masses[name]
+            m = num(mech.body(name).mass)
             total[:, 0] += m * np.diff(S[:, 6 * k + 3]) / h
             total[:, 1] += m * (np.diff(S[:, 6 * k + 4]) / h + g)
         subtree = set(mech.subtree(j.child))
