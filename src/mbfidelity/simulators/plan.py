@@ -20,7 +20,11 @@ them and lives here:
   angle_offset for a hinge, the slide along the unit axis for a prismatic joint), so
   ``v = A q + b`` with the inverse ``q = T v + c``, and the body angles are affine in
   both; a coordinate law whose argument is one engine joint value can sit on that joint
-  (`CoordinateMap.law_target`).
+  (`CoordinateMap.law_target`);
+- the planar kinematics: the bodies' frames from q (`body_states`) and q from the
+  frames (`joint_coordinates`), and the force elements' loads on the bodies
+  (`element_loads`), on numbers, on arrays of samples, or on symbols, which `traced`
+  compiles into the straight-line code of a step.
 """
 from __future__ import annotations
 
