@@ -173,7 +173,6 @@ def test_pymunk_frames_and_load_power_follow_the_description(sid):
     pytest.importorskip("pymunk")
     from mbfidelity.analytic.reference import reference
     from mbfidelity.comparisons.runner import DEFAULT_DT, _engine_mechanism
-    from mbfidelity.simulators.plan import coupled
     from mbfidelity.simulators.pymunk_backend import BACKEND
     from mbfidelity.systems import all_systems
 

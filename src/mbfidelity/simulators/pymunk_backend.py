@@ -100,6 +100,7 @@ import math
 from types import SimpleNamespace
 from dataclasses import dataclass, field
 from functools import cached_property
+from operator import itemgetter
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -838,33 +839,16 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
 
-def _turn(th, v) -> tuple:
-    """R(th) v."""
-    c, s = cos_sin(th)
-    return c * v[0] - s * v[1], s * v[0] + c * v[1]
-
-
-def _posed(x, y, th) -> tuple:
-    """A body's pose (x, y, theta, cos theta, sin theta)."""
-    return (x, y, th, *cos_sin(th))
-
-
 def _rot(pose: tuple, v) -> tuple:
-    """A body-frame vector in world axes, from the body's pose."""
+    """A body-frame vector in world axes, from the body's `_Frames.state`."""
     c, s = pose[3], pose[4]
     return c * v[0] - s * v[1], s * v[0] + c * v[1]
 
 
 def _place(pose: tuple, local) -> tuple:
-    """World position of a body point from the body's pose."""
+    """World position of a body point from the body's `_Frames.state`."""
     rx, ry = _rot(pose, local)
     return pose[0] + rx, pose[1] + ry
-
-
-def _swing(pose: tuple, rate: tuple, local) -> tuple:
-    """World velocity of a body point from the body's pose and rates (vx, vy, omega)."""
-    rx, ry = _rot(pose, local)
-    return rate[0] - rate[2] * ry, rate[1] + rate[2] * rx
 
 
 def _pt(v) -> tuple[float, float]:
@@ -897,152 +881,112 @@ def _group(comp: _Component) -> tuple:
 
 
 _ZERO = (0.0, 0.0, 0.0)
-_AT_REST = (0.0, 0.0, 0.0, 1.0, 0.0)
 _UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 class _Frames:
-    """The frame state (x, y, theta, vx, vy, omega) of each description body, computed
-    when asked (`frames[body]`); `rates` gives the frames at other engine rates on the
-    same positions (the columns of a velocity Jacobian)."""
+    """The frame state of each description body, computed when asked: `state` gives
+    (x, y, theta, cos theta, sin theta, vx, vy, omega), `frames[body]` the frame state
+    (x, y, theta, vx, vy, omega) of plan.py; `rates` gives the frames at other engine
+    rates (the columns of a velocity Jacobian)."""
 
-    def __init__(self, comp: "_Compiled", P: Sequence, V: Sequence, pose: dict | None = None,
-                 solved: dict | None = None):
+    def __init__(self, comp: "_Compiled", P: Sequence, V: Sequence):
         self.comp, self.P, self.V = comp, P, V
-        self.pose = {WORLD: _AT_REST} if pose is None else pose
-        self.solved = {} if solved is None else solved
-        self.rate: dict[str, tuple] = {WORLD: _ZERO}
+        self.cache: dict[str, tuple] = {WORLD: (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0)}
 
     def rates(self, V: Sequence) -> "_Frames":
-        return _Frames(self.comp, self.P, V, self.pose, self.solved)
+        return _Frames(self.comp, self.P, V)
 
     def __getitem__(self, body: str) -> tuple:
-        """The body's frame state (x, y, theta, vx, vy, omega)."""
-        return self.position(body)[:3] + self.velocity(body)
+        state = self.state(body)
+        return state[:3] + state[5:]
 
-    def point(self, body: str, local) -> tuple:
-        """World position and velocity (x, y, vx, vy) of a body point."""
-        pose = self.position(body)
-        return (*_place(pose, local), *_swing(pose, self.velocity(body), local))
-
-    def position(self, body: str) -> tuple:
-        pose = self.pose.get(body)
-        if pose is not None:
-            return pose
+    def state(self, body: str) -> tuple:
+        if body in self.cache:
+            return self.cache[body]
         kind = self.comp.kind[body]
         if kind[0] == "body":
             _, k, cog = kind
-            x, y, th = self.P[k]
-            pose = _posed(x, y, th)
+            (x, y, th), (vx, vy, w) = self.P[k], self.V[k]
+            c, s = cos_sin(th)
             if cog:  # the frame origin from the centre of gravity
-                rx, ry = _rot(pose, cog)
-                pose = (x - rx, y - ry, *pose[2:])
-        elif kind[0] == "fold":
+                rx, ry = c * cog[0] - s * cog[1], s * cog[0] + c * cog[1]
+                x, y, vx, vy = x - rx, y - ry, vx + w * ry, vy - w * rx
+            state = (x, y, th, c, s, vx, vy, w)
+        elif kind[0] == "fold":  # turns with `turner`, its point `local` on the pin
             _, turner, off, pin, pin_local, local = kind
-            pose = _posed(0.0, 0.0, self.position(turner)[2] + off)
-            (px, py), (rx, ry) = _place(self.position(pin), pin_local), _rot(pose, local)
-            pose = (px - rx, py - ry, *pose[2:])
-        elif kind[0] == "link":
+            turning = self.state(turner)
+            state = _hung(_moving(self.state(pin), pin_local), turning[2] + off, turning[7],
+                          local)
+        elif kind[0] == "link":  # its alpha on the point a, its beta towards b
             _, ra, pa, rb, pb, ell, alpha = kind
-            (ax, ay), (bx, by) = _place(self.position(ra), pa), _place(self.position(rb), pb)
-            wx, wy = bx - ax, by - ay
-            pose = _posed(0.0, 0.0, atan2(ell[0] * wy - ell[1] * wx, ell[0] * wx + ell[1] * wy))
-            rx, ry = _rot(pose, alpha)
-            pose = (ax - rx, ay - ry, *pose[2:])
+            a, b = _moving(self.state(ra), pa), _moving(self.state(rb), pb)
+            wx, wy = b[0] - a[0], b[1] - a[1]
+            th = atan2(ell[0] * wy - ell[1] * wx, ell[0] * wx + ell[1] * wy)
+            w = (wx * (b[3] - a[3]) - wy * (b[2] - a[2])) / (wx * wx + wy * wy)
+            state = _hung(a, th, w, alpha)
         else:
-            self._solve(kind[1])
-            return self.pose[body]
-        self.pose[body] = pose
-        return pose
+            self._group(kind[1])
+            return self.cache[body]
+        self.cache[body] = state
+        return state
 
-    def velocity(self, body: str) -> tuple:
-        rate = self.rate.get(body)
-        if rate is not None:
-            return rate
-        kind = self.comp.kind[body]
-        if kind[0] == "body":
-            _, k, cog = kind
-            vx, vy, w = self.V[k]
-            if cog:
-                rx, ry = _rot(self.position(body), cog)
-                vx, vy = vx + w * ry, vy - w * rx
-            rate = (vx, vy, w)
-        elif kind[0] == "fold":
-            _, turner, _, pin, pin_local, local = kind
-            w = self.velocity(turner)[2]
-            px, py = _swing(self.position(pin), self.velocity(pin), pin_local)
-            rx, ry = _rot(self.position(body), local)
-            rate = (px + w * ry, py - w * rx, w)
-        elif kind[0] == "link":
-            _, ra, pa, rb, pb, _, alpha = kind
-            (ax, ay), (bx, by) = _place(self.position(ra), pa), _place(self.position(rb), pb)
-            (vax, vay) = _swing(self.position(ra), self.velocity(ra), pa)
-            (vbx, vby) = _swing(self.position(rb), self.velocity(rb), pb)
-            wx, wy = bx - ax, by - ay
-            w = (wx * (vby - vay) - wy * (vbx - vax)) / (wx * wx + wy * wy)
-            rx, ry = _rot(self.position(body), alpha)
-            rate = (vax + w * ry, vay - w * rx, w)
-        else:
-            self.position(body)
-            self._solve_rates(kind[1])
-            return self.rate[body]
-        self.rate[body] = rate
-        return rate
-
-    def _solve(self, i: int) -> None:
-        """A free group's positions (and the travels of its slides and slots)."""
+    def _group(self, i: int) -> None:
+        """A free group's positions (and its slides' and slots' travels) from its joint
+        equations, then its rates from the same equations differentiated in time."""
         column, m, angles, equations = self.comp.groups[i]
-        angle: dict[str, object] = {}
+        turn: dict[str, tuple] = {}  # body -> (theta, omega)
         for body, known, off in angles:
-            angle[body] = (angle[known] if known in angle else self.position(known)[2]) + off
+            th, w = turn[known] if known in turn else itemgetter(2, 7)(self.state(known))
+            turn[body] = (th + off, w)
         A = [[0.0] * m for _ in range(m)]
-        known: list = []
+        known_p, known_v, slides = [], [], []
         for r, (points, slide) in enumerate(equations):
-            gx = gy = 0.0
+            gap = (0.0, 0.0, 0.0, 0.0)  # the known points' position and velocity
             for sign, body, local in points:
                 if body in column:
                     A[2 * r][column[body]] += sign
                     A[2 * r + 1][column[body] + 1] += sign
-                    rx, ry = _turn(angle[body], local)
+                    th, w = turn[body]
+                    c, s = cos_sin(th)
+                    p = _moving((0.0, 0.0, th, c, s, 0.0, 0.0, w), local)
                 else:
-                    rx, ry = _place(self.position(body), local)
-                gx, gy = gx + sign * rx, gy + sign * ry
-            if slide is not None:
+                    p = _moving(self.state(body), local)
+                gap = tuple(g + sign * v for g, v in zip(gap, p))
+            if slide is not None:  # the travel u along sign R d
                 k, body, d, sign = slide
-                dx, dy = _turn(angle[body] if body in angle else self.position(body)[2], d)
-                A[2 * r][k], A[2 * r + 1][k] = sign * dx, sign * dy
-            known += [gx, gy]
+                th, w = turn[body] if body in turn else itemgetter(2, 7)(self.state(body))
+                c, s = cos_sin(th)
+                A[2 * r][k] = sign * (c * d[0] - s * d[1])
+                A[2 * r + 1][k] = sign * (s * d[0] + c * d[1])
+                slides.append((r, k, w))
+            known_p += gap[:2]
+            known_v += gap[2:]
         solve = linear_solver(A)
-        x = solve([-v for v in known])
-        self.solved[i] = (angle, A, solve, x)
+        x = solve([-v for v in known_p])
+        for r, k, w in slides:  # d/dt (u sign R d) = u' sign R d + u omega perp(sign R d)
+            known_v[2 * r] -= w * A[2 * r + 1][k] * x[k]
+            known_v[2 * r + 1] += w * A[2 * r][k] * x[k]
+        v = solve([-g for g in known_v])
         for body, c in column.items():
-            self.pose[body] = _posed(x[c], x[c + 1], angle[body])
+            th, w = turn[body]
+            self.cache[body] = (x[c], x[c + 1], th, *cos_sin(th), v[c], v[c + 1], w)
 
-    def _solve_rates(self, i: int) -> None:
-        """A free group's rates: its equations differentiated in time."""
-        column, m, angles, equations = self.comp.groups[i]
-        angle, A, solve, x = self.solved[i]
-        omega: dict[str, object] = {}
-        for body, known, _ in angles:
-            omega[body] = omega[known] if known in omega else self.velocity(known)[2]
-        known_rates: list = []
-        for r, (points, slide) in enumerate(equations):
-            gx = gy = 0.0
-            for sign, body, local in points:
-                if body in column:
-                    rx, ry = _turn(angle[body], local)
-                    vx, vy = -omega[body] * ry, omega[body] * rx
-                else:
-                    vx, vy = _swing(self.position(body), self.velocity(body), local)
-                gx, gy = gx + sign * vx, gy + sign * vy
-            if slide is not None:  # d/dt (u sign R d) = u' sign R d + u omega perp(sign R d)
-                k, body = slide[:2]
-                w = omega[body] if body in omega else self.velocity(body)[2]
-                gx, gy = gx - w * A[2 * r + 1][k] * x[k], gy + w * A[2 * r][k] * x[k]
-            known_rates += [gx, gy]
-        v = solve([-v for v in known_rates])
-        for body, c in column.items():
-            self.rate[body] = (v[c], v[c + 1], omega[body])
+
+def _moving(state: tuple, local) -> tuple:
+    """World position and velocity (x, y, vx, vy) of a body point from the body's
+    `_Frames.state`."""
+    x, y, _, c, s, vx, vy, w = state
+    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
+    return x + rx, y + ry, vx - w * ry, vy + w * rx
+
+
+def _hung(pin: tuple, th, w, local) -> tuple:
+    """The `_Frames.state` of a body at angle th turning at w, whose point `local` is at
+    the moving point `pin` (x, y, vx, vy)."""
+    c, s = cos_sin(th)
+    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
+    return pin[0] - rx, pin[1] - ry, th, c, s, pin[2] + w * ry, pin[3] - w * rx, w
 
 
 def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
@@ -1165,12 +1109,12 @@ class _Compiled:
                 k = self.kind[body][1]
                 out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
                 continue
-            x, y = frames.position(body)[:2]
+            x, y = frames.state(body)[:2]
             for k in self.follows[body]:
                 for i, unit in enumerate(_UNITS):
                     rates = [_ZERO] * len(P)
                     rates[k] = unit
-                    vx, vy, w = frames.rates(rates).velocity(body)
+                    vx, vy, w = frames.rates(rates).state(body)[5:]
                     out[k][i] += torque * w if force is None else (
                         torque * w + force[0] * (vx - w * (point[1] - y))
                         + force[1] * (vy + w * (point[0] - x)))
@@ -1208,8 +1152,8 @@ def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray,
 
     def geometry(frames: _Frames) -> tuple:  # the slide's axis in world axes, or the hinge
         if slide:
-            return _rot(frames.position(joint.parent), _pt(joint.axis))
-        return _place(frames.position(joint.child), _pt(joint.child_anchor))
+            return _rot(frames.state(joint.parent), _pt(joint.axis))
+        return _place(frames.state(joint.child), _pt(joint.child_anchor))
 
     gx, gy = (np.broadcast_to(np.asarray(v, float), (n,)) for v in geometry(comp.frames(S[1:])))
     frames, g = comp.frames(S), num(mech.gravity)
@@ -1255,11 +1199,11 @@ def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
                     force))
 
     def normal(body, d):  # the unit normal of direction d of `body`, in world axes
-        dx, dy = _rot(frames.position(body), np.array(_pt(d)) / float(np.linalg.norm(_pt(d))))
+        dx, dy = _rot(frames.state(body), np.array(_pt(d)) / float(np.linalg.norm(_pt(d))))
         return -dy, dx
 
     for j in mech.joints:
-        w = _place(frames.position(j.child), _pt(j.child_anchor))
+        w = _place(frames.state(j.child), _pt(j.child_anchor))
         if isinstance(j, Revolute):
             for e in ((1.0, 0.0), (0.0, 1.0)):
                 pair("joint", j.name, j.child, j.parent, e, w)
@@ -1269,12 +1213,12 @@ def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
                                            (j.parent, None, None, -1.0)], None))
     for c in mech.constraints:
         if isinstance(c, PointOnPoint):
-            w = _place(frames.position(c.body_a), _pt(c.point_a))
+            w = _place(frames.state(c.body_a), _pt(c.point_a))
             for e in ((1.0, 0.0), (0.0, 1.0)):
                 pair("closure", c.name, c.body_a, c.body_b, e, w)
         elif isinstance(c, PointOnLine):
             pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
-                 _place(frames.position(c.body), _pt(c.point)))
+                 _place(frames.state(c.body), _pt(c.point)))
         else:
             out.append(("closure", c.name, [
                 load for name, coef in c.coefficients for load in coordinate_load(
@@ -1289,7 +1233,7 @@ def _wrenches(bodies: list[str], loads: list[Load], frames: _Frames, n: int) -> 
         if load[0] != WORLD:
             i = bodies.index(load[0])
             out[:, 3 * i:3 * i + 3] += np.column_stack(np.broadcast_arrays(
-                *wrench(load, frames.position(load[0])[:2]), np.zeros(n))[:3])
+                *wrench(load, frames.state(load[0])[:2]), np.zeros(n))[:3])
     return out
 
 
@@ -1999,7 +1943,7 @@ class PymunkBackend(Backend):
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
                 inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
-            cx, cy = arrays(frames.position(host)[:2])
+            cx, cy = arrays(frames.state(host)[:2])
             rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
