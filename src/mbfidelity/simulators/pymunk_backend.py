@@ -306,6 +306,10 @@ class _Layout:
         return self.dynamic + [c.name for c in self.carriers]
 
 
+class _Refused(ValueError):
+    """Why Chipmunk cannot express the mechanism (`PymunkBackend.translation_reason`)."""
+
+
 def _vec(v) -> np.ndarray:
     return np.array([num(v[0]), num(v[1])])
 
@@ -328,10 +332,10 @@ _GROOVE_LIMIT = (
 
 
 def _grooves(mech: Mechanism, folds: dict[str, _Fold],
-             skip: frozenset[int] = frozenset()) -> list[_Groove] | str:
+             skip: frozenset[int] = frozenset()) -> list[_Groove]:
     """The GrooveJoints of the prismatic joints (except those in `skip`, joints of
-    eliminated massless groups) and of the folded links, or why one of them would not be
-    exact in Chipmunk."""
+    eliminated massless groups) and of the folded links; refused when one of them would
+    not be exact in Chipmunk."""
     out: list[_Groove] = []
 
     def ends(j: Prismatic) -> tuple[float | None, float | None]:
@@ -346,8 +350,8 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
         base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
         axis = _vec(j.axis)
         if j.parent != WORLD and not _through_origin(base, axis):
-            return (f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
-                    f"parent's centre of mass. {_GROOVE_LIMIT}")
+            raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
+                           f"parent's centre of mass. {_GROOVE_LIMIT}")
         out.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *ends(j), (0.0, 0.0),
                            num(j.angle_offset)))
     for fold in folds.values():
@@ -374,7 +378,8 @@ def _grooves(mech: Mechanism, folds: dict[str, _Fold],
         if not (slot_ok and pin_ok):
             where = ("slot line off the slot body's centre of mass" if not slot_ok
                      else "pin off the pin body's centre of mass")
-            return f"massless link {fold.link} folds into a groove with its {where}. {_GROOVE_LIMIT}"
+            raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
+                           f"{_GROOVE_LIMIT}")
         out.append(_Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
                            *ends(pri), tuple(anchor), None))
     return out
@@ -402,7 +407,7 @@ def _effective_mass(m: float, inertia: float, d: float) -> float:
     return m * inertia / (inertia + m * d * d)
 
 
-def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink | str:
+def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink:
     joints = [j for j in mech.joints if name in (j.parent, j.child)]
     groups: list[tuple[np.ndarray, list[tuple[str, tuple[float, float]]]]] = []
     for j in joints:
@@ -411,7 +416,7 @@ def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink | str:
         else:
             own, other, at = _vec(j.child_anchor), j.parent, _vec(j.parent_anchor)
         if other in massless:
-            return f"massless body {name} is hinged to another massless body {other}"
+            raise _Refused(f"massless body {name} is hinged to another massless body {other}")
         for point, members in groups:
             if np.allclose(point, own, rtol=0, atol=1e-12):
                 members.append((other, tuple(at)))
@@ -419,26 +424,28 @@ def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink | str:
         else:
             groups.append((own, [(other, tuple(at))]))
     if len(groups) != 2:
-        return (f"massless body {name} has revolute joints at {len(groups)} distinct points; "
-                "only a link with two (an arm, a PinJoint in Chipmunk) can be eliminated")
+        raise _Refused(f"massless body {name} has revolute joints at {len(groups)} distinct "
+                       "points; only a link with two (an arm, a PinJoint in Chipmunk) can be "
+                       "eliminated")
     for _, members in groups:  # the world first: its point is exact
         members.sort(key=lambda m: m[0] != WORLD)
     seen = [m[0] for _, ms in groups for m in ms]
     if len(set(seen)) != len(seen):
-        return f"massless body {name} is hinged twice to the same body"
+        raise _Refused(f"massless body {name} is hinged twice to the same body")
     (pa, ma), (pb, mb) = groups
     return _RevLink(name, tuple(pa), tuple(pb), tuple(ma), tuple(mb))
 
 
 def _component(mech: Mechanism, group: set[str], real: set[str],
-               closures: list) -> _Component | str:
+               closures: list) -> _Component:
     joints = tuple(j for j in mech.joints if j.parent in group or j.child in group)
     mine = tuple(c for c in closures if set(_closure_bodies(c)) & group)
     ends = ({b for j in joints for b in (j.parent, j.child)}
             | {b for c in mine for b in _closure_bodies(c)}) - group
     bad = [b for b in ends if b != WORLD and b not in real]
     if bad:
-        return f"massless bodies {sorted(group)} are attached to other massless bodies {bad}"
+        raise _Refused(f"massless bodies {sorted(group)} are attached to other massless bodies "
+                       f"{bad}")
     known = set(ends) | {WORLD}
     angles: list[tuple[str, str, float]] = []
     changed = True
@@ -458,23 +465,23 @@ def _component(mech: Mechanism, group: set[str], real: set[str],
                 changed = True
     loose = sorted(group - known)
     if loose:
-        return (f"massless bodies {loose}: rotation not fixed by prismatic joints, and not a "
-                "foldable link or arm (Chipmunk has no massless bodies)")
+        raise _Refused(f"massless bodies {loose}: rotation not fixed by prismatic joints, and not "
+                       "a foldable link or arm (Chipmunk has no massless bodies)")
     unknowns = (2 * len(group) + sum(isinstance(j, Prismatic) for j in joints)
                 + sum(isinstance(c, PointOnLine) for c in mine))
     equations = 2 * (len(joints) + len(mine))
     if unknowns != equations:
-        return (f"massless bodies {sorted(group)}: their joints and constraints impose "
-                f"{equations - unknowns:+d} conditions on the bodies around them; only "
-                "massless groups that leave them free (or fold into one joint) can be "
-                "eliminated (Chipmunk has no massless bodies)")
+        raise _Refused(f"massless bodies {sorted(group)}: their joints and constraints impose "
+                       f"{equations - unknowns:+d} conditions on the bodies around them; only "
+                       "massless groups that leave them free (or fold into one joint) can be "
+                       "eliminated (Chipmunk has no massless bodies)")
     return _Component(tuple(sorted(group)), joints, mine, tuple(angles))
 
 
 def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
               massless: set[str], contact: bool = False):
-    """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch), or why the coupling cannot
-    be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
+    """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch); refused when the coupling
+    cannot be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
     circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
     contact replaces."""
     k: dict[str, float] = {}
@@ -482,8 +489,8 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     for name, coef in c.coefficients:
         j = mech.joints[mech.coordinates.index(name)]
         if isinstance(j, Prismatic):
-            return (f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
-                    "only angles (GearJoint)")
+            raise _Refused(f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
+                           "only angles (GearJoint)")
         s = -1.0 if j.clockwise else 1.0
         coef = num(coef)
         k[j.child] = k.get(j.child, 0.0) + coef * s
@@ -493,7 +500,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     scale = max((abs(v) for v in k.values()), default=0.0)
     bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
     if not bodies:
-        return f"coupling {c.name}: no body angle enters it"
+        raise _Refused(f"coupling {c.name}: no body angle enters it")
     if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
         if len(bodies) == 1:
             a = bodies[0]
@@ -532,20 +539,20 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
         circles = None
         if contact:
             if K not in massless:  # the carrier's hinges would keep the distance: see _build
-                return (f"contact {c.name}: the disc and the track must be hinged on a "
-                        "massless carrier arm, which the contact replaces")
+                raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
+                               "massless carrier arm, which the contact replaces")
             circles = (A, hubs[A][0], abs(lam) * d, B, hubs[B][0], abs(lam - 1) * d,
                        not 0.0 < lam < 1.0)
         return "pitch", _Pitch(c.name, A, B, hubs[A][0], hubs[B][0], d, lam, ka + kb, wrap, K,
                                circles)
-    return (f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
-            "couples the absolute angles of two bodies, and a coupling of three is "
-            "expressible here only as two bodies hinged on a common carrier (gear pair, "
-            "belt, rolling: a pivot at the pitch point)")
+    raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
+                   "couples the absolute angles of two bodies, and a coupling of three is "
+                   "expressible here only as two bodies hinged on a common carrier (gear pair, "
+                   "belt, rolling: a pivot at the pitch point)")
 
 
-#: closure kind -> (its builder: (plan context, constraint) -> why it cannot be built or
-#: "", the expressions it declares)
+#: closure kind -> (its builder: (plan context, constraint) -> None, refusing what it cannot
+#: build; the expressions it declares)
 _CLOSURES: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
 
 
@@ -557,19 +564,18 @@ def _closure(kind: str, *expressions: Expression) -> Callable:
     return register
 
 
-def _massless_end(ctx, c, bodies) -> str:
+def _massless_end(ctx, c, bodies) -> None:
     bad = [b for b in bodies if not ctx.engine_ok(b)]
-    return (f"constraint {c.name}: on massless body {bad[0]} that cannot be eliminated "
-            "with it") if bad else ""
+    if bad:
+        raise _Refused(f"constraint {c.name}: on massless body {bad[0]} that cannot be "
+                       "eliminated with it")
 
 
 @_closure(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
-def _pivot(ctx, c: PointOnPoint) -> str:
-    reason = _massless_end(ctx, c, (c.body_a, c.body_b))
-    if not reason:
-        ctx.layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
-                                  tuple(_vec(c.point_b))))
-    return reason
+def _pivot(ctx, c: PointOnPoint) -> None:
+    _massless_end(ctx, c, (c.body_a, c.body_b))
+    ctx.layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
+                              tuple(_vec(c.point_b))))
 
 
 @_closure(
@@ -584,10 +590,8 @@ def _pivot(ctx, c: PointOnPoint) -> str:
                            "GrooveJoint, their mass taken out of the host "
                            "(slider_compensation). " + _GROOVE_LIMIT,
                when="otherwise"))
-def _slot(ctx, c: PointOnLine) -> str:
-    reason = _massless_end(ctx, c, (c.body, c.line_body))
-    if reason:
-        return reason
+def _slot(ctx, c: PointOnLine) -> None:
+    _massless_end(ctx, c, (c.body, c.line_body))
     layout = ctx.layout
     point, base = _vec(c.point), _vec(c.line_point)
     direction = _vec(c.direction) / float(np.linalg.norm(_vec(c.direction)))
@@ -619,7 +623,6 @@ def _slot(ctx, c: PointOnLine) -> str:
             pin, anchor = substitute("pin", pin, point), np.zeros(2)
     layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -ctx.half, ctx.half,
                                   tuple(anchor), None))
-    return ""
 
 
 @_closure(ROLLING_CONTACT, Expression(
@@ -628,15 +631,12 @@ def _slot(ctx, c: PointOnLine) -> str:
                 "game-physics user would build. Measured on the disc of Fig. 39: trajectory "
                 "error 2-10 % of the amplitude (coupling 2-2.6e-3), slip up to 3e-4 m, "
                 "single-step losses of contact from one chord to the next"))
-def _contact(ctx, c: RollingContact) -> str:
-    out = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
-    if isinstance(out, str):
-        return out
-    if out[0] == "gear":
-        return (f"contact {c.name}: the disc and the track must be hinged on a massless "
-                "carrier arm, which the contact replaces")
-    ctx.layout.pitches.append(out[1])
-    return ""
+def _contact(ctx, c: RollingContact) -> None:
+    kind, value = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
+    if kind == "gear":
+        raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
+                       "massless carrier arm, which the contact replaces")
+    ctx.layout.pitches.append(value)
 
 
 @_closure(
@@ -649,13 +649,9 @@ def _contact(ctx, c: RollingContact) -> str:
                       "the coupling (gear pair, belt, rolling); other couplings are refused "
                       "(support)",
                when="three body angles, two hinged on a carrier"))
-def _gear(ctx, c: LinearCoupling) -> str:
-    out = _coupling(ctx.mech, c, ctx.engine_ok, ctx.massless)
-    if isinstance(out, str):
-        return out
-    kind, value = out
+def _gear(ctx, c: LinearCoupling) -> None:
+    kind, value = _coupling(ctx.mech, c, ctx.engine_ok, ctx.massless)
     (ctx.layout.gears if kind == "gear" else ctx.layout.pitches).append(value)
-    return ""
 
 
 def _moment(body, cfg: Mapping) -> float:
@@ -668,13 +664,13 @@ def _moment(body, cfg: Mapping) -> float:
     return num(body.mass) * float(cfg.get("point_mass_gyration", POINT_MASS_GYRATION)) ** 2
 
 
-def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
-    """The engine layout (bodies, folded links, pivots, grooves, substitutes), or the
-    reason the mechanism cannot be expressed."""
+def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
+    """The engine layout (bodies, folded links, pivots, grooves, substitutes); refused
+    (`_Refused`, with the reason) when the mechanism cannot be expressed."""
     cfg = cfg or {}
     reason = description_reason(mech)
     if reason:
-        return reason
+        raise _Refused(reason)
     dynamic: list[str] = []
     massless: list[str] = []
     for b in mech.bodies:
@@ -684,17 +680,17 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
         elif m > 0:  # a point mass (i == 0) gets its substitute moment (_moment)
             dynamic.append(b.name)
         else:
-            return (f"body {b.name}: mass 0 and inertia {i}; Chipmunk needs a mass > 0 "
-                    "(or both 0 for a massless link that can be eliminated)")
+            raise _Refused(f"body {b.name}: mass 0 and inertia {i}; Chipmunk needs a mass > 0 "
+                           "(or both 0 for a massless link that can be eliminated)")
     constraints = mech.constraints
     drives: list[_Drive] = []
     for p in mech.prescribed:
         index = mech.coordinates.index(p.coordinate)
         j = mech.joints[index]
         if j.child not in dynamic or (j.parent != WORLD and j.parent not in dynamic):
-            return (f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
-                    "the constraint that imposes the motion acts between bodies with mass "
-                    "(or the world)")
+            raise _Refused(f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
+                           "the constraint that imposes the motion acts between bodies with mass "
+                           "(or the world)")
         kinematic = (cfg.get("prescribed_motion", _DRIVE_ROUTES[0]) == _DRIVE_ROUTES[0]
                      and j.parent == WORLD)
         drives.append(_Drive(p.name, j, index, kinematic))
@@ -721,10 +717,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                 folds[name] = _Fold(name, inner, outer, partner=inner.parent, pin_body=outer.child)
             continue
         if all(isinstance(j, Revolute) for j in [inner, *children]):
-            link = _rev_link(mech, name, mset)
-            if isinstance(link, str):
-                return link
-            links[name] = link
+            links[name] = _rev_link(mech, name, mset)
     rest = [n for n in massless if n not in folds and n not in links]
     components: list[_Component] = []
     remaining = set(rest)
@@ -741,15 +734,10 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                         group.add(y)
                         remaining.discard(y)
                         grown = True
-        comp = _component(mech, group, set(dynamic), geometric)
-        if isinstance(comp, str):
-            return comp
-        components.append(comp)
+        components.append(_component(mech, group, set(dynamic), geometric))
     consumed = {id(c) for comp in components for c in comp.closures}
     in_component = frozenset(id(j) for comp in components for j in comp.joints)
     grooves = _grooves(mech, folds, in_component | driven)
-    if isinstance(grooves, str):
-        return grooves
     folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
     linked = {id(j) for j in mech.joints if j.parent in links or j.child in links}
     # a kinematic driver on the world needs no joint to it (it moves as it is told)
@@ -783,9 +771,8 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                           half=float(cfg.get("groove_half_length", 1000.0)),
                           fraction=float(cfg.get("slider_mass_fraction", 0.5)))
     for c in constraints:
-        reason = "" if id(c) in consumed else _CLOSURES[element_kind(c)][0](ctx, c)
-        if reason:
-            return reason
+        if id(c) not in consumed:
+            _CLOSURES[element_kind(c)][0](ctx, c)
 
     # --- engine masses; compensation of the slider substitutes -------------------------
     for name in dynamic:
@@ -822,7 +809,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout | str:
                                         "centre of gravity must stay on a groove)")
     for g in layout.grooves:
         if not (_slot_exact(layout, g) and _pin_exact(layout, g)):
-            return f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}"
+            raise _Refused(f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}")
     return layout
 
 
@@ -1239,8 +1226,10 @@ def _wrenches(bodies: list[str], loads: list[Load], frames: _Frames, n: int) -> 
 
 def _default_layout(mech: Mechanism) -> _Layout | None:
     """The layout at the default settings (None: refused as a whole, translation_reason)."""
-    layout = _plan(mech, BACKEND.default_settings())
-    return None if isinstance(layout, str) else layout
+    try:
+        return _plan(mech, BACKEND.default_settings())
+    except _Refused:
+        return None
 
 
 def _carried(mech: Mechanism, slot: PointOnLine) -> bool:
@@ -1444,8 +1433,11 @@ class PymunkBackend(Backend):
                       "tensor, hinges about horizontal axes) has no expression in it")
 
     def translation_reason(self, mechanism: Mechanism) -> str:
-        layout = _plan(mechanism, self.default_settings())
-        return layout if isinstance(layout, str) else ""
+        try:
+            _plan(mechanism, self.default_settings())
+        except _Refused as refused:
+            return str(refused)
+        return ""
 
     # --- building ------------------------------------------------------------------------
     @staticmethod
@@ -1696,9 +1688,10 @@ class PymunkBackend(Backend):
         """Build: (layout, compiled functions, space, engine bodies, the mechanism as
         balanced: a RollingContact stands for its coupling, the movers of the prescribed
         coordinates)."""
-        layout = _plan(mechanism, cfg)
-        if isinstance(layout, str):
-            raise ValueError(f"pymunk cannot express this mechanism: {layout}")
+        try:
+            layout = _plan(mechanism, cfg)
+        except _Refused as refused:
+            raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
         if layout.drives:
             # a prescribed coordinate starts with the rate of its first step, (q(h) - q0)/h,
             # as every later step moves it with (q(t + h) - q)/h: started with q'(0) the
