@@ -1122,20 +1122,40 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
     return _CACHE[key]
 
 
+def _subtree(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, H: float,
+             shift: int, h: float, t: np.ndarray) -> tuple[list, list, _Frames]:
+    """Newton-Euler on a joint's child subtree over each step n -> n+1: per body with mass
+    (massless links carry nothing), its centre of mass (its frame's origin; a kinematic
+    driver's engine centre of gravity is its hinge point) at n+1, m (a - g) and I alpha;
+    the element loads on the subtree as applied in the step (at the position-updated
+    state x + H v and t + shift h), and the frames they act at."""
+    mech, g = comp.mech, num(comp.mech.gravity)
+    subtree = mech.subtree(joint.child)
+    frames, bodies = comp.frames(S), []
+    for name in subtree:
+        if name in comp.layout.dynamic:
+            x, y, _, vx, vy, w = frames[name]
+            m, inertia = num(mech.body(name).mass), num(mech.body(name).inertia)
+            bodies.append((x[1:], y[1:], m * np.diff(vx) / h, m * (np.diff(vy) / h + g),
+                           inertia * np.diff(w) / h))
+    ahead = comp.frames(S[:-1], H)
+    loads = [load for load in comp.body_loads(ahead, t[:-1] + shift * h) if load[0] in subtree]
+    return bodies, loads, ahead
+
+
 def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, h: float,
                     H: float, shift: int, t: np.ndarray) -> np.ndarray:
     """Shape (N+1,): a prescribed coordinate's actuator force over step n -> n+1 at sample
     n+1 (where Chipmunk computed the impulses, as the reactions; sample 0 is NaN), from
-    Newton-Euler on the joint's child subtree: the joint's reaction has no component
-    along a slide and no moment about a hinge's point, so the actuator's generalized
-    force is, for a slide, d . sum m (a - g) and, for a hinge, s sum (I alpha + (r - A) x
-    m (a - g)) (A the hinge point, s = -1 for a clockwise coordinate), minus the same of
-    the element loads on the subtree as applied in that step. d is the slide's axis in
-    world axes (dq = 1 moves the child by d)."""
-    mech, n = comp.mech, len(t) - 1
+    Newton-Euler on the joint's child subtree (`_subtree`): the joint's reaction has no
+    component along a slide and no moment about a hinge's point, so the actuator's
+    generalized force is, for a slide, d . sum m (a - g) and, for a hinge, s sum (I alpha
+    + (r - A) x m (a - g)) (A the hinge point, s = -1 for a clockwise coordinate), minus
+    the same of the element loads on the subtree. d is the slide's axis in world axes
+    (dq = 1 moves the child by d)."""
+    n = len(t) - 1
     slide = isinstance(joint, Prismatic)
     sign = -1.0 if not slide and joint.clockwise else 1.0
-    subtree = set(mech.subtree(joint.child))
 
     def geometry(frames: _Frames) -> tuple:  # the slide's axis in world axes, or the hinge
         if slide:
@@ -1143,31 +1163,20 @@ def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray,
         return _place(frames.state(joint.child), _pt(joint.child_anchor))
 
     gx, gy = (np.broadcast_to(np.asarray(v, float), (n,)) for v in geometry(comp.frames(S[1:])))
-    frames, g = comp.frames(S), num(mech.gravity)
+    bodies, loads, ahead = _subtree(comp, joint, S, H, shift, h, t)
     total = np.zeros(n)
-    for name in comp.layout.dynamic:
-        if name not in subtree:
-            continue
-        # the body's centre of mass is its frame's origin (a kinematic driver's engine
-        # centre of gravity is its hinge point)
-        x, y, _, vx, vy, w = frames[name]
-        m = num(mech.body(name).mass)
-        fx, fy = m * np.diff(vx) / h, m * (np.diff(vy) / h + g)
+    for x, y, fx, fy, spin in bodies:
         if slide:
             total += gx * fx + gy * fy
         else:
-            total += sign * (num(mech.body(name).inertia) * np.diff(w) / h
-                             + (x[1:] - gx) * fy - (y[1:] - gy) * fx)
-    # the element loads on the subtree as applied in the step (position-updated)
-    ahead = comp.frames(S[:-1], H)
+            total += sign * (spin + (x - gx) * fy - (y - gy) * fx)
     ax, ay = geometry(ahead)
     external = np.zeros(n)
-    for load in comp.body_loads(ahead, t[:-1] + shift * h):
-        if load[0] in subtree:
-            if not slide:
-                external = external + wrench(load, (ax, ay))[2]
-            elif load[1] is not None:
-                external = external + ax * load[1][0] + ay * load[1][1]
+    for load in loads:
+        if not slide:
+            external = external + wrench(load, (ax, ay))[2]
+        elif load[1] is not None:
+            external = external + ax * load[1][0] + ay * load[1][1]
     out = np.full(len(t), np.nan)
     out[1:] = total - sign * external
     return out
@@ -1879,20 +1888,13 @@ class PymunkBackend(Backend):
         has no step before it and is NaN. A start with angular velocity shows an O(1)
         transient at sample 1: the first step also builds the steady O(h^2) joint gap of
         the position update, and its impulse contains that correction."""
-        j = mech.joint(joint)
-        g = num(mech.gravity)
-        dynamic = comp.layout.dynamic
+        bodies, loads, _ = _subtree(comp, mech.joint(joint), S, H, shift, h, t)
         total = np.zeros((len(t) - 1, 2))
-        for name in mech.subtree(j.child):
-            if name not in dynamic:
-                continue  # massless link
-            k = dynamic.index(name)
-            m = num(mech.body(name).mass)
-            total[:, 0] += m * np.diff(S[:, 6 * k + 3]) / h
-            total[:, 1] += m * (np.diff(S[:, 6 * k + 4]) / h + g)
-        subtree = set(mech.subtree(j.child))
-        for body, force, _, _ in comp.body_loads(comp.frames(S[:-1], H), t[:-1] + shift * h):
-            if force is not None and body in subtree:
+        for _, _, fx, fy, _ in bodies:
+            total[:, 0] += fx
+            total[:, 1] += fy
+        for _, force, _, _ in loads:
+            if force is not None:
                 for i in range(2):
                     total[:, i] -= force[i]
         out = np.full((len(t), 2), np.nan)
