@@ -118,7 +118,7 @@ def test_traced_step_function_is_the_numeric_one():
     n = len(mech.joints)
 
     def power(*args):
-        states = body_states_symbolic(mech, args[:n], args[n:2 * n])
+        states = _body_states_on_symbols(mech, args[:n], args[n:2 * n])
         return [_power(element_loads(mech, f)(states, args[-1]), states)]
 
     compiled = traced(power, 2 * n + 1)
@@ -127,7 +127,7 @@ def test_traced_step_function_is_the_numeric_one():
     assert compiled(*q[0], *qd[0], 0.3)[0] == pytest.approx(want, rel=TOL, abs=TOL)
 
 
-def body_states_symbolic(mech, q, qd) -> dict:
+def _body_states_on_symbols(mech, q, qd) -> dict:
     """body_states on symbols: the planar tree by `moving_point` (plan.py)."""
     from mbfidelity.simulators.plan import cos_sin, moving_point, num
     from mbfidelity.systems.model import WORLD, Revolute
