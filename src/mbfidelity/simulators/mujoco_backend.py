@@ -261,7 +261,9 @@ class _Plan:
     carrier: dict[str, str]  # description body -> MJCF body carrying it
     chains: dict[str, list[int]]  # MJCF body -> description joint indices, in order
     mj_parent: dict[str, str]
-    opts: dict
+    settings: dict  # the resolved settings
+    #: the step the file is written for (MJCF's default 0.002 s when written without one)
+    dt: float
     native: bool  # linear laws as MuJoCo's own springs and dampers
     autonomous: bool  # time-dependent laws left out (linearization)
     foldable: set[str]
@@ -314,7 +316,7 @@ class _Plan:
 
     @property
     def gravcomp(self) -> bool:
-        return bool(self.opts.get("substitute_gravcomp", True))
+        return bool(self.settings["substitute_gravcomp"])
 
     def anchor(self, joint) -> np.ndarray:
         """A joint's anchor (world) at the reference configuration, from its child's frame."""
@@ -389,7 +391,7 @@ def _body(plan: _Plan, body) -> None:
             f'{_fmt(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])}"/>')
         return
     if inertia == 0:  # a point mass: above MuJoCo's mjMINVAL (1e-15) whatever the mass
-        radius = float(plan.opts.get("point_mass_gyration", POINT_MASS_GYRATION))
+        radius = float(plan.settings["point_mass_gyration"])
         inertia = max(mass * radius**2, POINT_MASS_INERTIA_FLOOR)
     plan.add_inertial(body.name, mass, (0.0, 0.0), inertia)
 
@@ -415,7 +417,7 @@ def _massless_body(plan: _Plan, body) -> None:
     # constraints scale their stiffness with the mass they move
     loaded = body.name in _point_loaded_bodies(plan.mech)
     key = "massless_mass_ratio" if loaded else "link_mass_ratio"
-    mass = float(plan.opts.get(key, 3e-4 if loaded else 1e-9)) * plan.m_min
+    mass = float(plan.settings[key]) * plan.m_min
     plan.substitutes[body.name] = (mass, mass * GYRATION**2)
     plan.add_frame(body.name, gravcomp=True)
     plan.add_inertial(body.name, mass, (0.0, 0.0), mass * GYRATION**2)
@@ -528,7 +530,7 @@ def _slider_masses(plan: _Plan, pin_body: str) -> None:
     fixed pin does not move: its weight is cancelled (gravcomp) and its mass is a fraction
     of the slot body's; a massless pin's substitute carries its sliders."""
     mech = plan.mech
-    ratio = float(plan.opts.get("slider_mass_ratio", 0.3))
+    ratio = float(plan.settings["slider_mass_ratio"])
     cons = [c for c in mech.constraints
             if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
     if pin_body == WORLD:
@@ -616,20 +618,19 @@ def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict
                                                  "over its coefficient, its violation the "
                                                  "slip; linearize uses the coupling"))
 def _rolling_contact(plan: _Plan, c: RollingContact) -> None:
-    mech, opts = plan.mech, plan.opts
+    mech, s = plan.mech, plan.settings
     geo = _contact_geometry(mech, c, plan.foldable)
     cl = plan.coupling(c, "contact", slider=f"{c.name}:radial", contact=geo)
     plan.closures.append(cl)
-    ctau, czeta = opts.get("contact_solref", (0.002, 1.0))
-    cimp = opts.get("contact_solimp", (0.9, 0.95, 0.001, 0.5, 2))
-    params = (f' condim="3" friction="{_fmt(opts.get("contact_friction", 1.0), 0, 0)}"'
-              f' solref="{_fmt(ctau, czeta)}" solimp="{_fmt(*cimp)}"')
+    params = (f' condim="3" friction="{_fmt(s["contact_friction"], 0, 0)}" solref="'
+              f'{_fmt(float(s["contact_timeconst_steps"]) * plan.dt, s["contact_dampratio"])}"'
+              f' solimp="{_fmt(*s["contact_solimp"])}"')
     disc = plan.carrier[geo["disc"]]
     plan.geoms.setdefault(disc, []).append(
         f'<geom name="{c.name}:disc" type="sphere" size="{_fmt(geo["r"])}" '
         f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
         f'conaffinity="0"{params}/>')
-    nseg = int(opts.get("ring_segments", 720))
+    nseg = int(s["ring_segments"])
     R, (cx, cy) = geo["R"], geo["centre"]
     t = 0.1 * R  # radial thickness of the ring's boxes; the inner faces lie at R
     half = R * math.tan(math.pi / nseg)  # faces meet: a polygon circumscribing R
@@ -656,10 +657,10 @@ _builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by a control cal
     lambda plan, p: None)  # nothing in the MJCF: `_Compiled._make_control` imposes it
 
 
-def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
-          opts: Mapping | None = None) -> _Plan:
-    """``opts``: the constraint settings (slider_mass_ratio, massless_mass_ratio,
-    substitute_gravcomp, solref, solimp); defaults when None."""
+def _plan(mech: Mechanism, settings: dict, autonomous: bool = False,
+          dt: float | None = None) -> _Plan:
+    """The plan of a numeric mechanism under the (resolved) settings; `autonomous`
+    leaves the time loads out; `dt`: the step the file is written for."""
     cmap = coordinate_map(mech)
     foldable = _foldable(mech)
     carrier: dict[str, str] = {}
@@ -676,8 +677,8 @@ def _plan(mech: Mechanism, native: bool, autonomous: bool = False,
                  else carrier[mech.joints[chain[0]].parent] for name, chain in chains.items()}
     # the reference configuration of the MJCF: every engine joint value 0
     frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
-    plan = _Plan(mech, cmap, carrier, chains, mj_parent, dict(opts or {}), native,
-                 autonomous, foldable, frames)
+    plan = _Plan(mech, cmap, carrier, chains, mj_parent, settings, dt or 0.002,
+                 bool(settings["native_springs"]), autonomous, foldable, frames)
     for kind, element in elements(mech):
         _BUILDERS[kind](plan, element)
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
@@ -790,9 +791,9 @@ def _mjcf(plan: _Plan) -> str:
         out.append("  </tendon>")
     equalities = [cl for cl in plan.closures if cl.kind != "contact"]
     if equalities:
-        tau, zeta = plan.opts.get("solref", (0.02, 1.0))
-        soft = (f' solref="{_fmt(tau, zeta)}" '
-                f'solimp="{_fmt(*plan.opts.get("solimp", (0.9, 0.95, 0.001, 0.5, 2)))}"')
+        s = plan.settings
+        soft = (f' solref="{_fmt(float(s["constraint_timeconst_steps"]) * plan.dt, s["constraint_dampratio"])}"'
+                f' solimp="{_fmt(*s["constraint_solimp"])}"')
         out.append("  <equality>")
         for cl in equalities:
             name = cl.element.name
@@ -821,19 +822,20 @@ class _Compiled:
         else:
             self.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
         dis_refsafe = int(mujoco.mjtDisableBit.mjDSBL_REFSAFE)
-        if plan.opts.get("refsafe", True):
+        if plan.settings["refsafe"]:
             self.model.opt.disableflags &= ~dis_refsafe
         else:
             self.model.opt.disableflags |= dis_refsafe
         diagexact = int(mujoco.mjtEnableBit.mjENBL_DIAGEXACT)
-        if plan.opts.get("diagexact", True):
+        if plan.settings["diagexact"]:
             self.model.opt.enableflags |= diagexact
         else:
             self.model.opt.enableflags &= ~diagexact
         if plan.closures:
-            steps, zeta = plan.opts.get("timeconst_steps", 2.0), plan.opts.get("dampratio", 1.0)
-            self.model.eq_solref[:] = (float(steps) * dt, float(zeta))
-            self.model.eq_solimp[:] = plan.opts.get("solimp", (0.9, 0.95, 0.001, 0.5, 2))
+            s = plan.settings
+            self.model.eq_solref[:] = (float(s["constraint_timeconst_steps"]) * dt,
+                                       float(s["constraint_dampratio"]))
+            self.model.eq_solimp[:] = s["constraint_solimp"]
         self.data = mujoco.MjData(self.model)
         names = [j.name for j in plan.mech.joints]
         self.qadr = np.array([self.model.joint(nm).qposadr[0] for nm in names])
@@ -854,16 +856,16 @@ class _Compiled:
                                     dtype=int)
         self.disc_geom = [self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]
         m = self.model
-        cone = plan.opts.get("contact_cone", "pyramidal").upper()
+        cone = plan.settings["contact_cone"].upper()
         m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{cone}")
-        m.opt.impratio = float(plan.opts.get("impratio", 1.0))
-        m.opt.noslip_iterations = int(plan.opts.get("noslip_iterations", 0))
+        m.opt.impratio = float(plan.settings["impratio"])
+        m.opt.noslip_iterations = int(plan.settings["noslip_iterations"])
         if contacts:  # the contacts' time constant follows the step like the equalities'
-            cs = float(plan.opts.get("contact_timeconst_steps", 2.0)) * dt
+            cs = float(plan.settings["contact_timeconst_steps"]) * dt
             m.geom_solref[[self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]] = (
-                cs, float(plan.opts.get("contact_dampratio", 1.0)))
+                cs, float(plan.settings["contact_dampratio"]))
             ring = np.flatnonzero(m.geom_conaffinity == 2)
-            m.geom_solref[ring] = (cs, float(plan.opts.get("contact_dampratio", 1.0)))
+            m.geom_solref[ring] = (cs, float(plan.settings["contact_dampratio"]))
         self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
         self.actuator = np.zeros(len(plan.mech.prescribed))
@@ -1130,8 +1132,7 @@ class _ClosureSamples:
             raise RuntimeError("mujoco: the closures' equality rows changed between samples")
         self.force[k] = d.efc_force[:self.ne]
         self.pos[k] = d.efc_pos[:self.ne]
-        if self.sliders:
-            mujoco.mj_rnePostConstraint(m, d)
+        if self.sliders:  # after mj_rnePostConstraint
             acc = self.acc[k]
             for j, bid in self.sliders:
                 mujoco.mj_objectAcceleration(m, d, self.obj_body, bid, acc[j], 0)
@@ -1173,6 +1174,62 @@ class _ClosureSamples:
                 violation[name] = -u[:, 1] * pos[:, 0] + u[:, 0] * pos[:, 1]  # n . (P - L)
                 k_slider += 1
         return forces, violation
+
+
+class _Transmitted:
+    """Per joint the force MuJoCo books as passing from parent to child (``cfrc_int`` of
+    the child's MJCF body), and per point-to-point element that the callback applies
+    (joint-space forces, which ``cfrc_int`` counts as transmitted) its force on body_a;
+    native tendon forces are already external (MuJoCo puts them in ``cfrc_ext``).
+    `record(k)` after mj_forward and mj_rnePostConstraint at sample k; `result(t)`."""
+
+    def __init__(self, comp: _Compiled, n_samples: int, joints: Sequence[str]) -> None:
+        plan, m = comp.plan, comp.model
+        self.comp, self.joints = comp, joints
+        self.bodies = sorted({plan.carrier[plan.mech.joint(j).child] for j in joints})
+        self.bid = np.array([m.body(b).id for b in self.bodies])
+        self.p2p = [e for e in plan.p2p if e.native is None]
+        self.tids = np.array([m.tendon(e.tendon).id for e in self.p2p], dtype=int)
+        self.sid = np.array([[m.site(f"{e.element.name}:{x}").id for x in "ab"]
+                             for e in self.p2p], dtype=int).reshape(-1, 2)
+        # rolling by contact: the contact carries what the description's arm and coupling
+        # carried, so it counts as transmitted through the joints (contract point 6)
+        self.discs = [cl.contact for cl in plan.closures if cl.kind == "contact"]
+        self.disc_bid = np.array([m.body(plan.carrier[g["disc"]]).id for g in self.discs],
+                                 dtype=int)
+        N = n_samples
+        self.cf = np.empty((N, len(self.bodies), 2))
+        self.ext = np.empty((N, len(self.discs), 2))
+        self.ten = np.empty((N, len(self.tids), 2))
+        self.spos = np.empty((N, len(self.tids), 2, 2))
+
+    def record(self, k: int) -> None:
+        d = self.comp.data
+        self.cf[k] = d.cfrc_int[self.bid, 3:5]
+        if len(self.disc_bid):
+            self.ext[k] = d.cfrc_ext[self.disc_bid, 3:5]  # contact force on the disc (world)
+        if len(self.tids):
+            self.ten[k, :, 0] = d.ten_length[self.tids]
+            self.ten[k, :, 1] = d.ten_velocity[self.tids]
+            self.spos[k] = d.site_xpos[self.sid][:, :, :2]
+
+    def result(self, t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        plan = self.comp.plan
+        transmitted: dict[str, np.ndarray] = {}
+        for name in self.joints:
+            joint = plan.mech.joint(name)
+            inside = set(plan.mech.subtree(joint.child))
+            r = self.cf[:, self.bodies.index(plan.carrier[joint.child])].copy()
+            for i, g in enumerate(self.discs):
+                if g["disc"] in inside and g["track"] not in inside:
+                    r += self.ext[:, i]
+            transmitted[name] = r
+        pairs: dict[str, np.ndarray] = {}
+        for i, e in enumerate(self.p2p):
+            tension = ForceLaw.of(e.element).vector_law(self.ten[:, i, 0], self.ten[:, i, 1], t)
+            ab = self.spos[:, i, 1] - self.spos[:, i, 0]
+            pairs[e.element.name] = tension[:, None] * (ab / np.linalg.norm(ab, axis=1)[:, None])
+        return transmitted, pairs
 
 
 class _CallbacksInstalled:
@@ -1388,32 +1445,7 @@ class MujocoBackend(Backend):
         support = self.support(mechanism)
         if not support.ok:
             raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
-        steps = float(settings["constraint_timeconst_steps"])
-        opts = {
-            "slider_mass_ratio": float(settings["slider_mass_ratio"]),
-            "massless_mass_ratio": float(settings["massless_mass_ratio"]),
-            "link_mass_ratio": float(settings["link_mass_ratio"]),
-            "point_mass_gyration": float(settings["point_mass_gyration"]),
-            "substitute_gravcomp": bool(settings["substitute_gravcomp"]),
-            "timeconst_steps": steps,
-            "dampratio": float(settings["constraint_dampratio"]),
-            # the MJCF default timestep (0.002 s) when the file is written without one
-            "solref": (steps * (dt or 0.002), float(settings["constraint_dampratio"])),
-            "solimp": tuple(float(x) for x in settings["constraint_solimp"]),
-            "refsafe": bool(settings["refsafe"]),
-            "diagexact": bool(settings["diagexact"]),
-            "contact_timeconst_steps": float(settings["contact_timeconst_steps"]),
-            "contact_dampratio": float(settings["contact_dampratio"]),
-            "contact_solref": (float(settings["contact_timeconst_steps"]) * (dt or 0.002),
-                               float(settings["contact_dampratio"])),
-            "contact_solimp": tuple(float(x) for x in settings["contact_solimp"]),
-            "contact_friction": float(settings["contact_friction"]),
-            "contact_cone": settings["contact_cone"],
-            "impratio": float(settings["impratio"]),
-            "noslip_iterations": int(settings["noslip_iterations"]),
-            "ring_segments": int(settings["ring_segments"]),
-        }
-        return _plan(mechanism, bool(settings["native_springs"]), autonomous, opts)
+        return _plan(mechanism, settings, autonomous, dt)
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
                 dt: float | None = None) -> str:
@@ -1474,7 +1506,7 @@ class MujocoBackend(Backend):
         if comp.control is not None:
             outside.append("prescribed motions imposed by the harness's control callback "
                            f"(mjcb_control): {', '.join(p.name for p in mechanism.prescribed)}")
-        if plan.opts.get("ring_segments") and any(c.kind == "contact" for c in plan.closures):
+        if any(c.kind == "contact" for c in plan.closures):
             outside.append("the contact ring's solref, set on the compiled model")
         return xml, outside
 
@@ -1520,9 +1552,8 @@ class MujocoBackend(Backend):
                     get_state(m, d, row, spec)
             qpos, qvel = states[:, :m.nq], states[:, m.nq:]
             t = dt * np.arange(steps + 1)
-            transmitted, pairs = self._transmitted(comp, qpos, qvel, t, reaction_joints)
-            forces, violation = self._closures(comp, qpos, qvel, t)
-            actuators = self._actuators(comp, qpos, qvel, t)
+            actuators, forces, violation, transmitted, pairs = self._read_out(
+                comp, qpos, qvel, t, reaction_joints)
         q, qd = self._coordinates(comp, qpos, qvel)
         # a coupling's tendon equality acts in joint space: cfrc_int counts it as
         # transmitted
@@ -1562,106 +1593,38 @@ class MujocoBackend(Backend):
         plan = comp.plan
         return plan.cmap.coordinates(qpos[:, comp.qadr]), plan.cmap.rates(qvel[:, comp.vadr])
 
-    def _actuators(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
-                   t: np.ndarray) -> dict[str, np.ndarray]:
-        """Each prescribed coordinate's actuator force at each sampled state: what the
-        control callback applies there (mj_forward calls it with the sample's time)."""
+    @staticmethod
+    def _read_out(comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
+                  joints: Sequence[str]):
+        """One pass over the sampled states, outside the timed loop: mj_forward at each
+        sample's time (and mj_rnePostConstraint where reactions or sliders need the
+        bodies' accelerations), reading each prescribed coordinate's actuator force (what
+        the control callback applies there), the closures' forces and violations
+        (`_ClosureSamples`) and the joints' transmitted forces (`_Transmitted`)."""
+        import mujoco
+
+        m, d = comp.model, comp.data
         prescribed = comp.plan.mech.prescribed
-        if not prescribed:
-            return {}
-        import mujoco
-
-        m, d = comp.model, comp.data
-        out = np.empty((len(t), len(prescribed)))
-        d_qpos, d_qvel, forward = d.qpos, d.qvel, mujoco.mj_forward
-        for k in range(len(t)):
-            d_qpos[:] = qpos[k]
-            d_qvel[:] = qvel[k]
-            d.time = t[k]
-            forward(m, d)
-            out[k] = comp.actuator
-        return {p.name: out[:, i] for i, p in enumerate(prescribed)}
-
-    def _closures(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
-                  t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-        """Constraint forces (contract point 6) and violations at each sampled state."""
-        if not comp.plan.closures:
-            return {}, {}
-        import mujoco
-
-        m, d = comp.model, comp.data
-        samples = _ClosureSamples(comp, len(t))
+        actuators = np.empty((len(t), len(prescribed)))
+        readers = [r for r in (_ClosureSamples(comp, len(t)) if comp.plan.closures else None,
+                               _Transmitted(comp, len(t), joints) if joints else None) if r]
+        post = bool(joints) or bool(len(comp.slider_jnt))
         d_qpos, d_qvel = d.qpos, d.qvel  # fixed buffers of d (the efc arrays are not)
-        forward, record = mujoco.mj_forward, samples.record
+        forward, post_constraint = mujoco.mj_forward, mujoco.mj_rnePostConstraint
         for k in range(len(t)):
             d_qpos[:] = qpos[k]
             d_qvel[:] = qvel[k]
             d.time = t[k]
             forward(m, d)
-            record(k)
-        return samples.result()
-
-    def _transmitted(self, comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray,
-                     t: np.ndarray, joints: Sequence[str]
-                     ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-        """At each sampled state, per joint the force MuJoCo books as passing from parent
-        to child (``cfrc_int`` of the child's MJCF body), and per point-to-point element
-        that the callback applies (joint-space forces, which ``cfrc_int`` counts as
-        transmitted) its force on body_a; native tendon forces are already external
-        (MuJoCo puts them in ``cfrc_ext``)."""
-        if not joints:
-            return {}, {}
-        import mujoco
-
-        plan, m, d = comp.plan, comp.model, comp.data
-        mech = plan.mech
-        bodies = sorted({plan.carrier[mech.joint(j).child] for j in joints})
-        bid = np.array([m.body(b).id for b in bodies])
-        p2p = [e for e in plan.p2p if e.native is None]
-        tids = np.array([m.tendon(e.tendon).id for e in p2p], dtype=int)
-        sid = np.array([[m.site(f"{e.element.name}:a").id, m.site(f"{e.element.name}:b").id]
-                        for e in p2p], dtype=int).reshape(-1, 2)
-        # rolling by contact: the contact carries what the description's arm and coupling
-        # carried, so it counts as transmitted through the joints (contract point 6)
-        discs = [cl.contact for cl in plan.closures if cl.kind == "contact"]
-        disc_bid = np.array([m.body(plan.carrier[g["disc"]]).id for g in discs], dtype=int)
-        N = len(t)
-        cf = np.empty((N, len(bodies), 2))
-        ext = np.empty((N, len(discs), 2))
-        ten = np.empty((N, len(tids), 2))
-        spos = np.empty((N, len(tids), 2, 2))
-        # fixed buffers of d, viewed once
-        d_qpos, d_qvel, cfrc_int, cfrc_ext = d.qpos, d.qvel, d.cfrc_int, d.cfrc_ext
-        ten_length, ten_velocity, site_xpos = d.ten_length, d.ten_velocity, d.site_xpos
-        forward, post = mujoco.mj_forward, mujoco.mj_rnePostConstraint
-        for k in range(N):
-            d_qpos[:] = qpos[k]
-            d_qvel[:] = qvel[k]
-            d.time = t[k]
-            forward(m, d)
-            post(m, d)
-            cf[k] = cfrc_int[bid, 3:5]
-            if len(disc_bid):
-                ext[k] = cfrc_ext[disc_bid, 3:5]  # contact force on the disc (world)
-            if len(tids):
-                ten[k, :, 0] = ten_length[tids]
-                ten[k, :, 1] = ten_velocity[tids]
-                spos[k] = site_xpos[sid][:, :, :2]
-        transmitted: dict[str, np.ndarray] = {}
-        for name in joints:
-            joint = mech.joint(name)
-            inside = set(mech.subtree(joint.child))
-            r = cf[:, bodies.index(plan.carrier[joint.child])].copy()
-            for i, g in enumerate(discs):
-                if g["disc"] in inside and g["track"] not in inside:
-                    r += ext[:, i]
-            transmitted[name] = r
-        pairs: dict[str, np.ndarray] = {}
-        for i, e in enumerate(p2p):
-            tension = ForceLaw.of(e.element).vector_law(ten[:, i, 0], ten[:, i, 1], t)
-            ab = spos[:, i, 1] - spos[:, i, 0]
-            pairs[e.element.name] = tension[:, None] * (ab / np.linalg.norm(ab, axis=1)[:, None])
-        return transmitted, pairs
+            if post:
+                post_constraint(m, d)
+            actuators[k] = comp.actuator
+            for reader in readers:
+                reader.record(k)
+        forces, violation = readers[0].result() if comp.plan.closures else ({}, {})
+        transmitted, pairs = readers[-1].result(t) if joints else ({}, {})
+        return ({p.name: actuators[:, i] for i, p in enumerate(prescribed)}, forces,
+                violation, transmitted, pairs)
 
     # --- linearization -------------------------------------------------------------------
     @staticmethod
