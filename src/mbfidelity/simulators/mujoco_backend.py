@@ -1,68 +1,34 @@
 """MuJoCo backend: the description is translated to MJCF text and integrated with RK4.
 
-Translation (generic over the description, see `to_mjcf`):
+Translation (`to_mjcf`): each element kind of the description has one builder, registered
+with `_builds` together with the `Expression` it declares (contract point 5); the builders
+add MJCF fragments to a `_Plan`, which `_mjcf` assembles.
 
 - Every body with mass becomes an MJCF body whose frame is the description's
   centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
-  from geom density). The planar inertia goes on z; x and y get the same value so the
-  inertia is valid (they cannot act in planar motion). MuJoCo rejects a moving body of
-  zero inertia, so a point mass (central inertia 0) gets the substitute inertia m r^2
-  (setting ``point_mass_gyration``).
-- MuJoCo rejects massless moving bodies, so a massless body's joints are folded into its
-  single child: that MJCF body carries the chain of joints, which MuJoCo applies in order,
-  each with its anchor and axis expressed in the body frame at the reference
-  configuration. This is exact (no substitute mass).
-- ``Revolute`` -> hinge about z (relative angle); ``Prismatic`` -> slide in the x-y plane.
-  A spatial mechanism (model convention 10; open trees of massive bodies, relative
-  counter-clockwise joints without offset) is written body by body instead: frames at
-  parent_anchor - child_anchor, joints about the description's axes at child_anchor, the
-  full central tensor as ``fullinertia`` (compiled into body_inertia and body_iquat, read
-  back by `stored_inertia`) and gravity along -up.
-  Engine joint values v relate to the description coordinates q by a constant affine map
-  ``v = A q + b`` (A lower triangular, diagonal +-1 or the axis length): absolute angles
-  become ``q - theta_parent``, clockwise coordinates change sign. The reference
-  configuration of the MJCF (qpos0) is v = 0.
-- ``PointToPoint`` -> a spatial tendon between two sites. A law linear in LENGTH and
-  LENGTH_RATE uses the tendon's own stiffness/springlength/damping (exact, including free
-  length 0); any other law applies ``-T dL/dq`` from the passive callback.
-- ``CoordinateForce`` -> joint stiffness/springref/damping when the law is linear, has no
-  TIME and its coordinate is one engine joint; otherwise the passive callback
-  (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with ``d.time`` set to
-  the stage time, so time loads are evaluated at stage times.
+  from geom density); the planar inertia goes on z, and on x and y so that it is valid.
+  A massless body with a single child joint is folded into that child: its MJCF body
+  carries the chain of joints, which MuJoCo applies in order, each with its anchor and axis
+  in the body frame at the reference configuration (v = 0, body frames from
+  `plan.body_states`). A spatial mechanism (model convention 10) is written body by body:
+  frames at parent_anchor - child_anchor, joints about the description's axes at
+  child_anchor, the full central tensor as ``fullinertia`` (read back by
+  `stored_inertia`) and gravity along -up.
+- Engine joint values v relate to the description coordinates q by the affine map of
+  `plan.CoordinateMap`: absolute angles become ``q - theta_parent``, clockwise coordinates
+  change sign.
+- Laws that MuJoCo cannot hold natively, time loads among them, are applied by the passive
+  callback (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with
+  ``d.time`` set to the stage time.
 - Closure constraints become MuJoCo equalities, which are SOFT (solref/solimp; MuJoCo
   clamps the impedance at 0.9999, so each row transmits at most 99.99 % of the needed
-  force at once and a small violation makes up the rest):
-  ``PointOnPoint`` -> ``connect`` between two sites (site1 on body_a);
-  ``PointOnLine`` (MuJoCo has no point-on-line equality) -> a substitute slider body, child
-  of the slot body with a slide joint along the slot, ``connect``-ed to a site at the pin.
-  The slider follows the pin, so its mass (``slider_mass_ratio`` of the largest admissible
-  point mass) is taken out of the pin body: mass, centre of mass and inertia of the pin
-  body are adjusted so that pin body + slider have the description's mass, first and
-  second moments (exact while the constraint holds); on a fixed pin the slider does not
-  move and its weight is cancelled (gravcomp). A light slider would make MuJoCo's per-row
-  regularisation (relative to each world-axis row's diagonal) soften the row across a
-  rotating slot; ``LinearCoupling`` -> a fixed tendon ``sum(w_j v_j)`` over the engine joint
-  values (w = A^-T c, any number of coordinates) held by a tendon equality (exact linear
-  relation); ``RollingContact`` (a variant's stand-in for a rolling coupling) -> friction
-  contact of a sphere disc on a ring of boxes, the arm's length freed by a radial slide
-  (`_contact_geometry`). Massless bodies that cannot be folded
-  (several child joints, or loaded by a constraint or a point force) become substitute
-  bodies of small mass (``link_mass_ratio`` / ``massless_mass_ratio``, weight cancelled).
-  Each closure's force (contract point 6) and violation are read after ``mj_forward`` at
-  every sample; the violation is returned as ``RunResult.constraint_violation``.
+  force at once and a small violation makes up the rest). Each closure's force (contract
+  point 6) and violation are read after ``mj_forward`` at every sample; the violation is
+  returned as ``RunResult.constraint_violation``.
 - ``Prescribed`` coordinates (setting ``prescribed_motion``): a control callback
   (``mujoco.set_mjcb_control``, installed with the passive callback and restored after,
-  both being process-global) imposes the acceleration. MuJoCo calls it after the passive
-  and bias forces at every RK4 stage with ``d.time`` at the stage time; with f =
-  qfrc_passive - qfrc_bias and the prescribed coordinates q_p = T_p (v - b), it solves
-  (T_p M^-1 T_p^T) Q_p = q_p''(t) - T_p M^-1 f (``mj_solveM``) and applies T_p^T Q_p as
-  ``qfrc_applied``; Q_p is the actuator force in the description's coordinates (clockwise
-  hinges, absolute angles and axis lengths through T). Under Euler, implicit and
-  implicitfast it imposes the discrete acceleration ((q(t+h) - q)/h - q')/h with the
-  matrix the step solves, which puts the coordinate on q(t+h) at every step. Joint
+  both being process-global) imposes the acceleration (`_Compiled._make_control`). Joint
   equalities with a moving reference and mocap welds are soft, so they are not used.
-  The actuator force of each sample is the callback's at that state (``mj_forward`` at
-  the sample's time, outside the timed loop).
 - Prismatic ``limits`` are admissible intervals of the description, not stops; they are
   not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
   outside the interval).
@@ -318,10 +284,10 @@ class _Plan:
     def gravcomp(self) -> bool:
         return bool(self.settings["substitute_gravcomp"])
 
-    def anchor(self, joint) -> np.ndarray:
-        """A joint's anchor (world) at the reference configuration, from its child's frame."""
-        x, y, th = self.frames[joint.child][:3]
-        return np.array([x, y]) + rot(th) @ np.array([num(v) for v in joint.child_anchor[:2]])
+    def anchor(self, hinge) -> np.ndarray:
+        """A hinge's anchor (world) at the reference configuration."""
+        x, y, th = self.frames[hinge.parent][:3]
+        return np.array([x, y]) + rot(th) @ np.array([num(v) for v in hinge.parent_anchor[:2]])
 
     def local(self, body: str, vector: np.ndarray) -> np.ndarray:
         """A world vector in the frame of an MJCF body at the reference configuration."""
@@ -812,60 +778,43 @@ class _Compiled:
     def __init__(self, plan: _Plan, integrator: str, dt: float, autoreset: bool = False) -> None:
         import mujoco
 
-        self.mujoco = mujoco
-        self.plan = plan
-        self.model = mujoco.MjModel.from_xml_string(plan.xml)
-        self.model.opt.timestep = dt
-        self.model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
-        if autoreset:
-            self.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
-        else:
-            self.model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
-        dis_refsafe = int(mujoco.mjtDisableBit.mjDSBL_REFSAFE)
-        if plan.settings["refsafe"]:
-            self.model.opt.disableflags &= ~dis_refsafe
-        else:
-            self.model.opt.disableflags |= dis_refsafe
-        diagexact = int(mujoco.mjtEnableBit.mjENBL_DIAGEXACT)
-        if plan.settings["diagexact"]:
-            self.model.opt.enableflags |= diagexact
-        else:
-            self.model.opt.enableflags &= ~diagexact
+        self.mujoco, self.plan, s = mujoco, plan, plan.settings
+        self.model = m = mujoco.MjModel.from_xml_string(plan.xml)
+        m.opt.timestep = dt
+        m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
+        for field_name, bit, on in (
+                ("disableflags", mujoco.mjtDisableBit.mjDSBL_AUTORESET, not autoreset),
+                ("disableflags", mujoco.mjtDisableBit.mjDSBL_REFSAFE, not s["refsafe"]),
+                ("enableflags", mujoco.mjtEnableBit.mjENBL_DIAGEXACT, s["diagexact"])):
+            flags = getattr(m.opt, field_name)
+            setattr(m.opt, field_name, flags | int(bit) if on else flags & ~int(bit))
         if plan.closures:
-            s = plan.settings
-            self.model.eq_solref[:] = (float(s["constraint_timeconst_steps"]) * dt,
-                                       float(s["constraint_dampratio"]))
-            self.model.eq_solimp[:] = s["constraint_solimp"]
-        self.data = mujoco.MjData(self.model)
+            m.eq_solref[:] = (float(s["constraint_timeconst_steps"]) * dt,
+                              float(s["constraint_dampratio"]))
+            m.eq_solimp[:] = s["constraint_solimp"]
+        self.data = mujoco.MjData(m)
         names = [j.name for j in plan.mech.joints]
-        self.qadr = np.array([self.model.joint(nm).qposadr[0] for nm in names])
-        self.vadr = np.array([self.model.joint(nm).dofadr[0] for nm in names])
+        self.qadr = np.array([m.joint(nm).qposadr[0] for nm in names])
+        self.vadr = np.array([m.joint(nm).dofadr[0] for nm in names])
         sliders = [cl for cl in plan.closures if cl.kind == "slider"]
-        self.slider_jnt = np.array([self.model.joint(cl.slider).id for cl in sliders], dtype=int)
-        self.slider_qadr = np.array([self.model.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
-        self.slider_vadr = np.array([self.model.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
-        self.slider_body = np.array([self.model.body(cl.slider).id for cl in sliders], dtype=int)
-        self.slider_sites = [(self.model.site(cl.site1).id, self.model.site(cl.site2).id)
-                             for cl in sliders]
-        self.eq_id = [self.model.equality(cl.element.name).id if cl.kind != "contact" else -1
+        self.slider_jnt = np.array([m.joint(cl.slider).id for cl in sliders], dtype=int)
+        self.slider_qadr = np.array([m.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_vadr = np.array([m.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_body = np.array([m.body(cl.slider).id for cl in sliders], dtype=int)
+        self.slider_sites = [(m.site(cl.site1).id, m.site(cl.site2).id) for cl in sliders]
+        self.eq_id = [m.equality(cl.element.name).id if cl.kind != "contact" else -1
                       for cl in plan.closures]
         contacts = [cl for cl in plan.closures if cl.kind == "contact"]
-        self.radial_qadr = np.array([self.model.joint(cl.slider).qposadr[0] for cl in contacts],
-                                    dtype=int)
-        self.radial_vadr = np.array([self.model.joint(cl.slider).dofadr[0] for cl in contacts],
-                                    dtype=int)
-        self.disc_geom = [self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]
-        m = self.model
-        cone = plan.settings["contact_cone"].upper()
-        m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{cone}")
-        m.opt.impratio = float(plan.settings["impratio"])
-        m.opt.noslip_iterations = int(plan.settings["noslip_iterations"])
+        self.radial_qadr = np.array([m.joint(cl.slider).qposadr[0] for cl in contacts], dtype=int)
+        self.radial_vadr = np.array([m.joint(cl.slider).dofadr[0] for cl in contacts], dtype=int)
+        self.disc_geom = [m.geom(f"{cl.element.name}:disc").id for cl in contacts]
+        m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{s['contact_cone'].upper()}")
+        m.opt.impratio = float(s["impratio"])
+        m.opt.noslip_iterations = int(s["noslip_iterations"])
         if contacts:  # the contacts' time constant follows the step like the equalities'
-            cs = float(plan.settings["contact_timeconst_steps"]) * dt
-            m.geom_solref[[self.model.geom(f"{cl.element.name}:disc").id for cl in contacts]] = (
-                cs, float(plan.settings["contact_dampratio"]))
-            ring = np.flatnonzero(m.geom_conaffinity == 2)
-            m.geom_solref[ring] = (cs, float(plan.settings["contact_dampratio"]))
+            solref = (float(s["contact_timeconst_steps"]) * dt, float(s["contact_dampratio"]))
+            m.geom_solref[self.disc_geom] = solref
+            m.geom_solref[np.flatnonzero(m.geom_conaffinity == 2)] = solref
         self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
         self.actuator = np.zeros(len(plan.mech.prescribed))
@@ -881,12 +830,34 @@ class _Compiled:
                 and geom in d.contact.geom[d.efc_id[r]]]
         if not rows:
             return np.zeros(m.nv)
-        if mujoco.mj_isSparse(m):
-            J = np.zeros((d.nefc, m.nv))
-            mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
-        else:
-            J = d.efc_J.reshape(d.nefc, m.nv)
-        return J[rows].T @ d.efc_force[rows]
+        return self.efc_jacobian()[rows].T @ d.efc_force[rows]
+
+    def efc_jacobian(self) -> np.ndarray:
+        """The constraint Jacobian efc_J (nefc, nv), dense (after mj_forward)."""
+        mujoco, m, d = self.mujoco, self.model, self.data
+        if not mujoco.mj_isSparse(m):
+            return d.efc_J.reshape(d.nefc, m.nv).copy()
+        J = np.zeros((d.nefc, m.nv))
+        mujoco.mju_sparse2dense(J, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr, d.efc_J_colind)
+        return J
+
+    def inverse_fd(self, reset: Callable[[], None], eps: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Continuous-time K, C, M of mjd_inverseFD (finite differences of mj_inverse) at
+        the state `reset` sets, central differences by combining the forward (+eps) and
+        backward (-eps) ones; its outputs are transposed (row i = derivative with respect
+        to input i)."""
+        mujoco, m, d = self.mujoco, self.model, self.data
+        mats = []
+        for h in (eps, -eps):
+            reset()
+            d.qacc[:] = 0
+            mujoco.mj_forward(m, d)
+            d.qacc[:] = 0
+            DfDq, DfDv, DfDa = (np.zeros((m.nv, m.nv)) for _ in range(3))
+            mujoco.mjd_inverseFD(m, d, h, False, DfDq, DfDv, DfDa, None, None, None, None)
+            mats.append((DfDq, DfDv, DfDa))
+        return tuple((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
 
     def contact_state(self, cl: _Closure, k_contact: int) -> tuple[float, float]:
         """After mj_forward, for a rolling coupling built as contact (the k-th such
@@ -1643,16 +1614,7 @@ class MujocoBackend(Backend):
 
         def jacobian() -> np.ndarray:
             mujoco.mj_forward(m, d)
-            rows = [r for r in range(d.nefc) if d.efc_type[r] == eq_type]
-            J = np.zeros((len(rows), nv))
-            if not mujoco.mj_isSparse(m):
-                J[:] = d.efc_J.reshape(d.nefc, nv)[rows]
-            else:
-                dense = np.zeros((d.nefc, nv))
-                mujoco.mju_sparse2dense(dense, d.efc_J, d.efc_J_rownnz, d.efc_J_rowadr,
-                                        d.efc_J_colind)
-                J[:] = dense[rows]
-            return J
+            return comp.efc_jacobian()[[r for r in range(d.nefc) if d.efc_type[r] == eq_type]]
 
         comp.set_state(q_eq, np.zeros(n))
         qpos0 = d.qpos.copy()
@@ -1673,21 +1635,16 @@ class MujocoBackend(Backend):
                 cols.append(jacobian().T @ f)
             G[:, i] = (cols[0] - cols[1]) / (2 * eps)
         d.qpos[:] = qpos0
+
+        def reset() -> None:
+            d.qpos[:] = qpos0
+            d.qvel[:] = 0
+
         m.opt.disableflags |= dsbl_eq
         try:
-            mats = []
-            for h in (eps, -eps):
-                d.qpos[:] = qpos0
-                d.qvel[:] = 0
-                d.qacc[:] = 0
-                mujoco.mj_forward(m, d)
-                d.qacc[:] = 0
-                DfDq, DfDv, DfDa = (np.zeros((nv, nv)) for _ in range(3))
-                mujoco.mjd_inverseFD(m, d, h, False, DfDq, DfDv, DfDa, None, None, None, None)
-                mats.append((DfDq, DfDv, DfDa))
+            K, C, M = comp.inverse_fd(reset, eps)
         finally:
             m.opt.disableflags &= ~dsbl_eq
-        K, C, M = ((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
         K = K - G
         U, sv, Vt = np.linalg.svd(J)
         rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
@@ -1728,20 +1685,8 @@ class MujocoBackend(Backend):
                       "regularisation is left out)")
         elif s["linearization"] == "inverseFD":
             comp = _Compiled(plan, integrator, dt)
-            m, d = comp.model, comp.data
-            mats = []
             with _CallbacksInstalled(comp.callback, comp.control):
-                for h in (eps, -eps):  # forward and backward differences -> central
-                    comp.set_state(q_eq, np.zeros(n))
-                    d.qacc[:] = 0
-                    mujoco.mj_forward(m, d)
-                    d.qacc[:] = 0
-                    DfDq, DfDv, DfDa = (np.zeros((m.nv, m.nv)) for _ in range(3))
-                    mujoco.mjd_inverseFD(m, d, h, False, DfDq, DfDv, DfDa,
-                                         None, None, None, None)
-                    mats.append((DfDq, DfDv, DfDa))
-            # outputs are transposed (row i = derivative with respect to input i)
-            K, C, M = ((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
+                K, C, M = comp.inverse_fd(lambda: comp.set_state(q_eq, np.zeros(n)), eps)
             perm = comp.vadr
             K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
             eig = quadratic_eigenvalues(M, C, K)
