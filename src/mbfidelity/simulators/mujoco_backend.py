@@ -1,8 +1,8 @@
 """MuJoCo backend: the description is translated to MJCF text and integrated with RK4.
 
-Translation (`to_mjcf`): each element kind of the description has one builder, registered
-with `_builds` together with the `Expression` it declares (contract point 5); the builders
-add MJCF fragments to a `_Plan`, which `_mjcf` assembles.
+Translation (`to_mjcf`, module `mujoco_mjcf`): each element kind of the description has
+one builder, registered together with the `Expression` it declares (contract point 5);
+the builders add MJCF fragments to a `Plan`, which is assembled into the MJCF text.
 
 - Every body with mass becomes an MJCF body whose frame is the description's
   centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
@@ -45,737 +45,48 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (
-    WORLD,
-    Circle,
-    CoordinateForce,
-    Mechanism,
-    PointOnLine,
-    PointOnPoint,
-    PointToPoint,
-    Rectangle,
-    Revolute,
-    RollingContact,
-    Segment,
-    inertia_matrix,
-)
 from ..analytic.linear import quadratic_eigenvalues
+from ..systems._continua import Beam
+from ..systems.model import Mechanism
+from . import mujoco_mjcf
 from .base import (
     RK4_STABILITY,
-    Scheme,
     SEMI_IMPLICIT_EULER_STABILITY,
-    EXACT,
-    SOFT,
     SUBSTITUTE,
-    UNSUPPORTED,
+    BareLoop,
     Backend,
     BeamElement,
     BeamModes,
     Expression,
     Linearization,
-    BareLoop,
     Samples,
-    Stopwatch,
+    Scheme,
     Setting,
+    Stopwatch,
 )
-from ..systems._continua import Beam
-from .reactions import PAIR_ELEMENTS, joint_reactions
-from .plan import (
-    ELEMENT_KINDS,
-    spatial_tree_reason,
-    body_states,
-    element_kind,
-    elements,
-    BODY,
-    PRESCRIBED,
-    COORDINATE_FORCE_CUSTOM,
-    COORDINATE_FORCE_LINEAR,
-    LINEAR_COUPLING,
-    MASSLESS_BODY,
-    POINT_ON_LINE,
-    POINT_ON_POINT,
-    POINT_TO_POINT_CUSTOM,
-    POINT_TO_POINT_LINEAR,
-    PRISMATIC,
-    REVOLUTE,
-    ROLLING_CONTACT,
-    TIME_LOAD,
-    CoordinateMap,
-    ForceLaw,
-    coordinate_map,
-    coupled,
-    motions,
-    num,
-    rot,
-    rigid_body,
-    point_mass,
+from .mujoco_mjcf import (
+    POINT_MASS_GYRATION,
+    Closure,
+    Plan,
+    fmt,
+    spatial_reason,
+    translate,
 )
-
-#: what MuJoCo's soft equalities cost (docs/engines.md; the numbers per mechanism are
-#: measured in the results)
-SOFT_EQUALITY = (
-    "MuJoCo's equality constraints are soft: the impedance is capped below 1 (solimp) and "
-    "the reference time constant is tied to the step (2 dt), so each constraint force "
-    "falls short of the exact one by the impedance's shortfall and a small violation makes "
-    "up the rest; the constraint forces and the trajectories then carry a floor of their "
-    "own, above RK4's gates, which no solref/solimp choice removes. The time constant "
-    "follows the step, so the violation, and the trajectory error with it, falls as dt^2: "
-    "the observed order of convergence is 2, not RK4's 4 (mbfidelity convergence).")
-#: the metrics a soft closure is expected to push beyond the RK4 gates: its own force and
-#: the contact forces read from it, the motion and the energy the motion carries, and the
-#: order of convergence of the motion
-SOFT_EQUALITY_METRICS = ("*.trajectory_*", "*.energy_drift", "*.constraint_*", "*.contact_*",
-                         "convergence.order")
+from .plan import ForceLaw, coupled, motions, num
+from .reactions import joint_reactions
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
-def _fmt(*xs: float) -> str:
-    return " ".join(format(float(x), ".17g") for x in xs)
-
-
-def _xyz(point) -> str:
-    """A planar point of the description as an MJCF position."""
-    return _fmt(num(point[0]), num(point[1]), 0)
-
-
-def _site(name: str, point) -> str:
-    return f'<site name="{name}" pos="{_xyz(point)}"/>'
-
-
-@dataclass
-class _P2P:
-    element: PointToPoint
-    tendon: str
-    native: tuple[float, float, float] | None  # (stiffness, springlength, damping)
-    law: Callable[..., float]
-
-
-@dataclass
-class _Coord:
-    element: CoordinateForce
-    j: int  # description joint index (of its engine joint where the law is native)
-    native: tuple[float, float, float] | None  # (a, b, c) in engine units of joint j
-    law: Callable[..., float]
-    #: COORD = row . (v - b) over the engine joint values v, and the joint forces are
-    #: row * force
-    row: np.ndarray
-
-
-@dataclass
-class _Closure:
-    """A closure constraint and its MJCF equality: ``connect`` (PointOnPoint: site1 on
-    body_a, site2 on body_b), ``slider`` (PointOnLine: a connect between the pin's site1 and
-    the origin site2 of a slider body that slides along the slot on the slot body),
-    ``tendon`` (LinearCoupling: a fixed tendon sum(w_j v_j) over the engine joint values
-    held at ``offset`` by a tendon equality) or ``contact`` (RollingContact: the same
-    weights, no equality)."""
-
-    element: object
-    kind: str
-    site1: str = ""
-    site2: str = ""
-    slider: str = ""  # slider body (and its slide joint) name
-    weights: dict[str, float] = field(default_factory=dict)
-    offset: float = 0.0
-    coef: np.ndarray | None = None  # LinearCoupling: coefficients over the coordinates
-    contact: dict = field(default_factory=dict)  # RollingContact: see _contact_geometry
-
-
-@dataclass
-class _Joint:
-    """An MJCF joint: its type and its axis and (hinge) position in its MJCF body's frame;
-    `law`: the description joint index whose native law it carries, if any."""
-
-    name: str
-    type: str
-    axis: Sequence[float]
-    pos: Sequence[float] | None = None
-    law: int | None = None
-
-    def xml(self, attrs: str) -> str:
-        pos = "" if self.pos is None else f' pos="{_fmt(*self.pos)}"'
-        return (f'<joint name="{self.name}" type="{self.type}" axis="{_fmt(*self.axis)}"'
-                f'{pos}{attrs}/>')
-
-
-#: radius of gyration of the substitute bodies (their inertia is mass * GYRATION**2)
-GYRATION = 0.01
-#: the same for sliders: they turn with the slot body, whose inertia they add to
-SLIDER_GYRATION = 1e-5
-#: radius of gyration (m) of the inertia a point mass is given (setting
-#: point_mass_gyration)
-POINT_MASS_GYRATION = 1e-6
-#: the least substitute inertia of a point mass (kg m^2): ten times MuJoCo's mjMINVAL
-POINT_MASS_INERTIA_FLOOR = 1e-14
-
-
-@dataclass
-class _Plan:
-    """A numeric mechanism translated to MuJoCo terms: the MJCF fragments each element's
-    builder adds (per MJCF body: the <body> attributes, joints, <inertial>, sites, contact
-    geoms, slider bodies) and what the callbacks and the read-outs need."""
-
-    mech: Mechanism
-    cmap: CoordinateMap  # description coordinates q <-> engine joint values v
-    carrier: dict[str, str]  # description body -> MJCF body carrying it
-    chains: dict[str, list[int]]  # MJCF body -> description joint indices, in order
-    mj_parent: dict[str, str]
-    settings: dict  # the resolved settings
-    #: the step the file is written for (MJCF's default 0.002 s when written without one)
-    dt: float
-    native: bool  # linear laws as MuJoCo's own springs and dampers
-    autonomous: bool  # time-dependent laws left out (linearization)
-    foldable: set[str]
-    frames: dict[str, tuple[float, ...]]  # body frames at the reference configuration
-    heads: dict[str, str] = field(default_factory=dict)
-    joints: dict[str, list[_Joint]] = field(default_factory=dict)
-    inertial: dict[str, str] = field(default_factory=dict)
-    sites: dict[str, list[str]] = field(default_factory=dict)
-    geoms: dict[str, list[str]] = field(default_factory=dict)
-    sliders: dict[str, list[list[str]]] = field(default_factory=dict)
-    p2p: list[_P2P] = field(default_factory=list)
-    coord: list[_Coord] = field(default_factory=list)
-    closures: list[_Closure] = field(default_factory=list)
-    #: substitute (mass, inertia) of massless bodies that cannot be folded
-    substitutes: dict[str, tuple[float, float]] = field(default_factory=dict)
-    #: per engine joint, the summed linear coordinate laws (a, k, c) it may carry natively
-    joint_native: dict[int, list[float]] = field(default_factory=dict)
-    slider_mass: dict[str, float] = field(default_factory=dict)
-    xml: str = ""
-
-    @property
-    def n(self) -> int:
-        return len(self.mech.joints)
-
-    @property
-    def m_min(self) -> float:
-        return min(num(b.mass) for b in self.mech.bodies if not b.massless)
-
-    def add_inertial(self, body: str, mass: float, com: Sequence[float],
-                     inertia: float) -> None:
-        self.inertial[body] = (f'<inertial pos="{_fmt(com[0], com[1], 0)}" mass="{_fmt(mass)}" '
-                               f'diaginertia="{_fmt(inertia, inertia, inertia)}"/>')
-
-    def add_frame(self, body: str, gravcomp: bool = False) -> None:
-        """The <body> attributes: its frame relative to its MJCF parent at the reference
-        configuration (spatial: parent_anchor - child_anchor, model convention 10)."""
-        if self.mech.spatial:
-            j = self.mech.joints[self.chains[body][0]]
-            pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
-                      for a in (j.parent_anchor, j.child_anchor))
-            self.heads[body] = f'name="{body}" pos="{_fmt(*(pa - ca))}"'
-            return
-        x, y, th = self.frames[body][:3]
-        xp, yp, thp = self.frames[self.mj_parent[body]][:3]
-        rel = rot(thp).T @ np.array([x - xp, y - yp])
-        ang = th - thp
-        self.heads[body] = (f'name="{body}" pos="{_fmt(rel[0], rel[1], 0)}" '
-                            f'quat="{_fmt(math.cos(ang / 2), 0, 0, math.sin(ang / 2))}"'
-                            + (' gravcomp="1"' if gravcomp and self.gravcomp else ""))
-
-    @property
-    def gravcomp(self) -> bool:
-        return bool(self.settings["substitute_gravcomp"])
-
-    def anchor(self, hinge) -> np.ndarray:
-        """A hinge's anchor (world) at the reference configuration."""
-        x, y, th = self.frames[hinge.parent][:3]
-        return np.array([x, y]) + rot(th) @ np.array([num(v) for v in hinge.parent_anchor[:2]])
-
-    def local(self, body: str, vector: np.ndarray) -> np.ndarray:
-        """A world vector in the frame of an MJCF body at the reference configuration."""
-        return rot(self.frames[body][2]).T @ vector
-
-    def coupling(self, c, kind: str, **extra) -> _Closure:
-        """A linear relation c . q = C as a fixed tendon over the engine joint values."""
-        coef = np.zeros(self.n)
-        for name, value in c.coefficients:
-            coef[self.mech.coordinates.index(name)] += num(value)
-        w, offset = self.cmap.on_engine_values(coef, num(c.constant))
-        weights = {self.mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
-        return _Closure(c, kind, weights=weights, offset=offset, coef=coef, **extra)
-
-
-# --- element builders, each registered with its declared expression (contract point 5) --
-
-_BUILDERS: dict[str, Callable[[_Plan, object], None]] = {}
-_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
-
-
-def _builds(kind: str, *cases: Expression):
-    """Register the builder of one element kind together with the expression(s) it builds."""
-    def register(builder: Callable[[_Plan, object], None]):
-        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
-        return builder
-    return register
-
-
-def _point_loaded_bodies(mech: Mechanism) -> set[str]:
-    """Bodies that a loop or slot constraint or a point-to-point element acts on."""
-    return ({b for c in mech.constraints if isinstance(c, PAIR_ELEMENTS) for b in c.bodies}
-            | {b for f in mech.forces if isinstance(f, PointToPoint) for b in (f.body_a, f.body_b)})
-
-
-def _foldable(mech: Mechanism) -> set[str]:
-    """Massless bodies whose joints are folded into their single child (exact). A massless
-    body with another number of child joints, or that a constraint or a point-to-point
-    element refers to, has no such child frame: it becomes a substitute body of small mass
-    (setting ``massless_mass_ratio``)."""
-    used = _point_loaded_bodies(mech)
-    return {b.name for b in mech.bodies if b.massless and b.name not in used
-            and sum(1 for j in mech.joints if j.parent == b.name) == 1}
-
-
-@_builds(
-    BODY,
-    Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
-                      "explicit <inertial> (planar inertia on z, the same on x and y)",
-               when="mass and inertia > 0", applies=rigid_body),
-    Expression(SUBSTITUTE, "a point mass: an explicit <inertial> of inertia m r^2, "
-                           "r the setting point_mass_gyration. MuJoCo's compiler "
-                           "rejects moving bodies whose inertia is below mjMINVAL "
-                           "(also when a welded child carries the mass); the "
-                           "substitute changes the body's moment about any point by "
-                           "m r^2, relative (r/d)^2 at a distance d",
-               when="mass > 0, inertia 0", applies=point_mass),
-    Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass",
-               when="mass 0, inertia > 0"))
-def _body(plan: _Plan, body) -> None:
-    plan.add_frame(body.name)
-    mass, inertia = num(body.mass), num(body.inertia)
-    if plan.mech.spatial:
-        I = np.array(inertia_matrix(body).tolist(), dtype=float)
-        plan.inertial[body.name] = (
-            f'<inertial pos="0 0 0" mass="{_fmt(mass)}" fullinertia="'
-            f'{_fmt(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])}"/>')
-        return
-    if inertia == 0:  # a point mass: above MuJoCo's mjMINVAL (1e-15) whatever the mass
-        radius = float(plan.settings["point_mass_gyration"])
-        inertia = max(mass * radius**2, POINT_MASS_INERTIA_FLOOR)
-    plan.add_inertial(body.name, mass, (0.0, 0.0), inertia)
-
-
-@_builds(
-    MASSLESS_BODY,
-    Expression(EXACT, "folded: its joints become a chain of joints of its single "
-                      "child's MJCF body, anchors and axes at the reference "
-                      "configuration",
-               when="one child joint, and no constraint or point force on it",
-               applies=lambda mech, body: body.name in _foldable(mech)),
-    Expression(SUBSTITUTE, "a body of small mass (link_mass_ratio of the lightest "
-                           "body for a kinematic link, massless_mass_ratio where a "
-                           "constraint or a point force loads it), weight cancelled: "
-                           "MuJoCo rejects massless moving bodies",
-               when="several child joints, or loaded by a constraint or point force"))
-def _massless_body(plan: _Plan, body) -> None:
-    if body.name in plan.foldable:
-        return
-    # a pure kinematic link (several children, no constraint or point force on it)
-    # carries no load of its own and can be very light; a massless body that a
-    # constraint or a point force loads must be heavier, because MuJoCo's soft
-    # constraints scale their stiffness with the mass they move
-    loaded = body.name in _point_loaded_bodies(plan.mech)
-    key = "massless_mass_ratio" if loaded else "link_mass_ratio"
-    mass = float(plan.settings[key]) * plan.m_min
-    plan.substitutes[body.name] = (mass, mass * GYRATION**2)
-    plan.add_frame(body.name, gravcomp=True)
-    plan.add_inertial(body.name, mass, (0.0, 0.0), mass * GYRATION**2)
-
-
-@_builds(REVOLUTE, Expression(EXACT, "hinge about z on the relative angle (absolute and "
-                                     "clockwise coordinates through v = A q + b)"))
-def _revolute(plan: _Plan, joint) -> None:
-    i, body = plan.mech.joints.index(joint), plan.carrier[joint.child]
-    if plan.mech.spatial:  # about the description's axis at child_anchor
-        axis = [num(v) for v in (joint.axis if joint.axis is not None else (0, 0, 1))]
-        pos = [num(v) for v in joint.child_anchor] + [0.0] * (3 - len(joint.child_anchor))
-    else:
-        axis = (0, 0, 1)
-        loc = plan.local(body, plan.anchor(joint) - np.array(plan.frames[body][:2]))
-        pos = (loc[0], loc[1], 0)
-    plan.joints.setdefault(body, []).append(_Joint(joint.name, "hinge", axis, pos, i))
-
-
-@_builds(PRISMATIC, Expression(EXACT, "slide joint in the x-y plane (limits are admissible "
-                                      "intervals, not stops)"))
-def _prismatic(plan: _Plan, joint) -> None:
-    i, body = plan.mech.joints.index(joint), plan.carrier[joint.child]
-    axis = [num(v) for v in joint.axis] + [0.0] * (3 - len(joint.axis))
-    if not plan.mech.spatial:  # the axis turns with the parent
-        world = rot(plan.frames[joint.parent][2]) @ np.array(axis[:2])
-        ax = plan.local(body, world)
-        axis = (ax[0], ax[1], 0)
-    plan.joints.setdefault(body, []).append(_Joint(joint.name, "slide", axis, None, i))
-
-
-def _point_to_point(plan: _Plan, f: PointToPoint) -> None:
-    """A spatial tendon between two sites; a law linear in LENGTH and LENGTH_RATE that
-    MuJoCo's tendon spring (stiffness >= 0, free length >= 0) and damper can hold is
-    native, any other the passive callback's."""
-    law = ForceLaw.of(f)
-    lin = law.linear if plan.native else None
-    spec = None
-    if lin is not None:
-        a, k, c = lin
-        if k > 0 and -a / k >= 0 and c >= 0:
-            spec = (k, -a / k + 0.0, c)
-        elif k == 0 and a == 0 and c >= 0:
-            spec = (0.0, 0.0, c)
-    plan.p2p.append(_P2P(f, f.name, spec, law.law))
-    for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
-        plan.sites.setdefault(body, []).append(_site(f"{f.name}:{tag}", point))
-
-
-def _coordinate_force(plan: _Plan, f: CoordinateForce) -> None:
-    """Joint stiffness/springref/damping where the law is linear and its argument is one
-    engine joint value (`CoordinateMap.law_target`), otherwise the passive callback."""
-    law, weights = ForceLaw.of(f), f.weights(plan.mech.coordinates)
-    row = sum(sign * plan.cmap.T[k] for k, sign in weights.items())
-    row = np.where(np.abs(row) < 1e-12, 0.0, row)
-    j = plan.mech.coordinates.index(f.coordinate)
-    lin = law.linear if plan.native else None
-    target = plan.cmap.law_target(weights)
-    spec = None
-    if lin is not None and target is not None:
-        j, r = target  # COORD = r v_j: F(COORD) on COORD is r F(r v_j) on v_j
-        a, kq, cq = lin
-        spec = (a * r, kq * r * r, cq * r * r)
-        acc = plan.joint_native.setdefault(j, [0.0, 0.0, 0.0])
-        acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-    plan.coord.append(_Coord(f, j, spec, law.law, row))
-
-
-_builds(
-    POINT_TO_POINT_LINEAR,
-    Expression(EXACT, "spatial tendon with its own stiffness, springlength and damping "
-                      "(native_springs; otherwise the passive callback)"))(_point_to_point)
-_builds(POINT_TO_POINT_CUSTOM,
-        Expression(EXACT, "spatial tendon, -T dL/dq from the passive callback at every "
-                          "integrator stage"))(_point_to_point)
-_builds(COORDINATE_FORCE_LINEAR,
-        Expression(EXACT, "joint stiffness, springref and damping where the coordinate is "
-                          "one engine joint, otherwise the passive callback"))(_coordinate_force)
-_builds(COORDINATE_FORCE_CUSTOM,
-        Expression(EXACT, "passive callback (set_mjcb_passive) at every integrator "
-                          "stage"))(_coordinate_force)
-_FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
-                                      "stage time"))
-def _time_load(plan: _Plan, f) -> None:
-    if not plan.autonomous:  # a linearization leaves time loads out
-        _FORCES[type(f)](plan, f)
-
-
-@_builds(POINT_ON_POINT, Expression(SOFT, "connect equality between two sites",
-                                    expected_failures=SOFT_EQUALITY_METRICS,
-                                    reason=SOFT_EQUALITY))
-def _point_on_point(plan: _Plan, c: PointOnPoint) -> None:
-    plan.closures.append(_Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
-    for site, body, point in ((f"{c.name}:a", c.body_a, c.point_a),
-                              (f"{c.name}:b", c.body_b, c.point_b)):
-        plan.sites.setdefault(body, []).append(_site(site, point))
-
-
-def _slider_masses(plan: _Plan, pin_body: str) -> None:
-    """The sliders' masses of the slots whose pin is on `pin_body`. The slider follows the
-    pin point, so its mass is taken out of the pin body (mass, centre of mass and inertia
-    adjusted so that body + slider have the description's mass, first and second moments:
-    exact while the constraint holds); it can then be a sizeable fraction of the pin
-    body's mass, which keeps the constraint's rows well conditioned (MuJoCo's
-    regularisation is relative to each world-axis row's diagonal, and a tiny slider mass
-    makes the row along the slot dominate and soften the row across it). A slider on a
-    fixed pin does not move: its weight is cancelled (gravcomp) and its mass is a fraction
-    of the slot body's; a massless pin's substitute carries its sliders."""
-    mech = plan.mech
-    ratio = float(plan.settings["slider_mass_ratio"])
-    cons = [c for c in mech.constraints
-            if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
-    if pin_body == WORLD:
-        for c in cons:
-            lb = c.line_body
-            heavy = lb != WORLD and not mech.body(lb).massless
-            plan.slider_mass[c.name] = ratio * (num(mech.body(lb).mass) if heavy else plan.m_min)
-        return
-    if pin_body in plan.substitutes:
-        for c in cons:
-            plan.slider_mass[c.name] = ratio * plan.substitutes[pin_body][0]
-        return
-    body = mech.body(pin_body)
-    pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
-    mp, ip = num(body.mass), num(body.inertia)
-    # the largest point masses at the pins that leave a positive inertia
-    bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
-    masses = [ratio * bound for _ in cons]
-    plan.slider_mass.update({c.name: mc for c, mc in zip(cons, masses)})
-    rest = mp - sum(masses)
-    com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
-    inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
-               - rest * float(com @ com))
-    plan.add_inertial(pin_body, rest, (float(com[0]), float(com[1])), inertia)
-
-
-@_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
-                                               "the slot body (slide joint along the slot) "
-                                               "connected to the pin, its mass taken out of "
-                                               "the pin body (exact while the constraint "
-                                               "holds); the connect is soft",
-                                   expected_failures=SOFT_EQUALITY_METRICS,
-                                   reason=SOFT_EQUALITY))
-def _point_on_line(plan: _Plan, c: PointOnLine) -> None:
-    if c.name not in plan.slider_mass:
-        _slider_masses(plan, c.body)
-    mass = plan.slider_mass[c.name]
-    inertia = mass * SLIDER_GYRATION**2
-    cl = _Closure(c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider")
-    plan.closures.append(cl)
-    plan.sites.setdefault(c.body, []).append(_site(cl.site1, c.point))
-    gravcomp = (c.body == WORLD or c.body in plan.substitutes) and plan.gravcomp
-    dr = [num(v) for v in c.direction]
-    # the slot body's MJCF frame is its description frame (slot bodies are never folded):
-    # the slider starts at line_point, its joint value is the distance along the unit
-    # slot direction
-    parent = WORLD if c.line_body == WORLD else plan.carrier[c.line_body]
-    plan.sliders.setdefault(parent, []).append([
-        f'<body name="{cl.slider}" pos="{_xyz(c.line_point)}"'
-        + (' gravcomp="1">' if gravcomp else ">"),
-        f'  <joint name="{cl.slider}" type="slide" axis="{_fmt(dr[0], dr[1], 0)}"/>',
-        f'  <inertial pos="0 0 0" mass="{_fmt(mass)}" '
-        f'diaginertia="{_fmt(inertia, inertia, inertia)}"/>',
-        f'  <site name="{cl.site2}"/>',
-        "</body>"])
-
-
-@_builds(LINEAR_COUPLING, Expression(SOFT, "fixed tendon sum(w_j v_j) over the engine joint "
-                                           "values held by a tendon equality (an exact linear "
-                                           "relation; soft like every equality)",
-                                     expected_failures=SOFT_EQUALITY_METRICS,
-                                     reason=SOFT_EQUALITY))
-def _linear_coupling(plan: _Plan, c) -> None:
-    plan.closures.append(plan.coupling(c, "tendon"))
-
-
-def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict:
-    """Where a RollingContact sits in the MJCF: the disc's hub joint, the arm's hinge on
-    the track (the ring's centre, track frame) and the radii. The arm must fold into the
-    disc's MJCF body, which then also carries the radial slide that frees its length."""
-    if c.arm not in foldable:
-        raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
-                         "link that carries the disc only")
-    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
-    return {"disc": c.disc, "arm_joint": hinge.name, "disc_joint": hub.name,
-            "track": c.track, "centre": [num(v) for v in hinge.parent_anchor],
-            "R": num(c.track_radius), "r": num(c.disc_radius), "j": mech.joints.index(hub)}
-
-
-@_builds(ROLLING_CONTACT, Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
-                                                 "of ring_segments boxes (soft, regularised "
-                                                 "friction; the arm's length freed by a "
-                                                 "radial slide); its force is the contacts' "
-                                                 "generalized force on the disc's coordinate "
-                                                 "over its coefficient, its violation the "
-                                                 "slip; linearize uses the coupling"))
-def _rolling_contact(plan: _Plan, c: RollingContact) -> None:
-    mech, s = plan.mech, plan.settings
-    geo = _contact_geometry(mech, c, plan.foldable)
-    cl = plan.coupling(c, "contact", slider=f"{c.name}:radial", contact=geo)
-    plan.closures.append(cl)
-    params = (f' condim="3" friction="{_fmt(s["contact_friction"], 0, 0)}" solref="'
-              f'{_fmt(float(s["contact_timeconst_steps"]) * plan.dt, s["contact_dampratio"])}"'
-              f' solimp="{_fmt(*s["contact_solimp"])}"')
-    disc = plan.carrier[geo["disc"]]
-    plan.geoms.setdefault(disc, []).append(
-        f'<geom name="{c.name}:disc" type="sphere" size="{_fmt(geo["r"])}" '
-        f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
-        f'conaffinity="0"{params}/>')
-    nseg = int(s["ring_segments"])
-    R, (cx, cy) = geo["R"], geo["centre"]
-    t = 0.1 * R  # radial thickness of the ring's boxes; the inner faces lie at R
-    half = R * math.tan(math.pi / nseg)  # faces meet: a polygon circumscribing R
-    for k in range(nseg):
-        a = 2 * math.pi * k / nseg
-        x, y = cx + (R + t / 2) * math.cos(a), cy + (R + t / 2) * math.sin(a)
-        plan.geoms.setdefault(plan.carrier[geo["track"]], []).append(
-            f'<geom type="box" size="{_fmt(t / 2, half, 2 * geo["r"])}" '
-            f'pos="{_fmt(x, y, 0)}" quat="{_fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '
-            f'contype="0" conaffinity="2"{params}/>')
-    # the arm's length is freed: the contact's normal force replaces it (a slide right
-    # after the arm's hinge, along the arm)
-    anchor, hub = (plan.anchor(mech.joint(geo[k])) for k in ("arm_joint", "disc_joint"))
-    u = plan.local(disc, (hub - anchor) / np.linalg.norm(hub - anchor))
-    joints = plan.joints[disc]
-    at = next(k for k, jt in enumerate(joints) if jt.name == geo["arm_joint"])
-    joints.insert(at + 1, _Joint(cl.slider, "slide", (u[0], u[1], 0)))
-
-
-_builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by a control callback "
-                                      "(qfrc_applied from mj_solveM, every RK4 stage at "
-                                      "the stage time; setting prescribed_motion); the "
-                                      "applied force is the actuator force"))(
-    lambda plan, p: None)  # nothing in the MJCF: `_Compiled._make_control` imposes it
-
-
-def _plan(mech: Mechanism, settings: dict, autonomous: bool = False,
-          dt: float | None = None) -> _Plan:
-    """The plan of a numeric mechanism under the (resolved) settings; `autonomous`
-    leaves the time loads out; `dt`: the step the file is written for."""
-    cmap = coordinate_map(mech)
-    foldable = _foldable(mech)
-    carrier: dict[str, str] = {}
-    for body in reversed([j.child for j in mech.joints]):
-        if body in foldable:
-            child = next(j.child for j in mech.joints if j.parent == body)
-            carrier[body] = carrier[child]
-        else:
-            carrier[body] = body
-    chains: dict[str, list[int]] = {}
-    for i, j in enumerate(mech.joints):
-        chains.setdefault(carrier[j.child], []).append(i)
-    mj_parent = {name: WORLD if mech.joints[chain[0]].parent == WORLD
-                 else carrier[mech.joints[chain[0]].parent] for name, chain in chains.items()}
-    # the reference configuration of the MJCF: every engine joint value 0
-    frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
-    plan = _Plan(mech, cmap, carrier, chains, mj_parent, settings, dt or 0.002,
-                 bool(settings["native_springs"]), autonomous, foldable, frames)
-    for kind, element in elements(mech):
-        _BUILDERS[kind](plan, element)
-    # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
-    # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
-    for i, (a, k, c) in plan.joint_native.items():
-        if not (c <= 0 and (k < 0 or (k == 0 and a == 0))):
-            for e in plan.coord:
-                if e.j == i:
-                    e.native = None
-    plan.xml = _mjcf(plan)
-    return plan
-
-
-def _shape_geom(shape) -> str:
-    return _SHAPE_GEOMS.get(type(shape), lambda s: "")(shape)
-
-
-def _segment_geom(shape: Segment) -> str:
-    a, b = [num(v) for v in shape.a], [num(v) for v in shape.b]
-    r = num(shape.width) / 2
-    if a == b:
-        return f'<geom type="sphere" size="{_fmt(r)}" pos="{_fmt(a[0], a[1], 0)}"/>'
-    return f'<geom type="capsule" size="{_fmt(r)}" fromto="{_fmt(a[0], a[1], 0, b[0], b[1], 0)}"/>'
-
-
-def _rectangle_geom(shape: Rectangle) -> str:
-    w, h = num(shape.width), num(shape.height)
-    return (f'<geom type="box" size="{_fmt(w / 2, h / 2, min(w, h) / 4)}" '
-            f'pos="{_xyz(shape.center)}"/>')
-
-
-_SHAPE_GEOMS = {
-    Segment: _segment_geom,
-    Circle: lambda s: f'<geom type="sphere" size="{_fmt(num(s.radius))}" pos="{_xyz(s.center)}"/>',
-    Rectangle: _rectangle_geom,
-}
-
-
-def _spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial build cannot hold a spatial mechanism (empty: it can): closures
-    become equalities, slides slide joints."""
-    return spatial_tree_reason(mech, closures=True, slides=True)
-
-
-def _mjcf(plan: _Plan) -> str:
-    """The MJCF text of a plan, from the fragments its builders made."""
-    mech = plan.mech
-    native_joint = {e.j for e in plan.coord if e.native is not None}
-
-    def law(i: int | None) -> str:
-        """MuJoCo's own spring and damper of the linear law a + k v + c v' on joint i."""
-        if i not in native_joint:
-            return ""
-        a, k, c = plan.joint_native[i]
-        ref = -a / k if k != 0 else 0.0
-        return f' stiffness="{_fmt(-k)}" springref="{_fmt(ref)}" damping="{_fmt(-c)}"'
-
-    def indent(depth: int, lines) -> list[str]:
-        return [f"{'  ' * depth}{x}" for x in lines]
-
-    def body_xml(name: str, depth: int) -> list[str]:
-        lines = [f"<body {plan.heads[name]}>"]
-        lines += indent(1, [jt.xml(law(jt.law)) for jt in plan.joints[name]])
-        lines += indent(1, [plan.inertial[name]]
-                        + [g for g in map(_shape_geom, mech.body(name).shapes) if g]
-                        + plan.geoms.get(name, []) + plan.sites.get(name, []))
-        for child in plan.chains:
-            if plan.mj_parent[child] == name:
-                lines += indent(1, body_xml(child, 0))
-        for slider in plan.sliders.get(name, []):
-            lines += indent(1, slider)
-        return indent(depth, lines + ["</body>"])
-
-    g = num(mech.gravity)
-    gravity = (0, -g, 0)
-    if mech.spatial:
-        up = np.array([num(u) for u in mech.up], dtype=float)
-        gravity = -g * up / np.linalg.norm(up)
-    out = [
-        '<mujoco model="mbfidelity">',
-        '  <compiler angle="radian" inertiafromgeom="false"/>',
-        f'  <option gravity="{_fmt(*gravity)}">',
-        ('    <flag contact="disable"/>' if not plan.geoms else
-         '    <flag contact="enable" filterparent="disable"/>'),
-        "  </option>",
-        '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
-        "  <worldbody>",
-    ]
-    out += indent(2, plan.sites.get(WORLD, []))
-    for name in plan.chains:
-        if plan.mj_parent[name] == WORLD:
-            out += body_xml(name, 2)
-    for slider in plan.sliders.get(WORLD, []):
-        out += indent(2, slider)
-    out.append("  </worldbody>")
-    couplings = [cl for cl in plan.closures if cl.kind in ("tendon", "contact")]
-    if plan.p2p or couplings:
-        out.append("  <tendon>")
-        for cl in couplings:
-            out.append(f'    <fixed name="{cl.element.name}">')
-            out += [f'      <joint joint="{jn}" coef="{_fmt(w)}"/>' for jn, w in cl.weights.items()]
-            out.append("    </fixed>")
-        for e in plan.p2p:
-            k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
-            out += [f'    <spatial name="{e.tendon}" stiffness="{_fmt(k)}" '
-                    f'springlength="{_fmt(l0, l0)}" damping="{_fmt(c)}">',
-                    f'      <site site="{e.element.name}:a"/>',
-                    f'      <site site="{e.element.name}:b"/>',
-                    "    </spatial>"]
-        out.append("  </tendon>")
-    equalities = [cl for cl in plan.closures if cl.kind != "contact"]
-    if equalities:
-        s = plan.settings
-        soft = (f' solref="{_fmt(float(s["constraint_timeconst_steps"]) * plan.dt, s["constraint_dampratio"])}"'
-                f' solimp="{_fmt(*s["constraint_solimp"])}"')
-        out.append("  <equality>")
-        for cl in equalities:
-            name = cl.element.name
-            out.append(f'    <tendon name="{name}" tendon1="{name}" '
-                       f'polycoef="{_fmt(cl.offset, 0, 0, 0, 0)}"{soft}/>' if cl.kind == "tendon"
-                       else f'    <connect name="{name}" site1="{cl.site1}" '
-                            f'site2="{cl.site2}"{soft}/>')
-        out.append("  </equality>")
-    out.append("</mujoco>")
-    return "\n".join(out) + "\n"
-
-
 class _Compiled:
     """A compiled MuJoCo model of a plan plus the index maps and the passive callback."""
 
-    def __init__(self, plan: _Plan, integrator: str, dt: float, autoreset: bool = False) -> None:
+    def __init__(self, plan: Plan, integrator: str, dt: float, autoreset: bool = False) -> None:
         import mujoco
 
         self.mujoco, self.plan, s = mujoco, plan, plan.settings
@@ -859,7 +170,7 @@ class _Compiled:
             mats.append((DfDq, DfDv, DfDa))
         return tuple((mats[0][i] + mats[1][i]).T / 2 for i in range(3))
 
-    def contact_state(self, cl: _Closure, k_contact: int) -> tuple[float, float]:
+    def contact_state(self, cl: Closure, k_contact: int) -> tuple[float, float]:
         """After mj_forward, for a rolling coupling built as contact (the k-th such
         closure): the generalized force of the disc's contacts on the description
         coordinates (A^T qfrc), as the coupling's value -lam, i.e. that on the disc's
@@ -1398,25 +709,25 @@ class MujocoBackend(Backend):
 
         return mujoco.__version__
 
-    #: per element kind, what its registered builder makes (see `_builds`)
-    EXPRESSIONS = {kind: _EXPRESSIONS[kind] for kind in ELEMENT_KINDS if kind in _EXPRESSIONS}
+    #: per element kind, what its registered builder makes (mujoco_mjcf)
+    EXPRESSIONS = mujoco_mjcf.EXPRESSIONS
 
     SPATIAL_REASON = ""
 
     def translation_reason(self, mechanism: Mechanism) -> str:
         if mechanism.spatial:
-            return _spatial_reason(mechanism)
+            return spatial_reason(mechanism)
         if all(b.massless for b in mechanism.bodies):
             return "every body is massless (no mass scale for the substitute bodies)"
         return ""
 
     # --- translation ---------------------------------------------------------------------
     def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
-              dt: float | None = None) -> _Plan:
+              dt: float | None = None) -> Plan:
         support = self.support(mechanism)
         if not support.ok:
             raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
-        return _plan(mechanism, settings, autonomous, dt)
+        return translate(mechanism, settings, autonomous, dt)
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
                 dt: float | None = None) -> str:
@@ -1425,7 +736,7 @@ class MujocoBackend(Backend):
         Laws that need the passive callback are not in the file."""
         s = self.resolve_settings(settings)
         xml = self._plan(mechanism, s, dt=dt).xml
-        opt = f'integrator="{s["integrator"]}"' + (f' timestep="{_fmt(dt)}"' if dt else "")
+        opt = f'integrator="{s["integrator"]}"' + (f' timestep="{fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
         flags = []
         if not s["autoreset"]:
@@ -1457,12 +768,12 @@ class MujocoBackend(Backend):
         keys = []
         for name, (q, qd) in initial_states.items():
             comp.set_state(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
-            keys.append(f'    <key name="{name}" qpos="{_fmt(*comp.data.qpos)}" '
-                        f'qvel="{_fmt(*comp.data.qvel)}"/>')
+            keys.append(f'    <key name="{name}" qpos="{fmt(*comp.data.qpos)}" '
+                        f'qvel="{fmt(*comp.data.qvel)}"/>')
         custom = (f'  <custom>\n'
-                  f'    <numeric name="mbfidelity_qadr" data="{_fmt(*comp.qadr)}"/>\n'
-                  f'    <numeric name="mbfidelity_A" data="{_fmt(*plan.cmap.A.ravel())}"/>\n'
-                  f'    <numeric name="mbfidelity_b" data="{_fmt(*plan.cmap.b)}"/>\n'
+                  f'    <numeric name="mbfidelity_qadr" data="{fmt(*comp.qadr)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{fmt(*plan.cmap.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{fmt(*plan.cmap.b)}"/>\n'
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
