@@ -228,7 +228,7 @@ def test_discretization_sets_each_engines_chain_and_own_elements_beside_the_exac
 
 def test_the_soft_roller_is_judged_where_its_floor_is_below_the_gate(system):
     """MuJoCo's soft roller implies a backend-wide expected failure of trajectories
-    (simulators/mujoco_backend.py SOFT_EQUALITY, 1e-6 to 1e-5); the beam's release gate is
+    (simulators/mujoco_mjcf.py SOFT_EQUALITY, 1e-6 to 1e-5); the beam's release gate is
     wider, so the system declares those metrics "judged": a pass passes, a failure still
     fails (not an expected failure), and the backend's declaration covers none of them."""
     from mbfidelity.comparisons.runner import _judge, expectation_for, expectations
