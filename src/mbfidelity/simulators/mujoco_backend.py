@@ -2,7 +2,7 @@
 
 Translation (`to_mjcf`, module `mujoco_mjcf`): each element kind of the description has
 one builder, registered together with the `Expression` it declares (contract point 5);
-the builders add MJCF fragments to a `Plan`, which is assembled into the MJCF text.
+the builders add MJCF fragments to a `Build`, which is assembled into the MJCF text.
 
 - Every body with mass becomes an MJCF body whose frame is the description's
   centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
@@ -71,7 +71,7 @@ from .base import (
 from .mujoco_mjcf import (
     POINT_MASS_GYRATION,
     Closure,
-    Plan,
+    Build,
     fmt,
     spatial_reason,
     translate,
@@ -84,13 +84,13 @@ _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
 class _Compiled:
-    """A compiled MuJoCo model of a plan plus the index maps and the passive callback."""
+    """A compiled MuJoCo model of a build plus the index maps and the passive callback."""
 
-    def __init__(self, plan: Plan, integrator: str, dt: float, autoreset: bool = False) -> None:
+    def __init__(self, build: Build, integrator: str, dt: float, autoreset: bool = False) -> None:
         import mujoco
 
-        self.mujoco, self.plan, s = mujoco, plan, plan.settings
-        self.model = m = mujoco.MjModel.from_xml_string(plan.xml)
+        self.mujoco, self.build, s = mujoco, build, build.settings
+        self.model = m = mujoco.MjModel.from_xml_string(build.xml)
         m.opt.timestep = dt
         m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
         for field_name, bit, on in (
@@ -99,23 +99,23 @@ class _Compiled:
                 ("enableflags", mujoco.mjtEnableBit.mjENBL_DIAGEXACT, s["diagexact"])):
             flags = getattr(m.opt, field_name)
             setattr(m.opt, field_name, flags | int(bit) if on else flags & ~int(bit))
-        if plan.closures:
+        if build.closures:
             m.eq_solref[:] = (float(s["constraint_timeconst_steps"]) * dt,
                               float(s["constraint_dampratio"]))
             m.eq_solimp[:] = s["constraint_solimp"]
         self.data = mujoco.MjData(m)
-        names = [j.name for j in plan.mech.joints]
+        names = [j.name for j in build.mech.joints]
         self.qadr = np.array([m.joint(nm).qposadr[0] for nm in names])
         self.vadr = np.array([m.joint(nm).dofadr[0] for nm in names])
-        sliders = [cl for cl in plan.closures if cl.kind == "slider"]
+        sliders = [cl for cl in build.closures if cl.kind == "slider"]
         self.slider_jnt = np.array([m.joint(cl.slider).id for cl in sliders], dtype=int)
         self.slider_qadr = np.array([m.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
         self.slider_vadr = np.array([m.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
         self.slider_body = np.array([m.body(cl.slider).id for cl in sliders], dtype=int)
         self.slider_sites = [(m.site(cl.site1).id, m.site(cl.site2).id) for cl in sliders]
         self.eq_id = [m.equality(cl.element.name).id if cl.kind != "contact" else -1
-                      for cl in plan.closures]
-        contacts = [cl for cl in plan.closures if cl.kind == "contact"]
+                      for cl in build.closures]
+        contacts = [cl for cl in build.closures if cl.kind == "contact"]
         self.radial_qadr = np.array([m.joint(cl.slider).qposadr[0] for cl in contacts], dtype=int)
         self.radial_vadr = np.array([m.joint(cl.slider).dofadr[0] for cl in contacts], dtype=int)
         self.disc_geom = [m.geom(f"{cl.element.name}:disc").id for cl in contacts]
@@ -128,7 +128,7 @@ class _Compiled:
             m.geom_solref[np.flatnonzero(m.geom_conaffinity == 2)] = solref
         self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
-        self.actuator = np.zeros(len(plan.mech.prescribed))
+        self.actuator = np.zeros(len(build.mech.prescribed))
         self.control = self._make_control(integrator, dt)
 
     def _contact_qfrc(self, geom: int) -> np.ndarray:
@@ -177,27 +177,27 @@ class _Compiled:
         coordinate over its coefficient; and the accumulated slip Phi = c.q - const."""
         d = self.data
         qfrc = self._contact_qfrc(self.disc_geom[k_contact])
-        Q = self.plan.cmap.A.T @ qfrc[self.vadr]
+        Q = self.build.cmap.A.T @ qfrc[self.vadr]
         j = cl.contact["j"]
-        q = self.plan.cmap.T @ (d.qpos[self.qadr] - self.plan.cmap.b)
+        q = self.build.cmap.T @ (d.qpos[self.qadr] - self.build.cmap.b)
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
-        plan, model = self.plan, self.model
+        build, model = self.build, self.model
         half = dt / 2
         coord_terms = []
-        for e in plan.coord:
+        for e in build.coord:
             if e.native is not None:
                 continue
             row = e.row
             nz = np.flatnonzero(row)
             ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
-            const = float(-row @ plan.cmap.b)
+            const = float(-row @ build.cmap.b)
             # generalized force on the engine dofs: A^-T e_j F (row j of A^-1)
             outs = tuple((int(self.vadr[i]), float(row[i])) for i in nz)
             coord_terms.append((e.law, ins, const, outs))
         p2p_terms = []
-        for e in plan.p2p:
+        for e in build.p2p:
             if e.native is not None:
                 continue
             tid = model.tendon(e.tendon).id
@@ -245,16 +245,16 @@ class _Compiled:
         velocity derivative of the bias forces, by central differences, exact for a
         quadratic), and the target is the discrete acceleration ((q(t+h) - q)/h - q')/h
         that lands the coordinate on q(t+h) after the step."""
-        plan, model = self.plan, self.model
-        moves = motions(plan.mech)
+        build, model = self.build, self.model
+        moves = motions(build.mech)
         if not moves:
             return None
         mujoco = self.mujoco
         nv, k = model.nv, len(moves)
-        rows = plan.cmap.T[[mv.index for mv in moves]]  # q_p = rows (v - b)
+        rows = build.cmap.T[[mv.index for mv in moves]]  # q_p = rows (v - b)
         Tp = np.zeros((k, nv))
         Tp[:, self.vadr] = rows
-        qadr, b = self.qadr, plan.cmap.b
+        qadr, b = self.qadr, build.cmap.b
         stack = np.zeros((1 + k, nv))  # the free force and the actuators' columns
         stack[1:] = Tp
         solved = np.zeros_like(stack)
@@ -345,8 +345,8 @@ class _Compiled:
         value is (P - L) . u and its rate (v_P - v_L) . u, with v_L the velocity of the
         slot body's material point under the slider."""
         mujoco, m, d = self.mujoco, self.model, self.data
-        d.qpos[self.qadr] = self.plan.cmap.engine_values(q)
-        d.qvel[self.vadr] = self.plan.cmap.A @ np.asarray(qd, dtype=float)
+        d.qpos[self.qadr] = self.build.cmap.engine_values(q)
+        d.qvel[self.vadr] = self.build.cmap.A @ np.asarray(qd, dtype=float)
         d.time = t
         d.qpos[self.radial_qadr] = 0.0
         d.qvel[self.radial_vadr] = 0.0
@@ -379,7 +379,7 @@ class _ClosureSamples:
 
     def __init__(self, comp: _Compiled, n_samples: int) -> None:
         self.comp, self.n = comp, n_samples
-        self.closures = comp.plan.closures
+        self.closures = comp.build.closures
         self.contacts = [cl for cl in self.closures if cl.kind == "contact"]
         n_sliders = len(comp.slider_jnt)
         self.sliders = list(enumerate(comp.slider_body)) if n_sliders else []
@@ -444,8 +444,8 @@ class _ClosureSamples:
                 forces[name] = f[:, :2]
                 violation[name] = np.array([math.hypot(x, y) for x, y in pos[:, :2].tolist()])
             else:
-                # the slider's mass belongs to the pin (see _plan): the slot's force on
-                # pin + slider is the slide joint's force on the slider,
+                # the slider's mass belongs to the pin (mujoco_mjcf._slider_masses): the
+                # slot's force on pin + slider is the slide joint's force on the slider,
                 # m_s a_s - (weight not cancelled) + (connect force on the pin); MuJoCo's
                 # body accelerations are proper accelerations a - g
                 bid = self.comp.slider_body[k_slider]
@@ -466,18 +466,18 @@ class _Transmitted:
     `record(k)` after mj_forward and mj_rnePostConstraint at sample k; `result(t)`."""
 
     def __init__(self, comp: _Compiled, n_samples: int, joints: Sequence[str]) -> None:
-        plan, m = comp.plan, comp.model
+        build, m = comp.build, comp.model
         self.comp, self.joints = comp, joints
-        self.bodies = sorted({plan.carrier[plan.mech.joint(j).child] for j in joints})
+        self.bodies = sorted({build.carrier[build.mech.joint(j).child] for j in joints})
         self.bid = np.array([m.body(b).id for b in self.bodies])
-        self.p2p = [e for e in plan.p2p if e.native is None]
+        self.p2p = [e for e in build.p2p if e.native is None]
         self.tids = np.array([m.tendon(e.tendon).id for e in self.p2p], dtype=int)
         self.sid = np.array([[m.site(f"{e.element.name}:{x}").id for x in "ab"]
                              for e in self.p2p], dtype=int).reshape(-1, 2)
         # rolling by contact: the contact carries what the description's arm and coupling
         # carried, so it counts as transmitted through the joints (contract point 6)
-        self.discs = [cl.contact for cl in plan.closures if cl.kind == "contact"]
-        self.disc_bid = np.array([m.body(plan.carrier[g["disc"]]).id for g in self.discs],
+        self.discs = [cl.contact for cl in build.closures if cl.kind == "contact"]
+        self.disc_bid = np.array([m.body(build.carrier[g["disc"]]).id for g in self.discs],
                                  dtype=int)
         N = n_samples
         self.cf = np.empty((N, len(self.bodies), 2))
@@ -496,12 +496,12 @@ class _Transmitted:
             self.spos[k] = d.site_xpos[self.sid][:, :, :2]
 
     def result(self, t: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-        plan = self.comp.plan
+        build = self.comp.build
         transmitted: dict[str, np.ndarray] = {}
         for name in self.joints:
-            joint = plan.mech.joint(name)
-            inside = set(plan.mech.subtree(joint.child))
-            r = self.cf[:, self.bodies.index(plan.carrier[joint.child])].copy()
+            joint = build.mech.joint(name)
+            inside = set(build.mech.subtree(joint.child))
+            r = self.cf[:, self.bodies.index(build.carrier[joint.child])].copy()
             for i, g in enumerate(self.discs):
                 if g["disc"] in inside and g["track"] not in inside:
                     r += self.ext[:, i]
@@ -722,8 +722,8 @@ class MujocoBackend(Backend):
         return ""
 
     # --- translation ---------------------------------------------------------------------
-    def _plan(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
-              dt: float | None = None) -> Plan:
+    def _build(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
+              dt: float | None = None) -> Build:
         support = self.support(mechanism)
         if not support.ok:
             raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
@@ -735,7 +735,7 @@ class MujocoBackend(Backend):
         when given, the time step), to save and load with ``MjModel.from_xml_path``.
         Laws that need the passive callback are not in the file."""
         s = self.resolve_settings(settings)
-        xml = self._plan(mechanism, s, dt=dt).xml
+        xml = self._build(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
         flags = []
@@ -763,8 +763,8 @@ class MujocoBackend(Backend):
         not in the file: they are listed in the second element (empty: the file alone
         moves as the harness's build)."""
         s = self.resolve_settings(settings)
-        plan = self._plan(mechanism, s, dt=dt)
-        comp = _Compiled(plan, s["integrator"], dt, bool(s["autoreset"]))
+        build = self._build(mechanism, s, dt=dt)
+        comp = _Compiled(build, s["integrator"], dt, bool(s["autoreset"]))
         keys = []
         for name, (q, qd) in initial_states.items():
             comp.set_state(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
@@ -772,8 +772,8 @@ class MujocoBackend(Backend):
                         f'qvel="{fmt(*comp.data.qvel)}"/>')
         custom = (f'  <custom>\n'
                   f'    <numeric name="mbfidelity_qadr" data="{fmt(*comp.qadr)}"/>\n'
-                  f'    <numeric name="mbfidelity_A" data="{fmt(*plan.cmap.A.ravel())}"/>\n'
-                  f'    <numeric name="mbfidelity_b" data="{fmt(*plan.cmap.b)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{fmt(*build.cmap.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{fmt(*build.cmap.b)}"/>\n'
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
@@ -781,14 +781,14 @@ class MujocoBackend(Backend):
         head, tail = xml.rsplit("</mujoco>", 1)
         xml = f"{head}{custom}{keyframes}</mujoco>{tail}"
         outside = []
-        laws = [e.element.name for e in plan.coord + plan.p2p if e.native is None]
+        laws = [e.element.name for e in build.coord + build.p2p if e.native is None]
         if laws:
             outside.append("force laws applied by the harness's passive callback "
                            f"(mjcb_passive): {', '.join(laws)}")
         if comp.control is not None:
             outside.append("prescribed motions imposed by the harness's control callback "
                            f"(mjcb_control): {', '.join(p.name for p in mechanism.prescribed)}")
-        if any(c.kind == "contact" for c in plan.closures):
+        if any(c.kind == "contact" for c in build.closures):
             outside.append("the contact ring's solref, set on the compiled model")
         return xml, outside
 
@@ -839,7 +839,7 @@ class MujocoBackend(Backend):
         q, qd = self._coordinates(comp, qpos, qvel)
         # a coupling's tendon equality acts in joint space: cfrc_int counts it as
         # transmitted
-        couplings = {cl.element.name: forces[cl.element.name] for cl in comp.plan.closures
+        couplings = {cl.element.name: forces[cl.element.name] for cl in comp.build.closures
                      if cl.kind == "tendon"}
         reactions = joint_reactions(mechanism, reaction_joints, transmitted, t, q, qd,
                                     pair_forces=pairs, coupling_forces=couplings)
@@ -863,7 +863,7 @@ class MujocoBackend(Backend):
 
     def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
                   qd0: np.ndarray) -> _Compiled:
-        comp = _Compiled(self._plan(mechanism, cfg, dt=dt), cfg["integrator"], dt,
+        comp = _Compiled(self._build(mechanism, cfg, dt=dt), cfg["integrator"], dt,
                          bool(cfg["autoreset"]))
         comp.set_state(q0, qd0)
         return comp
@@ -872,8 +872,8 @@ class MujocoBackend(Backend):
     def _coordinates(comp: _Compiled, qpos: np.ndarray,
                      qvel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine joint values (rows) -> the description's coordinates and rates."""
-        plan = comp.plan
-        return plan.cmap.coordinates(qpos[:, comp.qadr]), plan.cmap.rates(qvel[:, comp.vadr])
+        build = comp.build
+        return build.cmap.coordinates(qpos[:, comp.qadr]), build.cmap.rates(qvel[:, comp.vadr])
 
     @staticmethod
     def _read_out(comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
@@ -886,9 +886,9 @@ class MujocoBackend(Backend):
         import mujoco
 
         m, d = comp.model, comp.data
-        prescribed = comp.plan.mech.prescribed
+        prescribed = comp.build.mech.prescribed
         actuators = np.empty((len(t), len(prescribed)))
-        readers = [r for r in (_ClosureSamples(comp, len(t)) if comp.plan.closures else None,
+        readers = [r for r in (_ClosureSamples(comp, len(t)) if comp.build.closures else None,
                                _Transmitted(comp, len(t), joints) if joints else None) if r]
         post = bool(joints) or bool(len(comp.slider_jnt))
         d_qpos, d_qvel = d.qpos, d.qvel  # fixed buffers of d (the efc arrays are not)
@@ -903,7 +903,7 @@ class MujocoBackend(Backend):
             actuators[k] = comp.actuator
             for reader in readers:
                 reader.record(k)
-        forces, violation = readers[0].result() if comp.plan.closures else ({}, {})
+        forces, violation = readers[0].result() if comp.build.closures else ({}, {})
         transmitted, pairs = readers[-1].result(t) if joints else ({}, {})
         return ({p.name: actuators[:, i] for i, p in enumerate(prescribed)}, forces,
                 violation, transmitted, pairs)
@@ -919,7 +919,7 @@ class MujocoBackend(Backend):
         import mujoco
 
         m, d = comp.model, comp.data
-        nv, n = m.nv, comp.plan.n
+        nv, n = m.nv, comp.build.n
         eq_type = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
         dsbl_eq = int(mujoco.mjtDisableBit.mjDSBL_EQUALITY)
 
@@ -978,14 +978,14 @@ class MujocoBackend(Backend):
             return None
         s = self.resolve_settings(settings)
         mechanism = coupled(mechanism)  # a contact has no linearization: the exact coupling
-        plan = self._plan(mechanism, s, autonomous=True, dt=dt)
-        n, eps = plan.n, float(s["fd_eps"])
+        build = self._build(mechanism, s, autonomous=True, dt=dt)
+        n, eps = build.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the
         # continuous-time inverse dynamics do not depend on the integrator)
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
-        if s["linearization"] == "inverseFD" and plan.closures:
-            comp = _Compiled(plan, integrator, dt)
+        if s["linearization"] == "inverseFD" and build.closures:
+            comp = _Compiled(build, integrator, dt)
             with _CallbacksInstalled(comp.callback, comp.control):
                 eig, extra = self._constrained_modes(comp, q_eq, eps)
             method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "
@@ -995,18 +995,18 @@ class MujocoBackend(Backend):
                       "to the null space of efc_J (exact constraints: MuJoCo's soft "
                       "regularisation is left out)")
         elif s["linearization"] == "inverseFD":
-            comp = _Compiled(plan, integrator, dt)
+            comp = _Compiled(build, integrator, dt)
             with _CallbacksInstalled(comp.callback, comp.control):
                 K, C, M = comp.inverse_fd(lambda: comp.set_state(q_eq, np.zeros(n)), eps)
             perm = comp.vadr
             K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
             eig = quadratic_eigenvalues(M, C, K)
-            A = plan.cmap.A  # v = A q + b: matrices in description coordinates are A^T X A
+            A = build.cmap.A  # v = A q + b: matrices in description coordinates are A^T X A
             extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
             method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central differences "
                       f"of mj_inverse, eps={eps:g})")
         else:
-            comp = _Compiled(plan, integrator, dt)
+            comp = _Compiled(build, integrator, dt)
             m, d = comp.model, comp.data
             with _CallbacksInstalled(comp.callback, comp.control):
                 comp.set_state(q_eq, np.zeros(n))
@@ -1017,7 +1017,7 @@ class MujocoBackend(Backend):
             extra = {"A_discrete": Ad, "integrator": integrator, "discrete_order": 1}
             method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, centered, "
                       f"eps={eps:g}), ln(lambda)/dt")
-        if plan.closures and s["linearization"] == "transitionFD":
+        if build.closures and s["linearization"] == "transitionFD":
             method += ("; soft closures: the spectrum includes the constraints' own fast "
                        "modes (time constant solref) and the substitute bodies' dofs")
         # order by imaginary then real part: real parts of undamped modes are FD noise

@@ -5,7 +5,7 @@ with `_builds` together with the `Expression`(s) it declares (contract point 5),
 the declaration and the code that builds the element are one thing; `translate` runs the
 builders over the description's elements in order, each adding MJCF fragments (per MJCF
 body: its <body> attributes, joints, <inertial>, sites, contact geoms, slider bodies;
-tendons and equalities) to a `Plan`, and `mjcf` assembles them. Body frames and joint
+tendons and equalities) to a `Build`, and `mjcf` assembles them. Body frames and joint
 anchors come from `plan.body_states` at the reference configuration (every engine joint
 value 0); engine joint values relate to the description coordinates by
 `plan.CoordinateMap`.
@@ -160,10 +160,11 @@ POINT_MASS_INERTIA_FLOOR = 1e-14
 
 
 @dataclass
-class Plan:
-    """A numeric mechanism translated to MuJoCo terms: the MJCF fragments each element's
-    builder adds (per MJCF body: the <body> attributes, joints, <inertial>, sites, contact
-    geoms, slider bodies) and what the callbacks and the read-outs need."""
+class Build:
+    """The MJCF build of a numeric mechanism: the fragments each element's builder adds
+    (per MJCF body: the <body> attributes, joints, <inertial>, sites, contact geoms, slider
+    bodies; the tendons and equalities) and what the callbacks and the read-outs need. Its
+    numbers come from the shared plan (`plan.CoordinateMap`, `plan.body_states`)."""
 
     mech: Mechanism
     cmap: CoordinateMap  # description coordinates q <-> engine joint values v
@@ -248,13 +249,13 @@ class Plan:
 
 # --- element builders, each registered with its declared expression (contract point 5) --
 
-_BUILDERS: dict[str, Callable[[Plan, object], None]] = {}
+_BUILDERS: dict[str, Callable[[Build, object], None]] = {}
 _EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
 
 
 def _builds(kind: str, *cases: Expression):
     """Register the builder of one element kind together with the expression(s) it builds."""
-    def register(builder: Callable[[Plan, object], None]):
+    def register(builder: Callable[[Build, object], None]):
         _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
         return builder
     return register
@@ -290,19 +291,19 @@ def _foldable(mech: Mechanism) -> set[str]:
                when="mass > 0, inertia 0", applies=point_mass),
     Expression(UNSUPPORTED, "MuJoCo rejects moving bodies with zero mass",
                when="mass 0, inertia > 0"))
-def _body(plan: Plan, body) -> None:
-    plan.add_frame(body.name)
+def _body(build: Build, body) -> None:
+    build.add_frame(body.name)
     mass, inertia = num(body.mass), num(body.inertia)
-    if plan.mech.spatial:
+    if build.mech.spatial:
         I = np.array(inertia_matrix(body).tolist(), dtype=float)
-        plan.inertial[body.name] = (
+        build.inertial[body.name] = (
             f'<inertial pos="0 0 0" mass="{fmt(mass)}" fullinertia="'
             f'{fmt(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])}"/>')
         return
     if inertia == 0:  # a point mass: above MuJoCo's mjMINVAL (1e-15) whatever the mass
-        radius = float(plan.settings["point_mass_gyration"])
+        radius = float(build.settings["point_mass_gyration"])
         inertia = max(mass * radius**2, POINT_MASS_INERTIA_FLOOR)
-    plan.add_inertial(body.name, mass, (0.0, 0.0), inertia)
+    build.add_inertial(body.name, mass, (0.0, 0.0), inertia)
 
 
 @_builds(
@@ -317,53 +318,53 @@ def _body(plan: Plan, body) -> None:
                            "constraint or a point force loads it), weight cancelled: "
                            "MuJoCo rejects massless moving bodies",
                when="several child joints, or loaded by a constraint or point force"))
-def _massless_body(plan: Plan, body) -> None:
-    if body.name in plan.foldable:
+def _massless_body(build: Build, body) -> None:
+    if body.name in build.foldable:
         return
     # a pure kinematic link (several children, no constraint or point force on it)
     # carries no load of its own and can be very light; a massless body that a
     # constraint or a point force loads must be heavier, because MuJoCo's soft
     # constraints scale their stiffness with the mass they move
-    loaded = body.name in _point_loaded_bodies(plan.mech)
+    loaded = body.name in _point_loaded_bodies(build.mech)
     key = "massless_mass_ratio" if loaded else "link_mass_ratio"
-    mass = float(plan.settings[key]) * plan.m_min
-    plan.substitutes[body.name] = (mass, mass * GYRATION**2)
-    plan.add_frame(body.name, gravcomp=True)
-    plan.add_inertial(body.name, mass, (0.0, 0.0), mass * GYRATION**2)
+    mass = float(build.settings[key]) * build.m_min
+    build.substitutes[body.name] = (mass, mass * GYRATION**2)
+    build.add_frame(body.name, gravcomp=True)
+    build.add_inertial(body.name, mass, (0.0, 0.0), mass * GYRATION**2)
 
 
 @_builds(REVOLUTE, Expression(EXACT, "hinge about z on the relative angle (absolute and "
                                      "clockwise coordinates through v = A q + b)"))
-def _revolute(plan: Plan, joint) -> None:
-    i, body = plan.mech.joints.index(joint), plan.carrier[joint.child]
-    if plan.mech.spatial:  # about the description's axis at child_anchor
+def _revolute(build: Build, joint) -> None:
+    i, body = build.mech.joints.index(joint), build.carrier[joint.child]
+    if build.mech.spatial:  # about the description's axis at child_anchor
         axis = [num(v) for v in (joint.axis if joint.axis is not None else (0, 0, 1))]
         pos = [num(v) for v in joint.child_anchor] + [0.0] * (3 - len(joint.child_anchor))
     else:
         axis = (0, 0, 1)
-        loc = plan.local(body, plan.anchor(joint) - np.array(plan.frames[body][:2]))
+        loc = build.local(body, build.anchor(joint) - np.array(build.frames[body][:2]))
         pos = (loc[0], loc[1], 0)
-    plan.joints.setdefault(body, []).append(_Joint(joint.name, "hinge", axis, pos, i))
+    build.joints.setdefault(body, []).append(_Joint(joint.name, "hinge", axis, pos, i))
 
 
 @_builds(PRISMATIC, Expression(EXACT, "slide joint in the x-y plane (limits are admissible "
                                       "intervals, not stops)"))
-def _prismatic(plan: Plan, joint) -> None:
-    i, body = plan.mech.joints.index(joint), plan.carrier[joint.child]
+def _prismatic(build: Build, joint) -> None:
+    i, body = build.mech.joints.index(joint), build.carrier[joint.child]
     axis = [num(v) for v in joint.axis] + [0.0] * (3 - len(joint.axis))
-    if not plan.mech.spatial:  # the axis turns with the parent
-        world = rot(plan.frames[joint.parent][2]) @ np.array(axis[:2])
-        ax = plan.local(body, world)
+    if not build.mech.spatial:  # the axis turns with the parent
+        world = rot(build.frames[joint.parent][2]) @ np.array(axis[:2])
+        ax = build.local(body, world)
         axis = (ax[0], ax[1], 0)
-    plan.joints.setdefault(body, []).append(_Joint(joint.name, "slide", axis, None, i))
+    build.joints.setdefault(body, []).append(_Joint(joint.name, "slide", axis, None, i))
 
 
-def _point_to_point(plan: Plan, f: PointToPoint) -> None:
+def _point_to_point(build: Build, f: PointToPoint) -> None:
     """A spatial tendon between two sites; a law linear in LENGTH and LENGTH_RATE that
     MuJoCo's tendon spring (stiffness >= 0, free length >= 0) and damper can hold is
     native, any other the passive callback's."""
     law = ForceLaw.of(f)
-    lin = law.linear if plan.native else None
+    lin = law.linear if build.native else None
     spec = None
     if lin is not None:
         a, k, c = lin
@@ -371,28 +372,28 @@ def _point_to_point(plan: Plan, f: PointToPoint) -> None:
             spec = (k, -a / k + 0.0, c)
         elif k == 0 and a == 0 and c >= 0:
             spec = (0.0, 0.0, c)
-    plan.p2p.append(_P2P(f, f.name, spec, law.law))
+    build.p2p.append(_P2P(f, f.name, spec, law.law))
     for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
-        plan.sites.setdefault(body, []).append(_site(f"{f.name}:{tag}", point))
+        build.sites.setdefault(body, []).append(_site(f"{f.name}:{tag}", point))
 
 
-def _coordinate_force(plan: Plan, f: CoordinateForce) -> None:
+def _coordinate_force(build: Build, f: CoordinateForce) -> None:
     """Joint stiffness/springref/damping where the law is linear and its argument is one
     engine joint value (`CoordinateMap.law_target`), otherwise the passive callback."""
-    law, weights = ForceLaw.of(f), f.weights(plan.mech.coordinates)
-    row = sum(sign * plan.cmap.T[k] for k, sign in weights.items())
+    law, weights = ForceLaw.of(f), f.weights(build.mech.coordinates)
+    row = sum(sign * build.cmap.T[k] for k, sign in weights.items())
     row = np.where(np.abs(row) < 1e-12, 0.0, row)
-    j = plan.mech.coordinates.index(f.coordinate)
-    lin = law.linear if plan.native else None
-    target = plan.cmap.law_target(weights)
+    j = build.mech.coordinates.index(f.coordinate)
+    lin = law.linear if build.native else None
+    target = build.cmap.law_target(weights)
     spec = None
     if lin is not None and target is not None:
         j, r = target  # COORD = r v_j: F(COORD) on COORD is r F(r v_j) on v_j
         a, kq, cq = lin
         spec = (a * r, kq * r * r, cq * r * r)
-        acc = plan.joint_native.setdefault(j, [0.0, 0.0, 0.0])
+        acc = build.joint_native.setdefault(j, [0.0, 0.0, 0.0])
         acc[:] = [acc[0] + spec[0], acc[1] + spec[1], acc[2] + spec[2]]
-    plan.coord.append(_Coord(f, j, spec, law.law, row))
+    build.coord.append(_Coord(f, j, spec, law.law, row))
 
 
 _builds(
@@ -413,22 +414,22 @@ _FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
 
 @_builds(TIME_LOAD, Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
                                       "stage time"))
-def _time_load(plan: Plan, f) -> None:
-    if not plan.autonomous:  # a linearization leaves time loads out
-        _FORCES[type(f)](plan, f)
+def _time_load(build: Build, f) -> None:
+    if not build.autonomous:  # a linearization leaves time loads out
+        _FORCES[type(f)](build, f)
 
 
 @_builds(POINT_ON_POINT, Expression(SOFT, "connect equality between two sites",
                                     expected_failures=SOFT_EQUALITY_METRICS,
                                     reason=SOFT_EQUALITY))
-def _point_on_point(plan: Plan, c: PointOnPoint) -> None:
-    plan.closures.append(Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
+def _point_on_point(build: Build, c: PointOnPoint) -> None:
+    build.closures.append(Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
     for site, body, point in ((f"{c.name}:a", c.body_a, c.point_a),
                               (f"{c.name}:b", c.body_b, c.point_b)):
-        plan.sites.setdefault(body, []).append(_site(site, point))
+        build.sites.setdefault(body, []).append(_site(site, point))
 
 
-def _slider_masses(plan: Plan, pin_body: str) -> None:
+def _slider_masses(build: Build, pin_body: str) -> None:
     """The sliders' masses of the slots whose pin is on `pin_body`. The slider follows the
     pin point, so its mass is taken out of the pin body (mass, centre of mass and inertia
     adjusted so that body + slider have the description's mass, first and second moments:
@@ -438,19 +439,19 @@ def _slider_masses(plan: Plan, pin_body: str) -> None:
     makes the row along the slot dominate and soften the row across it). A slider on a
     fixed pin does not move: its weight is cancelled (gravcomp) and its mass is a fraction
     of the slot body's; a massless pin's substitute carries its sliders."""
-    mech = plan.mech
-    ratio = float(plan.settings["slider_mass_ratio"])
+    mech = build.mech
+    ratio = float(build.settings["slider_mass_ratio"])
     cons = [c for c in mech.constraints
             if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
     if pin_body == WORLD:
         for c in cons:
             lb = c.line_body
             heavy = lb != WORLD and not mech.body(lb).massless
-            plan.slider_mass[c.name] = ratio * (num(mech.body(lb).mass) if heavy else plan.m_min)
+            build.slider_mass[c.name] = ratio * (num(mech.body(lb).mass) if heavy else build.m_min)
         return
-    if pin_body in plan.substitutes:
+    if pin_body in build.substitutes:
         for c in cons:
-            plan.slider_mass[c.name] = ratio * plan.substitutes[pin_body][0]
+            build.slider_mass[c.name] = ratio * build.substitutes[pin_body][0]
         return
     body = mech.body(pin_body)
     pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
@@ -458,12 +459,12 @@ def _slider_masses(plan: Plan, pin_body: str) -> None:
     # the largest point masses at the pins that leave a positive inertia
     bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
     masses = [ratio * bound for _ in cons]
-    plan.slider_mass.update({c.name: mc for c, mc in zip(cons, masses)})
+    build.slider_mass.update({c.name: mc for c, mc in zip(cons, masses)})
     rest = mp - sum(masses)
     com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
     inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
                - rest * float(com @ com))
-    plan.add_inertial(pin_body, rest, (float(com[0]), float(com[1])), inertia)
+    build.add_inertial(pin_body, rest, (float(com[0]), float(com[1])), inertia)
 
 
 @_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
@@ -473,21 +474,21 @@ def _slider_masses(plan: Plan, pin_body: str) -> None:
                                                "holds); the connect is soft",
                                    expected_failures=SOFT_EQUALITY_METRICS,
                                    reason=SOFT_EQUALITY))
-def _point_on_line(plan: Plan, c: PointOnLine) -> None:
-    if c.name not in plan.slider_mass:
-        _slider_masses(plan, c.body)
-    mass = plan.slider_mass[c.name]
+def _point_on_line(build: Build, c: PointOnLine) -> None:
+    if c.name not in build.slider_mass:
+        _slider_masses(build, c.body)
+    mass = build.slider_mass[c.name]
     inertia = mass * SLIDER_GYRATION**2
     cl = Closure(c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider")
-    plan.closures.append(cl)
-    plan.sites.setdefault(c.body, []).append(_site(cl.site1, c.point))
-    gravcomp = (c.body == WORLD or c.body in plan.substitutes) and plan.gravcomp
+    build.closures.append(cl)
+    build.sites.setdefault(c.body, []).append(_site(cl.site1, c.point))
+    gravcomp = (c.body == WORLD or c.body in build.substitutes) and build.gravcomp
     dr = [num(v) for v in c.direction]
     # the slot body's MJCF frame is its description frame (slot bodies are never folded):
     # the slider starts at line_point, its joint value is the distance along the unit
     # slot direction
-    parent = WORLD if c.line_body == WORLD else plan.carrier[c.line_body]
-    plan.sliders.setdefault(parent, []).append([
+    parent = WORLD if c.line_body == WORLD else build.carrier[c.line_body]
+    build.sliders.setdefault(parent, []).append([
         f'<body name="{cl.slider}" pos="{_xyz(c.line_point)}"'
         + (' gravcomp="1">' if gravcomp else ">"),
         f'  <joint name="{cl.slider}" type="slide" axis="{fmt(dr[0], dr[1], 0)}"/>',
@@ -502,8 +503,8 @@ def _point_on_line(plan: Plan, c: PointOnLine) -> None:
                                            "relation; soft like every equality)",
                                      expected_failures=SOFT_EQUALITY_METRICS,
                                      reason=SOFT_EQUALITY))
-def _linear_coupling(plan: Plan, c) -> None:
-    plan.closures.append(plan.coupling(c, "tendon"))
+def _linear_coupling(build: Build, c) -> None:
+    build.closures.append(build.coupling(c, "tendon"))
 
 
 def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict:
@@ -526,16 +527,16 @@ def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict
                                                  "generalized force on the disc's coordinate "
                                                  "over its coefficient, its violation the "
                                                  "slip; linearize uses the coupling"))
-def _rolling_contact(plan: Plan, c: RollingContact) -> None:
-    mech, s = plan.mech, plan.settings
-    geo = _contact_geometry(mech, c, plan.foldable)
-    cl = plan.coupling(c, "contact", slider=f"{c.name}:radial", contact=geo)
-    plan.closures.append(cl)
+def _rolling_contact(build: Build, c: RollingContact) -> None:
+    mech, s = build.mech, build.settings
+    geo = _contact_geometry(mech, c, build.foldable)
+    cl = build.coupling(c, "contact", slider=f"{c.name}:radial", contact=geo)
+    build.closures.append(cl)
     params = (f' condim="3" friction="{fmt(s["contact_friction"], 0, 0)}" solref="'
-              f'{fmt(float(s["contact_timeconst_steps"]) * plan.dt, s["contact_dampratio"])}"'
+              f'{fmt(float(s["contact_timeconst_steps"]) * build.dt, s["contact_dampratio"])}"'
               f' solimp="{fmt(*s["contact_solimp"])}"')
-    disc = plan.carrier[geo["disc"]]
-    plan.geoms.setdefault(disc, []).append(
+    disc = build.carrier[geo["disc"]]
+    build.geoms.setdefault(disc, []).append(
         f'<geom name="{c.name}:disc" type="sphere" size="{fmt(geo["r"])}" '
         f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
         f'conaffinity="0"{params}/>')
@@ -546,15 +547,15 @@ def _rolling_contact(plan: Plan, c: RollingContact) -> None:
     for k in range(nseg):
         a = 2 * math.pi * k / nseg
         x, y = cx + (R + t / 2) * math.cos(a), cy + (R + t / 2) * math.sin(a)
-        plan.geoms.setdefault(plan.carrier[geo["track"]], []).append(
+        build.geoms.setdefault(build.carrier[geo["track"]], []).append(
             f'<geom type="box" size="{fmt(t / 2, half, 2 * geo["r"])}" '
             f'pos="{fmt(x, y, 0)}" quat="{fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '
             f'contype="0" conaffinity="2"{params}/>')
     # the arm's length is freed: the contact's normal force replaces it (a slide right
     # after the arm's hinge, along the arm)
-    anchor, hub = (plan.anchor(mech.joint(geo[k])) for k in ("arm_joint", "disc_joint"))
-    u = plan.local(disc, (hub - anchor) / np.linalg.norm(hub - anchor))
-    joints = plan.joints[disc]
+    anchor, hub = (build.anchor(mech.joint(geo[k])) for k in ("arm_joint", "disc_joint"))
+    u = build.local(disc, (hub - anchor) / np.linalg.norm(hub - anchor))
+    joints = build.joints[disc]
     at = next(k for k, jt in enumerate(joints) if jt.name == geo["arm_joint"])
     joints.insert(at + 1, _Joint(cl.slider, "slide", (u[0], u[1], 0)))
 
@@ -563,15 +564,15 @@ _builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by a control cal
                                       "(qfrc_applied from mj_solveM, every RK4 stage at "
                                       "the stage time; setting prescribed_motion); the "
                                       "applied force is the actuator force"))(
-    lambda plan, p: None)  # nothing in the MJCF: the backend's control callback imposes it
+    lambda build, p: None)  # nothing in the MJCF: the backend's control callback imposes it
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
 EXPRESSIONS = {kind: _EXPRESSIONS[kind] for kind in ELEMENT_KINDS if kind in _EXPRESSIONS}
 
 
 def translate(mech: Mechanism, settings: dict, autonomous: bool = False,
-          dt: float | None = None) -> Plan:
-    """The plan of a numeric mechanism under the (resolved) settings; `autonomous`
+          dt: float | None = None) -> Build:
+    """The build of a numeric mechanism under the (resolved) settings; `autonomous`
     leaves the time loads out; `dt`: the step the file is written for."""
     cmap = coordinate_map(mech)
     foldable = _foldable(mech)
@@ -589,19 +590,19 @@ def translate(mech: Mechanism, settings: dict, autonomous: bool = False,
                  else carrier[mech.joints[chain[0]].parent] for name, chain in chains.items()}
     # the reference configuration of the MJCF: every engine joint value 0
     frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
-    plan = Plan(mech, cmap, carrier, chains, mj_parent, settings, dt or 0.002,
+    build = Build(mech, cmap, carrier, chains, mj_parent, settings, dt or 0.002,
                  bool(settings["native_springs"]), autonomous, foldable, frames)
     for kind, element in elements(mech):
-        _BUILDERS[kind](plan, element)
+        _BUILDERS[kind](build, element)
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
     # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
-    for i, (a, k, c) in plan.joint_native.items():
+    for i, (a, k, c) in build.joint_native.items():
         if not (c <= 0 and (k < 0 or (k == 0 and a == 0))):
-            for e in plan.coord:
+            for e in build.coord:
                 if e.j == i:
                     e.native = None
-    plan.xml = mjcf(plan)
-    return plan
+    build.xml = mjcf(build)
+    return build
 
 
 def _shape_geom(shape) -> str:
@@ -635,16 +636,16 @@ def spatial_reason(mech: Mechanism) -> str:
     return spatial_tree_reason(mech, closures=True, slides=True)
 
 
-def mjcf(plan: Plan) -> str:
-    """The MJCF text of a plan, from the fragments its builders made."""
-    mech = plan.mech
-    native_joint = {e.j for e in plan.coord if e.native is not None}
+def mjcf(build: Build) -> str:
+    """The MJCF text of a build, from the fragments its builders made."""
+    mech = build.mech
+    native_joint = {e.j for e in build.coord if e.native is not None}
 
     def law(i: int | None) -> str:
         """MuJoCo's own spring and damper of the linear law a + k v + c v' on joint i."""
         if i not in native_joint:
             return ""
-        a, k, c = plan.joint_native[i]
+        a, k, c = build.joint_native[i]
         ref = -a / k if k != 0 else 0.0
         return f' stiffness="{fmt(-k)}" springref="{fmt(ref)}" damping="{fmt(-c)}"'
 
@@ -652,15 +653,15 @@ def mjcf(plan: Plan) -> str:
         return [f"{'  ' * depth}{x}" for x in lines]
 
     def body_xml(name: str, depth: int) -> list[str]:
-        lines = [f"<body {plan.heads[name]}>"]
-        lines += indent(1, [jt.xml(law(jt.law)) for jt in plan.joints[name]])
-        lines += indent(1, [plan.inertial[name]]
+        lines = [f"<body {build.heads[name]}>"]
+        lines += indent(1, [jt.xml(law(jt.law)) for jt in build.joints[name]])
+        lines += indent(1, [build.inertial[name]]
                         + [g for g in map(_shape_geom, mech.body(name).shapes) if g]
-                        + plan.geoms.get(name, []) + plan.sites.get(name, []))
-        for child in plan.chains:
-            if plan.mj_parent[child] == name:
+                        + build.geoms.get(name, []) + build.sites.get(name, []))
+        for child in build.chains:
+            if build.mj_parent[child] == name:
                 lines += indent(1, body_xml(child, 0))
-        for slider in plan.sliders.get(name, []):
+        for slider in build.sliders.get(name, []):
             lines += indent(1, slider)
         return indent(depth, lines + ["</body>"])
 
@@ -673,27 +674,27 @@ def mjcf(plan: Plan) -> str:
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
         f'  <option gravity="{fmt(*gravity)}">',
-        ('    <flag contact="disable"/>' if not plan.geoms else
+        ('    <flag contact="disable"/>' if not build.geoms else
          '    <flag contact="enable" filterparent="disable"/>'),
         "  </option>",
         '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
         "  <worldbody>",
     ]
-    out += indent(2, plan.sites.get(WORLD, []))
-    for name in plan.chains:
-        if plan.mj_parent[name] == WORLD:
+    out += indent(2, build.sites.get(WORLD, []))
+    for name in build.chains:
+        if build.mj_parent[name] == WORLD:
             out += body_xml(name, 2)
-    for slider in plan.sliders.get(WORLD, []):
+    for slider in build.sliders.get(WORLD, []):
         out += indent(2, slider)
     out.append("  </worldbody>")
-    couplings = [cl for cl in plan.closures if cl.kind in ("tendon", "contact")]
-    if plan.p2p or couplings:
+    couplings = [cl for cl in build.closures if cl.kind in ("tendon", "contact")]
+    if build.p2p or couplings:
         out.append("  <tendon>")
         for cl in couplings:
             out.append(f'    <fixed name="{cl.element.name}">')
             out += [f'      <joint joint="{jn}" coef="{fmt(w)}"/>' for jn, w in cl.weights.items()]
             out.append("    </fixed>")
-        for e in plan.p2p:
+        for e in build.p2p:
             k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
             out += [f'    <spatial name="{e.tendon}" stiffness="{fmt(k)}" '
                     f'springlength="{fmt(l0, l0)}" damping="{fmt(c)}">',
@@ -701,10 +702,11 @@ def mjcf(plan: Plan) -> str:
                     f'      <site site="{e.element.name}:b"/>',
                     "    </spatial>"]
         out.append("  </tendon>")
-    equalities = [cl for cl in plan.closures if cl.kind != "contact"]
+    equalities = [cl for cl in build.closures if cl.kind != "contact"]
     if equalities:
-        s = plan.settings
-        soft = (f' solref="{fmt(float(s["constraint_timeconst_steps"]) * plan.dt, s["constraint_dampratio"])}"'
+        s = build.settings
+        tau = float(s["constraint_timeconst_steps"]) * build.dt
+        soft = (f' solref="{fmt(tau, s["constraint_dampratio"])}"'
                 f' solimp="{fmt(*s["constraint_solimp"])}"')
         out.append("  <equality>")
         for cl in equalities:
