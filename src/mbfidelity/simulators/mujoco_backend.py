@@ -984,39 +984,34 @@ class MujocoBackend(Backend):
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the
         # continuous-time inverse dynamics do not depend on the integrator)
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
-        if s["linearization"] == "inverseFD" and build.closures:
-            comp = _Compiled(build, integrator, dt)
-            with _CallbacksInstalled(comp.callback, comp.control):
+        comp = _Compiled(build, integrator, dt)
+        m, d = comp.model, comp.data
+        with _CallbacksInstalled(comp.callback, comp.control):
+            if s["linearization"] == "inverseFD" and build.closures:
                 eig, extra = self._constrained_modes(comp, q_eq, eps)
-            method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "
-                      f"central differences, eps={eps:g}) plus the geometric stiffness of "
-                      "the closure forces (equality Jacobian efc_J differentiated, forces "
-                      "from the static balance J^T f = qfrc_bias - qfrc_passive), reduced "
-                      "to the null space of efc_J (exact constraints: MuJoCo's soft "
-                      "regularisation is left out)")
-        elif s["linearization"] == "inverseFD":
-            comp = _Compiled(build, integrator, dt)
-            with _CallbacksInstalled(comp.callback, comp.control):
+                method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "
+                          f"central differences, eps={eps:g}) plus the geometric stiffness "
+                          "of the closure forces (equality Jacobian efc_J differentiated, "
+                          "forces from the static balance J^T f = qfrc_bias - "
+                          "qfrc_passive), reduced to the null space of efc_J (exact "
+                          "constraints: MuJoCo's soft regularisation is left out)")
+            elif s["linearization"] == "inverseFD":
                 K, C, M = comp.inverse_fd(lambda: comp.set_state(q_eq, np.zeros(n)), eps)
-            perm = comp.vadr
-            K, C, M = (X[np.ix_(perm, perm)] for X in (K, C, M))
-            eig = quadratic_eigenvalues(M, C, K)
-            A = build.cmap.A  # v = A q + b: matrices in description coordinates are A^T X A
-            extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
-            method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central differences "
-                      f"of mj_inverse, eps={eps:g})")
-        else:
-            comp = _Compiled(build, integrator, dt)
-            m, d = comp.model, comp.data
-            with _CallbacksInstalled(comp.callback, comp.control):
+                K, C, M = (X[np.ix_(comp.vadr, comp.vadr)] for X in (K, C, M))
+                eig = quadratic_eigenvalues(M, C, K)
+                A = build.cmap.A  # v = A q + b: in description coordinates, A^T X A
+                extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
+                method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central "
+                          f"differences of mj_inverse, eps={eps:g})")
+            else:
                 comp.set_state(q_eq, np.zeros(n))
                 mujoco.mj_forward(m, d)
                 Ad = np.zeros((2 * m.nv + m.na, 2 * m.nv + m.na))
                 mujoco.mjd_transitionFD(m, d, eps, True, Ad, None, None, None)
-            eig = np.log(np.linalg.eigvals(Ad).astype(complex)) / dt
-            extra = {"A_discrete": Ad, "integrator": integrator, "discrete_order": 1}
-            method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, centered, "
-                      f"eps={eps:g}), ln(lambda)/dt")
+                eig = np.log(np.linalg.eigvals(Ad).astype(complex)) / dt
+                extra = {"A_discrete": Ad, "integrator": integrator, "discrete_order": 1}
+                method = (f"mujoco mjd_transitionFD ({integrator} step, dt={dt:g}, "
+                          f"centered, eps={eps:g}), ln(lambda)/dt")
         if build.closures and s["linearization"] == "transitionFD":
             method += ("; soft closures: the spectrum includes the constraints' own fast "
                        "modes (time constant solref) and the substitute bodies' dofs")
