@@ -1,6 +1,8 @@
 """Exudyn backend: the minimal-coordinate route (`ObjectKinematicTree`).
 
-Translation (generic over the description, conventions 1-8 of `systems.model`):
+Translation (generic over the description, conventions 1-8 of `systems.model`). Each
+element kind has one builder, registered with the expressions it declares (`_builds`;
+`EXPRESSIONS` is read from that registry):
 
 - every joint becomes one link of one kinematic tree, in joint order (parents come first);
   `Revolute` -> ``RevoluteZ``, `Prismatic` -> ``PrismaticX`` with the joint frame turned so
@@ -8,11 +10,11 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
   body with orientation ``theta_body + beta`` (beta = 0 for revolute children, the axis
   angle minus the angle offset for prismatic children); the centre of mass is placed in
   that frame, so the description's body frames are reproduced exactly;
-- the engine's joint values ``u`` are relative; description coordinates are the affine map
-  ``q = T u + c`` (absolute revolute angles add the parent's angle, a non-unit prismatic
-  axis scales the slide), generalized forces map with ``T^T``;
+- the engine's joint values ``u`` are relative; description coordinates are the shared
+  affine map ``q = T u + c`` (`plan.CoordinateMap`), generalized forces map with ``T^T``;
 - massless link bodies are kept as zero-mass links (the tree accepts them while the
-  mass matrix stays regular, i.e. while a massive descendant carries the coordinates);
+  mass matrix stays regular, i.e. while a massive descendant carries the coordinates, or
+  while a closure constraint holds them: the augmented matrix [M C^T; C 0] is regular);
 - a spatial mechanism (model convention 10; open trees of massive bodies on relative
   counter-clockwise hinges about a link axis, without offset) gets RevoluteX/Y/Z links
   whose frames sit at the joints, aligned with their parents, with the full 3 x 3
@@ -26,40 +28,25 @@ Translation (generic over the description, conventions 1-8 of `systems.model`):
 - every step is sampled by in-memory sensors (write period dt/2, so each step is recorded
   exactly once), and Exudyn's C++ loop runs without Python stepping;
 - reactions: the tree has no joint-force output, so the force parent -> child is Newton's
-  law on the child's subtree, with the engine's centre-of-mass accelerations (kinematic
-  tree sensors, end-of-step accelerations), minus gravity and minus the element forces
-  that enter the subtree from outside (the engine's connector force, or the law on the
-  owning prismatic joint). The solvers record zero accelerations at t = 0, so that sample
-  uses the engine's mass matrix and right-hand side at the initial state;
+  law on the child's subtree (`reactions`), with the engine's centre-of-mass
+  accelerations (kinematic tree sensors, end-of-step accelerations), minus the element
+  and closure forces that enter the subtree from outside. The solvers record zero
+  accelerations at t = 0, so that sample uses the engine's mass matrix and right-hand
+  side at the initial state (constrained runs: the implicit solver's consistent ones);
 - linearization: `mbs.ComputeLinearizedSystem` (exact M; K and D from Exudyn's
   forward-difference Jacobian, taken at two steps and Richardson-extrapolated), then the
-  first-order eigenproblem with damping (all 2n eigenvalues).
-
-Closure constraints (`PointOnPoint`, `PointOnLine`, `LinearCoupling`) stay on the tree and
-are exact (index-3 algebraic equations, met to round-off):
-
-- PointOnPoint -> ``ObjectJointRevolute2D`` between two rigid markers (tree links through
-  ``MarkerKinematicTreeRigid``, the world through a ground body), marker 0 on body_a; its
-  ``Force`` output is the force on body_a from body_b (world axes);
-- PointOnLine -> ``ObjectJointPrismatic2D`` with ``constrainRotation=False`` (exact pin in
-  slot), marker 0 the pin, marker 1 the slot body with the slot normal in its frame; its
-  ``ForceLocal`` output is the slot's force on the pin in the pin marker's frame, turned to
-  world axes with the pin body's angle;
-- LinearCoupling -> ``ObjectConnectorCoordinateVector`` on the tree node's coordinates
-  (marker 1 a ground node): the description coordinates are affine in the engine's
-  (``q = T u + c``), so sum(coef q) - const = (coef T) u + (coef c - const), the same Phi;
-  its ``Force`` output is the multiplier lam of M u'' + ... + Phi_u^T lam = f, so the
-  coupling's generalized force is -lam;
-- explicit solvers cannot run algebraic equations, so a constrained mechanism runs
-  ``constrained_solver`` (GeneralizedAlpha, rho 0.9, or TrapezoidalIndex2; order 2). A
-  massless subtree is accepted when a closure constraint holds it (the augmented matrix
-  [M C^T; C 0] is then regular although M is not);
-- reactions add the closure forces that enter the child's subtree; the t = 0 sample uses
-  the implicit solver's consistent initial accelerations;
-- linearization on the constraint manifold: the tree's M, K, D as above, Exudyn's
-  constraint Jacobian C, the static multipliers C lam = f from Exudyn's own forces, the
-  constraint stiffness d(C lam)/du by central differences of C, and the null-space
+  first-order eigenproblem with damping (all 2n eigenvalues); with closure constraints on
+  the constraint manifold: Exudyn's constraint Jacobian C, the static multipliers C lam =
+  f, the constraint stiffness d(C lam)/du by central differences of C, and the null-space
   projection of ``ComputeODE2Eigenvalues`` (which alone omits d(C lam)/du).
+
+Closure constraints (`PointOnPoint` -> ``ObjectJointRevolute2D``, `PointOnLine` ->
+``ObjectJointPrismatic2D`` with the rotation free, `LinearCoupling` ->
+``ObjectConnectorCoordinateVector`` on the tree's coordinates) stay on the tree and are
+exact (index-3 algebraic equations, met to round-off); each builder says how its engine
+force maps to the contract's. Explicit solvers cannot run algebraic equations, so a
+constrained mechanism runs ``constrained_solver`` (GeneralizedAlpha, rho 0.9, or
+TrapezoidalIndex2; order 2).
 
 Prescribed motion (convention 9) is an algebraic equation on the tree as well:
 
@@ -86,69 +73,27 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import singledispatch
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (
-    WORLD,
-    CoordinateForce,
-    LinearCoupling,
-    Mechanism,
-    PointOnLine,
-    PointOnPoint,
-    PointToPoint,
-    Revolute,
-    inertia_matrix,
-)
 from ..analytic.linear import quadratic_eigenvalues
 from ..systems._continua import Beam
-from .base import (
-    EXACT,
-    RK3_STABILITY,
-    RK4_STABILITY,
-    SOFT,
-    UNSUPPORTED,
-    Backend,
-    BareLoop,
-    BeamElement,
-    BeamModes,
-    Expression,
-    Linearization,
-    Samples,
-    Scheme,
-    Setting,
-    Stopwatch,
-)
+from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mechanism,
+                             PointOnLine, PointOnPoint, PointToPoint, Prescribed, Prismatic,
+                             Revolute, inertia_matrix)
+from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
+                   BeamElement, BeamModes, Expression, Linearization, Samples, Scheme, Setting,
+                   Stopwatch)
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, LINEAR_COUPLING,
+                   MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT, POINT_TO_POINT_CUSTOM,
+                   POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
+                   TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
+                   constrained_bodies, coordinate_map, driven_start, element_kind,
+                   massive_below, num, rot, spatial_tree_reason)
 from .reactions import joint_reactions, subtree_force
-from .plan import (
-    CoordinateLaws,
-    driven_start,
-    spatial_tree_reason,
-    BODY,
-    PRESCRIBED,
-    COORDINATE_FORCE_CUSTOM,
-    COORDINATE_FORCE_LINEAR,
-    LINEAR_COUPLING,
-    MASSLESS_BODY,
-    POINT_ON_LINE,
-    POINT_ON_POINT,
-    POINT_TO_POINT_CUSTOM,
-    POINT_TO_POINT_LINEAR,
-    PRISMATIC,
-    REVOLUTE,
-    ROLLING_CONTACT,
-    TIME_LOAD,
-    CoordinateMap,
-    ForceLaw,
-    constrained_bodies,
-    coordinate_map,
-    motions,
-    num,
-    rot,
-    massive_below,
-)
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -195,28 +140,33 @@ def _rot3(angle: float) -> np.ndarray:
 
 @dataclass
 class _ClosureItem:
-    """One closure constraint as built in Exudyn, and how its engine force maps to the
-    contract's physical terms."""
+    """One closure constraint as built in Exudyn: its object, the output its sensor reads
+    ("Force" or "ForceLocal"), how that output maps to the contract's physical terms
+    (sensor rows, engine values u -> force), and whether the force acts between two
+    points (a pair force of the reactions) or on the coordinates (a coupling's)."""
 
     name: str
-    kind: str            # "point" (PointOnPoint), "line" (PointOnLine), "coupling"
-    obj: int             # Exudyn object number
-    frame_body: str = WORLD  # "line": the body of marker 0 (ForceLocal is in its frame)
-    row: np.ndarray | None = None    # "coupling": Phi = row . u + offset (engine u)
-    offset: float = 0.0
+    obj: int
+    output: str
+    force: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    pair: bool = True
 
 
 @dataclass
 class _DrivenItem:
     """One prescribed coordinate as built in Exudyn: the ``CoordinateConstraint`` `obj`
-    holding engine coordinate `index` at (q(t) - shift) / scale, where the description
-    coordinate is q = scale u + shift."""
+    holding engine coordinate `motion.index` at (q(t) - shift) / scale, where the
+    description coordinate is q = scale u + shift."""
 
     name: str
     obj: int
-    index: int
+    motion: Motion
     scale: float
     shift: float
+
+    @property
+    def index(self) -> int:
+        return self.motion.index
 
 
 @dataclass
@@ -228,7 +178,7 @@ class _Geometry:
     cmap: CoordinateMap
     link_of: dict[str, int]          # body name -> link index
     parents: list[int]
-    types: list[str]                 # "R" or "P"
+    types: list[str]                 # Exudyn joint type names
     offsets: list[np.ndarray]        # joint offsets (parent link frame), 2-vectors
     rotations: list[float]           # joint frame rotation against the parent link frame
     beta: dict[str, float]           # link frame orientation minus body angle
@@ -274,24 +224,61 @@ def _spatial_reason(mech: Mechanism) -> str:
     return ""
 
 
-def _spatial_tree(mech: Mechanism, exu) -> tuple[list, list, list, list, list]:
-    """(joint types, joint offsets, central tensors, centres of mass, gravity) of a
-    spatial open tree of hinges: each link frame at its joint, aligned with its parent
-    (model convention 10), the body's full 3 x 3 tensor about its centre of mass."""
-    def column(v):
-        return [float(num(c)) for c in v] + [0.0] * (3 - len(v))
+# --- element builders, registered per element kind with their expressions ------------------
 
-    types, offsets, tensors, coms = [], [], [], []
-    com_of = {WORLD: [0.0, 0.0, 0.0]}
-    for j in mech.joints:
-        types.append(getattr(exu.JointType, _AXIS_JOINTS[_hinge_axis(j)]))
-        offsets.append([a + b for a, b in zip(com_of[j.parent], column(j.parent_anchor))])
-        com_of[j.child] = [-c for c in column(j.child_anchor)]
-        coms.append(com_of[j.child])
-        tensors.append(np.array(inertia_matrix(mech.body(j.child)).tolist(), dtype=float))
-    up = np.array(column(mech.up))
-    gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
-    return types, offsets, tensors, coms, gravity
+#: element kind -> (its builder, the expressions it declares: contract point 5). A body's
+#: builder gives its link's mass and central tensor, a joint's its link frame, any other
+#: element's adds its items to the `_System` being built.
+_ELEMENTS: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
+
+
+def _builds(kind: str, *expressions: Expression) -> Callable:
+    """Register the decorated function as the builder of `kind`, with its expressions."""
+    def register(build: Callable) -> Callable:
+        _ELEMENTS[kind] = (build, expressions)
+        return build
+    return register
+
+
+def _builder(element) -> Callable:
+    return _ELEMENTS[element_kind(element)][0]
+
+
+@_builds(BODY, Expression(EXACT, "a link of the ObjectKinematicTree with its mass, centre "
+                                 "of mass and inertia"))
+@_builds(MASSLESS_BODY,
+         Expression(EXACT, "a zero-mass link: the mass matrix stays regular while a massive "
+                           "descendant carries its coordinates, or a closure constraint holds "
+                           "it (augmented matrix [M C^T; C 0])",
+                    when="a massive body below it, or a constraint on its subtree",
+                    applies=lambda mech, body: massive_below(mech, body) or bool(
+                        constrained_bodies(mech) & set(mech.subtree(body.name)))),
+         Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
+                                 "kinematic tree's mass matrix would be singular",
+                    when="only massless bodies below it, none constrained"))
+def _link_inertia(body: Body, mech: Mechanism) -> tuple[float, np.ndarray]:
+    """The link's mass and central tensor (link frame): a spatial body's full 3 x 3
+    tensor, stored as given (`stored_inertia`), a planar body's inertia about z."""
+    if mech.spatial:
+        return num(body.mass), np.array(inertia_matrix(body).tolist(), dtype=float)
+    return num(body.mass), np.diag([0.0, 0.0, num(body.inertia)])
+
+
+@_builds(REVOLUTE, Expression(EXACT, "RevoluteZ link of the kinematic tree (spatial: "
+                                     "RevoluteX, Y or Z)"))
+def _hinge(joint: Revolute, mech: Mechanism) -> tuple[str, float, float]:
+    """(Exudyn joint type, the joint frame's angle in the parent body's frame, the link
+    frame's angle minus the child body's)."""
+    return (_AXIS_JOINTS[_hinge_axis(joint)] if mech.spatial else "RevoluteZ",
+            num(joint.angle_offset), 0.0)
+
+
+@_builds(PRISMATIC, Expression(EXACT, "PrismaticX link, the joint frame turned to the axis"))
+def _slide(joint: Prismatic, mech: Mechanism) -> tuple[str, float, float]:
+    """As `_hinge`: the joint frame's x axis along the slide."""
+    axis = np.array([num(v) for v in joint.axis])
+    alpha = math.atan2(axis[1], axis[0])
+    return "PrismaticX", alpha, alpha - num(joint.angle_offset)
 
 
 def _geometry(mech: Mechanism) -> _Geometry:
@@ -302,29 +289,345 @@ def _geometry(mech: Mechanism) -> _Geometry:
     rotations: list[float] = []
     beta: dict[str, float] = {WORLD: 0.0}
     com: dict[str, np.ndarray] = {WORLD: np.zeros(2)}
-    cmap = coordinate_map(mech)
     for i, j in enumerate(mech.joints):
         p = j.parent
         parents.append(link_of[p] if p != WORLD else -1)
         link_of[j.child] = i
-        # in-plane components (a spatial tree's 3-D ones: `_spatial_tree`)
+        # in-plane components (a spatial tree's 3-D ones: `_spatial_frames`)
         parent_anchor = np.array([num(v) for v in j.parent_anchor][:2])
         child_anchor = np.array([num(v) for v in j.child_anchor][:2])
-        offset = num(j.angle_offset)
         # the joint point in the parent's link frame
         offsets.append(com[p] + rot(-beta[p]) @ parent_anchor)
-        if isinstance(j, Revolute):
-            types.append("R")
-            rotations.append(offset - beta[p])
-            beta[j.child] = 0.0
-        else:
-            types.append("P")
-            axis = np.array([num(v) for v in j.axis])
-            alpha = math.atan2(axis[1], axis[0])
-            rotations.append(alpha - beta[p])
-            beta[j.child] = alpha - offset
+        joint_type, angle, beta[j.child] = _builder(j)(j, mech)
+        types.append(joint_type)
+        rotations.append(angle - beta[p])
         com[j.child] = -rot(-beta[j.child]) @ child_anchor
-    return _Geometry(cmap, link_of, parents, types, offsets, rotations, beta, com)
+    return _Geometry(coordinate_map(mech), link_of, parents, types, offsets, rotations,
+                     beta, com)
+
+
+def _spatial_frames(mech: Mechanism) -> tuple[list, list, list]:
+    """(joint offsets, centres of mass, gravity) of a spatial open tree of hinges: each
+    link frame at its joint, aligned with its parent (model convention 10)."""
+    def column(v):
+        return [float(num(c)) for c in v] + [0.0] * (3 - len(v))
+
+    offsets, coms = [], []
+    com_of = {WORLD: [0.0, 0.0, 0.0]}
+    for j in mech.joints:
+        offsets.append([a + b for a, b in zip(com_of[j.parent], column(j.parent_anchor))])
+        com_of[j.child] = [-c for c in column(j.child_anchor)]
+        coms.append(com_of[j.child])
+    up = np.array(column(mech.up))
+    gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
+    return offsets, coms, gravity
+
+
+def _tree_links(mech: Mechanism, geo: _Geometry, exu) -> dict:
+    """The ``ObjectKinematicTree`` arguments that describe its links: planar links with
+    the frames of `geo`, or a spatial tree's (`_spatial_frames`; `_spatial_reason` bounds
+    the cases)."""
+    bodies = [mech.body(j.child) for j in mech.joints]
+    masses, tensors = zip(*(_builder(b)(b, mech) for b in bodies))
+    if mech.spatial:
+        offsets, coms, gravity = _spatial_frames(mech)
+        transformations = [np.eye(3)] * geo.n
+    else:
+        offsets = [[*o, 0.0] for o in geo.offsets]
+        coms = [[*geo.com[b.name], 0.0] for b in bodies]
+        transformations = [_rot3(a) for a in geo.rotations]
+        gravity = [0.0, -num(mech.gravity), 0.0]
+    return dict(gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
+                jointTypes=[getattr(exu.JointType, t) for t in geo.types],
+                linkParents=geo.parents,
+                jointTransformations=exu.Matrix3DList(transformations),
+                jointOffsets=exu.Vector3DList(offsets),
+                linkInertiasCOM=exu.Matrix3DList(list(tensors)),
+                linkCOMs=exu.Vector3DList(coms), linkMasses=list(masses))
+
+
+@dataclass
+class _System:
+    """The Exudyn system of one mechanism as the builders add to it: the engine and its
+    item classes, the system container (it owns `mbs`: it stays referenced while `mbs` is
+    used), the tree node and object, the tree's coordinate-force terms (set on the tree
+    once every element is built: `set_tree_forces`), and the connectors, closures and
+    prescribed coordinates built."""
+
+    exu: object
+    items: object
+    SC: object
+    mbs: object
+    mech: Mechanism
+    geo: _Geometry
+    cfg: dict
+    node: int = -1
+    tree: int = -1
+    P: np.ndarray = None
+    D: np.ndarray = None
+    force: np.ndarray = None
+    python_laws: list = field(default_factory=list)
+    connectors: dict[str, int] = field(default_factory=dict)
+    closures: list[_ClosureItem] = field(default_factory=list)
+    driven: list[_DrivenItem] = field(default_factory=list)
+    shared: dict[str, object] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.P, self.D, self.force = (np.zeros(self.geo.n) for _ in range(3))
+
+    def once(self, key: str, make: Callable[[], object]) -> object:
+        """An item several elements share (the ground, its markers), made at first use."""
+        if key not in self.shared:
+            self.shared[key] = make()
+        return self.shared[key]
+
+    def ground_node(self) -> int:
+        return self.once("ground node", lambda: self.mbs.AddNode(self.items.NodePointGround()))
+
+    def marker(self, body: str, point, rigid: bool = False) -> int:
+        """A marker at a body-frame point: on a tree link, or on the ground body (a rigid
+        marker where a joint needs its orientation)."""
+        pt = [num(v) for v in point]
+        if body == WORLD:
+            ground = self.once("ground", lambda: self.mbs.AddObject(self.items.ObjectGround()))
+            kind = self.items.MarkerBodyRigid if rigid else self.items.MarkerBodyPosition
+            return self.mbs.AddMarker(kind(bodyNumber=ground, localPosition=[*pt, 0.0]))
+        return self.mbs.AddMarker(self.items.MarkerKinematicTreeRigid(
+            objectNumber=self.tree, linkNumber=self.geo.link_of[body],
+            localPosition=[*self.geo.local_point(body, pt), 0.0]))
+
+    def native(self, element) -> tuple[float, float, float] | None:
+        """The element's affine law where the engine's own terms carry it (setting
+        native_linear_laws), None where a user function does."""
+        return ForceLaw.of(element).linear if self.cfg["native_linear_laws"] else None
+
+    def set_tree_forces(self) -> None:
+        """The coordinate-force terms the builders collected, set on the tree: PD terms
+        and joint forces (C++), one Python ``forceUserFunction`` for the other laws."""
+        n = self.geo.n
+        terms: dict[str, object] = {}
+        if np.any(self.P) or np.any(self.D):
+            terms.update(jointPControlVector=self.P.tolist(),
+                         jointDControlVector=self.D.tolist(),
+                         jointPositionOffsetVector=[0.0] * n,
+                         jointVelocityOffsetVector=[0.0] * n)
+        if np.any(self.force):
+            terms.update(jointForceVector=self.force.tolist())
+        if self.python_laws:
+            terms.update(forceUserFunction=_coordinate_user_function(
+                self.geo, CoordinateLaws(self.mech, self.python_laws)))
+        for key, value in terms.items():
+            self.mbs.SetObjectParameter(self.tree, key, value)
+
+    def sensor(self, kind: str, **arguments) -> int:
+        """An in-memory sensor of `kind` (SensorNode, SensorObject, ...)."""
+        return self.mbs.AddSensor(getattr(self.items, kind)(
+            storeInternal=True, writeToFile=False, **arguments))
+
+    def stored(self, sensor: int) -> np.ndarray:
+        """A sensor's samples: rows (t, values...)."""
+        return np.asarray(self.mbs.GetSensorStoredData(sensor))
+
+
+def _spring_damper(f: PointToPoint, system: _System, **law) -> None:
+    """An ``ObjectConnectorSpringDamper`` between the element's points, reference length
+    0 (its deltaL is the length itself), with the given law arguments."""
+    if f.body_a == WORLD and f.body_b == WORLD:
+        return  # acts on nothing
+    markers = [system.marker(f.body_a, f.point_a), system.marker(f.body_b, f.point_b)]
+    system.connectors[f.name] = system.mbs.AddObject(system.items.ObjectConnectorSpringDamper(
+        markerNumbers=markers, referenceLength=0.0, **law))
+
+
+@_builds(TIME_LOAD, Expression(EXACT, "a user function, called at every integrator stage "
+                                      "with the stage time"))
+@_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, "the tree's forceUserFunction, called "
+                                                    "at every integrator stage"))
+@_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, "ObjectConnectorSpringDamper with a "
+                                                  "springForceUserFunction, called at every "
+                                                  "integrator stage"))
+@singledispatch
+def _user_law(element, system: _System) -> None:
+    """A law through a Python user function, called at every integrator stage."""
+    raise TypeError(f"no user-function route for {type(element).__name__}")
+
+
+@_user_law.register
+def _(f: PointToPoint, system: _System) -> None:
+    _spring_damper(f, system, springForceUserFunction=_tension_user_function(
+        ForceLaw.of(f).law))
+
+
+@_user_law.register
+def _(f: CoordinateForce, system: _System) -> None:
+    system.python_laws.append(f)
+
+
+@_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, "ObjectConnectorSpringDamper with its own "
+                                                  "stiffness, damping and force (C++)"))
+def _native_spring_damper(f: PointToPoint, system: _System) -> None:
+    law = system.native(f)
+    if law is None:
+        return _user_law(f, system)
+    b0, bl, bv = law  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
+    _spring_damper(f, system, stiffness=bl, damping=bv, force=b0)
+
+
+@_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, "the tree's PD terms and joint force "
+                                                    "vector (C++) where the coordinate is one "
+                                                    "engine coordinate, otherwise the tree's "
+                                                    "forceUserFunction"))
+def _pd_terms(f: CoordinateForce, system: _System) -> None:
+    law = system.native(f)
+    # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
+    target = system.geo.cmap.law_target(f.weights(system.mech.coordinates))
+    if law is None or target is None:
+        return _user_law(f, system)
+    (j, s), (a0, ax, av) = target, law
+    system.force[j] += s * a0
+    system.P[j] += -s * s * ax
+    system.D[j] += -s * s * av
+
+
+@_builds(POINT_ON_POINT, Expression(EXACT, "ObjectJointRevolute2D: index-3 algebraic "
+                                           "equations, met to round-off"))
+def _revolute_2d(c: PointOnPoint, system: _System) -> None:
+    obj = system.mbs.AddObject(system.items.ObjectJointRevolute2D(markerNumbers=[
+        system.marker(c.body_a, c.point_a, rigid=True),
+        system.marker(c.body_b, c.point_b, rigid=True)]))
+    # its Force: the force on body_a (marker 0) from body_b, world axes
+    system.closures.append(_ClosureItem(c.name, obj, "Force",
+                                        lambda data, u: data[:, 1:3].copy()))
+
+
+@_builds(POINT_ON_LINE, Expression(EXACT, "ObjectJointPrismatic2D with the rotation free: an "
+                                          "exact pin in slot"))
+def _prismatic_2d(c: PointOnLine, system: _System) -> None:
+    geo = system.geo
+    d = np.array([num(v) for v in c.direction])
+    d = d / float(np.hypot(*d))
+    normal_local = rot(-geo.beta[c.line_body]) @ np.array([-d[1], d[0]])  # the slot normal
+    # Exudyn: (p1 - p0) . A1 n1 = 0, p0 the pin, p1 the slot point
+    obj = system.mbs.AddObject(system.items.ObjectJointPrismatic2D(
+        markerNumbers=[system.marker(c.body, c.point, rigid=True),
+                       system.marker(c.line_body, c.line_point, rigid=True)],
+        axisMarker0=[1.0, 0.0, 0.0], normalMarker1=[*normal_local, 0.0],
+        constrainRotation=False))
+
+    def slot_force(data: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """ForceLocal: the slot's force on the pin in the pin marker's frame, turned to
+        world axes."""
+        angle = geo.frame_angle(c.body, u)
+        cos, sin = np.cos(angle), np.sin(angle)
+        fx, fy = data[:, 1], data[:, 2]
+        return np.stack([cos * fx - sin * fy, sin * fx + cos * fy], axis=1)
+
+    system.closures.append(_ClosureItem(c.name, obj, "ForceLocal", slot_force))
+
+
+@_builds(LINEAR_COUPLING, Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
+                                            "coordinates (affine in the description's, so "
+                                            "the coupling stays linear)"))
+def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
+    mbs, items = system.mbs, system.items
+    a = np.zeros(system.geo.n)
+    for name, coef in c.coefficients:
+        a[system.mech.coordinates.index(name)] += num(coef)
+    row, constant = system.geo.cmap.on_engine_values(a, num(c.constant))  # row . u = constant
+    node_marker, ground_marker = system.once("coordinate markers", lambda: (
+        mbs.AddMarker(items.MarkerNodeCoordinates(nodeNumber=system.node)),
+        mbs.AddMarker(items.MarkerNodeCoordinates(nodeNumber=system.ground_node()))))
+    # Exudyn: X1 q1 - X0 q0 - v_off = 0 with q0 = u (marker 0), q1 empty
+    obj = mbs.AddObject(items.ObjectConnectorCoordinateVector(
+        markerNumbers=[node_marker, ground_marker], scalingMarker0=-row.reshape(1, -1),
+        scalingMarker1=np.zeros((1, 0)), offset=[constant]))
+    # its Force is the multiplier, entering as Phi_u^T lam as in the description (Phi
+    # identical): the generalized force is -lam
+    system.closures.append(_ClosureItem(c.name, obj, "Force",
+                                        lambda data, u: -data[:, 1:2].copy(), pair=False))
+
+
+@_builds(
+    PRESCRIBED,
+    Expression(EXACT, "ObjectConnectorCoordinate between a ground coordinate and the "
+                      "joint's engine coordinate, offsetUserFunction(_t) = q(t), q'(t) at the "
+                      "implicit solver's times (driven_solver), started from consistent "
+                      "accelerations; actuator force -multiplier / scale; order 2 "
+                      "(TrapezoidalIndex2) in the coordinates and the force",
+               when="the prescribed coordinate is one engine joint value",
+               applies=lambda mech, prescribed: _engine_coordinate(
+                   coordinate_map(mech).T, mech.coordinates.index(prescribed.coordinate))),
+    Expression(UNSUPPORTED, "an absolute angle on a turning parent is a combination of "
+                            "engine joint values, which Exudyn's coordinate constraint (one "
+                            "coordinate, time offset) cannot hold",
+               when="the prescribed coordinate combines several joint values"))
+def _coordinate_constraint(p: Prescribed, system: _System) -> None:
+    """An ``ObjectConnectorCoordinate`` between a ground coordinate (marker 0) and the
+    tree node's coordinate (marker 1): Exudyn's equation u - 0 - UF(t) = 0 with the offset
+    UF(t) = (q(t) - shift) / scale and its rate UF_t, both evaluated by the solver at its
+    own stage times (the index-2 solver imposes the rate, the index-3 one the position)."""
+    mbs, items, cmap = system.mbs, system.items, system.geo.cmap
+    motion = Motion(p, system.mech.coordinates.index(p.coordinate))
+    k = motion.index
+    scale, shift = float(cmap.T[k, k]), float(cmap.c[k])
+    ground_marker = system.once("ground coordinate", lambda: mbs.AddMarker(
+        items.MarkerNodeCoordinate(nodeNumber=system.ground_node(), coordinate=0)))
+    marker = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=system.node, coordinate=k))
+    obj = mbs.AddObject(items.ObjectConnectorCoordinate(
+        markerNumbers=[ground_marker, marker],
+        offsetUserFunction=_offset_function(motion.position, scale, shift),
+        offsetUserFunction_t=_offset_function(motion.rate, scale, 0.0)))
+    system.driven.append(_DrivenItem(p.name, obj, motion, scale, shift))
+
+
+def _offset_function(f: Callable[[float], float], scale: float, shift: float):
+    def uf(mbs, t, item, offset):
+        return (f(t) - shift) / scale
+    return uf
+
+
+def _tension_user_function(law: Callable[..., float]):
+    def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
+        return law(delta_l, delta_l_t, t)  # referenceLength 0: delta_l is the length
+    return uf
+
+
+def _coordinate_user_function(geo: _Geometry, laws: CoordinateLaws):
+    """The laws' generalized force on the engine coordinates (T^T Q)."""
+    T, c, n = geo.cmap.T, geo.cmap.c, geo.n
+    if np.array_equal(T, np.eye(n)) and not np.any(c):
+        def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
+            return laws.generalized(u, u_t, t)
+        return uf
+
+    def uf_mapped(mbs, t, item, u, u_t):
+        Q = laws.generalized(T @ np.asarray(u) + c, T @ np.asarray(u_t), t)
+        return (T.T @ np.asarray(Q)).tolist()
+    return uf_mapped
+
+
+def _build(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict) -> _System:
+    """The Exudyn system of `mech` started at (q0, qd0): the tree node, the kinematic
+    tree, then every force, closure constraint and prescribed coordinate by its kind's
+    builder, in description order."""
+    import exudyn as exu
+    import exudyn.itemInterface as items
+
+    geo = _geometry(mech)
+    Tinv = np.linalg.inv(geo.cmap.T)
+    u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.cmap.c)
+    ud0 = Tinv @ np.asarray(qd0, dtype=float)
+    SC = exu.SystemContainer()
+    system = _System(exu, items, SC, SC.AddSystem(), mech, geo, cfg)
+    system.node = system.mbs.AddNode(items.NodeGenericODE2(
+        referenceCoordinates=[0.0] * geo.n, initialCoordinates=u0.tolist(),
+        initialCoordinates_t=ud0.tolist(), numberOfODE2Coordinates=geo.n))
+    system.tree = system.mbs.AddObject(items.ObjectKinematicTree(
+        nodeNumber=system.node, **_tree_links(mech, geo, exu)))
+    for element in (*mech.forces, *mech.constraints, *mech.prescribed):
+        _builder(element)(element, system)
+    system.set_tree_forces()
+    return system
 
 
 class ExudynBackend(Backend):
@@ -452,59 +755,10 @@ class ExudynBackend(Backend):
 
     # --- support ---------------------------------------------------------------------------
     EXPRESSIONS = {
-        BODY: (Expression(EXACT, "a link of the ObjectKinematicTree with its mass, centre of "
-                                 "mass and inertia"),),
-        MASSLESS_BODY: (
-            Expression(EXACT, "a zero-mass link: the mass matrix stays regular while a "
-                              "massive descendant carries its coordinates, or a closure "
-                              "constraint holds it (augmented matrix [M C^T; C 0])",
-                       when="a massive body below it, or a constraint on its subtree",
-                       applies=lambda mech, body: massive_below(mech, body) or bool(
-                           constrained_bodies(mech) & set(mech.subtree(body.name)))),
-            Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
-                                    "kinematic tree's mass matrix would be singular",
-                       when="only massless bodies below it, none constrained"),
-        ),
-        REVOLUTE: (Expression(EXACT, "RevoluteZ link of the kinematic tree"),),
-        PRISMATIC: (Expression(EXACT, "PrismaticX link, the joint frame turned to the axis"),),
-        POINT_TO_POINT_LINEAR: (Expression(EXACT, "ObjectConnectorSpringDamper with its own "
-                                                  "stiffness, damping and force (C++)"),),
-        POINT_TO_POINT_CUSTOM: (Expression(EXACT, "ObjectConnectorSpringDamper with a "
-                                                  "springForceUserFunction, called at every "
-                                                  "integrator stage"),),
-        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "the tree's PD terms and joint force "
-                                                    "vector (C++) where the coordinate is one "
-                                                    "engine coordinate, otherwise the tree's "
-                                                    "forceUserFunction"),),
-        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, "the tree's forceUserFunction, called at "
-                                                    "every integrator stage"),),
-        TIME_LOAD: (Expression(EXACT, "a user function, called at every integrator stage "
-                                      "with the stage time"),),
-        POINT_ON_POINT: (Expression(EXACT, "ObjectJointRevolute2D: index-3 algebraic "
-                                           "equations, met to round-off"),),
-        POINT_ON_LINE: (Expression(EXACT, "ObjectJointPrismatic2D with the rotation free: an "
-                                          "exact pin in slot"),),
-        LINEAR_COUPLING: (Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
-                                            "coordinates (affine in the description's, so "
-                                            "the coupling stays linear)"),),
+        **{kind: expressions for kind, (_, expressions) in _ELEMENTS.items()},
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
                                                   "Exudyn holds the rolling coupling exactly "
                                                   "(LinearCoupling)"),),
-        PRESCRIBED: (
-            Expression(EXACT, "ObjectConnectorCoordinate between a ground coordinate and the "
-                              "joint's engine coordinate, offsetUserFunction(_t) = q(t), "
-                              "q'(t) at the implicit solver's times (driven_solver), "
-                              "started from consistent accelerations; actuator force "
-                              "-multiplier / scale; order 2 (TrapezoidalIndex2) in the "
-                              "coordinates and the force",
-                       when="the prescribed coordinate is one engine joint value",
-                       applies=lambda mech, prescribed: _engine_coordinate(
-                           coordinate_map(mech).T, mech.coordinates.index(prescribed.coordinate))),
-            Expression(UNSUPPORTED, "an absolute angle on a turning parent is a combination "
-                                    "of engine joint values, which Exudyn's coordinate "
-                                    "constraint (one coordinate, time offset) cannot hold",
-                       when="the prescribed coordinate combines several joint values"),
-        ),
     }
 
     SPATIAL_REASON = ""
@@ -513,228 +767,34 @@ class ExudynBackend(Backend):
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """The tree's linkInertiasCOM as stored (a full 3 x 3 tensor, not diagonalised),
         in principal form."""
-        cfg = self.resolve_settings(settings)
         zeros = np.zeros(len(mechanism.joints))
-        _, mbs, _, _, tree, _, _ = self._build(mechanism, zeros, zeros, cfg)
-        tensors = np.array(mbs.GetObjectParameter(tree, "linkInertiasCOM"), dtype=float)
-        out = {}
-        for j, tensor in zip(mechanism.joints, tensors.reshape(-1, 3, 3)):
-            values, axes = np.linalg.eigh(tensor)
-            out[j.child] = (values, axes)
-        return out
+        system = _build(mechanism, zeros, zeros, self.resolve_settings(settings))
+        tensors = np.array(system.mbs.GetObjectParameter(system.tree, "linkInertiasCOM"),
+                           dtype=float)
+        return {j.child: np.linalg.eigh(tensor)
+                for j, tensor in zip(mechanism.joints, tensors.reshape(-1, 3, 3))}
 
     def translation_reason(self, mechanism: Mechanism) -> str:
         return _spatial_reason(mechanism) if mechanism.spatial else ""
 
-    # --- model building --------------------------------------------------------------------
-    def _build(self, mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, settings: dict):
-        import exudyn as exu
-        from exudyn.itemInterface import (MarkerBodyPosition, MarkerKinematicTreeRigid,
-                                          NodeGenericODE2, ObjectConnectorSpringDamper,
-                                          ObjectGround, ObjectKinematicTree)
+    # --- model building: the element builders above; the consistent start --------------------
+    def _mass_and_rhs(self, system: _System, explicit: bool) -> tuple[np.ndarray, np.ndarray]:
+        """The engine's mass matrix and ODE2 right-hand side at the initial state, from a
+        solver helper (explicit, or the implicit second-order one)."""
+        exu, mbs = system.exu, system.mbs
+        sim = self._simulation_settings(exu, system.cfg, 1.0, 1)
+        if explicit:
+            sim.timeIntegration.solverType = exu.DynamicSolverType.RK44
+        helper = exu.MainSolverExplicit() if explicit else exu.MainSolverImplicitSecondOrder()
+        helper.InitializeSolver(mbs, sim)
+        helper.ComputeMassMatrix(mbs)
+        mass = np.asarray(helper.GetSystemMassMatrix())
+        helper.ComputeODE2RHS(mbs)
+        rhs = np.asarray(helper.GetSystemResidual())[:len(mass)]
+        helper.FinalizeSolver(mbs, sim)
+        return mass, rhs
 
-        geo = _geometry(mech)
-        n = geo.n
-        Tinv = np.linalg.inv(geo.cmap.T)
-        u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.cmap.c)
-        ud0 = Tinv @ np.asarray(qd0, dtype=float)
-
-        SC = exu.SystemContainer()
-        mbs = SC.AddSystem()
-        node = mbs.AddNode(NodeGenericODE2(referenceCoordinates=[0.0] * n,
-                                           initialCoordinates=u0.tolist(),
-                                           initialCoordinates_t=ud0.tolist(),
-                                           numberOfODE2Coordinates=n))
-        bodies = [j.child for j in mech.joints]
-        joint_types = [exu.JointType.RevoluteZ if t == "R" else exu.JointType.PrismaticX
-                       for t in geo.types]
-        inertias = [np.diag([0.0, 0.0, num(mech.body(b).inertia)]) for b in bodies]
-        coms = [[*geo.com[b], 0.0] for b in bodies]
-        offsets = [[*o, 0.0] for o in geo.offsets]
-        transformations = [_rot3(a) for a in geo.rotations]
-        gravity = [0.0, -num(mech.gravity), 0.0]
-        if mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
-            joint_types, offsets, inertias, coms, gravity = _spatial_tree(mech, exu)
-            transformations = [np.eye(3)] * n
-
-        # coordinate forces: native PD terms where the law is affine and maps to one
-        # engine coordinate, the rest through one Python user function of the tree
-        P = np.zeros(n)
-        D = np.zeros(n)
-        f_const = np.zeros(n)
-        python_laws: list[CoordinateForce] = []
-        for f in mech.forces:
-            if not isinstance(f, CoordinateForce):
-                continue
-            weights = f.weights(mech.coordinates)
-            law = ForceLaw.of(f)
-            aff = law.linear if settings["native_linear_laws"] else None
-            # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
-            target = geo.cmap.law_target(weights)
-            if aff is not None and target is not None:
-                j, s = target
-                a0, ax, av = aff
-                f_const[j] += s * a0
-                P[j] += -s * s * ax
-                D[j] += -s * s * av
-            else:
-                python_laws.append(f)
-
-        tree_args = dict(
-            nodeNumber=node, gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
-            jointTypes=joint_types, linkParents=geo.parents,
-            jointTransformations=exu.Matrix3DList(transformations),
-            jointOffsets=exu.Vector3DList(offsets),
-            linkInertiasCOM=exu.Matrix3DList(inertias), linkCOMs=exu.Vector3DList(coms),
-            linkMasses=[num(mech.body(b).mass) for b in bodies],
-        )
-        if np.any(P) or np.any(D):
-            tree_args.update(jointPControlVector=P.tolist(), jointDControlVector=D.tolist(),
-                             jointPositionOffsetVector=[0.0] * n,
-                             jointVelocityOffsetVector=[0.0] * n)
-        if np.any(f_const):
-            tree_args.update(jointForceVector=f_const.tolist())
-        if python_laws:
-            tree_args.update(forceUserFunction=self._coordinate_user_function(
-                geo, CoordinateLaws(mech, python_laws)))
-        tree = mbs.AddObject(ObjectKinematicTree(**tree_args))
-
-        # point-to-point elements: spring-dampers between markers
-        ground = None
-        connectors: dict[str, object] = {}
-        for f in mech.forces:
-            if not isinstance(f, PointToPoint):
-                continue
-            if f.body_a == WORLD and f.body_b == WORLD:
-                continue  # acts on nothing
-            markers = []
-            for body, point in ((f.body_a, f.point_a), (f.body_b, f.point_b)):
-                pt = [num(v) for v in point]
-                if body == WORLD:
-                    if ground is None:
-                        ground = mbs.AddObject(ObjectGround())
-                    markers.append(mbs.AddMarker(MarkerBodyPosition(
-                        bodyNumber=ground, localPosition=[*pt, 0.0])))
-                else:
-                    markers.append(mbs.AddMarker(MarkerKinematicTreeRigid(
-                        objectNumber=tree, linkNumber=geo.link_of[body],
-                        localPosition=[*geo.local_point(body, pt), 0.0])))
-            law = ForceLaw.of(f)
-            aff = law.linear if settings["native_linear_laws"] else None
-            if aff is not None:
-                b0, bl, bv = aff  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
-                conn = ObjectConnectorSpringDamper(markerNumbers=markers, referenceLength=0.0,
-                                                   stiffness=bl, damping=bv, force=b0)
-            else:
-                # referenceLength 0, so deltaL is the length itself
-                conn = ObjectConnectorSpringDamper(
-                    markerNumbers=markers, referenceLength=0.0,
-                    springForceUserFunction=self._tension_user_function(law.law))
-            connectors[f.name] = mbs.AddObject(conn)
-        return exu, mbs, SC, node, tree, geo, connectors
-
-    @staticmethod
-    def _add_closures(exu, mbs, mech: Mechanism, node: int, tree: int,
-                      geo: _Geometry) -> list[_ClosureItem]:
-        """The closure constraints as exact (index-3) Exudyn constraints on the tree:
-        PointOnPoint -> ``ObjectJointRevolute2D`` (marker 0 on body_a), PointOnLine ->
-        ``ObjectJointPrismatic2D`` with the rotation free (marker 0: the pin, marker 1: the
-        slot body, whose frame carries the slot normal), LinearCoupling ->
-        ``ObjectConnectorCoordinateVector`` on the tree node's coordinates (the description
-        coordinates are affine in the engine's, so the coupling stays linear)."""
-        from exudyn.itemInterface import (MarkerBodyRigid, MarkerKinematicTreeRigid,
-                                          MarkerNodeCoordinates, NodePointGround,
-                                          ObjectConnectorCoordinateVector, ObjectGround,
-                                          ObjectJointPrismatic2D, ObjectJointRevolute2D)
-
-        items: list[_ClosureItem] = []
-        ground: list[int] = []
-
-        def rigid_marker(body: str, point) -> int:
-            pt = [num(v) for v in point]
-            if body == WORLD:
-                if not ground:
-                    ground.append(mbs.AddObject(ObjectGround()))
-                return mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground[0],
-                                                     localPosition=[*pt, 0.0]))
-            return mbs.AddMarker(MarkerKinematicTreeRigid(
-                objectNumber=tree, linkNumber=geo.link_of[body],
-                localPosition=[*geo.local_point(body, pt), 0.0]))
-
-        node_marker = None
-        ground_marker = None
-        for c in mech.constraints:
-            if isinstance(c, PointOnPoint):
-                obj = mbs.AddObject(ObjectJointRevolute2D(markerNumbers=[
-                    rigid_marker(c.body_a, c.point_a), rigid_marker(c.body_b, c.point_b)]))
-                items.append(_ClosureItem(c.name, "point", obj))
-            elif isinstance(c, PointOnLine):
-                d = np.array([num(v) for v in c.direction])
-                d = d / float(np.hypot(*d))
-                normal = np.array([-d[1], d[0]])  # the slot normal of the description
-                normal_local = rot(-geo.beta[c.line_body]) @ normal
-                # Exudyn: (p1 - p0) . A1 n1 = 0, p0 the pin, p1 the slot point
-                obj = mbs.AddObject(ObjectJointPrismatic2D(
-                    markerNumbers=[rigid_marker(c.body, c.point),
-                                   rigid_marker(c.line_body, c.line_point)],
-                    axisMarker0=[1.0, 0.0, 0.0], normalMarker1=[*normal_local, 0.0],
-                    constrainRotation=False))
-                items.append(_ClosureItem(c.name, "line", obj, frame_body=c.body))
-            elif isinstance(c, LinearCoupling):
-                a = np.zeros(geo.n)
-                for name, coef in c.coefficients:
-                    a[mech.coordinates.index(name)] += num(coef)
-                row = a @ geo.cmap.T                      # Phi = row . u + offset
-                offset = float(a @ geo.cmap.c) - num(c.constant)
-                if node_marker is None:
-                    node_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
-                    ground_node = mbs.AddNode(NodePointGround())
-                    ground_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=ground_node))
-                # Exudyn: X1 q1 - X0 q0 - v_off = 0 with q0 = u (marker 0), q1 empty
-                obj = mbs.AddObject(ObjectConnectorCoordinateVector(
-                    markerNumbers=[node_marker, ground_marker],
-                    scalingMarker0=-row.reshape(1, -1), scalingMarker1=np.zeros((1, 0)),
-                    offset=[-offset]))
-                items.append(_ClosureItem(c.name, "coupling", obj, row=row, offset=offset))
-            else:  # pragma: no cover - the Constraint union is closed
-                raise TypeError(c)
-        return items
-
-    @staticmethod
-    def _add_prescribed(mbs, mech: Mechanism, node: int, geo: _Geometry) -> list[_DrivenItem]:
-        """Every prescribed coordinate as an ``ObjectConnectorCoordinate`` between a
-        ground coordinate (marker 0) and the tree node's coordinate (marker 1): Exudyn's
-        equation u - 0 - UF(t) = 0 with the offset UF(t) = (q(t) - shift) / scale and its
-        rate UF_t, both evaluated by the solver at its own stage times (the index-2 solver
-        imposes the rate, the index-3 one the position)."""
-        from exudyn.itemInterface import (MarkerNodeCoordinate, NodePointGround,
-                                          ObjectConnectorCoordinate)
-
-        items: list[_DrivenItem] = []
-        ground_marker = None
-        for motion in motions(mech):
-            p = motion.index
-            scale, shift = float(geo.cmap.T[p, p]), float(geo.cmap.c[p])
-            if ground_marker is None:
-                ground_node = mbs.AddNode(NodePointGround())
-                ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground_node,
-                                                                   coordinate=0))
-            marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=p))
-            obj = mbs.AddObject(ObjectConnectorCoordinate(
-                markerNumbers=[ground_marker, marker],
-                offsetUserFunction=ExudynBackend._offset_function(motion.position, scale, shift),
-                offsetUserFunction_t=ExudynBackend._offset_function(motion.rate, scale, 0.0)))
-            items.append(_DrivenItem(motion.element.name, obj, p, scale, shift))
-        return items
-
-    @staticmethod
-    def _offset_function(f: Callable[[float], float], scale: float, shift: float):
-        def uf(mbs, t, item, offset):
-            return (f(t) - shift) / scale
-        return uf
-
-    def _consistent_start(self, exu, mbs, cfg: dict, mech: Mechanism,
-                          driven: list[_DrivenItem]) -> np.ndarray:
+    def _consistent_start(self, system: _System) -> np.ndarray:
         """Initial accelerations and multipliers that meet the prescribed accelerations
         q''(0). Exudyn's own initial accelerations differentiate the constraints without
         their time terms (its documentation: dg/dt 'not implemented'), i.e. as if q''(0)
@@ -745,49 +805,21 @@ class ExudynBackend(Backend):
         f with C = e_p^T), written into the initial state that the solver starts from
         (computeInitialAccelerations off for driven runs). Returns lam (the solver records
         zero multipliers for the sample at t = 0)."""
-        sim = self._simulation_settings(exu, cfg, 1.0, 1)
-        helper = exu.MainSolverImplicitSecondOrder()
-        helper.InitializeSolver(mbs, sim)
-        helper.ComputeMassMatrix(mbs)
-        mass = np.asarray(helper.GetSystemMassMatrix())
+        mass, rhs = self._mass_and_rhs(system, explicit=False)
         n = len(mass)
-        helper.ComputeODE2RHS(mbs)
-        rhs = np.asarray(helper.GetSystemResidual())[:n]
-        helper.FinalizeSolver(mbs, sim)
-        accelerations = {m.index: m.acceleration(0.0) for m in motions(mech)}
         acc = np.zeros(n)
-        held = [d.index for d in driven]
-        for d in driven:
-            acc[d.index] = accelerations[d.index] / d.scale
+        held = [d.index for d in system.driven]
+        for d in system.driven:
+            acc[d.index] = d.motion.acceleration(0.0) / d.scale
         free = [i for i in range(n) if i not in held]
         if free:
             acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
                                         rhs[free] - mass[np.ix_(free, held)] @ acc[held])
         lam = rhs[held] - (mass @ acc)[held]
-        initial = exu.ConfigurationType.Initial
-        mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
-        mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
+        initial = system.exu.ConfigurationType.Initial
+        system.mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
+        system.mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
         return lam
-
-    @staticmethod
-    def _tension_user_function(law: Callable[..., float]):
-        def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
-            return law(delta_l, delta_l_t, t)  # referenceLength 0: delta_l is the length
-        return uf
-
-    @staticmethod
-    def _coordinate_user_function(geo: _Geometry, laws: CoordinateLaws):
-        """The laws' generalized force on the engine coordinates (T^T Q)."""
-        T, c, n = geo.cmap.T, geo.cmap.c, geo.n
-        if np.array_equal(T, np.eye(n)) and not np.any(c):
-            def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
-                return laws.generalized(u, u_t, t)
-            return uf
-
-        def uf_mapped(mbs, t, item, u, u_t):
-            Q = laws.generalized(T @ np.asarray(u) + c, T @ np.asarray(u_t), t)
-            return (T.T @ np.asarray(Q)).tolist()
-        return uf_mapped
 
     def _simulation_settings(self, exu, settings: dict, t_end: float, steps: int):
         s = exu.SimulationSettings()
@@ -833,26 +865,20 @@ class ExudynBackend(Backend):
         if not support.ok:
             raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
         solver = self._solver_for(mechanism, cfg)
-        q0, qd0 = driven_start(mechanism, q0, qd0)
-        exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
-        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
-        driven = self._add_prescribed(mbs, mechanism, node, geo)
-        data = mbs.systemData
+        system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
+        mbs, data = system.mbs, system.mbs.systemData
         items = [(kind, get(i)) for kind, count, get in (
             ("Node", data.NumberOfNodes(), mbs.GetNode),
             ("Object", data.NumberOfObjects(), mbs.GetObject),
             ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
             ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
-        sim = self._simulation_settings(exu, cfg, 1.0, int(round(1.0 / dt)))
-        sim.timeIntegration.generalizedAlpha.computeInitialAccelerations = not driven
-        if closures or driven:
-            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
-                cfg["constrained_spectral_radius"])
+        sim = self._simulation_settings(system.exu, cfg, 1.0, int(round(1.0 / dt)))
+        self._algebraic_settings(sim, system)
         outside = []
         if mechanism.forces:
             outside.append("the force laws computed in Python user functions: "
                            + ", ".join(f.name for f in mechanism.forces))
-        if driven:
+        if system.driven:
             outside.append("the prescribed motions' offset user functions and the "
                            "consistent start the harness computes: "
                            + ", ".join(p.name for p in mechanism.prescribed))
@@ -860,8 +886,9 @@ class ExudynBackend(Backend):
             title=(f"The mechanism as mbfidelity builds it in Exudyn {self.version()}, from "
                    f"the initial state of scenario {name!r}, solver {solver}.\nBackend "
                    f"settings:\n" + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
-            items=items, simulation=sim.GetDictionary(), solver=solver, node=int(node),
-            coordinates=coordinates, T=geo.cmap.T, c=geo.cmap.c, dt=dt, not_in_script=outside)
+            items=items, simulation=sim.GetDictionary(), solver=solver, node=int(system.node),
+            coordinates=coordinates, T=system.geo.cmap.T, c=system.geo.cmap.c, dt=dt,
+            not_in_script=outside)
         return text, outside
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
@@ -877,80 +904,70 @@ class ExudynBackend(Backend):
                        reaction_joints: tuple[str, ...]) -> Samples:
         solver = self._solver_for(mechanism, cfg)
         t_run = steps * dt
-        q0, qd0 = driven_start(mechanism, q0, qd0)
-        exu, mbs, SC, node, tree, geo, connectors = self._build(mechanism, q0, qd0, cfg)
-        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
-        driven = self._add_prescribed(mbs, mechanism, node, geo)
-        from exudyn.itemInterface import SensorKinematicTree, SensorNode, SensorObject
-
-        ovt = exu.OutputVariableType
-        sens = dict(storeInternal=True, writeToFile=False)
-        s_u = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates, **sens))
-        s_ut = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates_t,
-                                        **sens))
+        system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
+        geo, closures, driven = system.geo, system.closures, system.driven
+        ovt = system.exu.OutputVariableType
+        s_u = system.sensor("SensorNode", nodeNumber=system.node,
+                            outputVariableType=ovt.Coordinates)
+        s_ut = system.sensor("SensorNode", nodeNumber=system.node,
+                             outputVariableType=ovt.Coordinates_t)
         # centre-of-mass accelerations of every massive body below a requested joint
         acc_bodies: set[str] = set()
         for name in reaction_joints:
             joint = mechanism.joint(name)
             acc_bodies |= {b for b in mechanism.subtree(joint.child)
                            if num(mechanism.body(b).mass) != 0}
-        s_acc = {b: mbs.AddSensor(SensorKinematicTree(
-            objectNumber=tree, linkNumber=geo.link_of[b], localPosition=[*geo.com[b], 0.0],
-            outputVariableType=ovt.Acceleration, **sens)) for b in sorted(acc_bodies)}
-        # engine force of every connector that can cross a requested joint
-        s_conn = {name: mbs.AddSensor(SensorObject(objectNumber=obj, outputVariableType=ovt.Force,
-                                                   **sens))
-                  for name, obj in connectors.items()} if reaction_joints else {}
-        # engine force of every closure constraint: the joints' force (world axes, on
-        # marker 0) or, for the prismatic 2-D joint, the force in marker 0's frame; the
-        # coordinate constraint's Lagrange multiplier
-        s_closure = {c.name: mbs.AddSensor(SensorObject(
-            objectNumber=c.obj, outputVariableType=ovt.ForceLocal if c.kind == "line"
-            else ovt.Force, **sens)) for c in closures}
-        # the multiplier of every prescribed coordinate's constraint
-        s_driven = {d.name: mbs.AddSensor(SensorObject(objectNumber=d.obj,
-                                                       outputVariableType=ovt.Force, **sens))
-                    for d in driven}
-        mbs.Assemble()
+        s_acc = {b: system.sensor("SensorKinematicTree", objectNumber=system.tree,
+                                  linkNumber=geo.link_of[b], localPosition=[*geo.com[b], 0.0],
+                                  outputVariableType=ovt.Acceleration)
+                 for b in sorted(acc_bodies)}
+
+        def force_sensor(obj: int, output: str = "Force") -> int:
+            return system.sensor("SensorObject", objectNumber=obj,
+                                 outputVariableType=getattr(ovt, output))
+
+        # engine force of every connector that can cross a requested joint; of every
+        # closure constraint (its item says which output); the multiplier of every
+        # prescribed coordinate's constraint
+        s_conn = ({name: force_sensor(obj) for name, obj in system.connectors.items()}
+                  if reaction_joints else {})
+        s_closure = {c.name: force_sensor(c.obj, c.output) for c in closures}
+        s_driven = {d.name: force_sensor(d.obj) for d in driven}
+        system.mbs.Assemble()
         # constrained and driven runs: the implicit solver's sample at t = 0 holds its
         # consistent initial accelerations (computeInitialAccelerations)
-        acc0 = (self._initial_accelerations(exu, mbs, cfg, s_acc)
+        acc0 = (self._initial_accelerations(system, s_acc)
                 if s_acc and not (closures or driven) else {})
-        lam0 = self._consistent_start(exu, mbs, cfg, mechanism, driven) if driven else None
-        clock = self._solve(exu, mbs, cfg, solver, bool(closures or driven), t_run, steps,
-                            initial_accelerations=not driven)
+        lam0 = self._consistent_start(system) if driven else None
+        clock = self._solve(system, solver, t_run, steps)
 
-        U = np.asarray(mbs.GetSensorStoredData(s_u))
-        Ut = np.asarray(mbs.GetSensorStoredData(s_ut))
+        U, Ut = system.stored(s_u), system.stored(s_ut)
         t = U[:, 0]
         if len(t) != steps + 1 or abs(t[-1] - t_run) > 1e-9 * max(1.0, t_run):
             raise RuntimeError(f"exudyn sensors returned {len(t)} samples, expected {steps + 1}")
         u, ut = U[:, 1:], Ut[:, 1:]
         q, qd = geo.coordinates(u, ut)
 
-        constraint_forces = {
-            c.name: self._closure_force(c, np.asarray(mbs.GetSensorStoredData(s_closure[c.name])),
-                                        geo, u)
-            for c in closures}
+        constraint_forces = {c.name: c.force(system.stored(s_closure[c.name]), u)
+                             for c in closures}
         actuator_forces = {}
         for k, d in enumerate(driven):
-            lam = np.asarray(mbs.GetSensorStoredData(s_driven[d.name]))[:, 1].copy()
+            lam = system.stored(s_driven[d.name])[:, 1].copy()
             lam[0] = lam0[k]  # the solver records zero multipliers at t = 0
-            actuator_forces[d.name] = self._actuator_force(d, lam)
+            # Exudyn adds C_u^T lam = lam e_p to the engine equations: the constraint
+            # pushes engine coordinate p with -lam, -lam / scale on q (virtual work)
+            actuator_forces[d.name] = -lam / d.scale
         reactions: dict[str, np.ndarray] = {}
         if reaction_joints:
-            acc = {b: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3] for b, s in s_acc.items()}
+            acc = {b: system.stored(s)[:, 1:3] for b, s in s_acc.items()}
             for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
                 acc[b][0] = a0
+            # Newton on each subtree: every element force from outside is taken out;
             # Exudyn's connector force is the force on marker 0 (body_a)
-            conn_force = {name: np.asarray(mbs.GetSensorStoredData(s))[:, 1:3]
-                          for name, s in s_conn.items()}
-            # Newton on each subtree: every element force from outside is taken out
             newton = {name: subtree_force(mechanism, name, t, acc) for name in reaction_joints}
-            pairs = {**conn_force, **{c.name: constraint_forces[c.name] for c in closures
-                                      if c.kind != "coupling"}}
-            couplings = {c.name: constraint_forces[c.name] for c in closures
-                         if c.kind == "coupling"}
+            pairs = {**{name: system.stored(s)[:, 1:3] for name, s in s_conn.items()},
+                     **{c.name: constraint_forces[c.name] for c in closures if c.pair}}
+            couplings = {c.name: constraint_forces[c.name] for c in closures if not c.pair}
             reactions = joint_reactions(mechanism, reaction_joints, newton, t, q, qd,
                                         pair_forces=pairs, coupling_forces=couplings)
         return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
@@ -959,43 +976,43 @@ class ExudynBackend(Backend):
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The system of `simulate` without its sensors, solved by the same solver."""
         solver = self._solver_for(mechanism, cfg)
-        # SC owns mbs: it stays referenced until the solve returns
-        q0, qd0 = driven_start(mechanism, q0, qd0)
-        exu, mbs, SC, node, tree, geo, _ = self._build(mechanism, q0, qd0, cfg)
-        closures = self._add_closures(exu, mbs, mechanism, node, tree, geo)
-        driven = self._add_prescribed(mbs, mechanism, node, geo)
-        mbs.Assemble()
-        if driven:
-            self._consistent_start(exu, mbs, cfg, mechanism, driven)
-        clock = self._solve(exu, mbs, cfg, solver, bool(closures or driven), steps * dt,
-                            steps, initial_accelerations=not driven)
-        current = exu.ConfigurationType.Current
-        u = np.asarray(mbs.systemData.GetODE2Coordinates(configuration=current))
-        ut = np.asarray(mbs.systemData.GetODE2Coordinates_t(configuration=current))
-        q, qd = geo.coordinates(u[None, :], ut[None, :])
+        system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
+        system.mbs.Assemble()
+        if system.driven:
+            self._consistent_start(system)
+        clock = self._solve(system, solver, steps * dt, steps)
+        current = system.exu.ConfigurationType.Current
+        data = system.mbs.systemData
+        u = np.asarray(data.GetODE2Coordinates(configuration=current))
+        ut = np.asarray(data.GetODE2Coordinates_t(configuration=current))
+        q, qd = system.geo.coordinates(u[None, :], ut[None, :])
         return BareLoop(clock.cpu, q[0], qd[0])
 
-    def _solve(self, exu, mbs, cfg: dict, solver: str, constrained: bool, t_run: float,
-               steps: int, initial_accelerations: bool = True) -> Stopwatch:
-        """SolveDynamic over `steps` steps of the assembled system, timed.
-        `initial_accelerations` False: the implicit solver starts from the accelerations
-        already in the initial state instead of computing its own."""
+    @staticmethod
+    def _algebraic_settings(sim, system: _System) -> None:
+        """A driven run starts from the consistent accelerations already in its initial
+        state (`_consistent_start`) instead of the implicit solver's own; a run with
+        algebraic equations uses the constrained spectral radius."""
+        ti = sim.timeIntegration
+        ti.generalizedAlpha.computeInitialAccelerations = not system.driven
+        if system.closures or system.driven:
+            ti.generalizedAlpha.spectralRadius = float(system.cfg["constrained_spectral_radius"])
+
+    def _solve(self, system: _System, solver: str, t_run: float, steps: int) -> Stopwatch:
+        """SolveDynamic over `steps` steps of the assembled system, timed."""
         import exudyn.solver as exu_solver
 
-        solver_type = getattr(exu.DynamicSolverType, solver)
-        sim = self._simulation_settings(exu, cfg, t_run, steps)
+        solver_type = getattr(system.exu.DynamicSolverType, solver)
+        sim = self._simulation_settings(system.exu, system.cfg, t_run, steps)
         sim.timeIntegration.solverType = solver_type
-        sim.timeIntegration.generalizedAlpha.computeInitialAccelerations = initial_accelerations
-        if constrained:
-            sim.timeIntegration.generalizedAlpha.spectralRadius = float(
-                cfg["constrained_spectral_radius"])
+        self._algebraic_settings(sim, system)
         # Python user functions allocate on every call; Exudyn then prints a speed hint
         # after the run. The hint is expected here, so it is silenced for this call only.
         threshold = exu_solver.solverCheckMemoryAllocationsThreshold
         exu_solver.solverCheckMemoryAllocationsThreshold = float("inf")
         try:
             with Stopwatch() as clock:
-                mbs.SolveDynamic(sim, solverType=solver_type)
+                system.mbs.SolveDynamic(sim, solverType=solver_type)
             return clock
         finally:
             exu_solver.solverCheckMemoryAllocationsThreshold = threshold
@@ -1018,47 +1035,15 @@ class ExudynBackend(Backend):
                    "prescribed coordinate would not move"))
         return solver
 
-    @staticmethod
-    def _closure_force(item: _ClosureItem, data: np.ndarray, geo: _Geometry,
-                       u: np.ndarray) -> np.ndarray:
-        """The engine's constraint force in the contract's terms (base.py point 6)."""
-        if item.kind == "point":
-            # the revolute 2-D joint's Force: the force on body_a (marker 0) from body_b
-            return data[:, 1:3].copy()
-        if item.kind == "line":
-            # ForceLocal: force of the slot on the pin, in the pin marker's frame
-            ang = geo.frame_angle(item.frame_body, u)
-            c, s = np.cos(ang), np.sin(ang)
-            fx, fy = data[:, 1], data[:, 2]
-            return np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
-        # coordinate constraint: Exudyn's multiplier enters as Phi_u^T lam, as in the
-        # description (Phi identical), so the generalized force is -lam
-        return -data[:, 1:2].copy()
 
-    @staticmethod
-    def _actuator_force(item: _DrivenItem, lam: np.ndarray) -> np.ndarray:
-        """The actuator's generalized force on the description coordinate from the
-        multiplier: Exudyn adds C_u^T lam = lam e_p to the engine equations, so the
-        constraint pushes engine coordinate p with -lam, and q = scale u + shift maps it
-        to -lam / scale on q (virtual work)."""
-        return -lam / item.scale
-
-    def _initial_accelerations(self, exu, mbs, cfg: dict, sensors: dict) -> dict[str, np.ndarray]:
+    def _initial_accelerations(self, system: _System, sensors: dict) -> dict[str, np.ndarray]:
         """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
         right-hand side (the solvers store zero accelerations for the first sample)."""
-        sim = self._simulation_settings(exu, cfg, 1.0, 1)
-        sim.timeIntegration.solverType = exu.DynamicSolverType.RK44
-        helper = exu.MainSolverExplicit()
-        helper.InitializeSolver(mbs, sim)
-        helper.ComputeMassMatrix(mbs)
-        mass = np.asarray(helper.GetSystemMassMatrix())
-        helper.ComputeODE2RHS(mbs)
-        rhs = np.asarray(helper.GetSystemResidual())[:len(mass)]
-        helper.FinalizeSolver(mbs, sim)
-        a0 = np.linalg.solve(mass, rhs)
-        mbs.systemData.SetODE2Coordinates_tt(a0.tolist(),
-                                             configuration=exu.ConfigurationType.Current)
-        return {b: np.asarray(mbs.GetSensorValues(s))[:2] for b, s in sensors.items()}
+        mass, rhs = self._mass_and_rhs(system, explicit=True)
+        system.mbs.systemData.SetODE2Coordinates_tt(
+            np.linalg.solve(mass, rhs).tolist(),
+            configuration=system.exu.ConfigurationType.Current)
+        return {b: np.asarray(system.mbs.GetSensorValues(s))[:2] for b, s in sensors.items()}
 
     # --- linearization ---------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
@@ -1070,14 +1055,13 @@ class ExudynBackend(Backend):
         if not support.ok or mechanism.prescribed:
             return None
         q_eq = np.asarray(q_eq, dtype=float)
-        if mechanism.constraints:
-            return self._linearize_constrained(mechanism, q_eq, cfg)
         # the autonomous system: the excitation e(t) does not belong to the equilibrium
-        exu, mbs, SC, node, tree, geo, _ = self._build(
-            mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
-        mbs.Assemble()
+        system = _build(mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
+        system.mbs.Assemble()
+        M, K, D = self._tree_mkd(system.exu, system.mbs, cfg)
+        if mechanism.constraints:
+            return self._linearize_constrained(system, q_eq, M, K, D)
         eps = float(cfg["linearization_relative_epsilon"])
-        M, K, D = self._tree_mkd(exu, mbs, cfg)
         eig = quadratic_eigenvalues(M, D, K)
         how = ("two forward-difference Jacobians (eps, eps/2) Richardson-extrapolated"
                if cfg["linearization_richardson"] else "one forward-difference Jacobian")
@@ -1107,8 +1091,8 @@ class ExudynBackend(Backend):
             K, D = 2 * K2 - K, 2 * D2 - D
         return M, K, D
 
-    def _linearize_constrained(self, mechanism: Mechanism, q_eq: np.ndarray,
-                               cfg: dict) -> Linearization:
+    def _linearize_constrained(self, system: _System, q_eq: np.ndarray, M: np.ndarray,
+                               K: np.ndarray, D: np.ndarray) -> Linearization:
         """Linearization on the constraint manifold from the engine's own matrices: M, K,
         D of the tree (``ComputeLinearizedSystem``, Richardson as above), the constraint
         Jacobian C (n x m, Exudyn's ``ComputeJacobianAE``), the static multipliers from
@@ -1116,14 +1100,10 @@ class ExudynBackend(Backend):
         d(C lam)/du by central differences of Exudyn's C; then the null-space projection
         Exudyn's ``ComputeODE2Eigenvalues`` uses. (``ComputeODE2Eigenvalues`` itself has no
         d(C lam)/du term: the loaded slot of the eccentric cam came out 2.7 % low.)"""
-        mech = mechanism.without_time_loads()
-        exu, mbs, SC, node, tree, geo, _ = self._build(mech, q_eq, np.zeros_like(q_eq), cfg)
-        self._add_closures(exu, mbs, mech, node, tree, geo)
-        mbs.Assemble()
-        n = geo.n
-        u_eq = np.linalg.solve(geo.cmap.T, q_eq - geo.cmap.c)
+        exu, mbs, cfg, cmap = system.exu, system.mbs, system.cfg, system.geo.cmap
+        n = system.geo.n
+        u_eq = np.linalg.solve(cmap.T, q_eq - cmap.c)
         eps = float(cfg["linearization_relative_epsilon"])
-        M, K, D = self._tree_mkd(exu, mbs, cfg)
 
         def forces_and_jacobian(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Exudyn's ODE2 right-hand side f and constraint Jacobian C (n x m) at u."""
