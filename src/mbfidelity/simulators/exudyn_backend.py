@@ -48,26 +48,15 @@ force maps to the contract's. Explicit solvers cannot run algebraic equations, s
 constrained mechanism runs ``constrained_solver`` (GeneralizedAlpha, rho 0.9, or
 TrapezoidalIndex2; order 2).
 
-Prescribed motion (convention 9) is an algebraic equation on the tree as well:
-
-- each prescribed coordinate q = scale u_p + shift (one engine joint value; an absolute
-  angle on a turning parent, a sum of joint values, is refused) is an
-  ``ObjectConnectorCoordinate`` between a ground coordinate and the tree node's coordinate
-  p, equation u_p - UF(t) = 0 with ``offsetUserFunction`` UF = (q(t) - shift) / scale and
-  ``offsetUserFunction_t`` its rate, both from `plan.Motion` (symbolic derivatives) and
-  evaluated by the solver at its own times; the prescribed coordinates start on the motion
-  (q(0), q'(0)) whatever the initial state says;
-- Exudyn's explicit solvers silently ignore the offset (the coordinate would stay put),
-  so a driven mechanism runs the implicit ``driven_solver`` and an explicit one is refused;
-- Exudyn's initial accelerations leave the constraints' time terms out (as if q''(0) were
-  0); the trapezoidal rule then carries the inconsistency as a multiplier that alternates
-  from step to step and never decays. The backend computes the consistent initial
-  accelerations and multipliers itself (engine M and right-hand side at t = 0, u_p'' =
-  q''(0) / scale) and starts the solver from them;
-- the actuator force is -lam / scale (Exudyn adds C_u^T lam = lam e_p to the engine
-  equations; virtual work maps it to the description coordinate), read at every step as
-  the solver leaves it, the t = 0 sample from the consistent start; reactions of a driven
-  prismatic joint exclude the actuator force along the slide, like a coordinate force.
+Prescribed motion (convention 9) is an algebraic equation on the tree as well: each
+prescribed coordinate, one engine joint value q = scale u_p + shift, is held by an
+``ObjectConnectorCoordinate`` whose offset user functions give q(t), q'(t) (`plan.Motion`,
+symbolic derivatives) at the solver's own times; the prescribed coordinates start on the
+motion whatever the initial state says. Exudyn's explicit solvers silently ignore the
+offset, so a driven mechanism runs the implicit ``driven_solver``, started from consistent
+accelerations and multipliers the backend computes (Exudyn's own leave the constraints'
+time terms out: `_consistent_start`). The actuator force is -lam / scale (virtual work);
+reactions of a driven prismatic joint exclude it along the slide, like a coordinate force.
 """
 from __future__ import annotations
 
@@ -125,13 +114,6 @@ _AXIAL_FACTOR = 1e4
 _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
-def _engine_coordinate(geo_T: np.ndarray, index: int) -> bool:
-    """True when description coordinate `index` is one engine joint value (scaled and
-    shifted): its row of q = T u + c has its only entry on the diagonal."""
-    row = geo_T[index]
-    return row[index] != 0 and np.count_nonzero(row) == 1
-
-
 def _rot3(angle: float) -> np.ndarray:
     out = np.eye(3)
     out[:2, :2] = rot(angle)
@@ -164,10 +146,6 @@ class _DrivenItem:
     scale: float
     shift: float
 
-    @property
-    def index(self) -> int:
-        return self.motion.index
-
 
 @dataclass
 class _Geometry:
@@ -179,7 +157,7 @@ class _Geometry:
     link_of: dict[str, int]          # body name -> link index
     parents: list[int]
     types: list[str]                 # Exudyn joint type names
-    offsets: list[np.ndarray]        # joint offsets (parent link frame), 2-vectors
+    offsets: list[np.ndarray]        # joint offsets (parent link frame), 3-vectors
     rotations: list[float]           # joint frame rotation against the parent link frame
     beta: dict[str, float]           # link frame orientation minus body angle
     com: dict[str, np.ndarray]       # centre of mass in the link frame
@@ -190,7 +168,7 @@ class _Geometry:
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
-        return self.com[body] + rot(-self.beta[body]) @ np.asarray(point, dtype=float)
+        return self.com[body] + _rot3(-self.beta[body]) @ np.array([*point, 0.0])
 
     def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
@@ -288,62 +266,46 @@ def _geometry(mech: Mechanism) -> _Geometry:
     offsets: list[np.ndarray] = []
     rotations: list[float] = []
     beta: dict[str, float] = {WORLD: 0.0}
-    com: dict[str, np.ndarray] = {WORLD: np.zeros(2)}
+    com: dict[str, np.ndarray] = {WORLD: np.zeros(3)}
+
+    def column(v) -> np.ndarray:
+        """An anchor in 3-D: a planar one's in-plane components, a spatial one's all."""
+        values = [num(c) for c in v][:3 if mech.spatial else 2]
+        return np.array(values + [0.0] * (3 - len(values)))
+
     for i, j in enumerate(mech.joints):
         p = j.parent
         parents.append(link_of[p] if p != WORLD else -1)
         link_of[j.child] = i
-        # in-plane components (a spatial tree's 3-D ones: `_spatial_frames`)
-        parent_anchor = np.array([num(v) for v in j.parent_anchor][:2])
-        child_anchor = np.array([num(v) for v in j.child_anchor][:2])
-        # the joint point in the parent's link frame
-        offsets.append(com[p] + rot(-beta[p]) @ parent_anchor)
+        # the joint point in the parent's link frame (a spatial tree's frames are aligned
+        # with their parents: beta = 0, model convention 10)
+        offsets.append(com[p] + _rot3(-beta[p]) @ column(j.parent_anchor))
         joint_type, angle, beta[j.child] = _builder(j)(j, mech)
         types.append(joint_type)
         rotations.append(angle - beta[p])
-        com[j.child] = -rot(-beta[j.child]) @ child_anchor
+        com[j.child] = -_rot3(-beta[j.child]) @ column(j.child_anchor)
     return _Geometry(coordinate_map(mech), link_of, parents, types, offsets, rotations,
                      beta, com)
 
 
-def _spatial_frames(mech: Mechanism) -> tuple[list, list, list]:
-    """(joint offsets, centres of mass, gravity) of a spatial open tree of hinges: each
-    link frame at its joint, aligned with its parent (model convention 10)."""
-    def column(v):
-        return [float(num(c)) for c in v] + [0.0] * (3 - len(v))
-
-    offsets, coms = [], []
-    com_of = {WORLD: [0.0, 0.0, 0.0]}
-    for j in mech.joints:
-        offsets.append([a + b for a, b in zip(com_of[j.parent], column(j.parent_anchor))])
-        com_of[j.child] = [-c for c in column(j.child_anchor)]
-        coms.append(com_of[j.child])
-    up = np.array(column(mech.up))
-    gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
-    return offsets, coms, gravity
-
-
 def _tree_links(mech: Mechanism, geo: _Geometry, exu) -> dict:
-    """The ``ObjectKinematicTree`` arguments that describe its links: planar links with
-    the frames of `geo`, or a spatial tree's (`_spatial_frames`; `_spatial_reason` bounds
-    the cases)."""
+    """The ``ObjectKinematicTree`` arguments that describe its links (the frames of `geo`,
+    each body's mass and tensor from its builder) and gravity, along -y or, in a spatial
+    mechanism, against its `up`."""
     bodies = [mech.body(j.child) for j in mech.joints]
     masses, tensors = zip(*(_builder(b)(b, mech) for b in bodies))
+    gravity = [0.0, -num(mech.gravity), 0.0]
     if mech.spatial:
-        offsets, coms, gravity = _spatial_frames(mech)
-        transformations = [np.eye(3)] * geo.n
-    else:
-        offsets = [[*o, 0.0] for o in geo.offsets]
-        coms = [[*geo.com[b.name], 0.0] for b in bodies]
-        transformations = [_rot3(a) for a in geo.rotations]
-        gravity = [0.0, -num(mech.gravity), 0.0]
+        up = np.array([num(c) for c in mech.up] + [0.0] * (3 - len(mech.up)))
+        gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
     return dict(gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
                 jointTypes=[getattr(exu.JointType, t) for t in geo.types],
                 linkParents=geo.parents,
-                jointTransformations=exu.Matrix3DList(transformations),
-                jointOffsets=exu.Vector3DList(offsets),
+                jointTransformations=exu.Matrix3DList([_rot3(a) for a in geo.rotations]),
+                jointOffsets=exu.Vector3DList([list(o) for o in geo.offsets]),
                 linkInertiasCOM=exu.Matrix3DList(list(tensors)),
-                linkCOMs=exu.Vector3DList(coms), linkMasses=list(masses))
+                linkCOMs=exu.Vector3DList([list(geo.com[b.name]) for b in bodies]),
+                linkMasses=list(masses))
 
 
 @dataclass
@@ -394,7 +356,7 @@ class _System:
             return self.mbs.AddMarker(kind(bodyNumber=ground, localPosition=[*pt, 0.0]))
         return self.mbs.AddMarker(self.items.MarkerKinematicTreeRigid(
             objectNumber=self.tree, linkNumber=self.geo.link_of[body],
-            localPosition=[*self.geo.local_point(body, pt), 0.0]))
+            localPosition=list(self.geo.local_point(body, pt))))
 
     def native(self, element) -> tuple[float, float, float] | None:
         """The element's affine law where the engine's own terms carry it (setting
@@ -555,8 +517,9 @@ def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
                       "accelerations; actuator force -multiplier / scale; order 2 "
                       "(TrapezoidalIndex2) in the coordinates and the force",
                when="the prescribed coordinate is one engine joint value",
-               applies=lambda mech, prescribed: _engine_coordinate(
-                   coordinate_map(mech).T, mech.coordinates.index(prescribed.coordinate))),
+               # its row of q = T u + c has one entry (T is triangular, its diagonal whole)
+               applies=lambda mech, prescribed: np.count_nonzero(coordinate_map(mech).T[
+                   mech.coordinates.index(prescribed.coordinate)]) == 1),
     Expression(UNSUPPORTED, "an absolute angle on a turning parent is a combination of "
                             "engine joint values, which Exudyn's coordinate constraint (one "
                             "coordinate, time offset) cannot hold",
@@ -808,9 +771,9 @@ class ExudynBackend(Backend):
         mass, rhs = self._mass_and_rhs(system, explicit=False)
         n = len(mass)
         acc = np.zeros(n)
-        held = [d.index for d in system.driven]
+        held = [d.motion.index for d in system.driven]
         for d in system.driven:
-            acc[d.index] = d.motion.acceleration(0.0) / d.scale
+            acc[d.motion.index] = d.motion.acceleration(0.0) / d.scale
         free = [i for i in range(n) if i not in held]
         if free:
             acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
@@ -860,10 +823,7 @@ class ExudynBackend(Backend):
         if not initial_states:
             raise ValueError("the script starts from a scenario's initial state: none given")
         name, (q0, qd0) = next(iter(initial_states.items()))
-        cfg = self.resolve_settings(settings)
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"exudyn cannot express this mechanism: {support.reason}")
+        cfg, _ = self._run_frame(mechanism, 1.0, dt, settings)  # support and settings
         solver = self._solver_for(mechanism, cfg)
         system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
         mbs, data = system.mbs, system.mbs.systemData
@@ -912,13 +872,11 @@ class ExudynBackend(Backend):
         s_ut = system.sensor("SensorNode", nodeNumber=system.node,
                              outputVariableType=ovt.Coordinates_t)
         # centre-of-mass accelerations of every massive body below a requested joint
-        acc_bodies: set[str] = set()
-        for name in reaction_joints:
-            joint = mechanism.joint(name)
-            acc_bodies |= {b for b in mechanism.subtree(joint.child)
-                           if num(mechanism.body(b).mass) != 0}
+        acc_bodies = {b for name in reaction_joints
+                      for b in mechanism.subtree(mechanism.joint(name).child)
+                      if num(mechanism.body(b).mass) != 0}
         s_acc = {b: system.sensor("SensorKinematicTree", objectNumber=system.tree,
-                                  linkNumber=geo.link_of[b], localPosition=[*geo.com[b], 0.0],
+                                  linkNumber=geo.link_of[b], localPosition=list(geo.com[b]),
                                   outputVariableType=ovt.Acceleration)
                  for b in sorted(acc_bodies)}
 
@@ -1059,20 +1017,18 @@ class ExudynBackend(Backend):
         system = _build(mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
         system.mbs.Assemble()
         M, K, D = self._tree_mkd(system.exu, system.mbs, cfg)
-        if mechanism.constraints:
-            return self._linearize_constrained(system, q_eq, M, K, D)
         eps = float(cfg["linearization_relative_epsilon"])
-        eig = quadratic_eigenvalues(M, D, K)
-        how = ("two forward-difference Jacobians (eps, eps/2) Richardson-extrapolated"
-               if cfg["linearization_richardson"] else "one forward-difference Jacobian")
-        return Linearization(
-            eigenvalues=eig[np.argsort(eig.imag)],
-            method="exudyn mbs.ComputeLinearizedSystem (M exact; K, D from the kinematic "
-                   f"tree's numerical Jacobian: {how}), first-order eigenproblem",
-            extra={"coordinates": "engine relative joint values (eigenvalues are invariant)",
-                   "relative_epsilon": eps},
-        )
-
+        if mechanism.constraints:
+            eig, method, extra = self._on_constraint_manifold(system, q_eq, M, K, D, eps)
+        else:
+            eig = quadratic_eigenvalues(M, D, K)
+            how = ("two forward-difference Jacobians (eps, eps/2) Richardson-extrapolated"
+                   if cfg["linearization_richardson"] else "one forward-difference Jacobian")
+            method = ("exudyn mbs.ComputeLinearizedSystem (M exact; K, D from the kinematic "
+                      f"tree's numerical Jacobian: {how}), first-order eigenproblem")
+            extra = {"coordinates": "engine relative joint values (eigenvalues are invariant)",
+                     "relative_epsilon": eps}
+        return Linearization(eigenvalues=eig[np.argsort(eig.imag)], method=method, extra=extra)
 
     def _tree_mkd(self, exu, mbs, cfg: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, K, D of the assembled tree from ``ComputeLinearizedSystem``; Exudyn
@@ -1091,9 +1047,10 @@ class ExudynBackend(Backend):
             K, D = 2 * K2 - K, 2 * D2 - D
         return M, K, D
 
-    def _linearize_constrained(self, system: _System, q_eq: np.ndarray, M: np.ndarray,
-                               K: np.ndarray, D: np.ndarray) -> Linearization:
-        """Linearization on the constraint manifold from the engine's own matrices: M, K,
+    def _on_constraint_manifold(self, system: _System, q_eq: np.ndarray, M: np.ndarray,
+                                K: np.ndarray, D: np.ndarray, eps: float
+                                ) -> tuple[np.ndarray, str, dict]:
+        """(eigenvalues, method, extra): the linearization on the constraint manifold from the engine's own matrices: M, K,
         D of the tree (``ComputeLinearizedSystem``, Richardson as above), the constraint
         Jacobian C (n x m, Exudyn's ``ComputeJacobianAE``), the static multipliers from
         the engine's forces (C lam = f at the equilibrium) and the constraint stiffness
@@ -1103,7 +1060,6 @@ class ExudynBackend(Backend):
         exu, mbs, cfg, cmap = system.exu, system.mbs, system.cfg, system.geo.cmap
         n = system.geo.n
         u_eq = np.linalg.solve(cmap.T, q_eq - cmap.c)
-        eps = float(cfg["linearization_relative_epsilon"])
 
         def forces_and_jacobian(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Exudyn's ODE2 right-hand side f and constraint Jacobian C (n x m) at u."""
@@ -1146,20 +1102,15 @@ class ExudynBackend(Backend):
             np.abs(eig.imag) <= tiny, 0.0, eig.imag)
         how = ("Richardson-extrapolated forward differences"
                if cfg["linearization_richardson"] else "one forward difference")
-        return Linearization(
-            eigenvalues=eig[np.argsort(eig.imag)],
-            method="exudyn tree M, K, D (mbs.ComputeLinearizedSystem, K and D by " + how
-                   + "), constraint Jacobian C (MainSolverStatic.ComputeJacobianAE), static "
-                   "multipliers from C lam = f, constraint stiffness d(C lam)/du by central "
-                   "differences of C; null-space (SVD) projection as in "
-                   "ComputeODE2Eigenvalues, first-order eigenproblem",
-            extra={"coordinates": "null space of the engine's constraint Jacobian "
-                                  "(eigenvalues are invariant)",
-                   "relative_epsilon": eps, "constraint_step": step,
-                   "multipliers": lam.tolist(), "equilibrium_residual": residual,
-                   "constraint_rank": rank},
-        )
-
+        method = ("exudyn tree M, K, D (mbs.ComputeLinearizedSystem, K and D by " + how
+                  + "), constraint Jacobian C (MainSolverStatic.ComputeJacobianAE), static "
+                  "multipliers from C lam = f, constraint stiffness d(C lam)/du by central "
+                  "differences of C; null-space (SVD) projection as in "
+                  "ComputeODE2Eigenvalues, first-order eigenproblem")
+        return eig, method, {"coordinates": "null space of the engine's constraint Jacobian "
+                                            "(eigenvalues are invariant)",
+                             "relative_epsilon": eps, "constraint_step": step, "multipliers": lam.tolist(),
+                             "equilibrium_residual": residual, "constraint_rank": rank}
 
     # --- flexible elements (contract point 12) ----------------------------------------------
     BEAM_ELEMENTS = {
