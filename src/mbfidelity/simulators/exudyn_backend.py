@@ -325,9 +325,9 @@ class _System:
     cfg: dict
     node: int = -1
     tree: int = -1
-    P: np.ndarray = None
-    D: np.ndarray = None
-    force: np.ndarray = None
+    P: np.ndarray = field(init=False)      # the tree's PD terms and joint forces
+    D: np.ndarray = field(init=False)
+    force: np.ndarray = field(init=False)
     python_laws: list = field(default_factory=list)
     connectors: dict[str, int] = field(default_factory=dict)
     closures: list[_ClosureItem] = field(default_factory=list)
