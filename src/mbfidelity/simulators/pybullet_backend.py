@@ -139,9 +139,11 @@ from .plan import (
     ForceLaw,
     constrained_bodies,
     coordinate_map,
+    coupling_row,
     element_kind,
     elements,
     num,
+    point_state,
 )
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
@@ -188,10 +190,7 @@ def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
 
 def _point(ls, link: int, point) -> tuple[float, float, float, float]:
     """World position and velocity of a body point (centre-of-mass frame)."""
-    x, y, th, vx, vy, om = _pose(ls, link)
-    c, s = math.cos(th), math.sin(th)
-    rx, ry = c * point[0] - s * point[1], s * point[0] + c * point[1]
-    return x + rx, y + ry, vx - om * ry, vy + om * rx
+    return point_state(_pose(ls, link), point)
 
 
 def _turned(th: np.ndarray, x, y) -> np.ndarray:
@@ -271,27 +270,14 @@ def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
 
 def _two_joint_gear(mech: Mechanism, coupling: LinearCoupling) -> bool:
     """The coupling, written on the engine joint values, involves exactly two of them."""
-    cmap = coordinate_map(mech)
-    return int(np.count_nonzero(_gear_terms(coupling, mech.coordinates, cmap.T, cmap.b)[2])) == 2
+    row, _ = coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
+    return int(np.count_nonzero(row)) == 2
 
 
 def _one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
     """The prescribed coordinate is one engine joint value (not a sum of them)."""
     i = mech.coordinates.index(prescribed.coordinate)
     return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
-
-
-def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
-                bvec: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, float]:
-    """The coupling sum(c q) = const written on the engine joint values:
-    w . jv = const + c . A^-1 b with w = A^-T c. Returns (c, const, w, rhs)."""
-    cvec = np.zeros(len(coords))
-    for name, coef in c.coefficients:
-        cvec[coords.index(name)] += num(coef)
-    const = num(c.constant)
-    w = Ainv.T @ cvec
-    w[np.abs(w) < 1e-14 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
-    return cvec, const, w, const + float(cvec @ Ainv @ bvec)
 
 
 # --- closure constraints: one class per PyBullet construct ---------------------------
@@ -355,13 +341,19 @@ class _Slot(_Pin):
     direction: tuple[float, float] = (1.0, 0.0)
     aux: int = -1
 
+    def _line(self, ls) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, float]]:
+        """World position and velocity of the pin P and of the slot body's point L, and
+        the slot's direction u in world axes, from link states."""
+        th = _pose(ls, self.line_link)[2]
+        c, s = math.cos(th), math.sin(th)
+        u = (c * self.direction[0] - s * self.direction[1],
+             s * self.direction[0] + c * self.direction[1])
+        return (_point(ls, self.pin_link, self.pin_point),
+                _point(ls, self.line_link, self.line_point), u)
+
     def violation(self, ls) -> float:
         """Signed distance n . (P - L) of the pin from the slot line (m)."""
-        px, py, _, _ = _point(ls, self.pin_link, self.pin_point)
-        lx, ly, _, _ = _point(ls, self.line_link, self.line_point)
-        th = _pose(ls, self.line_link)[2]
-        ux = math.cos(th) * self.direction[0] - math.sin(th) * self.direction[1]
-        uy = math.sin(th) * self.direction[0] + math.cos(th) * self.direction[1]
+        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(ls)
         return -uy * (px - lx) + ux * (py - ly)
 
 
@@ -375,11 +367,7 @@ class _Slider(_Slot):
         """The slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
         with v_L the velocity of the slot body's material point L ((P - L) is along u, so
         the rotation of u adds nothing)."""
-        px, py, pvx, pvy = _point(ls, self.pin_link, self.pin_point)
-        lx, ly, lvx, lvy = _point(ls, self.line_link, self.line_point)
-        th = _pose(ls, self.line_link)[2]
-        ux = math.cos(th) * self.direction[0] - math.sin(th) * self.direction[1]
-        uy = math.sin(th) * self.direction[0] + math.cos(th) * self.direction[1]
+        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
         s = (px - lx) * ux + (py - ly) * uy
         sd = (pvx - lvx) * ux + (pvy - lvy) * uy
         p.resetJointState(body, eidx[self.aux], s, sd, physicsClientId=cid)
@@ -431,21 +419,10 @@ class _Rotor(_Slot):
         Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
         (fixed) the slot body would feel the force at L instead of at the pin (measured: a
         bar slotted along its own axis through its pivot then swings freely)."""
-        def pose(link):
-            if link < 0:
-                return 0.0, 0.0, 0.0
-            st = ls[slot_of[link]]
-            return st[0][0], st[0][1], 2.0 * math.atan2(st[1][2], st[1][3])
-        x, y, th = pose(self.pin_link)
-        cs, sn = math.cos(th), math.sin(th)
-        px = x + cs * self.pin_point[0] - sn * self.pin_point[1]
-        py = y + sn * self.pin_point[0] + cs * self.pin_point[1]
-        x, y, th = pose(self.line_link)
-        cs, sn = math.cos(th), math.sin(th)
-        lx = x + cs * self.line_point[0] - sn * self.line_point[1]
-        ly = y + sn * self.line_point[0] + cs * self.line_point[1]
+        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(
+            {lk: ls[m] for lk, m in slot_of.items()})
+        s = (px - lx) * ux + (py - ly) * uy
         ux, uy = self.direction
-        s = (px - lx) * (cs * ux - sn * uy) + (py - ly) * (sn * ux + cs * uy)
         return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
 
 
@@ -774,7 +751,8 @@ def _point_on_line(model: _Translation, c) -> None:
                                  "constraint, and a one-joint coupling would be a lock",
                     when="one, or three or more, engine joint values"))
 def _linear_coupling(model: _Translation, c) -> None:
-    cvec, const, w, rhs = _gear_terms(c, model.mech.coordinates, model.map.T, model.map.b)
+    cvec, const = coupling_row(model.mech, c)
+    w, rhs = model.map.on_engine_values(cvec, const)
     nz = np.flatnonzero(w)
     if len(nz) != 2:  # guarded by support()
         raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
@@ -1608,14 +1586,9 @@ class PyBulletBackend(Backend):
         component f, track on disc, along t = k x u with u from the track centre to the
         disc) is what the coupling's -lambda stands for."""
         ct = model.contact
-        cvec = np.zeros(model.n)
-        for name, coef in coupling.coefficients:
-            cvec[model.mech.coordinates.index(name)] += num(coef)
-        const = num(coupling.constant)
-        arm = model.mech.joints[ct.hub].parent
-        th = model.map.angle(arm, q)
-        ux0, uy0 = ct.radial
-        ux, uy = np.cos(th) * ux0 - np.sin(th) * uy0, np.sin(th) * ux0 + np.cos(th) * uy0
+        cvec, const = coupling_row(model.mech, coupling)
+        u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
+        ux, uy = u[:, 0], u[:, 1]
         normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
         friction = FC[:, 0] * -uy + FC[:, 1] * ux
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -1650,14 +1623,9 @@ class PyBulletBackend(Backend):
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
         q = model.map.coordinates(JV[:, :model.n])
-        transmitted: dict[str, np.ndarray] = {}
-        for r, (i, name) in enumerate(zip(joint_ids, names)):
-            joint = model.mech.joints[i]
-            th = model.map.angle(joint.parent, q)
-            c, s = np.cos(th), np.sin(th)
-            fx, fy = out[:, r, 0], out[:, r, 1]
-            transmitted[name] = np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
-        return transmitted
+        return {name: _turned(model.map.angle(model.mech.joints[i].parent, q),
+                              out[:, r, 0], out[:, r, 1])
+                for r, (i, name) in enumerate(zip(joint_ids, names))}
 
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
