@@ -997,25 +997,16 @@ class PyBulletBackend(Backend):
         link, shapes) adds one massless JOINT_FIXED link per shape on that link (their
         engine indices go to `model.fixed_links`). Returns (body id, engine link index of
         each model link, {joint index: (x link, y link)})."""
-        masses, positions, orientations, inertial, parents, types, axes = [], [], [], [], [], [], []
-        shapes: list[int] = []
-        inertial_orientations: list[list[float]] = []
+        rows: list[tuple] = []  # per link, its columns of createMultiBody's arguments
         collision = dict(collision or {})
         engine_index: list[int] = [-1] * len(model.links)
         virtual: dict[int, tuple[int, int]] = {}
 
         def add(mass, pos, orn, ipos, parent, jtype, axis, shape=-1,
                 iorn=(0.0, 0.0, 0.0, 1.0)) -> int:
-            masses.append(mass)
-            positions.append(pos)
-            orientations.append(orn)
-            inertial.append(ipos)
-            inertial_orientations.append(list(iorn))
-            parents.append(parent + 1)  # createMultiBody counts links from 1; 0 = base
-            types.append(jtype)
-            axes.append(axis)
-            shapes.append(shape)
-            return len(masses) - 1
+            # createMultiBody counts links from 1; 0 = base
+            rows.append((mass, shape, pos, orn, ipos, list(iorn), parent + 1, jtype, axis))
+            return len(rows) - 1
 
         for i in model.creation_order():
             lk = model.links[i]
@@ -1037,7 +1028,9 @@ class PyBulletBackend(Backend):
             for shape in host_shapes:
                 fixed.append(add(0.0, [0.0, 0.0, 0.0], [0, 0, 0, 1], [0.0, 0.0, 0.0],
                                  engine_index[host], p.JOINT_FIXED, [0, 0, 1], shape))
-        nl = len(masses)
+        nl = len(rows)
+        masses, shapes, positions, orientations, inertial, inertial_orientations, parents, \
+            types, axes = map(list, zip(*rows))
         if nl > _MAX_LINKS:
             raise ValueError(f"pybullet multibodies keep at most {_MAX_LINKS} links "
                              f"(createMultiBody silently drops the rest); this model "
@@ -1062,15 +1055,13 @@ class PyBulletBackend(Backend):
         if fixed_shapes is not None:
             model.fixed_links = [created[k] for k in fixed]
         # body-level parameters in their own calls (they reset the link index to -1)
-        p.changeDynamics(body, -1, linearDamping=float(settings["linear_damping"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, angularDamping=float(settings["angular_damping"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, maxJointVelocity=float(settings["max_joint_velocity"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, activationState=(
-            p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
-            else p.ACTIVATION_STATE_DISABLE_SLEEPING), physicsClientId=cid)
+        for key, value in (
+                ("linearDamping", float(settings["linear_damping"])),
+                ("angularDamping", float(settings["angular_damping"])),
+                ("maxJointVelocity", float(settings["max_joint_velocity"])),
+                ("activationState", p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
+                 else p.ACTIVATION_STATE_DISABLE_SLEEPING)):
+            p.changeDynamics(body, -1, **{key: value}, physicsClientId=cid)
         for i, lk in enumerate(model.links):
             diagonal = lk.principal[0] if lk.principal else [lk.inertia] * 3
             if settings["explicit_inertia"]:
@@ -1106,11 +1097,6 @@ class PyBulletBackend(Backend):
                 solverResidualThreshold=float(settings["solver_residual_threshold"]),
                 physicsClientId=cid)
         return cid
-
-    # --- closure constraints -------------------------------------------------------------
-    @staticmethod
-    def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
-        """(x, y, theta, vx, vy, omega) of a link's centre-of-mass frame (-1: the base)."""
 
     # --- closure constraints -------------------------------------------------------------
     @staticmethod
@@ -1191,42 +1177,49 @@ class PyBulletBackend(Backend):
             raise
         return _World(cid, body, eidx, model, cids)
 
-    def _inputs(self, p, world: _World, dt: float
-                ) -> tuple[Callable[[int, list, list], tuple[np.ndarray | None, list | None]],
-                           bool] | None:
-        """What the engine must be given before step k, or None when nothing: the joint
-        forces of the CoordinateForce laws (from the joint values and rates at the start
-        of the step, `jv` and `jvd` over at least the n coordinate links) and the
-        point-to-point forces (from the engine's link states), both at t = k dt, and the
-        PRISMATIC pivots moved under the pins (`_Rotor.pivot`). Returns that function,
-        which gives back the joint forces and the (x, y) force on point b of each
-        point-to-point element (None where there are none), and whether it reads `jv` and
-        `jvd`."""
+    @staticmethod
+    def _inputs(p, world: _World, dt: float, cfg: dict
+                ) -> tuple[Callable[[int, list, list], list | None] | None, bool]:
+        """What the engine must be given before step k: the joint forces of the
+        CoordinateForce laws (from the joint values and rates at the start of the step,
+        `jv` and `jvd` over at least the n coordinate links) and the point-to-point forces
+        (from the engine's link states), both at t = k dt; the PRISMATIC pivots moved under
+        the pins (`_Rotor.pivot`); the velocity motors of the prescribed coordinates
+        (setting prescribed_motion), each driven joint's target velocity set to
+        (v(t_k+1) - v)/h. Returns that function, which gives back the (x, y) force on point
+        b of each point-to-point element (None where there are none), and whether it reads
+        `jv` and `jvd`; (None, False) when nothing is given."""
         model, cid, body, eidx = world.model, world.cid, world.body, world.eidx
         n = model.n
         has_cf = bool(model.coordinate_laws)
         n_pf = len(model.point_forces)
         moving = [(world.cids[r], c) for r, c in enumerate(model.closures) if c.follows_pin]
-        if not (has_cf or n_pf or moving):
-            return None
+        driven = model.driven
+        if not (has_cf or n_pf or moving or driven):
+            return None, False
         set_motors = p.setJointMotorControlArray
         get_links = p.getLinkStates
         apply_force = p.applyExternalForce
         change = p.changeConstraint
         torque_mode, world_frame = p.TORQUE_CONTROL, p.WORLD_FRAME
+        velocity_mode = p.VELOCITY_CONTROL
         links = eidx[:n]
         point_links = [eidx[k] for k in model.point_links]
         pos_of = {k: m for m, k in enumerate(model.point_links)}
-        Ainv, bvec = model.map.T, model.map.b
+        Ainv, A, bvec = model.map.T, model.map.A, model.map.b
         identity = model.map.identity
         moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
                                if lk >= 0})
         moving_eidx = [eidx[lk] for lk in moving_links]
         slot_of = {lk: m for m, lk in enumerate(moving_links)}
+        driven_links = [eidx[m.index] for m in driven]
+        drives = [(float(A[m.index, m.index]), m.position, float(bvec[m.index]), m.index)
+                  for m in driven]
+        motor_force = [float(cfg["prescribed_motor_force"])] * len(driven)
 
-        def apply(k: int, jv: list, jvd: list) -> tuple[np.ndarray | None, list | None]:
+        def apply(k: int, jv: list, jvd: list) -> list | None:
             t = k * dt
-            tau = forces = None
+            forces = None
             if has_cf:
                 if identity:
                     tau = model.coordinate_torques(jv[:n], jvd[:n], t)
@@ -1253,65 +1246,35 @@ class PyBulletBackend(Backend):
                 ls = get_links(body, moving_eidx, physicsClientId=cid)
                 for uid, c in moving:
                     change(uid, jointChildPivot=c.pivot(ls, slot_of), physicsClientId=cid)
-            return tau, forces
+            if driven:
+                t_next = (k + 1) * dt
+                target = [(a * q(t_next) + c - jv[i]) / dt for a, q, c, i in drives]
+                set_motors(body, driven_links, velocity_mode, targetVelocities=target,
+                           forces=motor_force, physicsClientId=cid)
+            return forces
 
-        return apply, has_cf
-
-    @staticmethod
-    def _drivers(p, world: _World, dt: float, cfg: dict):
-        """The velocity motors of the prescribed coordinates (setting prescribed_motion):
-        a function of the step k and the engine joint values that sets every driven
-        joint's target velocity to (v(t_k+1) - v)/h, or None without prescribed motion;
-        and the engine link and A[i, i] of each (the actuator force is A[i, i] tau)."""
-        driven = world.model.driven
-        if not driven:
-            return None, []
-        model, body, cid = world.model, world.body, world.cid
-        A, b = model.map.A, model.map.b
-        links = [world.eidx[m.index] for m in driven]
-        scale = [float(A[m.index, m.index]) for m in driven]
-        shift = [float(b[m.index]) for m in driven]
-        position = [m.position for m in driven]
-        slot = [m.index for m in driven]
-        force = [float(cfg["prescribed_motor_force"])] * len(driven)
-        set_motors, velocity_mode = p.setJointMotorControlArray, p.VELOCITY_CONTROL
-
-        def drive(k: int, jv: list) -> None:
-            t_next = (k + 1) * dt
-            target = [(a * q(t_next) + c - jv[i]) / dt
-                      for a, q, c, i in zip(scale, position, shift, slot)]
-            set_motors(body, links, velocity_mode, targetVelocities=target, forces=force,
-                       physicsClientId=cid)
-
-        return drive, list(zip(links, scale, (m.element.name for m in driven)))
+        return apply, has_cf or bool(driven)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
-        """The world of `simulate` stepped with only the per-step inputs (`_inputs`) and
-        the drive of the prescribed coordinates (`_drivers`)."""
+        """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
         import pybullet as p
 
         world = self._open(p, mechanism, q0, qd0, dt, cfg)
         try:
-            inputs = self._inputs(p, world, dt)
+            apply, reads = self._inputs(p, world, dt, cfg)
             step, cid = p.stepSimulation, world.cid
             get_states, body, links = p.getJointStates, world.body, world.eidx[:world.model.n]
-            drive, _ = self._drivers(p, world, dt, cfg)
-            apply, needs_state = inputs if inputs is not None else (None, False)
-            read = drive is not None or needs_state
             jv = jvd = []
             with Stopwatch() as clock:
-                if apply is None and drive is None:
+                if apply is None:
                     for _ in range(steps):
                         step(physicsClientId=cid)
-                for k in range(steps if apply is not None or drive is not None else 0):
-                    if read:
+                for k in range(steps if apply is not None else 0):
+                    if reads:
                         js = get_states(body, links, physicsClientId=cid)
                         jv, jvd = [s[0] for s in js], [s[1] for s in js]
-                    if apply is not None:
-                        apply(k, jv, jvd)
-                    if drive is not None:
-                        drive(k, jv)
+                    apply(k, jv, jvd)
                     step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
             cmap = world.model.map
@@ -1341,7 +1304,7 @@ class PyBulletBackend(Backend):
         world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
         try:
             outside = []
-            if self._inputs(pybullet, world, dt) is not None:
+            if mechanism.forces or any(c.follows_pin for c in world.model.closures):
                 laws = [e.name for e in mechanism.forces]
                 outside.append("the force laws' joint and point forces (TORQUE_CONTROL and "
                                f"applyExternalForce before every step): {', '.join(laws)}")
@@ -1397,33 +1360,28 @@ class PyBulletBackend(Backend):
             get_states = p.getJointStates
             get_cstate = p.getConstraintState
             get_contacts = p.getContactPoints
-            all_links = eidx
             sensor_slots = [eidx[i] for i in joint_ids]
             n_cs = len(cids)
-            inputs = self._inputs(p, world, dt)
-            apply = inputs[0] if inputs is not None else None
-            drive, driven = self._drivers(p, world, dt, cfg)
-            driven_slots = [all_links.index(link) for link, _, _ in driven]
+            apply, _ = self._inputs(p, world, dt, cfg)
+            driven = [(model.map.A[m.index, m.index], m.element.name) for m in model.driven]
+            driven_slots = [m.index for m in model.driven]
             motor = np.full((total + 1, len(driven)), np.nan)
             if contact is not None:
                 ring_links = set(model.fixed_links)
                 disc_link = eidx[model.link_of[contact.inner]]
 
-            js = get_states(body, all_links, physicsClientId=cid)
+            js = get_states(body, eidx, physicsClientId=cid)
             with Stopwatch() as clock:
                 for k in range(total):
                     jv = [s[0] for s in js]
                     jvd = [s[1] for s in js]
                     JV[k] = jv
                     JVD[k] = jvd
-                    if apply is not None:
-                        _, forces = apply(k, jv, jvd)
-                        if forces is not None:
-                            f_point[k] = forces
-                    if drive is not None:
-                        drive(k, jv)
+                    forces = apply(k, jv, jvd) if apply is not None else None
+                    if forces is not None:
+                        f_point[k] = forces
                     step(physicsClientId=cid)
-                    js = get_states(body, all_links, physicsClientId=cid)
+                    js = get_states(body, eidx, physicsClientId=cid)
                     # the motor's force read after a step belongs to the state before it
                     for r, slot in enumerate(driven_slots):
                         motor[k, r] = js[slot][3]
@@ -1483,7 +1441,7 @@ class PyBulletBackend(Backend):
                                                   JV[: steps + 1], FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
-        actuators = {name: a * motor[: steps + 1, r] for r, (_, a, name) in enumerate(driven)}
+        actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
         # the substitutes' own error: each closure's violation at every sample
         extras = {"constraint_violation": violation}
         if contact_report is not None:
