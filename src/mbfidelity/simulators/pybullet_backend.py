@@ -2,7 +2,14 @@
 a fixed base at the world origin, one link per joint, no collision shapes and explicit
 inertias.
 
-Translation (generic over the description, conventions 1-8 of `systems.model`):
+Translation (generic over the description, conventions 1-8 of `systems.model`): each
+element kind of the description (`plan.ELEMENT_KINDS`) has one builder, registered together
+with the expressions it builds (`_builds`; `EXPRESSIONS` is that registry's declarations),
+which puts the element into `_Translation`, the mechanism in PyBullet's terms (links,
+closures, point forces, coordinate laws, drives) from the shared plan's numbers and
+coordinate map; each closure is one class per PyBullet construct (`_Pin`, `_Slider`,
+`_Rotor`, `_Gear`) that creates its constraint, places its extra link, and turns the
+engine's constraint rows into the contract's force and violation.
 
 - Each body becomes one link whose URDF link frame sits at the anchor of the joint that
   places it (the body's ``child_anchor``) with the body's orientation; the inertial frame
