@@ -148,6 +148,7 @@ from .plan import (
     coordinate_map,
     coupling_row,
     element_kind,
+    element_loads,
     elements,
     num,
     point_state,
@@ -235,29 +236,25 @@ def _extra_link(name: str, parent: int, revolute: bool, mass: float, inertia: fl
 
 @dataclass
 class _PointForce:
+    """A point-to-point element on the links `link_a`, `link_b` (-1: world), its loads
+    from the shared plan (`plan.element_loads`)."""
+
     name: str
-    link_a: int   # -1: world
-    point_a: tuple[float, float]
+    link_a: int
     link_b: int
+    point_a: tuple[float, float]  # in the body frames
     point_b: tuple[float, float]
-    law: Callable[[float, float, float], float]
+    body_a: str
+    body_b: str
+    loads: Callable[[Mapping, float], list]
     time_dependent: bool
 
-    def points(self, ls) -> tuple[float, ...]:
-        """World positions and velocities of both points from link states."""
-        return _point(ls, self.link_a, self.point_a) + _point(ls, self.link_b, self.point_b)
-
     def force(self, ls, t: float) -> tuple[float, float, float, float, float, float]:
-        """(force on b x, y, point a x, y, point b x, y); the force on a is opposite."""
-        ax, ay, vax, vay, bx, by, vbx, vby = self.points(ls)
-        dx, dy = bx - ax, by - ay
-        length = math.hypot(dx, dy)
-        if length == 0.0:
-            return 0.0, 0.0, ax, ay, bx, by
-        ux, uy = dx / length, dy / length
-        rate = ux * (vbx - vax) + uy * (vby - vay)
-        tension = self.law(length, rate, t)
-        return -tension * ux, -tension * uy, ax, ay, bx, by
+        """(force on b x, y, point a x, y, point b x, y) from link states (`ls[link]`);
+        the force on a is opposite."""
+        states = {self.body_a: _pose(ls, self.link_a), self.body_b: _pose(ls, self.link_b)}
+        (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
+        return fx, fy, ax, ay, bx, by
 
 
 def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
@@ -690,8 +687,8 @@ def _slide(model: _Translation, j) -> None:
 def _point_force(model: _Translation, f) -> None:
     law = ForceLaw.of(f)
     model.point_forces.append(_PointForce(
-        f.name, model.link_of[f.body_a], _xy(f.point_a), model.link_of[f.body_b],
-        _xy(f.point_b), law.law, law.time_dependent))
+        f.name, model.link_of[f.body_a], model.link_of[f.body_b], _xy(f.point_a),
+        _xy(f.point_b), f.body_a, f.body_b, element_loads(model.mech, f), law.time_dependent))
 
 
 @_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _JOINT_FORCE))
