@@ -306,13 +306,17 @@ class _Pin:
     follows_pin = False
 
     def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
-        uid = p.createConstraint(
-            body, _engine(eidx, self.parent), body, _engine(eidx, self.child),
-            p.JOINT_POINT2POINT, [0, 0, 0], _xyz(self.parent_point),
-            _xyz(self.child_point), physicsClientId=cid)
+        uid = p.createConstraint(body, _engine(eidx, self.parent), body,
+                                 _engine(eidx, self.child), *self.frames(p),
+                                 physicsClientId=cid)
         p.changeConstraint(uid, maxForce=float(cfg["constraint_max_force"]),
                            physicsClientId=cid)
         return uid
+
+    def frames(self, p) -> tuple:
+        """createConstraint's joint type, axis and parent and child pivots."""
+        return (p.JOINT_POINT2POINT, [0, 0, 0], _xyz(self.parent_point),
+                _xyz(self.child_point))
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
         """Set the state of its extra link from the description state (none here)."""
@@ -390,14 +394,9 @@ class _Rotor(_Slot):
 
     follows_pin = True
 
-    def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
-        uid = p.createConstraint(
-            body, _engine(eidx, self.parent), body, _engine(eidx, self.child),
-            p.JOINT_PRISMATIC, [self.direction[0], self.direction[1], 0.0],
-            [0.0, 0.0, 0.0], _xyz(self.child_point), physicsClientId=cid)
-        p.changeConstraint(uid, maxForce=float(cfg["constraint_max_force"]),
-                           physicsClientId=cid)
-        return uid
+    def frames(self, p) -> tuple:
+        return (p.JOINT_PRISMATIC, [self.direction[0], self.direction[1], 0.0],
+                [0.0, 0.0, 0.0], _xyz(self.child_point))
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
         """The rotor turned to the slot body's angle, th_slot - th_pin, at the relative
@@ -1678,15 +1677,11 @@ class PyBulletBackend(Backend):
             K = np.zeros((n, n))
             C = np.zeros((n, n))
             v0 = np.zeros(n)
-            for i in range(n):
+            for i, e in enumerate(np.eye(n)):
                 h = h_rel * max(1.0, abs(jv_eq[i]))
-                e = np.zeros(n)
-                e[i] = h
-                K[:, i] = (residual(jv_eq + e, v0) - residual(jv_eq - e, v0)) / (2 * h)
-                hv = h_rel
-                ev = np.zeros(n)
-                ev[i] = hv
-                C[:, i] = (residual(jv_eq, v0 + ev) - residual(jv_eq, v0 - ev)) / (2 * hv)
+                K[:, i] = (residual(jv_eq + h * e, v0) - residual(jv_eq - h * e, v0)) / (2 * h)
+                C[:, i] = (residual(jv_eq, v0 + h_rel * e)
+                           - residual(jv_eq, v0 - h_rel * e)) / (2 * h_rel)
         finally:
             p.disconnect(physicsClientId=cid)
         eig = quadratic_eigenvalues(M, C, K)
