@@ -468,36 +468,6 @@ class _Gear:
         return q @ self.weights - self.constant
 
 
-@dataclass
-class _Contact:
-    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
-    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
-
-    coupling: str
-    outer: str
-    inner: str
-    R: float
-    r: float
-    centre: tuple[float, float]       # outer circle centre, outer body frame
-    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
-    hub: int                          # joint index of the inner body (its parent: the arm)
-    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
-
-
-def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
-    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
-    the track, the disc's circle at its hub, and the radial slider runs along the arm
-    from that hinge to the hub."""
-    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
-    centre = tuple(num(v) for v in hinge.parent_anchor)
-    arm = (np.array([num(v) for v in hub.parent_anchor])
-           - np.array([num(v) for v in hinge.child_anchor]))
-    u = arm / np.linalg.norm(arm)
-    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
-                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
-                    (float(u[0]), float(u[1])))
-
-
 def _spatial_reason(mech: Mechanism) -> str:
     """Why the spatial build cannot hold a spatial mechanism (empty: it can)."""
     return spatial_tree_reason(mech, closures=False, slides=False)
@@ -765,6 +735,39 @@ def _linear_coupling(model: _Translation, c) -> None:
                                 constant=const))
 
 
+# --- rolling by friction contact (a variant's stand-in for a rolling coupling) ---------
+
+
+@dataclass
+class _Contact:
+    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
+    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
+
+    coupling: str
+    outer: str
+    inner: str
+    R: float
+    r: float
+    centre: tuple[float, float]       # outer circle centre, outer body frame
+    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
+    hub: int                          # joint index of the inner body (its parent: the arm)
+    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
+
+
+def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
+    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
+    the track, the disc's circle at its hub, and the radial slider runs along the arm
+    from that hinge to the hub."""
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    centre = tuple(num(v) for v in hinge.parent_anchor)
+    arm = (np.array([num(v) for v in hub.parent_anchor])
+           - np.array([num(v) for v in hinge.child_anchor]))
+    u = arm / np.linalg.norm(arm)
+    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
+                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
+                    (float(u[0]), float(u[1])))
+
+
 @_builds(ROLLING_CONTACT, Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
                                                  "of contact_ring_boxes boxes (velocity-level "
                                                  "contact with erp; the hub on a massless "
@@ -781,6 +784,112 @@ def _rolling_contact(model: _Translation, c) -> None:
                                    0.0, 0.0, list(hub.position), (u[0], u[1], 0.0)))
     hub.parent, hub.position = k, [0.0, 0.0, 0.0]
     model.radial_link = k
+
+
+def _contact_shapes(p, cid: int, model: _Translation, cfg: dict
+                    ) -> tuple[dict[int, int], tuple[int, list[int]]]:
+    """Collision shapes of the contact variant: on the track, a ring of boxes whose
+    inner faces are tangent to the track circle (a regular polygon with the circle as
+    its incircle); on the disc, a sphere of the disc's radius centred on it (sphere-box
+    contacts are analytic in Bullet). Shape frames are relative to the link (joint)
+    frame, not to the centre of mass (measured with getAABB)."""
+    ct = model.contact
+    n_box = int(cfg["contact_ring_boxes"])
+    if n_box < 8:
+        raise ValueError("contact_ring_boxes must be at least 8")
+    lo, li = model.link_of[ct.outer], model.link_of[ct.inner]
+    off = model.links[lo].inertial_position  # body frame -> link frame: + this
+    cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
+    thick = 0.1 * ct.R
+    half_len = ct.R * math.tan(math.pi / n_box) * 1.001
+    depth = 2.0 * ct.r
+    pos, orn, half = [], [], []
+    for i in range(n_box):
+        a = 2.0 * math.pi * i / n_box
+        rho = ct.R + thick / 2.0
+        pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
+        orn.append(_quat_z(a))
+        half.append([thick / 2.0, half_len, depth])
+    # createCollisionShapeArray keeps only the first 16 children (measured with
+    # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
+    # its own massless fixed link on the track
+    ring = []
+    for k0 in range(0, n_box, 16):
+        sl = slice(k0, min(k0 + 16, n_box))
+        ring.append(p.createCollisionShapeArray(
+            [p.GEOM_BOX] * len(half[sl]), halfExtents=half[sl],
+            collisionFramePositions=pos[sl], collisionFrameOrientations=orn[sl],
+            physicsClientId=cid))
+    off = model.links[li].inertial_position
+    disc = p.createCollisionShape(
+        p.GEOM_SPHERE, radius=ct.r, collisionFramePosition=[
+            ct.inner_centre[0] + off[0], ct.inner_centre[1] + off[1], 0.0],
+        physicsClientId=cid)
+    if min(ring) < 0 or disc < 0:
+        raise RuntimeError("pybullet could not create the contact shapes")
+    return {li: disc}, (lo, ring)
+
+def _contact_dynamics(p, cid: int, body: int, eidx: list[int], model: _Translation,
+                      cfg: dict) -> None:
+    """Friction and contact solver parameters (Bullet combines the two links'
+    friction coefficients by product: the disc gets 1, the track the setting)."""
+    ct = model.contact
+    disc = eidx[model.link_of[ct.inner]]
+    for link, mu in [(e, float(cfg["contact_friction"])) for e in model.fixed_links] + [
+            (disc, 1.0)]:
+        for key, value in (("lateralFriction", mu), ("spinningFriction", 0.0),
+                           ("rollingFriction", 0.0), ("restitution", 0.0)):
+            p.changeDynamics(body, link, physicsClientId=cid, **{key: value})
+    # only the disc and the ring collide (the ring's compounds overlap each other)
+    for e in model.fixed_links:
+        p.setCollisionFilterGroupMask(body, e, 1, 2, physicsClientId=cid)
+    p.setCollisionFilterGroupMask(body, disc, 2, 1, physicsClientId=cid)
+    p.setPhysicsEngineParameter(
+        contactERP=float(cfg["contact_erp"]), frictionERP=float(cfg["contact_erp"]),
+        contactSlop=0.0, restitutionVelocityThreshold=0.0,
+        contactBreakingThreshold=float(cfg["contact_breaking_threshold"]),
+        physicsClientId=cid)
+
+def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, float]:
+    """Force of the track on the disc (world x, y) summed over the contact points of
+    the step, and the number of points. Bullet's normal on B points towards A; the
+    normal and friction impulses push A along +n, +dir and B along -n, -dir."""
+    fx = fy = 0.0
+    count = 0
+    for cp in points:
+        la, lb = cp[3], cp[4]
+        if la in ring and lb == disc:
+            sign = -1.0
+        elif la == disc and lb in ring:
+            sign = 1.0
+        else:
+            continue
+        nrm, fn = cp[7], cp[9]
+        d1, f1, d2, f2 = cp[11], cp[10], cp[13], cp[12]
+        fx += sign * (fn * nrm[0] + f1 * d1[0] + f2 * d2[0])
+        fy += sign * (fn * nrm[1] + f1 * d1[1] + f2 * d2[1])
+        count += 1
+    return fx, fy, float(count)
+
+def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray,
+                    qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
+    """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
+    (m/s), penetration of the disc into the track (radial slider value, m), normal
+    and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
+    component f, track on disc, along t = k x u with u from the track centre to the
+    disc) is what the coupling's -lambda stands for."""
+    ct = model.contact
+    cvec, const = coupling_row(model.mech, coupling)
+    u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
+    ux, uy = u[:, 0], u[:, 1]
+    normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
+    friction = FC[:, 0] * -uy + FC[:, 1] * ux
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(friction) / normal
+    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
+            "penetration": JV[:, model.radial_link], "normal_force": normal,
+            "friction": friction, "friction_ratio": ratio,
+            "contact_points": FC[:, 2]}
 
 
 @_builds(PRESCRIBED,
@@ -1157,7 +1266,7 @@ class PyBulletBackend(Backend):
         cid = self._connect(p, cfg, dt, model.gravity_vector,
                             constrained=bool(model.closures) or model.contact is not None)
         try:
-            shapes, ring = (self._contact_shapes(p, cid, model, cfg)
+            shapes, ring = (_contact_shapes(p, cid, model, cfg)
                             if model.contact is not None else (None, None))
             body, eidx, _ = self._build(p, cid, model, cfg, collision=shapes, fixed_shapes=ring)
             jv0 = model.map.engine_values(q0)
@@ -1172,7 +1281,7 @@ class PyBulletBackend(Backend):
                     c.place(p, cid, body, eidx, ls)
             cids = self._add_constraints(p, cid, body, eidx, model, cfg)
             if model.contact is not None:
-                self._contact_dynamics(p, cid, body, eidx, model, cfg)
+                _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
                 p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
         except BaseException:
@@ -1394,7 +1503,7 @@ class PyBulletBackend(Backend):
                         st = get_cstate(cids[r], physicsClientId=cid)
                         CF[k, r, : len(st)] = st
                     if contact is not None:
-                        FC[k] = self._contact_force(
+                        FC[k] = _contact_force(
                             get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
                             ring_links, disc_link)
                     if use_sensor:
@@ -1440,7 +1549,7 @@ class PyBulletBackend(Backend):
 
         contact_report = None
         if contact is not None:
-            contact_report = self._contact_report(model, coupling, q, qd,
+            contact_report = _contact_report(model, coupling, q, qd,
                                                   JV[: steps + 1], FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
@@ -1450,114 +1559,6 @@ class PyBulletBackend(Backend):
         if contact_report is not None:
             extras["contact"] = contact_report
         return Samples(q, qd, clock, reactions, forces, actuators, extras=extras)
-
-    # --- rolling by friction contact ---------------------------------------------------
-    def _contact_shapes(self, p, cid: int, model: _Translation, cfg: dict
-                        ) -> tuple[dict[int, int], tuple[int, list[int]]]:
-        """Collision shapes of the contact variant: on the track, a ring of boxes whose
-        inner faces are tangent to the track circle (a regular polygon with the circle as
-        its incircle); on the disc, a sphere of the disc's radius centred on it (sphere-box
-        contacts are analytic in Bullet). Shape frames are relative to the link (joint)
-        frame, not to the centre of mass (measured with getAABB)."""
-        ct = model.contact
-        n_box = int(cfg["contact_ring_boxes"])
-        if n_box < 8:
-            raise ValueError("contact_ring_boxes must be at least 8")
-        lo, li = model.link_of[ct.outer], model.link_of[ct.inner]
-        off = model.links[lo].inertial_position  # body frame -> link frame: + this
-        cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
-        thick = 0.1 * ct.R
-        half_len = ct.R * math.tan(math.pi / n_box) * 1.001
-        depth = 2.0 * ct.r
-        pos, orn, half = [], [], []
-        for i in range(n_box):
-            a = 2.0 * math.pi * i / n_box
-            rho = ct.R + thick / 2.0
-            pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
-            orn.append(_quat_z(a))
-            half.append([thick / 2.0, half_len, depth])
-        # createCollisionShapeArray keeps only the first 16 children (measured with
-        # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
-        # its own massless fixed link on the track
-        ring = []
-        for k0 in range(0, n_box, 16):
-            sl = slice(k0, min(k0 + 16, n_box))
-            ring.append(p.createCollisionShapeArray(
-                [p.GEOM_BOX] * len(half[sl]), halfExtents=half[sl],
-                collisionFramePositions=pos[sl], collisionFrameOrientations=orn[sl],
-                physicsClientId=cid))
-        off = model.links[li].inertial_position
-        disc = p.createCollisionShape(
-            p.GEOM_SPHERE, radius=ct.r, collisionFramePosition=[
-                ct.inner_centre[0] + off[0], ct.inner_centre[1] + off[1], 0.0],
-            physicsClientId=cid)
-        if min(ring) < 0 or disc < 0:
-            raise RuntimeError("pybullet could not create the contact shapes")
-        return {li: disc}, (lo, ring)
-
-    def _contact_dynamics(self, p, cid: int, body: int, eidx: list[int], model: _Translation,
-                          cfg: dict) -> None:
-        """Friction and contact solver parameters (Bullet combines the two links'
-        friction coefficients by product: the disc gets 1, the track the setting)."""
-        ct = model.contact
-        disc = eidx[model.link_of[ct.inner]]
-        for link, mu in [(e, float(cfg["contact_friction"])) for e in model.fixed_links] + [
-                (disc, 1.0)]:
-            for key, value in (("lateralFriction", mu), ("spinningFriction", 0.0),
-                               ("rollingFriction", 0.0), ("restitution", 0.0)):
-                p.changeDynamics(body, link, physicsClientId=cid, **{key: value})
-        # only the disc and the ring collide (the ring's compounds overlap each other)
-        for e in model.fixed_links:
-            p.setCollisionFilterGroupMask(body, e, 1, 2, physicsClientId=cid)
-        p.setCollisionFilterGroupMask(body, disc, 2, 1, physicsClientId=cid)
-        p.setPhysicsEngineParameter(
-            contactERP=float(cfg["contact_erp"]), frictionERP=float(cfg["contact_erp"]),
-            contactSlop=0.0, restitutionVelocityThreshold=0.0,
-            contactBreakingThreshold=float(cfg["contact_breaking_threshold"]),
-            physicsClientId=cid)
-
-    @staticmethod
-    def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, float]:
-        """Force of the track on the disc (world x, y) summed over the contact points of
-        the step, and the number of points. Bullet's normal on B points towards A; the
-        normal and friction impulses push A along +n, +dir and B along -n, -dir."""
-        fx = fy = 0.0
-        count = 0
-        for cp in points:
-            la, lb = cp[3], cp[4]
-            if la in ring and lb == disc:
-                sign = -1.0
-            elif la == disc and lb in ring:
-                sign = 1.0
-            else:
-                continue
-            nrm, fn = cp[7], cp[9]
-            d1, f1, d2, f2 = cp[11], cp[10], cp[13], cp[12]
-            fx += sign * (fn * nrm[0] + f1 * d1[0] + f2 * d2[0])
-            fy += sign * (fn * nrm[1] + f1 * d1[1] + f2 * d2[1])
-            count += 1
-        return fx, fy, float(count)
-
-    @staticmethod
-    def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray,
-                        qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
-        """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
-        (m/s), penetration of the disc into the track (radial slider value, m), normal
-        and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
-        component f, track on disc, along t = k x u with u from the track centre to the
-        disc) is what the coupling's -lambda stands for."""
-        ct = model.contact
-        cvec, const = coupling_row(model.mech, coupling)
-        u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
-        ux, uy = u[:, 0], u[:, 1]
-        normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
-        friction = FC[:, 0] * -uy + FC[:, 1] * ux
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.abs(friction) / normal
-        return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
-                "penetration": JV[:, model.radial_link], "normal_force": normal,
-                "friction": friction, "friction_ratio": ratio,
-                "contact_points": FC[:, 2]}
 
     def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
