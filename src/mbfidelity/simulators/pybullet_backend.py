@@ -1450,30 +1450,23 @@ class PyBulletBackend(Backend):
         world = self._open(p, mechanism, q0, qd0, dt, cfg,
                            sensor_joints=joint_ids if use_sensor else ())
         cid, body, eidx, model, cids = world.cid, world.body, world.eidx, world.model, world.cids
-        contact, coupling = model.contact, model.coupling
-        n = model.n
-        n_all = len(model.links)
-        closures = model.closures
+        contact, closures, n = model.contact, model.closures, model.n
         # one extra step gives the reaction/acceleration (and the constraint forces) of
         # the last sample
         total = steps + 1 if (reaction_joints or closures or contact
                               or mechanism.prescribed) else steps
         try:
-            JV = np.empty((total + 1, n_all))
-            JVD = np.empty((total + 1, n_all))
+            JV, JVD = np.empty((total + 1, len(eidx))), np.empty((total + 1, len(eidx)))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
-            n_pf = len(model.point_forces)
-            f_point = np.zeros((total + 1, n_pf, 2))  # force on point b (on a: opposite)
+            # force on point b of each point-to-point element (on a: opposite)
+            f_point = np.zeros((total + 1, len(model.point_forces), 2))
             CF = np.full((total + 1, len(closures), 6), np.nan)  # getConstraintState rows
             # contact variant: force of the track on the disc (x, y) and contact count
             FC = np.zeros((total + 1, 3))
 
-            step = p.stepSimulation
-            get_states = p.getJointStates
-            get_cstate = p.getConstraintState
-            get_contacts = p.getContactPoints
+            step, get_states = p.stepSimulation, p.getJointStates
+            get_cstate, get_contacts = p.getConstraintState, p.getContactPoints
             sensor_slots = [eidx[i] for i in joint_ids]
-            n_cs = len(cids)
             apply, _ = self._inputs(p, world, dt, cfg)
             driven = [(model.map.A[m.index, m.index], m.element.name) for m in model.driven]
             driven_slots = [m.index for m in model.driven]
@@ -1485,10 +1478,8 @@ class PyBulletBackend(Backend):
             js = get_states(body, eidx, physicsClientId=cid)
             with Stopwatch() as clock:
                 for k in range(total):
-                    jv = [s[0] for s in js]
-                    jvd = [s[1] for s in js]
-                    JV[k] = jv
-                    JVD[k] = jvd
+                    JV[k] = jv = [s[0] for s in js]
+                    JVD[k] = jvd = [s[1] for s in js]
                     forces = apply(k, jv, jvd) if apply is not None else None
                     if forces is not None:
                         f_point[k] = forces
@@ -1499,8 +1490,8 @@ class PyBulletBackend(Backend):
                         motor[k, r] = js[slot][3]
                     # constraint and contact forces read after a step belong to the state
                     # before it
-                    for r in range(n_cs):
-                        st = get_cstate(cids[r], physicsClientId=cid)
+                    for r, uid in enumerate(cids):
+                        st = get_cstate(uid, physicsClientId=cid)
                         CF[k, r, : len(st)] = st
                     if contact is not None:
                         FC[k] = _contact_force(
@@ -1549,7 +1540,7 @@ class PyBulletBackend(Backend):
 
         contact_report = None
         if contact is not None:
-            contact_report = _contact_report(model, coupling, q, qd,
+            contact_report = _contact_report(model, model.coupling, q, qd,
                                                   JV[: steps + 1], FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
