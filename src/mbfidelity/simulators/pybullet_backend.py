@@ -105,6 +105,7 @@ from ..systems.model import (
     Mechanism,
     PointToPoint,
     Prescribed,
+    RollingContact,
     inertia_matrix,
 )
 from ..analytic.linear import quadratic_eigenvalues
