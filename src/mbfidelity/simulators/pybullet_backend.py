@@ -254,7 +254,12 @@ class _PointForce:
         """(force on b x, y, point a x, y, point b x, y) from link states (`ls[link]`);
         the force on a is opposite."""
         states = {self.body_a: _pose(ls, self.link_a), self.body_b: _pose(ls, self.link_b)}
-        (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
+        try:
+            (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
+        except ZeroDivisionError:  # the points coincide: the force has no direction
+            ax, ay = _point(ls, self.link_a, self.point_a)[:2]
+            bx, by = _point(ls, self.link_b, self.point_b)[:2]
+            return 0.0, 0.0, ax, ay, bx, by
         return fx, fy, ax, ay, bx, by
 
 
