@@ -767,3 +767,13 @@ def element_loads(mech: Mechanism, element: PointToPoint | CoordinateForce
         return [load for sign, _, _, apply in terms for load in apply(states, sign * value)]
 
     return coordinate_force
+
+
+def coupling_row(mech: Mechanism, coupling: LinearCoupling | RollingContact
+                 ) -> tuple[np.ndarray, float]:
+    """A coupling sum a_k q_k = C as its row a over the description coordinates and its
+    constant C (a RollingContact: the rolling coupling it stands for)."""
+    row = np.zeros(len(mech.coordinates))
+    for name, coefficient in coupling.coefficients:
+        row[mech.coordinates.index(name)] += num(coefficient)
+    return row, num(coupling.constant)

@@ -2,7 +2,14 @@
 a fixed base at the world origin, one link per joint, no collision shapes and explicit
 inertias.
 
-Translation (generic over the description, conventions 1-8 of `systems.model`):
+Translation (generic over the description, conventions 1-8 of `systems.model`): each
+element kind of the description (`plan.ELEMENT_KINDS`) has one builder, registered together
+with the expressions it builds (`_builds`; `EXPRESSIONS` is that registry's declarations),
+which puts the element into `_Translation`, the mechanism in PyBullet's terms (links,
+closures, point forces, coordinate laws, drives) from the shared plan's numbers and
+coordinate map; each closure is one class per PyBullet construct (`_Pin`, `_Slider`,
+`_Rotor`, `_Gear`) that creates its constraint, places its extra link, and turns the
+engine's constraint rows into the contract's force and violation.
 
 - Each body becomes one link whose URDF link frame sits at the anchor of the joint that
   places it (the body's ``child_anchor``) with the body's orientation; the inertial frame
@@ -86,7 +93,7 @@ step: refused.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -96,10 +103,8 @@ from ..systems.model import (
     CoordinateForce,
     LinearCoupling,
     Mechanism,
-    PointOnLine,
-    PointOnPoint,
+    PointToPoint,
     Prescribed,
-    Revolute,
     RollingContact,
     inertia_matrix,
 )
@@ -123,10 +128,10 @@ from .base import (
 from .reactions import joint_reactions
 from .plan import (
     CoordinateLaws,
+    Motion,
     spatial_tree_reason,
     BODY,
     PRESCRIBED,
-    motions,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -142,7 +147,12 @@ from .plan import (
     ForceLaw,
     constrained_bodies,
     coordinate_map,
+    coupling_row,
+    element_kind,
+    element_loads,
+    elements,
     num,
+    point_state,
 )
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
@@ -161,11 +171,48 @@ def _quat_z(angle: float) -> list[float]:
     return [0.0, 0.0, math.sin(angle / 2.0), math.cos(angle / 2.0)]
 
 
+def _xy(point) -> tuple[float, float]:
+    """A description point's numbers."""
+    return num(point[0]), num(point[1])
+
+
+def _xyz(point) -> list[float]:
+    """A planar point in PyBullet's 3-D terms."""
+    return [point[0], point[1], 0.0]
+
+
+def _engine(eidx: Sequence[int], link: int) -> int:
+    """The engine link index of a translation link (-1: the fixed base)."""
+    return eidx[link] if link >= 0 else -1
+
+
+def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
+    """(x, y, theta, vx, vy, omega) of a link's centre-of-mass frame from its link state
+    (`ls[link]`; -1: the base; without velocities in the state they are zero)."""
+    if link < 0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    st = ls[link]
+    com, quat = st[0], st[1]
+    vel, omega = (st[6], st[7][2]) if len(st) > 6 else ((0.0, 0.0, 0.0), 0.0)
+    return com[0], com[1], 2.0 * math.atan2(quat[2], quat[3]), vel[0], vel[1], omega
+
+
+def _point(ls, link: int, point) -> tuple[float, float, float, float]:
+    """World position and velocity of a body point (centre-of-mass frame)."""
+    return point_state(_pose(ls, link), point)
+
+
+def _turned(th: np.ndarray, x, y) -> np.ndarray:
+    """The vectors (x, y) turned by the angles th, one row per sample (N, 2)."""
+    c, s = np.cos(th), np.sin(th)
+    return np.stack([c * x - s * y, s * x + c * y], axis=1)
+
+
 @dataclass
 class _Link:
     name: str          # joint name
     body: str          # child body
-    parent: int        # engine link index of the parent body, -1 for the world
+    parent: int        # translation link index of the parent body, -1 for the world
     revolute: bool
     mass: float
     inertia: float
@@ -173,68 +220,47 @@ class _Link:
     orientation: list[float]       # joint frame orientation in the parent's link frame
     inertial_position: list[float]  # centre of mass in the link frame
     axis: list[float]               # joint axis in the joint (= link) frame
-    axis_parent: np.ndarray         # unit prismatic axis in the parent body frame (2,)
     #: a spatial body's principal moments and the quaternion of its principal axes in the
     #: link frame (None: the planar inertia on every axis, identity frame)
     principal: tuple[list[float], list[float]] | None = None
 
 
+def _extra_link(name: str, parent: int, revolute: bool, mass: float, inertia: float,
+                position: list[float], axis) -> _Link:
+    """A link beyond the description's (a rotor, a slider, the contact's radial slider):
+    its frame aligned with the parent's, its centre of mass at its origin."""
+    return _Link(name=name, body=name, parent=parent, revolute=revolute, mass=mass,
+                 inertia=inertia, position=position, orientation=[0.0, 0.0, 0.0, 1.0],
+                 inertial_position=[0.0, 0.0, 0.0], axis=[float(axis[0]), float(axis[1]),
+                                                          float(axis[2])])
+
+
 @dataclass
 class _PointForce:
+    """A point-to-point element on the links `link_a`, `link_b` (-1: world), its loads
+    from the shared plan (`plan.element_loads`)."""
+
     name: str
-    link_a: int   # -1: world
-    point_a: tuple[float, float]
+    link_a: int
     link_b: int
+    point_a: tuple[float, float]  # in the body frames
     point_b: tuple[float, float]
-    law: Callable[[float, float, float], float]
     body_a: str
     body_b: str
+    loads: Callable[[Mapping, float], list]
     time_dependent: bool
 
-
-
-@dataclass
-class _Closure:
-    """A closure constraint and its PyBullet constraint (links are plan link indices,
-    -1 = the fixed base; points in centre-of-mass frames = the description's body frames).
-
-    kind "p2p" (PointOnPoint): JOINT_POINT2POINT, parent = body_a's link at point_a,
-    child = body_b's link at point_b.
-    kind "prismatic" (PointOnLine, default): a rotor link (revolute, no mass, small
-    inertia) on the pin body at the pin, and a JOINT_PRISMATIC constraint (rotor =
-    parent, axis along the slot in its frame; slot body = child, pivot moved under the
-    pin before each step): one in-plane row normal to the slot plus a row locking the
-    rotor's angle to the slot body's; the rotor's inertia is the only substitute.
-    kind "slider" (PointOnLine, alternative): a slider link (prismatic along the slot,
-    small mass) on the slot body and a JOINT_POINT2POINT pin (parent) - slider (child).
-    kind "gear" (LinearCoupling): JOINT_GEAR jv[a] + ratio jv[b] = target between engine
-    joints a and b; `scale` (w_a) turns its force into the coupling's -multiplier."""
-
-    element: object
-    kind: str
-    parent: int = -1
-    parent_point: tuple[float, float] = (0.0, 0.0)
-    child: int = -1
-    child_point: tuple[float, float] = (0.0, 0.0)
-    # PointOnLine: pin and slot (line) geometry, and the extra link (slider or rotor)
-    pin_link: int = -1
-    pin_point: tuple[float, float] = (0.0, 0.0)
-    line_link: int = -1
-    line_point: tuple[float, float] = (0.0, 0.0)
-    direction: tuple[float, float] = (1.0, 0.0)
-    aux: int = -1
-    #: prismatic: the constraint's in-plane normal row direction in the slot body frame
-    row_normal: tuple[float, float] = (0.0, 1.0)
-    #: (link on which the reported force acts, link of the opposite force): for reactions
-    force_links: tuple[int, int] = (-1, -1)
-    # gear
-    a: int = -1
-    b: int = -1
-    ratio: float = 0.0
-    target: float = 0.0
-    scale: float = 1.0
-    weights: np.ndarray | None = None  # coupling coefficients c (description coordinates)
-    constant: float = 0.0
+    def force(self, ls, t: float) -> tuple[float, float, float, float, float, float]:
+        """(force on b x, y, point a x, y, point b x, y) from link states (`ls[link]`);
+        the force on a is opposite."""
+        states = {self.body_a: _pose(ls, self.link_a), self.body_b: _pose(ls, self.link_b)}
+        try:
+            (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
+        except ZeroDivisionError:  # the points coincide: the force has no direction
+            ax, ay = _point(ls, self.link_a, self.point_a)[:2]
+            bx, by = _point(ls, self.link_b, self.point_b)[:2]
+            return 0.0, 0.0, ax, ay, bx, by
+        return fx, fy, ax, ay, bx, by
 
 
 def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
@@ -254,8 +280,8 @@ def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
 
 def _two_joint_gear(mech: Mechanism, coupling: LinearCoupling) -> bool:
     """The coupling, written on the engine joint values, involves exactly two of them."""
-    cmap = coordinate_map(mech)
-    return int(np.count_nonzero(_gear_terms(coupling, mech.coordinates, cmap.T, cmap.b)[2])) == 2
+    row, _ = coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
+    return int(np.count_nonzero(row)) == 2
 
 
 def _one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
@@ -264,47 +290,188 @@ def _one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
     return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
 
 
-def _gear_terms(c: LinearCoupling, coords: Sequence[str], Ainv: np.ndarray,
-                bvec: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, float]:
-    """The coupling sum(c q) = const written on the engine joint values:
-    w . jv = const + c . A^-1 b with w = A^-T c. Returns (c, const, w, rhs)."""
-    cvec = np.zeros(len(coords))
-    for name, coef in c.coefficients:
-        cvec[coords.index(name)] += num(coef)
-    const = num(c.constant)
-    w = Ainv.T @ cvec
-    w[np.abs(w) < 1e-14 * max(float(np.max(np.abs(w))), 1e-300)] = 0.0
-    return cvec, const, w, const + float(cvec @ Ainv @ bvec)
+# --- closure constraints: one class per PyBullet construct ---------------------------
 
 
 @dataclass
-class _Contact:
-    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
-    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
+class _Pin:
+    """PointOnPoint: JOINT_POINT2POINT, parent = body_a's link at point_a, child =
+    body_b's link at point_b (translation link indices, -1 = the fixed base; points in
+    centre-of-mass frames = the description's body frames). Its rows along world x, y, z
+    hold the force on the CHILD (a bar held at its tip by the base, bar = parent, reads
+    -m g / 2): the contract's force on body_a (the parent) is minus the rows."""
 
-    coupling: str
-    outer: str
-    inner: str
-    R: float
-    r: float
-    centre: tuple[float, float]       # outer circle centre, outer body frame
-    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
-    hub: int                          # joint index of the inner body (its parent: the arm)
-    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
+    element: object
+    parent: int
+    parent_point: tuple[float, float]
+    child: int
+    child_point: tuple[float, float]
+    #: its force acts between two bodies (reactions take it out where it crosses a cut)
+    pair = True
+    #: its child pivot is moved under the pin before every step
+    follows_pin = False
+
+    def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
+        uid = p.createConstraint(body, _engine(eidx, self.parent), body,
+                                 _engine(eidx, self.child), *self.frames(p),
+                                 physicsClientId=cid)
+        p.changeConstraint(uid, maxForce=float(cfg["constraint_max_force"]),
+                           physicsClientId=cid)
+        return uid
+
+    def frames(self, p) -> tuple:
+        """createConstraint's joint type, axis and parent and child pivots."""
+        return (p.JOINT_POINT2POINT, [0, 0, 0], _xyz(self.parent_point),
+                _xyz(self.child_point))
+
+    def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
+        """Set the state of its extra link from the description state (none here)."""
+
+    def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
+        """getConstraintState rows (N, 6) -> the contract's force (signs measured)."""
+        return -rows[:, :2]
+
+    def violations(self, q: np.ndarray) -> np.ndarray:
+        """Its violation at the samples q where it follows from q alone; otherwise an
+        array that `violation` fills sample by sample from the engine's link states."""
+        return np.empty(len(q))
+
+    def violation(self, ls) -> float:
+        """Distance of the two points (m)."""
+        px, py, _, _ = _point(ls, self.parent, self.parent_point)
+        bx, by, _, _ = _point(ls, self.child, self.child_point)
+        return math.hypot(px - bx, py - by)
 
 
-def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
-    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
-    the track, the disc's circle at its hub, and the radial slider runs along the arm
-    from that hinge to the hub."""
-    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
-    centre = tuple(num(v) for v in hinge.parent_anchor)
-    arm = (np.array([num(v) for v in hub.parent_anchor])
-           - np.array([num(v) for v in hinge.child_anchor]))
-    u = arm / np.linalg.norm(arm)
-    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
-                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
-                    (float(u[0]), float(u[1])))
+@dataclass
+class _Slot(_Pin):
+    """PointOnLine: the pin (`pin_link`, `pin_point`), the slot's line (`line_link`,
+    `line_point`, unit `direction` in the slot body's frame) and the extra link `aux`."""
+
+    pin_link: int = -1
+    pin_point: tuple[float, float] = (0.0, 0.0)
+    line_link: int = -1
+    line_point: tuple[float, float] = (0.0, 0.0)
+    direction: tuple[float, float] = (1.0, 0.0)
+    aux: int = -1
+
+    def _line(self, ls) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, float]]:
+        """World position and velocity of the pin P and of the slot body's point L, and
+        the slot's direction u in world axes, from link states."""
+        th = _pose(ls, self.line_link)[2]
+        c, s = math.cos(th), math.sin(th)
+        u = (c * self.direction[0] - s * self.direction[1],
+             s * self.direction[0] + c * self.direction[1])
+        return (_point(ls, self.pin_link, self.pin_point),
+                _point(ls, self.line_link, self.line_point), u)
+
+    def violation(self, ls) -> float:
+        """Signed distance n . (P - L) of the pin from the slot line (m)."""
+        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(ls)
+        return -uy * (px - lx) + ux * (py - ly)
+
+
+@dataclass
+class _Slider(_Slot):
+    """PointOnLine, setting point_on_line = 'slider': a slider link (prismatic along the
+    slot, small mass) on the slot body and a JOINT_POINT2POINT pin (parent) - slider
+    (child); its force on the pin (parent) is minus the rows."""
+
+    def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
+        """The slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
+        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
+        the rotation of u adds nothing)."""
+        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
+        s = (px - lx) * ux + (py - ly) * uy
+        sd = (pvx - lvx) * ux + (pvy - lvy) * uy
+        p.resetJointState(body, eidx[self.aux], s, sd, physicsClientId=cid)
+
+
+@dataclass
+class _Rotor(_Slot):
+    """PointOnLine (default): a rotor link (revolute, no mass, small inertia) on the pin
+    body at the pin, and a JOINT_PRISMATIC constraint (rotor = parent, axis along the slot
+    in its frame; slot body = child, pivot moved under the pin before each step): one
+    in-plane row normal to the slot plus a row locking the rotor's angle to the slot
+    body's; the rotor's inertia is the only substitute. Row 1 is the in-plane normal of
+    the slot (`_slider_row_normal`, turned with the slot body) and holds the force on the
+    PARENT (checked with either body as parent on the scotch yoke); the parent is the
+    rotor, i.e. the pin: the contract's force is + row 1 times that normal."""
+
+    follows_pin = True
+
+    def frames(self, p) -> tuple:
+        return (p.JOINT_PRISMATIC, [self.direction[0], self.direction[1], 0.0],
+                [0.0, 0.0, 0.0], _xyz(self.child_point))
+
+    def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
+        """The rotor turned to the slot body's angle, th_slot - th_pin, at the relative
+        rate w_slot - w_pin."""
+        _, _, th_l, _, _, w_l = _pose(ls, self.line_link)
+        _, _, th_p, _, _, w_p = _pose(ls, self.pin_link)
+        rel = math.remainder(th_l - th_p, 2.0 * math.pi)
+        p.resetJointState(body, eidx[self.aux], rel, w_l - w_p, physicsClientId=cid)
+
+    def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
+        if self.line_link >= 0:
+            th = model.map.angle(model.links[self.line_link].body, q)
+        else:
+            th = np.zeros(len(rows))
+        nx, ny = _slider_row_normal(self.direction)
+        cs, sn = np.cos(th), np.sin(th)
+        f = rows[:, 1]
+        return np.stack([f * (cs * nx - sn * ny), f * (sn * nx + cs * ny)], axis=1)
+
+    def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
+        """The slot body's point under the pin (its projection on the slot line), in the
+        slot body's frame: L + ((P - L) . u) u. PyBullet's JOINT_PRISMATIC evaluates its
+        Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
+        (fixed) the slot body would feel the force at L instead of at the pin (measured: a
+        bar slotted along its own axis through its pivot then swings freely)."""
+        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(
+            {lk: ls[m] for lk, m in slot_of.items()})
+        s = (px - lx) * ux + (py - ly) * uy
+        ux, uy = self.direction
+        return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
+
+
+@dataclass
+class _Gear:
+    """LinearCoupling: JOINT_GEAR jv[a] + ratio jv[b] = target between engine joints a and
+    b. Its one row f gives the joint forces f (1, ratio) on (a, b) (checked against inverse
+    dynamics), i.e. (f / w_a) w = A^-T c f / w_a: the coupling's generalized force is
+    c f / w_a and -lambda = f / w_a (`scale` = w_a)."""
+
+    element: object
+    a: int
+    b: int
+    ratio: float
+    target: float
+    scale: float
+    weights: np.ndarray  # coupling coefficients c (description coordinates)
+    constant: float
+    pair = False
+    follows_pin = False
+
+    def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
+        uid = p.createConstraint(body, eidx[self.a], body, eidx[self.b], p.JOINT_GEAR,
+                                 [0, 0, 1], [0, 0, 0], [0, 0, 0], physicsClientId=cid)
+        kw = {"gearRatio": self.ratio, "maxForce": float(cfg["constraint_max_force"])}
+        erp = float(cfg["gear_erp"])
+        if erp:
+            kw.update(erp=erp, relativePositionTarget=self.target)
+        p.changeConstraint(uid, physicsClientId=cid, **kw)
+        return uid
+
+    def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
+        """No extra link."""
+
+    def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
+        return rows[:, :1] / self.scale
+
+    def violations(self, q: np.ndarray) -> np.ndarray:
+        """Phi = c . q - constant."""
+        return q @ self.weights - self.constant
 
 
 def _spatial_reason(mech: Mechanism) -> str:
@@ -339,22 +506,22 @@ def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
                  orientation=[0.0, 0.0, 0.0, 1.0],
                  inertial_position=[float(v) for v in -ca],
                  axis=[float(v) for v in axis / np.linalg.norm(axis)],
-                 axis_parent=np.zeros(2), principal=principal_inertia(tensor))
+                 principal=principal_inertia(tensor))
 
 
-class _Plan:
-    """Numeric translation of a (numeric) mechanism into PyBullet terms.
+class _Translation:
+    """The mechanism in PyBullet's terms, built element by element by the builders
+    registered per element kind (`_BUILDERS`) from the shared plan's numbers and coordinate
+    map (`map`): `links`, one per description joint (the first `n`), then the extra links
+    (the rolling contact's radial slider, one rotor or slider per PointOnLine), with
+    `creation_order` putting parents first; the `closures`, the point-to-point elements
+    (`point_forces`), the coordinate laws, the rolling `contact` and the `driven`
+    (prescribed) coordinates."""
 
-    `links` lists the engine links: one per description joint (the first `n`), then the
-    extra links (the contact variant's radial slider, one rotor or slider per
-    PointOnLine constraint); `creation_order` puts parents first."""
-
-    def __init__(self, mech: Mechanism, massless_mass: float,
-                 opts: Mapping | None = None,
-                 contact: _Contact | None = None) -> None:
-        opts = dict(opts or {})
-        self.mech = mech
+    def __init__(self, mech: Mechanism, cfg: Mapping) -> None:
+        self.mech, self.cfg = mech, cfg
         self.n = len(mech.joints)
+        self.map = coordinate_map(mech)
         gravity = num(mech.gravity)
         up = np.array([num(u) for u in mech.up], dtype=float)
         self.gravity_vector = ((0.0, -gravity, 0.0) if not mech.spatial
@@ -363,147 +530,29 @@ class _Plan:
         inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
         self.i_min = min((i for i in inertias if i > 0), default=1.0)
-        parents = {j.parent for j in mech.joints}
-        constrained = constrained_bodies(mech)
-        leaf_ratio = float(opts.get("massless_leaf_mass_ratio", 1e-6))
-        #: massless bodies that carry nothing but are held by a constraint: singular for
-        #: the articulated-body algorithm, given a small substitute mass (named setting)
-        self.leaf_substitutes: list[str] = []
-        link_of: dict[str, int] = {WORLD: -1}
-        anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
-        cmap = self.map = coordinate_map(mech)
+        self.link_of: dict[str, int] = {WORLD: -1}
+        self.anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
+        self.inertia_of: dict[str, tuple[float, float]] = {}  # body -> (mass, inertia)
         self.links: list[_Link] = []
-        for i, j in enumerate(mech.joints):
-            body = mech.body(j.child)
-            pa = (num(j.parent_anchor[0]), num(j.parent_anchor[1]))
-            ca = (num(j.child_anchor[0]), num(j.child_anchor[1]))
-            off = num(j.angle_offset)
-            panchor = anchor_of[j.parent]
-            axis_parent = np.zeros(2)
-            if isinstance(j, Revolute):
-                axis = [0.0, 0.0, 1.0]
-            else:
-                ax = np.array([num(j.axis[0]), num(j.axis[1])])
-                axis_parent = ax / cmap.A[i, i]
-                c, s = math.cos(-off), math.sin(-off)
-                axis = [c * axis_parent[0] - s * axis_parent[1],
-                        s * axis_parent[0] + c * axis_parent[1], 0.0]
-            mass, inertia = num(body.mass), num(body.inertia)
-            if mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
-                self.links.append(_spatial_link(mech, i, link_of[j.parent],
-                                                anchor_of[j.parent]))
-                link_of[j.child] = i
-                anchor_of[j.child] = tuple(-v for v in self.links[-1].inertial_position)
-                continue
-            if body.massless:
-                mass, inertia = massless_mass, 0.0
-                if body.name not in parents and body.name in constrained:
-                    mass = leaf_ratio * self.m_min
-                    inertia = leaf_ratio * self.i_min if isinstance(j, Revolute) else 0.0
-                    self.leaf_substitutes.append(body.name)
-            self.links.append(_Link(
-                name=j.name, body=j.child, parent=link_of[j.parent],
-                revolute=isinstance(j, Revolute), mass=mass, inertia=inertia,
-                position=[pa[0] - panchor[0], pa[1] - panchor[1], 0.0],
-                orientation=_quat_z(off),
-                inertial_position=[-ca[0], -ca[1], 0.0],
-                axis=axis, axis_parent=axis_parent))
-            link_of[j.child] = i
-            anchor_of[j.child] = ca
-        self.link_of = link_of
-
-        # rolling contact variant: the disc's hub rides on a massless radial slider on the
-        # arm, so that the contact, not the arm, carries the normal force
-        self.contact = contact
-        self.radial_link = -1
-        if contact is not None:
-            hub = self.links[contact.hub]
-            k = len(self.links)
-            u = np.array(contact.radial)
-            self.links.append(_Link(
-                name=f"{contact.coupling}:radial", body=f"{contact.coupling}:radial",
-                parent=hub.parent, revolute=False, mass=0.0, inertia=0.0,
-                position=list(hub.position), orientation=[0.0, 0.0, 0.0, 1.0],
-                inertial_position=[0.0, 0.0, 0.0], axis=[float(u[0]), float(u[1]), 0.0],
-                axis_parent=u))
-            hub.parent, hub.position = k, [0.0, 0.0, 0.0]
-            self.radial_link = k
-
-        # closure constraints (rotors / sliders become extra links after the description's)
-        self.closures: list[_Closure] = []
-        route = str(opts.get("point_on_line", "prismatic"))
-        slider_mass = float(opts.get("slider_mass_ratio", 1e-6)) * self.m_min
-        rotor_inertia = float(opts.get("rotor_inertia_ratio", 1e-6)) * self.i_min
-        for c in mech.constraints:
-            if isinstance(c, PointOnPoint):
-                la, lb = link_of[c.body_a], link_of[c.body_b]
-                self.closures.append(_Closure(
-                    c, "p2p", la, (num(c.point_a[0]), num(c.point_a[1])),
-                    lb, (num(c.point_b[0]), num(c.point_b[1])), force_links=(la, lb)))
-            elif isinstance(c, PointOnLine):
-                u = np.array([num(c.direction[0]), num(c.direction[1])])
-                u = u / float(np.hypot(*u))
-                lp = (num(c.line_point[0]), num(c.line_point[1]))
-                pp = (num(c.point[0]), num(c.point[1]))
-                lpin, lline = link_of[c.body], link_of[c.line_body]
-                k = len(self.links)
-                geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
-                           direction=(float(u[0]), float(u[1])), aux=k)
-                if route == "slider":
-                    anchor = anchor_of[c.line_body]
-                    self.links.append(_Link(
-                        name=f"{c.name}:slider", body=f"{c.name}:slider", parent=lline,
-                        revolute=False, mass=slider_mass, inertia=0.0,
-                        position=[lp[0] - anchor[0], lp[1] - anchor[1], 0.0],
-                        orientation=[0.0, 0.0, 0.0, 1.0], inertial_position=[0.0, 0.0, 0.0],
-                        axis=[float(u[0]), float(u[1]), 0.0], axis_parent=u))
-                    self.closures.append(_Closure(
-                        c, "slider", lpin, pp, k, (0.0, 0.0), force_links=(lpin, k), **geo))
-                else:
-                    anchor = anchor_of[c.body]
-                    self.links.append(_Link(
-                        name=f"{c.name}:rotor", body=f"{c.name}:rotor", parent=lpin,
-                        revolute=True, mass=0.0, inertia=rotor_inertia,
-                        position=[pp[0] - anchor[0], pp[1] - anchor[1], 0.0],
-                        orientation=[0.0, 0.0, 0.0, 1.0], inertial_position=[0.0, 0.0, 0.0],
-                        axis=[0.0, 0.0, 1.0], axis_parent=np.zeros(2)))
-                    self.closures.append(_Closure(
-                        c, "prismatic", k, (0.0, 0.0), lline, lp,
-                        row_normal=_slider_row_normal(u), force_links=(k, lline), **geo))
-            elif isinstance(c, LinearCoupling):
-                cvec, const, w, rhs = _gear_terms(c, mech.coordinates, cmap.T, cmap.b)
-                nz = np.flatnonzero(w)
-                if len(nz) != 2:  # guarded by support()
-                    raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
-                ia, ib = sorted(nz, key=lambda i: -abs(w[i]))
-                self.closures.append(_Closure(
-                    c, "gear", a=int(ia), b=int(ib), ratio=float(w[ib] / w[ia]),
-                    target=float(rhs / w[ia]), scale=float(w[ia]), weights=cvec,
-                    constant=const))
-            else:  # guarded by support()
-                raise TypeError(f"unsupported constraint {c!r}")
-
-        coordinate: list[CoordinateForce] = []
+        self.closures: list[_Pin | _Gear] = []
         self.point_forces: list[_PointForce] = []
-        for f in mech.forces:
-            law = ForceLaw.of(f)
-            if isinstance(f, CoordinateForce):
-                coordinate.append(f)
-                continue
-            self.point_forces.append(_PointForce(
-                f.name, link_of[f.body_a],
-                (num(f.point_a[0]), num(f.point_a[1])),
-                link_of[f.body_b], (num(f.point_b[0]), num(f.point_b[1])),
-                law.law, f.body_a, f.body_b, law.time_dependent))
-        self.coordinate_laws = CoordinateLaws(mech, coordinate)
+        self.coordinate_forces: list[CoordinateForce] = []
+        self.contact: _Contact | None = None
+        self.coupling: LinearCoupling | None = None  # the rolling coupling a contact stands for
+        self.radial_link = -1
+        self.fixed_links: list[int] = []  # engine links of the contact ring (`_build`)
+        self.driven: list[Motion] = []
+        for kind, element in elements(mech):
+            _BUILDERS[kind](self, element)
+        self.coordinate_laws = CoordinateLaws(mech, self.coordinate_forces)
         self.autonomous_laws = CoordinateLaws(
-            mech, [f for f in coordinate if not ForceLaw.of(f).time_dependent])
+            mech, [f for f in self.coordinate_forces if not ForceLaw.of(f).time_dependent])
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
     def creation_order(self) -> list[int]:
-        """Plan link indices with every parent before its children (the plan order unless
-        a link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
+        """Link indices with every parent before its children (the link order unless a
+        link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
         done: set[int] = set()
         order: list[int] = []
         while len(order) < len(self.links):
@@ -519,6 +568,348 @@ class _Plan:
         return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))
 
 
+# --- the builders, registered per element kind with the expressions they build ---------
+
+#: per element kind of the description, the function that builds an element of it into
+#: the `_Translation` (contract point 5), and the expressions it builds
+_BUILDERS: dict[str, Callable[[_Translation, object], None]] = {}
+_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
+
+
+def _builds(kind: str, *expressions: Expression):
+    """Register the decorated function as the builder of `kind`, which builds the
+    declared `expressions` (the declaration and the code that builds it are one thing)."""
+    def register(builder):
+        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, expressions
+        return builder
+    return register
+
+
+@_builds(BODY, Expression(EXACT, "a link of the reduced-coordinate multibody with the "
+                                 "explicit mass and central inertia (changeDynamics), "
+                                 "no collision shape"))
+def _massive_body(model: _Translation, body) -> None:
+    model.inertia_of[body.name] = (num(body.mass), num(body.inertia))
+
+
+def _carries_child(mech: Mechanism, body) -> bool:
+    return any(j.parent == body.name for j in mech.joints)
+
+
+def _held_by_closure(mech: Mechanism, body) -> bool:
+    return body.name in constrained_bodies(mech)
+
+
+@_builds(MASSLESS_BODY,
+         Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body algorithm "
+                           "inverts only each joint's articulated inertia, which its child "
+                           "carries", when="it carries a child", applies=_carries_child),
+         Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of the "
+                                "smallest body's), since zero would make the articulated-"
+                                "body algorithm singular",
+                    when="it carries nothing but a closure constraint holds it",
+                    applies=_held_by_closure),
+         Expression(UNSUPPORTED, "a massless link that carries nothing is singular for the "
+                                 "articulated-body algorithm",
+                    when="it carries nothing and no constraint holds it"))
+def _massless_body(model: _Translation, body) -> None:
+    mass, inertia = float(model.cfg["massless_link_mass"]), 0.0
+    if not _carries_child(model.mech, body) and _held_by_closure(model.mech, body):
+        ratio = float(model.cfg["massless_leaf_mass_ratio"])
+        hinged = element_kind(model.mech.joint_of_child(body.name)) == REVOLUTE
+        mass, inertia = ratio * model.m_min, ratio * model.i_min if hinged else 0.0
+    model.inertia_of[body.name] = (mass, inertia)
+
+
+def _joint_link(model: _Translation, j, revolute: bool, axis: list[float]) -> None:
+    """The link of description joint j: its URDF frame at the joint's anchor on the
+    parent, turned by the angle offset; its inertial frame at -child_anchor."""
+    i = model.mech.joints.index(j)
+    if model.mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
+        model.links.append(_spatial_link(model.mech, i, model.link_of[j.parent],
+                                         model.anchor_of[j.parent]))
+        model.anchor_of[j.child] = tuple(-v for v in model.links[-1].inertial_position)
+    else:
+        pa, ca = _xy(j.parent_anchor), _xy(j.child_anchor)
+        panchor = model.anchor_of[j.parent]
+        mass, inertia = model.inertia_of[j.child]
+        model.links.append(_Link(
+            name=j.name, body=j.child, parent=model.link_of[j.parent], revolute=revolute,
+            mass=mass, inertia=inertia, position=[pa[0] - panchor[0], pa[1] - panchor[1], 0.0],
+            orientation=_quat_z(num(j.angle_offset)), inertial_position=[-ca[0], -ca[1], 0.0],
+            axis=axis))
+        model.anchor_of[j.child] = ca
+    model.link_of[j.child] = i
+
+
+@_builds(REVOLUTE, Expression(EXACT, "revolute link about z, the joint frame turned by "
+                                     "angle_offset"))
+def _hinge(model: _Translation, j) -> None:
+    _joint_link(model, j, True, [0.0, 0.0, 1.0])
+
+
+@_builds(PRISMATIC, Expression(EXACT, "prismatic link along the unit axis (its length in "
+                                      "v = A q + b)"))
+def _slide(model: _Translation, j) -> None:
+    i = model.mech.joints.index(j)
+    axis = np.array([num(j.axis[0]), num(j.axis[1])]) / model.map.A[i, i]
+    c, s = math.cos(-num(j.angle_offset)), math.sin(-num(j.angle_offset))
+    _joint_link(model, j, False, [c * axis[0] - s * axis[1], s * axis[0] + c * axis[1], 0.0])
+
+
+@_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _POINT_FORCE))
+@_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, _POINT_FORCE))
+def _point_force(model: _Translation, f) -> None:
+    law = ForceLaw.of(f)
+    model.point_forces.append(_PointForce(
+        f.name, model.link_of[f.body_a], model.link_of[f.body_b], _xy(f.point_a),
+        _xy(f.point_b), f.body_a, f.body_b, element_loads(model.mech, f), law.time_dependent))
+
+
+@_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _JOINT_FORCE))
+@_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, _JOINT_FORCE))
+def _coordinate_force(model: _Translation, f) -> None:
+    model.coordinate_forces.append(f)
+
+
+#: a time load is built as the element it is
+_LOADS = {PointToPoint: _point_force, CoordinateForce: _coordinate_force}
+
+
+@_builds(TIME_LOAD, Expression(EXACT, "evaluated at the time of the start of each step, the "
+                                      "single stage of the semi-implicit Euler step"))
+def _time_load(model: _Translation, f) -> None:
+    _LOADS[type(f)](model, f)
+
+
+@_builds(POINT_ON_POINT, Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
+                                           "erp 1 (no regularisation; the position error of "
+                                           "a step is removed in the next)"))
+def _point_on_point(model: _Translation, c) -> None:
+    model.closures.append(_Pin(c, model.link_of[c.body_a], _xy(c.point_a),
+                               model.link_of[c.body_b], _xy(c.point_b)))
+
+
+@_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
+                                               "inertia rotor_inertia_ratio of the smallest) "
+                                               "and a JOINT_PRISMATIC rotor -> slot body whose "
+                                               "pivot follows the pin: the rotor's inertia is "
+                                               "the only substitute (point_on_line='slider': "
+                                               "a slider link of small mass)"))
+def _point_on_line(model: _Translation, c) -> None:
+    u = np.array([num(c.direction[0]), num(c.direction[1])])
+    u = u / float(np.hypot(*u))
+    lp, pp = _xy(c.line_point), _xy(c.point)
+    lpin, lline = model.link_of[c.body], model.link_of[c.line_body]
+    k = len(model.links)
+    geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
+               direction=(float(u[0]), float(u[1])), aux=k)
+    if model.cfg["point_on_line"] == "slider":
+        anchor = model.anchor_of[c.line_body]
+        mass = float(model.cfg["slider_mass_ratio"]) * model.m_min
+        model.links.append(_extra_link(f"{c.name}:slider", lline, False, mass, 0.0,
+                                       [lp[0] - anchor[0], lp[1] - anchor[1], 0.0],
+                                       (u[0], u[1], 0.0)))
+        model.closures.append(_Slider(c, lpin, pp, k, (0.0, 0.0), **geo))
+    else:
+        anchor = model.anchor_of[c.body]
+        inertia = float(model.cfg["rotor_inertia_ratio"]) * model.i_min
+        model.links.append(_extra_link(f"{c.name}:rotor", lpin, True, 0.0, inertia,
+                                       [pp[0] - anchor[0], pp[1] - anchor[1], 0.0],
+                                       (0.0, 0.0, 1.0)))
+        model.closures.append(_Rotor(c, k, (0.0, 0.0), lline, lp, **geo))
+
+
+@_builds(LINEAR_COUPLING,
+         Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, solved at "
+                           "velocity level (exact for a linear constraint)",
+                    when="two engine joint values", applies=_two_joint_gear),
+         Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
+                                 "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
+                                 "joint's current velocity as a target, it is not a three-term "
+                                 "constraint, and a one-joint coupling would be a lock",
+                    when="one, or three or more, engine joint values"))
+def _linear_coupling(model: _Translation, c) -> None:
+    cvec, const = coupling_row(model.mech, c)
+    w, rhs = model.map.on_engine_values(cvec, const)
+    nz = np.flatnonzero(w)
+    if len(nz) != 2:  # guarded by support()
+        raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
+    ia, ib = sorted(nz, key=lambda i: -abs(w[i]))
+    model.closures.append(_Gear(c, int(ia), int(ib), ratio=float(w[ib] / w[ia]),
+                                target=float(rhs / w[ia]), scale=float(w[ia]), weights=cvec,
+                                constant=const))
+
+
+# --- rolling by friction contact (a variant's stand-in for a rolling coupling) ---------
+
+
+@dataclass
+class _Contact:
+    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
+    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
+
+    coupling: str
+    outer: str
+    inner: str
+    R: float
+    r: float
+    centre: tuple[float, float]       # outer circle centre, outer body frame
+    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
+    hub: int                          # joint index of the inner body (its parent: the arm)
+    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
+
+
+def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
+    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
+    the track, the disc's circle at its hub, and the radial slider runs along the arm
+    from that hinge to the hub."""
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    centre = tuple(num(v) for v in hinge.parent_anchor)
+    arm = (np.array([num(v) for v in hub.parent_anchor])
+           - np.array([num(v) for v in hinge.child_anchor]))
+    u = arm / np.linalg.norm(arm)
+    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
+                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
+                    (float(u[0]), float(u[1])))
+
+
+@_builds(ROLLING_CONTACT, Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
+                                                 "of contact_ring_boxes boxes (velocity-level "
+                                                 "contact with erp; the hub on a massless "
+                                                 "radial slider); its force is the tangential "
+                                                 "contact force, its violation the slip"))
+def _rolling_contact(model: _Translation, c) -> None:
+    """The disc's hub rides on a massless radial slider on the arm, so that the contact,
+    not the arm, carries the normal force (shapes and friction: `_contact_shapes`)."""
+    model.contact, model.coupling = _contact_of(model.mech, c), c.coupling
+    hub = model.links[model.contact.hub]
+    k = len(model.links)
+    u = model.contact.radial
+    model.links.append(_extra_link(f"{model.contact.coupling}:radial", hub.parent, False,
+                                   0.0, 0.0, list(hub.position), (u[0], u[1], 0.0)))
+    hub.parent, hub.position = k, [0.0, 0.0, 0.0]
+    model.radial_link = k
+
+
+def _contact_shapes(p, cid: int, model: _Translation, cfg: dict
+                    ) -> tuple[dict[int, int], tuple[int, list[int]]]:
+    """Collision shapes of the contact variant: on the track, a ring of boxes whose
+    inner faces are tangent to the track circle (a regular polygon with the circle as
+    its incircle); on the disc, a sphere of the disc's radius centred on it (sphere-box
+    contacts are analytic in Bullet). Shape frames are relative to the link (joint)
+    frame, not to the centre of mass (measured with getAABB)."""
+    ct = model.contact
+    n_box = int(cfg["contact_ring_boxes"])
+    if n_box < 8:
+        raise ValueError("contact_ring_boxes must be at least 8")
+    lo, li = model.link_of[ct.outer], model.link_of[ct.inner]
+    off = model.links[lo].inertial_position  # body frame -> link frame: + this
+    cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
+    thick = 0.1 * ct.R
+    half_len = ct.R * math.tan(math.pi / n_box) * 1.001
+    depth = 2.0 * ct.r
+    pos, orn, half = [], [], []
+    for i in range(n_box):
+        a = 2.0 * math.pi * i / n_box
+        rho = ct.R + thick / 2.0
+        pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
+        orn.append(_quat_z(a))
+        half.append([thick / 2.0, half_len, depth])
+    # createCollisionShapeArray keeps only the first 16 children (measured with
+    # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
+    # its own massless fixed link on the track
+    ring = []
+    for k0 in range(0, n_box, 16):
+        sl = slice(k0, min(k0 + 16, n_box))
+        ring.append(p.createCollisionShapeArray(
+            [p.GEOM_BOX] * len(half[sl]), halfExtents=half[sl],
+            collisionFramePositions=pos[sl], collisionFrameOrientations=orn[sl],
+            physicsClientId=cid))
+    off = model.links[li].inertial_position
+    disc = p.createCollisionShape(
+        p.GEOM_SPHERE, radius=ct.r, collisionFramePosition=[
+            ct.inner_centre[0] + off[0], ct.inner_centre[1] + off[1], 0.0],
+        physicsClientId=cid)
+    if min(ring) < 0 or disc < 0:
+        raise RuntimeError("pybullet could not create the contact shapes")
+    return {li: disc}, (lo, ring)
+
+def _contact_dynamics(p, cid: int, body: int, eidx: list[int], model: _Translation,
+                      cfg: dict) -> None:
+    """Friction and contact solver parameters (Bullet combines the two links'
+    friction coefficients by product: the disc gets 1, the track the setting)."""
+    ct = model.contact
+    disc = eidx[model.link_of[ct.inner]]
+    for link, mu in [(e, float(cfg["contact_friction"])) for e in model.fixed_links] + [
+            (disc, 1.0)]:
+        for key, value in (("lateralFriction", mu), ("spinningFriction", 0.0),
+                           ("rollingFriction", 0.0), ("restitution", 0.0)):
+            p.changeDynamics(body, link, physicsClientId=cid, **{key: value})
+    # only the disc and the ring collide (the ring's compounds overlap each other)
+    for e in model.fixed_links:
+        p.setCollisionFilterGroupMask(body, e, 1, 2, physicsClientId=cid)
+    p.setCollisionFilterGroupMask(body, disc, 2, 1, physicsClientId=cid)
+    p.setPhysicsEngineParameter(
+        contactERP=float(cfg["contact_erp"]), frictionERP=float(cfg["contact_erp"]),
+        contactSlop=0.0, restitutionVelocityThreshold=0.0,
+        contactBreakingThreshold=float(cfg["contact_breaking_threshold"]),
+        physicsClientId=cid)
+
+def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, float]:
+    """Force of the track on the disc (world x, y) summed over the contact points of
+    the step, and the number of points. Bullet's normal on B points towards A; the
+    normal and friction impulses push A along +n, +dir and B along -n, -dir."""
+    fx = fy = 0.0
+    count = 0
+    for cp in points:
+        la, lb = cp[3], cp[4]
+        if la in ring and lb == disc:
+            sign = -1.0
+        elif la == disc and lb in ring:
+            sign = 1.0
+        else:
+            continue
+        nrm, fn = cp[7], cp[9]
+        d1, f1, d2, f2 = cp[11], cp[10], cp[13], cp[12]
+        fx += sign * (fn * nrm[0] + f1 * d1[0] + f2 * d2[0])
+        fy += sign * (fn * nrm[1] + f1 * d1[1] + f2 * d2[1])
+        count += 1
+    return fx, fy, float(count)
+
+def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray,
+                    qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
+    """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
+    (m/s), penetration of the disc into the track (radial slider value, m), normal
+    and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
+    component f, track on disc, along t = k x u with u from the track centre to the
+    disc) is what the coupling's -lambda stands for."""
+    ct = model.contact
+    cvec, const = coupling_row(model.mech, coupling)
+    u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
+    ux, uy = u[:, 0], u[:, 1]
+    normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
+    friction = FC[:, 0] * -uy + FC[:, 1] * ux
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(friction) / normal
+    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
+            "penetration": JV[:, model.radial_link], "normal_force": normal,
+            "friction": friction, "friction_ratio": ratio,
+            "contact_points": FC[:, 2]}
+
+
+@_builds(PRESCRIBED,
+         Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
+                           "force that never saturates (prescribed_motion): the coordinate "
+                           "lands on q(t+h) at every step; actuator force from getJointState",
+                    when="the coordinate is one engine joint value", applies=_one_joint_value),
+         Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an absolute "
+                                 "angle on a turning parent): one joint motor cannot impose "
+                                 "it", when="otherwise"))
+def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
+    model.driven.append(Motion(prescribed, model.mech.coordinates.index(prescribed.coordinate)))
+
+
 @dataclass
 class _World:
     """A PyBullet client with the mechanism built and its initial state set
@@ -526,11 +917,9 @@ class _World:
 
     cid: int
     body: int
-    eidx: list[int]  # engine link index of each plan link
-    plan: _Plan
+    eidx: list[int]  # engine link index of each translation link
+    model: _Translation
     cids: list[int]  # the PyBullet constraint of each closure
-    contact: _Contact | None
-    coupling: LinearCoupling | None  # the rolling coupling a contact stands for
 
 
 class PyBulletBackend(Backend):
@@ -708,70 +1097,7 @@ class PyBulletBackend(Backend):
             import pybullet
             return f"api {pybullet.getAPIVersion()}"
 
-    EXPRESSIONS = {
-        BODY: (Expression(EXACT, "a link of the reduced-coordinate multibody with the "
-                                 "explicit mass and central inertia (changeDynamics), "
-                                 "no collision shape"),),
-        MASSLESS_BODY: (
-            Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body "
-                              "algorithm inverts only each joint's articulated inertia, "
-                              "which its child carries", when="it carries a child",
-                       applies=lambda mech, body: any(j.parent == body.name
-                                                      for j in mech.joints)),
-            Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of "
-                                   "the smallest body's), since zero would make the "
-                                   "articulated-body algorithm singular",
-                       when="it carries nothing but a closure constraint holds it",
-                       applies=lambda mech, body: body.name in constrained_bodies(mech)),
-            Expression(UNSUPPORTED, "a massless link that carries nothing is singular for "
-                                    "the articulated-body algorithm",
-                       when="it carries nothing and no constraint holds it"),
-        ),
-        REVOLUTE: (Expression(EXACT, "revolute link about z, the joint frame turned by "
-                                     "angle_offset"),),
-        PRISMATIC: (Expression(EXACT, "prismatic link along the unit axis (its length in "
-                                      "v = A q + b)"),),
-        POINT_TO_POINT_LINEAR: (Expression(EXACT, _POINT_FORCE),),
-        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _POINT_FORCE),),
-        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _JOINT_FORCE),),
-        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _JOINT_FORCE),),
-        TIME_LOAD: (Expression(EXACT, "evaluated at the time of the start of each step, the "
-                                      "single stage of the semi-implicit Euler step"),),
-        POINT_ON_POINT: (Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
-                                           "erp 1 (no regularisation; the position error of "
-                                           "a step is removed in the next)"),),
-        POINT_ON_LINE: (Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
-                                               "inertia rotor_inertia_ratio of the smallest) "
-                                               "and a JOINT_PRISMATIC rotor -> slot body whose "
-                                               "pivot follows the pin: the rotor's inertia is "
-                                               "the only substitute (point_on_line='slider': "
-                                               "a slider link of small mass)"),),
-        ROLLING_CONTACT: (Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
-                                                 "of contact_ring_boxes boxes (velocity-level "
-                                                 "contact with erp; the hub on a massless "
-                                                 "radial slider); its force is the tangential "
-                                                 "contact force, its violation the slip"),),
-        LINEAR_COUPLING: (
-            Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, "
-                              "solved at velocity level (exact for a linear constraint)",
-                       when="two engine joint values", applies=_two_joint_gear),
-            Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
-                                    "(jv_a + ratio jv_b = target); its gearAuxLink only adds "
-                                    "that joint's current velocity as a target, it is not a "
-                                    "three-term constraint, and a one-joint coupling would be "
-                                    "a lock", when="one, or three or more, engine joint values"),
-        ),
-        PRESCRIBED: (
-            Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h "
-                              "with a force that never saturates (prescribed_motion): the "
-                              "coordinate lands on q(t+h) at every step; actuator force from "
-                              "getJointState", when="the coordinate is one engine joint value",
-                       applies=_one_joint_value),
-            Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an "
-                                    "absolute angle on a turning parent): one joint motor "
-                                    "cannot impose it", when="otherwise"),
-        ),
-    }
+    EXPRESSIONS = _EXPRESSIONS
 
     SPATIAL_REASON = ""
 
@@ -779,38 +1105,29 @@ class PyBulletBackend(Backend):
         return _spatial_reason(mechanism) if mechanism.spatial else ""
 
     # --- model building ----------------------------------------------------------------
-    def _build(self, p, cid: int, plan: _Plan, settings: dict,
+    def _build(self, p, cid: int, model: _Translation, settings: dict,
                split: Sequence[int] = (), collision: Mapping[int, int] | None = None,
                fixed_shapes: tuple[int, Sequence[int]] | None = None
                ) -> tuple[int, list[int], dict[int, tuple[int, int]]]:
         """Create the multibody; `split` lists joint indices in front of which two massless
         prismatic joints (parent-frame x, y) are inserted; `collision` gives collision
-        shapes of some plan links (default none: no contacts); `fixed_shapes` = (plan
+        shapes of some model links (default none: no contacts); `fixed_shapes` = (model
         link, shapes) adds one massless JOINT_FIXED link per shape on that link (their
-        engine indices go to `plan.fixed_links`). Returns (body id, engine link index of
-        each plan link, {joint index: (x link, y link)})."""
-        masses, positions, orientations, inertial, parents, types, axes = [], [], [], [], [], [], []
-        shapes: list[int] = []
-        inertial_orientations: list[list[float]] = []
+        engine indices go to `model.fixed_links`). Returns (body id, engine link index of
+        each model link, {joint index: (x link, y link)})."""
+        rows: list[tuple] = []  # per link, its columns of createMultiBody's arguments
         collision = dict(collision or {})
-        engine_index: list[int] = [-1] * len(plan.links)
+        engine_index: list[int] = [-1] * len(model.links)
         virtual: dict[int, tuple[int, int]] = {}
 
         def add(mass, pos, orn, ipos, parent, jtype, axis, shape=-1,
                 iorn=(0.0, 0.0, 0.0, 1.0)) -> int:
-            masses.append(mass)
-            positions.append(pos)
-            orientations.append(orn)
-            inertial.append(ipos)
-            inertial_orientations.append(list(iorn))
-            parents.append(parent + 1)  # createMultiBody counts links from 1; 0 = base
-            types.append(jtype)
-            axes.append(axis)
-            shapes.append(shape)
-            return len(masses) - 1
+            # createMultiBody counts links from 1; 0 = base
+            rows.append((mass, shape, pos, orn, ipos, list(iorn), parent + 1, jtype, axis))
+            return len(rows) - 1
 
-        for i in plan.creation_order():
-            lk = plan.links[i]
+        for i in model.creation_order():
+            lk = model.links[i]
             parent = engine_index[lk.parent] if lk.parent >= 0 else -1
             pos = lk.position
             if i in split:
@@ -829,7 +1146,9 @@ class PyBulletBackend(Backend):
             for shape in host_shapes:
                 fixed.append(add(0.0, [0.0, 0.0, 0.0], [0, 0, 0, 1], [0.0, 0.0, 0.0],
                                  engine_index[host], p.JOINT_FIXED, [0, 0, 1], shape))
-        nl = len(masses)
+        nl = len(rows)
+        masses, shapes, positions, orientations, inertial, inertial_orientations, parents, \
+            types, axes = map(list, zip(*rows))
         if nl > _MAX_LINKS:
             raise ValueError(f"pybullet multibodies keep at most {_MAX_LINKS} links "
                              f"(createMultiBody silently drops the rest); this model "
@@ -852,18 +1171,16 @@ class PyBulletBackend(Backend):
         engine_index = [created[k] for k in engine_index]
         virtual = {i: (created[vx], created[vy]) for i, (vx, vy) in virtual.items()}
         if fixed_shapes is not None:
-            plan.fixed_links = [created[k] for k in fixed]
+            model.fixed_links = [created[k] for k in fixed]
         # body-level parameters in their own calls (they reset the link index to -1)
-        p.changeDynamics(body, -1, linearDamping=float(settings["linear_damping"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, angularDamping=float(settings["angular_damping"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, maxJointVelocity=float(settings["max_joint_velocity"]),
-                         physicsClientId=cid)
-        p.changeDynamics(body, -1, activationState=(
-            p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
-            else p.ACTIVATION_STATE_DISABLE_SLEEPING), physicsClientId=cid)
-        for i, lk in enumerate(plan.links):
+        for key, value in (
+                ("linearDamping", float(settings["linear_damping"])),
+                ("angularDamping", float(settings["angular_damping"])),
+                ("maxJointVelocity", float(settings["max_joint_velocity"])),
+                ("activationState", p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
+                 else p.ACTIVATION_STATE_DISABLE_SLEEPING)):
+            p.changeDynamics(body, -1, **{key: value}, physicsClientId=cid)
+        for i, lk in enumerate(model.links):
             diagonal = lk.principal[0] if lk.principal else [lk.inertia] * 3
             if settings["explicit_inertia"]:
                 p.changeDynamics(body, engine_index[i], mass=float(lk.mass),
@@ -874,7 +1191,7 @@ class PyBulletBackend(Backend):
                     or abs(info[2][2] - diagonal[2]) > 1e-12 * max(1.0, diagonal[2])):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
-            moving = sorted(set(range(nl)) - set(getattr(plan, "fixed_links", ())
+            moving = sorted(set(range(nl)) - set(getattr(model, "fixed_links", ())
                                                  if fixed_shapes is not None else ()))
             p.setJointMotorControlArray(body, moving, p.VELOCITY_CONTROL,
                                         targetVelocities=[0.0] * len(moving),
@@ -901,207 +1218,45 @@ class PyBulletBackend(Backend):
 
     # --- closure constraints -------------------------------------------------------------
     @staticmethod
-    def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
-        """(x, y, theta, vx, vy, omega) of a link's centre-of-mass frame (-1: the base)."""
-        if link < 0:
-            return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        st = ls[link]
-        com, quat = st[0], st[1]
-        vel, omega = (st[6], st[7][2]) if len(st) > 6 else ((0.0, 0.0, 0.0), 0.0)
-        return com[0], com[1], 2.0 * math.atan2(quat[2], quat[3]), vel[0], vel[1], omega
-
-    @classmethod
-    def _point(cls, ls, link: int, point) -> tuple[float, float, float, float]:
-        """World position and velocity of a body point (centre-of-mass frame)."""
-        x, y, th, vx, vy, om = cls._pose(ls, link)
-        c, s = math.cos(th), math.sin(th)
-        rx, ry = c * point[0] - s * point[1], s * point[0] + c * point[1]
-        return x + rx, y + ry, vx - om * ry, vy + om * rx
-
-    def _place_aux(self, p, cid: int, body: int, eidx: list[int], plan: _Plan) -> None:
-        """Joint values and rates of the extra links from the (consistent) description
-        state. A slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
-        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
-        the rotation of u adds nothing). A rotor is turned to the slot body's angle,
-        th_slot - th_pin, at the relative rate w_slot - w_pin."""
-        n = plan.n
-        ls = p.getLinkStates(body, eidx[:n], computeLinkVelocity=1,
-                             computeForwardKinematics=1, physicsClientId=cid)
-        for c in plan.closures:
-            if c.kind == "slider":
-                px, py, pvx, pvy = self._point(ls, c.pin_link, c.pin_point)
-                lx, ly, lvx, lvy = self._point(ls, c.line_link, c.line_point)
-                th = self._pose(ls, c.line_link)[2]
-                ux = math.cos(th) * c.direction[0] - math.sin(th) * c.direction[1]
-                uy = math.sin(th) * c.direction[0] + math.cos(th) * c.direction[1]
-                s = (px - lx) * ux + (py - ly) * uy
-                sd = (pvx - lvx) * ux + (pvy - lvy) * uy
-                p.resetJointState(body, eidx[c.aux], s, sd, physicsClientId=cid)
-            elif c.kind == "prismatic":
-                _, _, th_l, _, _, w_l = self._pose(ls, c.line_link)
-                _, _, th_p, _, _, w_p = self._pose(ls, c.pin_link)
-                rel = math.remainder(th_l - th_p, 2.0 * math.pi)
-                p.resetJointState(body, eidx[c.aux], rel, w_l - w_p, physicsClientId=cid)
-
-    @staticmethod
-    def _pivot_under_pin(ls, slot_of: Mapping[int, int], c: _Closure) -> list[float]:
-        """The slot body's point under the pin (its projection on the slot line), in the
-        slot body's frame: L + ((P - L) . u) u. PyBullet's JOINT_PRISMATIC evaluates its
-        Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
-        (fixed) the slot body would feel the force at L instead of at the pin (measured: a
-        bar slotted along its own axis through its pivot then swings freely)."""
-        def pose(link):
-            if link < 0:
-                return 0.0, 0.0, 0.0
-            st = ls[slot_of[link]]
-            return st[0][0], st[0][1], 2.0 * math.atan2(st[1][2], st[1][3])
-        x, y, th = pose(c.pin_link)
-        cs, sn = math.cos(th), math.sin(th)
-        px = x + cs * c.pin_point[0] - sn * c.pin_point[1]
-        py = y + sn * c.pin_point[0] + cs * c.pin_point[1]
-        x, y, th = pose(c.line_link)
-        cs, sn = math.cos(th), math.sin(th)
-        lx = x + cs * c.line_point[0] - sn * c.line_point[1]
-        ly = y + sn * c.line_point[0] + cs * c.line_point[1]
-        ux, uy = c.direction
-        s = (px - lx) * (cs * ux - sn * uy) + (py - ly) * (sn * ux + cs * uy)
-        return [c.line_point[0] + s * ux, c.line_point[1] + s * uy, 0.0]
-
-    def _add_constraints(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
+    def _add_constraints(p, cid: int, body: int, eidx: list[int], model: _Translation,
                          cfg: dict) -> list[int]:
         """One PyBullet constraint per closure (frames relative to the centre-of-mass
         frames, which are the description's body frames)."""
         out = []
-        max_force = float(cfg["constraint_max_force"])
-        for c in plan.closures:
-            pa = eidx[c.parent] if c.parent >= 0 else -1
-            ch = eidx[c.child] if c.child >= 0 else -1
-            if c.kind in ("p2p", "slider"):
-                uid = p.createConstraint(
-                    body, pa, body, ch, p.JOINT_POINT2POINT, [0, 0, 0],
-                    [c.parent_point[0], c.parent_point[1], 0.0],
-                    [c.child_point[0], c.child_point[1], 0.0], physicsClientId=cid)
-                p.changeConstraint(uid, maxForce=max_force, physicsClientId=cid)
-            elif c.kind == "prismatic":
-                # parent: the rotor (axis in its frame, aligned with the slot's); child:
-                # the slot body, its pivot moved under the pin before every step
-                uid = p.createConstraint(
-                    body, pa, body, ch, p.JOINT_PRISMATIC,
-                    [c.direction[0], c.direction[1], 0.0], [0.0, 0.0, 0.0],
-                    [c.child_point[0], c.child_point[1], 0.0], physicsClientId=cid)
-                p.changeConstraint(uid, maxForce=max_force, physicsClientId=cid)
-            else:
-                uid = p.createConstraint(body, eidx[c.a], body, eidx[c.b], p.JOINT_GEAR,
-                                         [0, 0, 1], [0, 0, 0], [0, 0, 0], physicsClientId=cid)
-                kw = {"gearRatio": c.ratio, "maxForce": max_force}
-                erp = float(cfg["gear_erp"])
-                if erp:
-                    kw.update(erp=erp, relativePositionTarget=c.target)
-                p.changeConstraint(uid, physicsClientId=cid, **kw)
+        for c in model.closures:
+            uid = c.create(p, cid, body, eidx, cfg)
             if uid < 0:
                 raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
             out.append(uid)
         return out
 
     @staticmethod
-    def _constraint_forces(plan: _Plan, CF: np.ndarray, JV: np.ndarray
+    def _constraint_forces(model: _Translation, CF: np.ndarray, JV: np.ndarray
                            ) -> dict[str, np.ndarray]:
-        """getConstraintState rows -> the contract's physical terms (signs measured).
-        POINT2POINT: rows along world x, y, z holding the force on the CHILD (a bar held
-        at its tip by the base, bar = parent, reads -m g / 2): PointOnPoint reports the
-        force on body_a (the parent), i.e. minus the rows; the slider route, the force on
-        the pin (parent), also minus the rows. PRISMATIC: row 1 is the in-plane normal of
-        the slot (`_slider_row_normal`, turned with the slot body) and holds the force on
-        the PARENT (checked with either body as parent on the scotch yoke); the parent is
-        the rotor, i.e. the pin: + row 1 times that normal. JOINT_GEAR: one row f, the
-        joint forces f (1, ratio) on (a, b) (checked against inverse dynamics), i.e.
-        (f / w_a) w = A^-T c f / w_a: the coupling's generalized force is c f / w_a and
-        -lambda = f / w_a."""
-        out = {}
-        q = plan.map.coordinates(JV[:, :plan.n]) if plan.closures else None
-        for r, c in enumerate(plan.closures):
-            if c.kind == "gear":
-                out[c.element.name] = CF[:, r, :1] / c.scale
-            elif c.kind == "prismatic":
-                if c.line_link >= 0:
-                    body = plan.links[c.line_link].body
-                    th = plan.map.angle(body, q)
-                else:
-                    th = np.zeros(len(CF))
-                nx, ny = c.row_normal
-                cs, sn = np.cos(th), np.sin(th)
-                f = CF[:, r, 1]
-                out[c.element.name] = np.stack([f * (cs * nx - sn * ny),
-                                                f * (sn * nx + cs * ny)], axis=1)
-            else:
-                out[c.element.name] = -CF[:, r, :2]
-        return out
+        """getConstraintState rows -> the contract's physical terms (each closure's
+        `force`, signs measured)."""
+        q = model.map.coordinates(JV[:, :model.n]) if model.closures else None
+        return {c.element.name: c.force(CF[:, r], q, model)
+                for r, c in enumerate(model.closures)}
 
-    def _violations(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
+    @staticmethod
+    def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
                     JV: np.ndarray) -> dict[str, np.ndarray]:
-        """Each closure's violation at every sample, from the engine's own forward
-        kinematics: PointOnPoint, distance of the two points (m); PointOnLine, signed
-        distance n . (P - L) of the pin from the slot line (m); LinearCoupling, Phi."""
-        if not plan.closures:
+        """Each closure's violation at every sample (`violations`, or `violation` from the
+        engine's own forward kinematics)."""
+        if not model.closures:
             return {}
-        N = len(JV)
-        out = {c.element.name: np.empty(N) for c in plan.closures}
-        geo = [c for c in plan.closures if c.kind != "gear"]
-        q = plan.map.coordinates(JV[:, :plan.n])
-        for c in plan.closures:
-            if c.kind == "gear":
-                out[c.element.name] = q @ c.weights - c.constant
-        if not geo:
-            return out
+        q = model.map.coordinates(JV[:, :model.n])
+        out = {c.element.name: c.violations(q) for c in model.closures}
+        geo = [c for c in model.closures if c.pair]
         n_all = len(eidx)
-        for k in range(N):
+        for k in range(len(JV) if geo else 0):
             p.resetJointStatesMultiDof(body, eidx, [[v] for v in JV[k]], [[0.0]] * n_all,
                                        physicsClientId=cid)
             ls = p.getLinkStates(body, eidx, computeForwardKinematics=1, physicsClientId=cid)
             for c in geo:
-                if c.kind == "p2p":
-                    px, py, _, _ = self._point(ls, c.parent, c.parent_point)
-                    bx, by, _, _ = self._point(ls, c.child, c.child_point)
-                    out[c.element.name][k] = math.hypot(px - bx, py - by)
-                else:
-                    px, py, _, _ = self._point(ls, c.pin_link, c.pin_point)
-                    lx, ly, _, _ = self._point(ls, c.line_link, c.line_point)
-                    th = self._pose(ls, c.line_link)[2]
-                    ux = math.cos(th) * c.direction[0] - math.sin(th) * c.direction[1]
-                    uy = math.sin(th) * c.direction[0] + math.cos(th) * c.direction[1]
-                    out[c.element.name][k] = -uy * (px - lx) + ux * (py - ly)
+                out[c.element.name][k] = c.violation(ls)
         return out
-
-    @staticmethod
-    def _points(ls, pf: _PointForce) -> tuple[float, float, float, float, float, float,
-                                                float, float]:
-        """World position and velocity of both points of an element from link states."""
-        out = []
-        for link, (px, py) in ((pf.link_a, pf.point_a), (pf.link_b, pf.point_b)):
-            if link < 0:
-                out += [px, py, 0.0, 0.0]
-                continue
-            st = ls[link]
-            com, quat, vel, omega = st[0], st[1], st[6], st[7][2]
-            th = 2.0 * math.atan2(quat[2], quat[3])
-            c, s = math.cos(th), math.sin(th)
-            rx, ry = c * px - s * py, s * px + c * py
-            out += [com[0] + rx, com[1] + ry, vel[0] - omega * ry, vel[1] + omega * rx]
-        return tuple(out)  # type: ignore[return-value]
-
-    @staticmethod
-    def _tension_force(pf: _PointForce, pts, t: float) -> tuple[float, float, float, float,
-                                                                 float, float]:
-        """(force on b x, y, point a x, y, point b x, y); the force on a is opposite."""
-        ax, ay, vax, vay, bx, by, vbx, vby = pts
-        dx, dy = bx - ax, by - ay
-        length = math.hypot(dx, dy)
-        if length == 0.0:
-            return 0.0, 0.0, ax, ay, bx, by
-        ux, uy = dx / length, dy / length
-        rate = ux * (vbx - vax) + uy * (vby - vay)
-        tension = pf.law(length, rate, t)
-        return -tension * ux, -tension * uy, ax, ay, bx, by
 
     # --- contract points 6 and 9 ---------------------------------------------------------
     def _open(self, p, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, dt: float,
@@ -1112,91 +1267,92 @@ class PyBulletBackend(Backend):
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
-        contact = coupling = None
-        rolling = [c for c in mechanism.constraints if isinstance(c, RollingContact)]
-        if rolling:
-            contact = _contact_of(mechanism, rolling[0])
-            coupling = rolling[0].coupling
-            mechanism = replace(mechanism, constraints=tuple(
-                c for c in mechanism.constraints if c is not rolling[0]))
-        plan = _Plan(mechanism, float(cfg["massless_link_mass"]), cfg, contact=contact)
-        n = plan.n
-        cid = self._connect(p, cfg, dt, plan.gravity_vector,
-                            constrained=bool(plan.closures) or contact is not None)
+        model = _Translation(mechanism, cfg)
+        n = model.n
+        cid = self._connect(p, cfg, dt, model.gravity_vector,
+                            constrained=bool(model.closures) or model.contact is not None)
         try:
-            shapes, ring = (self._contact_shapes(p, cid, plan, cfg) if contact is not None
-                            else (None, None))
-            body, eidx, _ = self._build(p, cid, plan, cfg, collision=shapes, fixed_shapes=ring)
-            jv0 = plan.map.engine_values(q0)
-            jvd0 = plan.map.A @ np.asarray(qd0, dtype=float)
+            shapes, ring = (_contact_shapes(p, cid, model, cfg)
+                            if model.contact is not None else (None, None))
+            body, eidx, _ = self._build(p, cid, model, cfg, collision=shapes, fixed_shapes=ring)
+            jv0 = model.map.engine_values(q0)
+            jvd0 = model.map.A @ np.asarray(qd0, dtype=float)
             for i in range(n):
                 p.resetJointState(body, eidx[i], float(jv0[i]), float(jvd0[i]),
                                   physicsClientId=cid)
-            if len(plan.links) > n:
-                self._place_aux(p, cid, body, eidx, plan)
-            cids = self._add_constraints(p, cid, body, eidx, plan, cfg)
-            if contact is not None:
-                self._contact_dynamics(p, cid, body, eidx, plan, cfg)
+            if len(model.links) > n:  # the extra links from the (consistent) state
+                ls = p.getLinkStates(body, eidx[:n], computeLinkVelocity=1,
+                                     computeForwardKinematics=1, physicsClientId=cid)
+                for c in model.closures:
+                    c.place(p, cid, body, eidx, ls)
+            cids = self._add_constraints(p, cid, body, eidx, model, cfg)
+            if model.contact is not None:
+                _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
                 p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
         except BaseException:
             p.disconnect(physicsClientId=cid)
             raise
-        return _World(cid, body, eidx, plan, cids, contact, coupling)
+        return _World(cid, body, eidx, model, cids)
 
-    def _inputs(self, p, world: _World, dt: float
-                ) -> tuple[Callable[[int, list, list], tuple[np.ndarray | None, list | None]],
-                           bool] | None:
-        """What the engine must be given before step k, or None when nothing: the joint
-        forces of the CoordinateForce laws (from the joint values and rates at the start
-        of the step, `jv` and `jvd` over at least the n coordinate links) and the
-        point-to-point forces (from the engine's link states), both at t = k dt, and the
-        PRISMATIC pivots moved under the pins (see `_pivot_under_pin`). Returns that
-        function, which gives back the joint forces and the (x, y) force on point b of
-        each point-to-point element (None where there are none), and whether it reads
-        `jv` and `jvd`."""
-        plan, cid, body, eidx = world.plan, world.cid, world.body, world.eidx
-        n = plan.n
-        has_cf = bool(plan.coordinate_laws)
-        n_pf = len(plan.point_forces)
-        moving = [(world.cids[r], c) for r, c in enumerate(plan.closures)
-                  if c.kind == "prismatic"]
-        if not (has_cf or n_pf or moving):
-            return None
+    @staticmethod
+    def _inputs(p, world: _World, dt: float, cfg: dict
+                ) -> tuple[Callable[[int, list, list], list | None] | None, bool]:
+        """What the engine must be given before step k: the joint forces of the
+        CoordinateForce laws (from the joint values and rates at the start of the step,
+        `jv` and `jvd` over at least the n coordinate links) and the point-to-point forces
+        (from the engine's link states), both at t = k dt; the PRISMATIC pivots moved under
+        the pins (`_Rotor.pivot`); the velocity motors of the prescribed coordinates
+        (setting prescribed_motion), each driven joint's target velocity set to
+        (v(t_k+1) - v)/h. Returns that function, which gives back the (x, y) force on point
+        b of each point-to-point element (None where there are none), and whether it reads
+        `jv` and `jvd`; (None, False) when nothing is given."""
+        model, cid, body, eidx = world.model, world.cid, world.body, world.eidx
+        n = model.n
+        has_cf = bool(model.coordinate_laws)
+        n_pf = len(model.point_forces)
+        moving = [(world.cids[r], c) for r, c in enumerate(model.closures) if c.follows_pin]
+        driven = model.driven
+        if not (has_cf or n_pf or moving or driven):
+            return None, False
         set_motors = p.setJointMotorControlArray
         get_links = p.getLinkStates
         apply_force = p.applyExternalForce
         change = p.changeConstraint
         torque_mode, world_frame = p.TORQUE_CONTROL, p.WORLD_FRAME
+        velocity_mode = p.VELOCITY_CONTROL
         links = eidx[:n]
-        point_links = [eidx[k] for k in plan.point_links]
-        pos_of = {k: m for m, k in enumerate(plan.point_links)}
-        Ainv, bvec = plan.map.T, plan.map.b
-        identity = plan.map.identity
+        point_links = [eidx[k] for k in model.point_links]
+        pos_of = {k: m for m, k in enumerate(model.point_links)}
+        Ainv, A, bvec = model.map.T, model.map.A, model.map.b
+        identity = model.map.identity
         moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
                                if lk >= 0})
         moving_eidx = [eidx[lk] for lk in moving_links]
         slot_of = {lk: m for m, lk in enumerate(moving_links)}
+        driven_links = [eidx[m.index] for m in driven]
+        drives = [(float(A[m.index, m.index]), m.position, float(bvec[m.index]), m.index)
+                  for m in driven]
+        motor_force = [float(cfg["prescribed_motor_force"])] * len(driven)
 
-        def apply(k: int, jv: list, jvd: list) -> tuple[np.ndarray | None, list | None]:
+        def apply(k: int, jv: list, jvd: list) -> list | None:
             t = k * dt
-            tau = forces = None
+            forces = None
             if has_cf:
                 if identity:
-                    tau = plan.coordinate_torques(jv[:n], jvd[:n], t)
+                    tau = model.coordinate_torques(jv[:n], jvd[:n], t)
                 else:
                     q = Ainv @ (np.asarray(jv[:n]) - bvec)
                     qd = Ainv @ np.asarray(jvd[:n])
-                    tau = plan.coordinate_torques(q, qd, t)
+                    tau = model.coordinate_torques(q, qd, t)
                 set_motors(body, links, torque_mode, forces=tau.tolist(), physicsClientId=cid)
             if n_pf:
                 ls = get_links(body, point_links, computeLinkVelocity=1,
                                computeForwardKinematics=1, physicsClientId=cid)
-                ls_by_link = {lk: ls[pos_of[lk]] for lk in plan.point_links}
+                ls_by_link = {lk: ls[pos_of[lk]] for lk in model.point_links}
                 forces = []
-                for pf in plan.point_forces:
-                    fx, fy, ax, ay, bx, by = self._tension_force(
-                        pf, self._points(ls_by_link, pf), t)
+                for pf in model.point_forces:
+                    fx, fy, ax, ay, bx, by = pf.force(ls_by_link, t)
                     forces.append((fx, fy))
                     if pf.link_b >= 0:
                         apply_force(body, eidx[pf.link_b], [fx, fy, 0.0], [bx, by, 0.0],
@@ -1207,78 +1363,41 @@ class PyBulletBackend(Backend):
             if moving:
                 ls = get_links(body, moving_eidx, physicsClientId=cid)
                 for uid, c in moving:
-                    change(uid, jointChildPivot=self._pivot_under_pin(ls, slot_of, c),
-                           physicsClientId=cid)
-            return tau, forces
+                    change(uid, jointChildPivot=c.pivot(ls, slot_of), physicsClientId=cid)
+            if driven:
+                t_next = (k + 1) * dt
+                target = [(a * q(t_next) + c - jv[i]) / dt for a, q, c, i in drives]
+                set_motors(body, driven_links, velocity_mode, targetVelocities=target,
+                           forces=motor_force, physicsClientId=cid)
+            return forces
 
-        return apply, has_cf
-
-    @staticmethod
-    def _drivers(p, world: _World, mechanism: Mechanism, dt: float, cfg: dict):
-        """The velocity motors of the prescribed coordinates (setting prescribed_motion):
-        a function of the step k and the engine joint values that sets every driven
-        joint's target velocity to (v(t_k+1) - v)/h, or None without prescribed motion;
-        and the engine link and A[i, i] of each (the actuator force is A[i, i] tau)."""
-        driven = motions(mechanism)
-        if not driven:
-            return None, []
-        plan, body, cid = world.plan, world.body, world.cid
-        A, b = plan.map.A, plan.map.b
-        links = [world.eidx[m.index] for m in driven]
-        scale = [float(A[m.index, m.index]) for m in driven]
-        shift = [float(b[m.index]) for m in driven]
-        position = [m.position for m in driven]
-        slot = [m.index for m in driven]
-        force = [float(cfg["prescribed_motor_force"])] * len(driven)
-        set_motors, velocity_mode = p.setJointMotorControlArray, p.VELOCITY_CONTROL
-
-        def drive(k: int, jv: list) -> None:
-            t_next = (k + 1) * dt
-            target = [(a * q(t_next) + c - jv[i]) / dt
-                      for a, q, c, i in zip(scale, position, shift, slot)]
-            set_motors(body, links, velocity_mode, targetVelocities=target, forces=force,
-                       physicsClientId=cid)
-
-        return drive, list(zip(links, scale, (m.element.name for m in driven)))
+        return apply, has_cf or bool(driven)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
-        """The world of `simulate` stepped with only the per-step inputs (`_inputs`) and
-        the drive of the prescribed coordinates (`_drivers`)."""
+        """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
         import pybullet as p
 
         world = self._open(p, mechanism, q0, qd0, dt, cfg)
         try:
-            inputs = self._inputs(p, world, dt)
+            apply, reads = self._inputs(p, world, dt, cfg)
             step, cid = p.stepSimulation, world.cid
-            get_states, body, links = p.getJointStates, world.body, world.eidx[:world.plan.n]
-            drive, _ = self._drivers(p, world, mechanism, dt, cfg)
-            apply, needs_state = inputs if inputs is not None else (None, False)
+            get_states, body, links = p.getJointStates, world.body, world.eidx[:world.model.n]
+            jv = jvd = []
             with Stopwatch() as clock:
-                if drive is not None:
-                    for k in range(steps):
-                        js = get_states(body, links, physicsClientId=cid)
-                        jv = [s[0] for s in js]
-                        if apply is not None:
-                            apply(k, jv, [s[1] for s in js])
-                        drive(k, jv)
-                        step(physicsClientId=cid)
-                elif apply is None:
+                if apply is None:
                     for _ in range(steps):
                         step(physicsClientId=cid)
-                elif not needs_state:
-                    for k in range(steps):
-                        apply(k, [], [])
-                        step(physicsClientId=cid)
-                else:
-                    for k in range(steps):
+                for k in range(steps if apply is not None else 0):
+                    if reads:
                         js = get_states(body, links, physicsClientId=cid)
-                        apply(k, [s[0] for s in js], [s[1] for s in js])
-                        step(physicsClientId=cid)
+                        jv, jvd = [s[0] for s in js], [s[1] for s in js]
+                    apply(k, jv, jvd)
+                    step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
-            plan = world.plan
-            return BareLoop(clock.cpu, plan.map.coordinates(np.array([[s[0] for s in js]]))[0],
-                            plan.map.rates(np.array([[s[1] for s in js]]))[0])
+            cmap = world.model.map
+            return BareLoop(clock.cpu, cmap.coordinates(np.array([[s[0] for s in js]]))[0],
+                            cmap.rates(np.array([[s[1] for s in js]]))[0])
         finally:
             p.disconnect(physicsClientId=world.cid)
 
@@ -1303,14 +1422,14 @@ class PyBulletBackend(Backend):
         world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
         try:
             outside = []
-            if self._inputs(pybullet, world, dt) is not None:
+            if mechanism.forces or any(c.follows_pin for c in world.model.closures):
                 laws = [e.name for e in mechanism.forces]
                 outside.append("the force laws' joint and point forces (TORQUE_CONTROL and "
                                f"applyExternalForce before every step): {', '.join(laws)}")
             if mechanism.prescribed:
                 outside.append("the prescribed motions' velocity motors, set before every "
                                "step: " + ", ".join(p.name for p in mechanism.prescribed))
-            n = world.plan.n
+            n = world.model.n
             text = script(
                 title=(f"The mechanism as mbfidelity builds it in PyBullet "
                        f"{self.version()}, from the initial state of scenario {name!r}.\n"
@@ -1321,7 +1440,7 @@ class PyBulletBackend(Backend):
                 step="pybullet.stepSimulation(physicsClientId=cid)",
                 read=(f"[s[0] for s in pybullet.getJointStates({world.body}, "
                       f"{list(world.eidx[:n])}, physicsClientId=cid)]"),
-                coordinates=coordinates, T=world.plan.map.T, c=world.plan.map.c, dt=dt,
+                coordinates=coordinates, T=world.model.map.T, c=world.model.map.c, dt=dt,
                 not_in_script=outside)
         finally:
             pybullet.disconnect(physicsClientId=world.cid)
@@ -1336,66 +1455,52 @@ class PyBulletBackend(Backend):
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
         world = self._open(p, mechanism, q0, qd0, dt, cfg,
                            sensor_joints=joint_ids if use_sensor else ())
-        cid, body, eidx, plan, cids = world.cid, world.body, world.eidx, world.plan, world.cids
-        contact, coupling = world.contact, world.coupling
-        n = plan.n
-        n_all = len(plan.links)
-        closures = plan.closures
+        cid, body, eidx, model, cids = world.cid, world.body, world.eidx, world.model, world.cids
+        contact, closures, n = model.contact, model.closures, model.n
         # one extra step gives the reaction/acceleration (and the constraint forces) of
         # the last sample
         total = steps + 1 if (reaction_joints or closures or contact
                               or mechanism.prescribed) else steps
         try:
-            JV = np.empty((total + 1, n_all))
-            JVD = np.empty((total + 1, n_all))
+            JV, JVD = np.empty((total + 1, len(eidx))), np.empty((total + 1, len(eidx)))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
-            n_pf = len(plan.point_forces)
-            f_point = np.zeros((total + 1, n_pf, 2))  # force on point b (on a: opposite)
+            # force on point b of each point-to-point element (on a: opposite)
+            f_point = np.zeros((total + 1, len(model.point_forces), 2))
             CF = np.full((total + 1, len(closures), 6), np.nan)  # getConstraintState rows
             # contact variant: force of the track on the disc (x, y) and contact count
             FC = np.zeros((total + 1, 3))
 
-            step = p.stepSimulation
-            get_states = p.getJointStates
-            get_cstate = p.getConstraintState
-            get_contacts = p.getContactPoints
-            all_links = eidx
+            step, get_states = p.stepSimulation, p.getJointStates
+            get_cstate, get_contacts = p.getConstraintState, p.getContactPoints
             sensor_slots = [eidx[i] for i in joint_ids]
-            n_cs = len(cids)
-            inputs = self._inputs(p, world, dt)
-            apply = inputs[0] if inputs is not None else None
-            drive, driven = self._drivers(p, world, mechanism, dt, cfg)
-            driven_slots = [all_links.index(link) for link, _, _ in driven]
+            apply, _ = self._inputs(p, world, dt, cfg)
+            driven = [(model.map.A[m.index, m.index], m.element.name) for m in model.driven]
+            driven_slots = [m.index for m in model.driven]
             motor = np.full((total + 1, len(driven)), np.nan)
             if contact is not None:
-                ring_links = set(plan.fixed_links)
-                disc_link = eidx[plan.link_of[contact.inner]]
+                ring_links = set(model.fixed_links)
+                disc_link = eidx[model.link_of[contact.inner]]
 
-            js = get_states(body, all_links, physicsClientId=cid)
+            js = get_states(body, eidx, physicsClientId=cid)
             with Stopwatch() as clock:
                 for k in range(total):
-                    jv = [s[0] for s in js]
-                    jvd = [s[1] for s in js]
-                    JV[k] = jv
-                    JVD[k] = jvd
-                    if apply is not None:
-                        _, forces = apply(k, jv, jvd)
-                        if forces is not None:
-                            f_point[k] = forces
-                    if drive is not None:
-                        drive(k, jv)
+                    JV[k] = jv = [s[0] for s in js]
+                    JVD[k] = jvd = [s[1] for s in js]
+                    forces = apply(k, jv, jvd) if apply is not None else None
+                    if forces is not None:
+                        f_point[k] = forces
                     step(physicsClientId=cid)
-                    js = get_states(body, all_links, physicsClientId=cid)
+                    js = get_states(body, eidx, physicsClientId=cid)
                     # the motor's force read after a step belongs to the state before it
                     for r, slot in enumerate(driven_slots):
                         motor[k, r] = js[slot][3]
                     # constraint and contact forces read after a step belong to the state
                     # before it
-                    for r in range(n_cs):
-                        st = get_cstate(cids[r], physicsClientId=cid)
+                    for r, uid in enumerate(cids):
+                        st = get_cstate(uid, physicsClientId=cid)
                         CF[k, r, : len(st)] = st
                     if contact is not None:
-                        FC[k] = self._contact_force(
+                        FC[k] = _contact_force(
                             get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
                             ring_links, disc_link)
                     if use_sensor:
@@ -1406,14 +1511,14 @@ class PyBulletBackend(Backend):
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
 
-            forces = self._constraint_forces(plan, CF[: steps + 1], JV[: steps + 1])
-            q = plan.map.coordinates(JV[: steps + 1, :n])
-            qd = plan.map.rates(JVD[: steps + 1, :n])
+            forces = self._constraint_forces(model, CF[: steps + 1], JV[: steps + 1])
+            q = model.map.coordinates(JV[: steps + 1, :n])
+            qd = model.map.rates(JVD[: steps + 1, :n])
             reactions: dict[str, np.ndarray] = {}
             if reaction_joints:
                 # a gear is a joint force: both routes see it
                 gears = {c.element.name: forces[c.element.name] for c in closures
-                         if c.kind == "gear"}
+                         if not c.pair}
                 if use_sensor:
                     transmitted = {name: sensor[: steps + 1, r].copy()
                                    for r, name in enumerate(reaction_joints)}
@@ -1421,7 +1526,7 @@ class PyBulletBackend(Backend):
                 else:
                     jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
                     transmitted = self._inverse_dynamics_forces(
-                        p, cid, plan, cfg, joint_ids, list(reaction_joints),
+                        p, cid, model, cfg, joint_ids, list(reaction_joints),
                         JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
                     # inverse dynamics applies no element: the point-to-point and the
                     # closure forces across the cut are in its force (on body_a: minus
@@ -1429,143 +1534,30 @@ class PyBulletBackend(Backend):
                     # carries what the description's arm and coupling carried, so it
                     # counts as transmitted through the joints (contract point 6)
                     pairs = {pf.name: -f_point[: steps + 1, e]
-                             for e, pf in enumerate(plan.point_forces)}
+                             for e, pf in enumerate(model.point_forces)}
                     pairs.update({c.element.name: forces[c.element.name] for c in closures
-                                  if c.kind != "gear"})
+                                  if c.pair})
                 reactions = joint_reactions(mechanism, reaction_joints, transmitted,
                                             dt * np.arange(steps + 1), q, qd,
                                             pair_forces=pairs, coupling_forces=gears)
-            violation = self._violations(p, cid, body, eidx, plan, JV[: steps + 1])
+            violation = self._violations(p, cid, body, eidx, model, JV[: steps + 1])
         finally:
             p.disconnect(physicsClientId=cid)
 
         contact_report = None
         if contact is not None:
-            contact_report = self._contact_report(plan, coupling, q, qd,
+            contact_report = _contact_report(model, model.coupling, q, qd,
                                                   JV[: steps + 1], FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
-        actuators = {name: a * motor[: steps + 1, r] for r, (_, a, name) in enumerate(driven)}
+        actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
         # the substitutes' own error: each closure's violation at every sample
         extras = {"constraint_violation": violation}
         if contact_report is not None:
             extras["contact"] = contact_report
         return Samples(q, qd, clock, reactions, forces, actuators, extras=extras)
 
-    # --- rolling by friction contact ---------------------------------------------------
-    def _contact_shapes(self, p, cid: int, plan: _Plan, cfg: dict
-                        ) -> tuple[dict[int, int], tuple[int, list[int]]]:
-        """Collision shapes of the contact variant: on the track, a ring of boxes whose
-        inner faces are tangent to the track circle (a regular polygon with the circle as
-        its incircle); on the disc, a sphere of the disc's radius centred on it (sphere-box
-        contacts are analytic in Bullet). Shape frames are relative to the link (joint)
-        frame, not to the centre of mass (measured with getAABB)."""
-        ct = plan.contact
-        n_box = int(cfg["contact_ring_boxes"])
-        if n_box < 8:
-            raise ValueError("contact_ring_boxes must be at least 8")
-        lo, li = plan.link_of[ct.outer], plan.link_of[ct.inner]
-        off = plan.links[lo].inertial_position  # body frame -> link frame: + this
-        cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
-        thick = 0.1 * ct.R
-        half_len = ct.R * math.tan(math.pi / n_box) * 1.001
-        depth = 2.0 * ct.r
-        pos, orn, half = [], [], []
-        for i in range(n_box):
-            a = 2.0 * math.pi * i / n_box
-            rho = ct.R + thick / 2.0
-            pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
-            orn.append(_quat_z(a))
-            half.append([thick / 2.0, half_len, depth])
-        # createCollisionShapeArray keeps only the first 16 children (measured with
-        # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
-        # its own massless fixed link on the track
-        ring = []
-        for k0 in range(0, n_box, 16):
-            sl = slice(k0, min(k0 + 16, n_box))
-            ring.append(p.createCollisionShapeArray(
-                [p.GEOM_BOX] * len(half[sl]), halfExtents=half[sl],
-                collisionFramePositions=pos[sl], collisionFrameOrientations=orn[sl],
-                physicsClientId=cid))
-        off = plan.links[li].inertial_position
-        disc = p.createCollisionShape(
-            p.GEOM_SPHERE, radius=ct.r, collisionFramePosition=[
-                ct.inner_centre[0] + off[0], ct.inner_centre[1] + off[1], 0.0],
-            physicsClientId=cid)
-        if min(ring) < 0 or disc < 0:
-            raise RuntimeError("pybullet could not create the contact shapes")
-        return {li: disc}, (lo, ring)
-
-    def _contact_dynamics(self, p, cid: int, body: int, eidx: list[int], plan: _Plan,
-                          cfg: dict) -> None:
-        """Friction and contact solver parameters (Bullet combines the two links'
-        friction coefficients by product: the disc gets 1, the track the setting)."""
-        ct = plan.contact
-        disc = eidx[plan.link_of[ct.inner]]
-        for link, mu in [(e, float(cfg["contact_friction"])) for e in plan.fixed_links] + [
-                (disc, 1.0)]:
-            for key, value in (("lateralFriction", mu), ("spinningFriction", 0.0),
-                               ("rollingFriction", 0.0), ("restitution", 0.0)):
-                p.changeDynamics(body, link, physicsClientId=cid, **{key: value})
-        # only the disc and the ring collide (the ring's compounds overlap each other)
-        for e in plan.fixed_links:
-            p.setCollisionFilterGroupMask(body, e, 1, 2, physicsClientId=cid)
-        p.setCollisionFilterGroupMask(body, disc, 2, 1, physicsClientId=cid)
-        p.setPhysicsEngineParameter(
-            contactERP=float(cfg["contact_erp"]), frictionERP=float(cfg["contact_erp"]),
-            contactSlop=0.0, restitutionVelocityThreshold=0.0,
-            contactBreakingThreshold=float(cfg["contact_breaking_threshold"]),
-            physicsClientId=cid)
-
-    @staticmethod
-    def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, float]:
-        """Force of the track on the disc (world x, y) summed over the contact points of
-        the step, and the number of points. Bullet's normal on B points towards A; the
-        normal and friction impulses push A along +n, +dir and B along -n, -dir."""
-        fx = fy = 0.0
-        count = 0
-        for cp in points:
-            la, lb = cp[3], cp[4]
-            if la in ring and lb == disc:
-                sign = -1.0
-            elif la == disc and lb in ring:
-                sign = 1.0
-            else:
-                continue
-            nrm, fn = cp[7], cp[9]
-            d1, f1, d2, f2 = cp[11], cp[10], cp[13], cp[12]
-            fx += sign * (fn * nrm[0] + f1 * d1[0] + f2 * d2[0])
-            fy += sign * (fn * nrm[1] + f1 * d1[1] + f2 * d2[1])
-            count += 1
-        return fx, fy, float(count)
-
-    @staticmethod
-    def _contact_report(plan: _Plan, coupling: LinearCoupling, q: np.ndarray,
-                        qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
-        """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
-        (m/s), penetration of the disc into the track (radial slider value, m), normal
-        and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
-        component f, track on disc, along t = k x u with u from the track centre to the
-        disc) is what the coupling's -lambda stands for."""
-        ct = plan.contact
-        cvec = np.zeros(plan.n)
-        for name, coef in coupling.coefficients:
-            cvec[plan.mech.coordinates.index(name)] += num(coef)
-        const = num(coupling.constant)
-        arm = plan.mech.joints[ct.hub].parent
-        th = plan.map.angle(arm, q)
-        ux0, uy0 = ct.radial
-        ux, uy = np.cos(th) * ux0 - np.sin(th) * uy0, np.sin(th) * ux0 + np.cos(th) * uy0
-        normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
-        friction = FC[:, 0] * -uy + FC[:, 1] * ux
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.abs(friction) / normal
-        return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
-                "penetration": JV[:, plan.radial_link], "normal_force": normal,
-                "friction": friction, "friction_ratio": ratio,
-                "contact_points": FC[:, 2]}
-
-    def _inverse_dynamics_forces(self, p, cid: int, plan: _Plan, cfg: dict,
+    def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
                                  JVD: np.ndarray, JVDD: np.ndarray) -> dict[str, np.ndarray]:
         """The force from parent to child at each joint (world axes): the inverse-dynamics
@@ -1573,7 +1565,7 @@ class PyBulletBackend(Backend):
         of the joint. It applies no force element and no closure, so it holds every force
         that reaches the child's subtree from outside (`reactions.joint_reaction` takes
         them out)."""
-        body, eidx, virtual = self._build(p, cid, plan, cfg, split=set(joint_ids))
+        body, eidx, virtual = self._build(p, cid, model, cfg, split=set(joint_ids))
         ndof = p.getNumJoints(body, physicsClientId=cid)
         slots = np.array(eidx)
         vslots = [virtual[i] for i in joint_ids]
@@ -1589,15 +1581,10 @@ class PyBulletBackend(Backend):
                           physicsClientId=cid)
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
-        q = plan.map.coordinates(JV[:, :plan.n])
-        transmitted: dict[str, np.ndarray] = {}
-        for r, (i, name) in enumerate(zip(joint_ids, names)):
-            joint = plan.mech.joints[i]
-            th = plan.map.angle(joint.parent, q)
-            c, s = np.cos(th), np.sin(th)
-            fx, fy = out[:, r, 0], out[:, r, 1]
-            transmitted[name] = np.stack([c * fx - s * fy, s * fx + c * fy], axis=1)
-        return transmitted
+        q = model.map.coordinates(JV[:, :model.n])
+        return {name: _turned(model.map.angle(model.mech.joints[i].parent, q),
+                              out[:, r, 0], out[:, r, 1])
+                for r, (i, name) in enumerate(zip(joint_ids, names))}
 
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
                        ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -1606,12 +1593,12 @@ class PyBulletBackend(Backend):
         import pybullet as p
 
         cfg = self.resolve_settings(settings)
-        plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
-        cid = self._connect(p, cfg, 1e-3, plan.gravity_vector)
+        model = _Translation(mechanism, cfg)
+        cid = self._connect(p, cfg, 1e-3, model.gravity_vector)
         try:
-            body, eidx, _ = self._build(p, cid, plan, cfg)
+            body, eidx, _ = self._build(p, cid, model, cfg)
             out = {}
-            for i, lk in enumerate(plan.links[:plan.n]):
+            for i, lk in enumerate(model.links[:model.n]):
                 info = p.getDynamicsInfo(body, eidx[i], physicsClientId=cid)
                 R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=cid))
                 out[lk.body] = (np.array(info[2], dtype=float), R.reshape(3, 3))
@@ -1632,13 +1619,13 @@ class PyBulletBackend(Backend):
             # calculateMassMatrix / calculateInverseDynamics describe the open tree only;
             # PyBullet has no constrained linearization (the free-vibration fit remains)
             return None
-        plan = _Plan(mechanism, float(cfg["massless_link_mass"]))
-        n = plan.n
+        model = _Translation(mechanism, cfg)
+        n = model.n
         h_rel = float(cfg["linearize_step"])
-        cid = self._connect(p, cfg, dt, plan.gravity_vector)
+        cid = self._connect(p, cfg, dt, model.gravity_vector)
         try:
-            body, eidx, _ = self._build(p, cid, plan, cfg)
-            jv_eq = plan.map.engine_values(np.asarray(q_eq, dtype=float))
+            body, eidx, _ = self._build(p, cid, model, cfg)
+            jv_eq = model.map.engine_values(np.asarray(q_eq, dtype=float))
             zeros = [0.0] * n
             perm = np.asarray(eidx[:n])  # engine (depth-first) index of each joint
 
@@ -1650,10 +1637,10 @@ class PyBulletBackend(Backend):
 
             def applied(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
                 """Engine joint forces of the autonomous force elements at (jv, jvd)."""
-                q = plan.map.coordinates(jv)
-                qd = plan.map.rates(jvd)
-                tau = plan.coordinate_torques(q, qd, 0.0, autonomous=True)
-                pfs = [pf for pf in plan.point_forces if not pf.time_dependent]
+                q = model.map.coordinates(jv)
+                qd = model.map.rates(jvd)
+                tau = model.coordinate_torques(q, qd, 0.0, autonomous=True)
+                pfs = [pf for pf in model.point_forces if not pf.time_dependent]
                 if not pfs:
                     return tau
                 for i in range(n):
@@ -1661,16 +1648,16 @@ class PyBulletBackend(Backend):
                                       physicsClientId=cid)
                 ls = {lk: p.getLinkState(body, eidx[lk], computeLinkVelocity=1,
                                          computeForwardKinematics=1, physicsClientId=cid)
-                      for lk in plan.point_links}
+                      for lk in model.point_links}
                 for pf in pfs:
-                    fx, fy, *_ = self._tension_force(pf, self._points(ls, pf), 0.0)
+                    fx, fy, *_ = pf.force(ls, 0.0)
                     for link, point, sign in ((pf.link_b, pf.point_b, 1.0),
                                               (pf.link_a, pf.point_a, -1.0)):
                         if link < 0:
                             continue
                         # calculateJacobian takes the point in the URDF link frame (the
                         # joint frame), not about the centre of mass as its docstring says
-                        ip = plan.links[link].inertial_position
+                        ip = model.links[link].inertial_position
                         jac_t, _ = p.calculateJacobian(
                             body, eidx[link], [point[0] + ip[0], point[1] + ip[1], 0.0],
                             engine(jv), engine(jvd), zeros, physicsClientId=cid)
@@ -1688,15 +1675,11 @@ class PyBulletBackend(Backend):
             K = np.zeros((n, n))
             C = np.zeros((n, n))
             v0 = np.zeros(n)
-            for i in range(n):
+            for i, e in enumerate(np.eye(n)):
                 h = h_rel * max(1.0, abs(jv_eq[i]))
-                e = np.zeros(n)
-                e[i] = h
-                K[:, i] = (residual(jv_eq + e, v0) - residual(jv_eq - e, v0)) / (2 * h)
-                hv = h_rel
-                ev = np.zeros(n)
-                ev[i] = hv
-                C[:, i] = (residual(jv_eq, v0 + ev) - residual(jv_eq, v0 - ev)) / (2 * hv)
+                K[:, i] = (residual(jv_eq + h * e, v0) - residual(jv_eq - h * e, v0)) / (2 * h)
+                C[:, i] = (residual(jv_eq, v0 + h_rel * e)
+                           - residual(jv_eq, v0 - h_rel * e)) / (2 * h_rel)
         finally:
             p.disconnect(physicsClientId=cid)
         eig = quadratic_eigenvalues(M, C, K)
