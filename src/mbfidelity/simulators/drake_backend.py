@@ -68,7 +68,7 @@ from __future__ import annotations
 import inspect
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -96,6 +96,7 @@ from .plan import (
     CoordinateLaws,
     driven_start,
     BODY,
+    ELEMENT_KINDS,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -112,6 +113,8 @@ from .plan import (
     CoordinateMap,
     ForceLaw,
     coordinate_map,
+    element_kind,
+    elements,
     motions,
     num,
     massive_below,
@@ -182,7 +185,8 @@ def _slider_mass(mech: Mechanism, slot: PointOnLine) -> float:
         return 0.0
     rho = izz / (2 * mass * pin ** 2) if pin > 0 else np.inf
     share = 0.5 if rho == np.inf else min(0.5, 0.5 * rho / (1 + rho))
-    slots = sum(1 for c in mech.constraints if isinstance(c, PointOnLine) and c.body == body.name)
+    slots = sum(1 for c in mech.constraints
+                if element_kind(c) == POINT_ON_LINE and c.body == body.name)
     return share * mass / slots
 
 
@@ -209,7 +213,7 @@ def _inertia(mech: Mechanism, body) -> tuple[float, list, tuple]:
     first_moment = np.zeros(3)
     kept = mass
     for c in mech.constraints:
-        if isinstance(c, PointOnLine) and c.body == body.name:
+        if element_kind(c) == POINT_ON_LINE and c.body == body.name:
             lent, pin = _slider_mass(mech, c), np.array([num(c.point[0]), num(c.point[1]), 0.0])
             tensor -= lent * (pin @ pin * np.eye(3) - np.outer(pin, pin))
             first_moment -= lent * pin
@@ -224,9 +228,9 @@ def _discrete(mech: Mechanism, cfg: Mapping) -> bool:
     closure or coupling, which a continuous plant refuses; a law that jumps, which its
     error control cannot cross)."""
     return (cfg["plant"] == "discrete" or bool(mech.constraints)
-            or any(isinstance(f, (CoordinateForce, PointToPoint))
-                   and ForceLaw.of(f).linear is None and _jumps(ForceLaw.of(f).expr)
-                   for f in mech.forces))
+            or any(element_kind(f) in (COORDINATE_FORCE_CUSTOM, POINT_TO_POINT_CUSTOM,
+                                       TIME_LOAD)
+                   and _jumps(ForceLaw.of(f).expr) for f in mech.forces))
 
 
 def _coupler(mech: Mechanism, coupling: LinearCoupling
@@ -260,6 +264,299 @@ class _Built:
     #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
     #: slot's unit direction), for the slider's initial state (`_place_slider`)
     slots: list = field(default_factory=list)
+
+
+@dataclass
+class _Build:
+    """A plant being built: what each element's builder adds to (through the recorder,
+    so that `export` writes every plant call) and what the force system and the read-out
+    need afterwards."""
+
+    mech: Mechanism
+    rec: "_Recorder"
+    plant: object
+    cmap: CoordinateMap
+    #: laws as Drake's own elements where they express them (`native_elements`)
+    native: bool
+    bodies: dict                      # description body (and WORLD) -> Drake body
+    #: per description joint: the viscous damping its native coordinate laws give it
+    damping: list
+    #: per native coordinate law (by name): (its joint, stiffness, nominal value)
+    springs: dict
+    joints: list = field(default_factory=list)
+    python_laws: list = field(default_factory=list)   # CoordinateForce laws of the LeafSystem
+    python_p2p: list = field(default_factory=list)    # PointToPoint laws of the LeafSystem
+    prescribed: list = field(default_factory=list)    # motions the LeafSystem imposes
+    slots: list = field(default_factory=list)         # see `_Built.slots`
+
+    def frame(self, body: str, name: str, anchor, angle: float):
+        """A frame on `body` at `anchor` (its frame's coordinates), turned by `angle`."""
+        from pydrake.math import RigidTransform, RotationMatrix
+        from pydrake.multibody.tree import FixedOffsetFrame
+
+        rec = self.rec
+        point = [num(anchor[0]), num(anchor[1]), 0.0]
+        pose = rec(None, RigidTransform, "RigidTransform",
+                   rec(None, RotationMatrix.MakeZRotation, "RotationMatrix.MakeZRotation",
+                       angle), point)
+        parent = rec(None, self.bodies[body].body_frame,
+                     f"{rec.code(self.bodies[body])}.body_frame")
+        return rec(f"frame_{name}", self.plant.AddFrame, "plant.AddFrame",
+                   rec(None, FixedOffsetFrame, "FixedOffsetFrame", name, parent, pose))
+
+
+def _native_coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool
+                            ) -> dict[str, tuple[int, float, float, float]]:
+    """Per coordinate law that Drake's own elements hold (by name): (joint, stiffness,
+    nominal value, damping). A law goes to them when its coordinate is r v_j, one engine
+    joint value (COORD = sum sign q_i = (sum sign T_i) v + sum sign c_i): then
+    tau_j = r F(r v_j, r v_j') = r a + r^2 b v_j + r^2 c v_j', a spring of stiffness
+    k = -r^2 b >= 0 and nominal value r a / k, and a damper -r^2 c >= 0. The joints take
+    the damping when they are built, so it is known before the laws' own builders run."""
+    held = {}
+    for kind, f in elements(mech):
+        if kind != COORDINATE_FORCE_LINEAR or not native:
+            continue
+        target = cmap.law_target(f.weights(mech.coordinates))
+        if target is None:
+            continue
+        j, r = target
+        a, b, c = ForceLaw.of(f).linear
+        k, d = -r * r * b, -r * r * c
+        if k >= 0 and d >= 0 and (k > 0 or a == 0):
+            held[f.name] = (j, k, r * a / k if k > 0 else 0.0, d)
+    return held
+
+
+_BUILDERS: dict[str, Callable[[_Build, object], None]] = {}
+_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
+
+
+def _builds(kind: str, *cases: Expression):
+    """Register the builder of one element kind with the expression(s) it declares."""
+    def register(builder: Callable[[_Build, object], None]):
+        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
+        return builder
+    return register
+
+
+def _body(build: _Build, body) -> None:
+    from pydrake.multibody.tree import SpatialInertia, UnitInertia
+
+    rec = build.rec
+    mass, com, unit = _inertia(build.mech, body)
+    build.bodies[body.name] = rec(
+        f"body_{len(build.bodies)}", build.plant.AddRigidBody, "plant.AddRigidBody",
+        body.name, rec(None, SpatialInertia, "SpatialInertia", mass, com,
+                       rec(None, UnitInertia, "UnitInertia", *unit)))
+
+
+_builds(BODY, Expression(EXACT, "a rigid body with its mass and central inertia (zero "
+                                "central inertia accepted: point masses are exact)"))(_body)
+_builds(
+    MASSLESS_BODY,
+    Expression(EXACT, "a zero-mass body: the articulated inertia stays regular while a "
+                      "massive descendant carries its coordinates",
+               when="a massive body below it", applies=massive_below),
+    Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the plant's "
+                            "mass matrix would be singular",
+               when="only massless bodies below it"))(_body)
+
+
+def _add_joint(build: _Build, made) -> None:
+    rec = build.rec
+    build.joints.append(rec(f"joint_{len(build.joints)}", build.plant.AddJoint,
+                            "plant.AddJoint", made))
+
+
+@_builds(REVOLUTE, Expression(EXACT, "RevoluteJoint about z between frames at the anchors "
+                                     "(the parent's turned by the angle offset)"))
+def _revolute(build: _Build, joint: Revolute) -> None:
+    from pydrake.multibody.tree import RevoluteJoint
+
+    jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor,
+                     num(joint.angle_offset))
+    jc = build.frame(joint.child, f"{joint.name}_on_child", joint.child_anchor, 0.0)
+    _add_joint(build, build.rec(
+        None, RevoluteJoint, "RevoluteJoint", joint.name, jp, jc, [0.0, 0.0, 1.0],
+        damping=build.damping[len(build.joints)]))
+
+
+@_builds(PRISMATIC, Expression(EXACT, "PrismaticJoint along the unit axis"))
+def _prismatic(build: _Build, joint) -> None:
+    from pydrake.multibody.tree import PrismaticJoint
+
+    axis = np.array([num(joint.axis[0]), num(joint.axis[1]), 0.0])
+    jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor, 0.0)
+    jc = build.frame(joint.child, f"{joint.name}_on_child", joint.child_anchor,
+                     -num(joint.angle_offset))
+    _add_joint(build, build.rec(
+        None, PrismaticJoint, "PrismaticJoint", joint.name, jp, jc,
+        axis / np.linalg.norm(axis), damping=build.damping[len(build.joints)]))
+
+
+def _point_to_point(build: _Build, f: PointToPoint) -> None:
+    """Drake's own spring element where it expresses the law (`_native_spring`), else
+    the law in the LeafSystem; a force between two points of one body is internal."""
+    from pydrake.multibody.tree import LinearBushingRollPitchYaw, LinearSpringDamper
+
+    if f.body_a == f.body_b:
+        return
+    spring = _native_spring(ForceLaw.of(f)) if build.native else None
+    if spring is None:
+        build.python_p2p.append(f)
+        return
+    rec = build.rec
+    free_length, stiffness, damper = spring
+    if free_length == 0:
+        # a spring of zero free length pulls each point towards the other with k times
+        # their separation: a bushing with isotropic force stiffness and no torque, whose
+        # force acts on the line between its frames' origins
+        element = rec(None, LinearBushingRollPitchYaw, "LinearBushingRollPitchYaw",
+                      build.frame(f.body_a, f"{f.name}_a", f.point_a, 0.0),
+                      build.frame(f.body_b, f"{f.name}_b", f.point_b, 0.0),
+                      [0.0] * 3, [0.0] * 3, [stiffness] * 3, [0.0] * 3)
+    else:
+        element = rec(None, LinearSpringDamper, "LinearSpringDamper",
+                      build.bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
+                      build.bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
+                      free_length, stiffness, damper)
+    rec("", build.plant.AddForceElement, "plant.AddForceElement", element)
+
+
+def _coordinate_force(build: _Build, f: CoordinateForce) -> None:
+    """Drake's joint spring (its damping went to the joint) where the law is held
+    natively (`_native_coordinate_laws`), else the law in the LeafSystem."""
+    from pydrake.multibody.tree import PrismaticSpring, RevoluteSpring
+
+    if f.name not in build.springs:
+        build.python_laws.append(f)
+        return
+    j, stiffness, nominal, _ = build.springs[f.name]
+    if stiffness > 0:
+        spring = (RevoluteSpring if element_kind(build.mech.joints[j]) == REVOLUTE
+                  else PrismaticSpring)
+        build.rec("", build.plant.AddForceElement, "plant.AddForceElement",
+                  build.rec(None, spring, spring.__name__, build.joints[j], nominal, stiffness))
+
+
+_builds(POINT_TO_POINT_LINEAR,
+        Expression(EXACT, "LinearSpringDamper where the law is a spring of positive free "
+                          "length with a non-negative damper, an isotropic "
+                          "LinearBushingRollPitchYaw without torque for a spring of zero free "
+                          "length, otherwise the law as externally applied spatial forces "
+                          "from a LeafSystem at every integrator stage"))(_point_to_point)
+_builds(POINT_TO_POINT_CUSTOM,
+        Expression(EXACT, "externally applied spatial forces on both bodies from a "
+                          "LeafSystem, evaluated at every integrator stage (at the start of "
+                          "each step where the plant is discrete, as for a law that jumps: "
+                          "the error control has no event location)"))(_point_to_point)
+_builds(COORDINATE_FORCE_LINEAR,
+        Expression(EXACT, "RevoluteSpring or PrismaticSpring and the joint's damping where "
+                          "the law acts on one joint value with non-negative stiffness and "
+                          "damping, otherwise the plant's applied generalized "
+                          "force"))(_coordinate_force)
+_builds(COORDINATE_FORCE_CUSTOM,
+        Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
+                          "evaluated at every integrator stage",
+                   when="the law is continuous",
+                   applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
+        Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
+                          "evaluated at the start of each step of the discrete plant (the "
+                          "error control cannot cross a jump: it has no event location)",
+                   when="the law jumps (dry friction)"))(_coordinate_force)
+_FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
+
+
+@_builds(TIME_LOAD, Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
+                                      "the stage time"))
+def _time_load(build: _Build, f) -> None:
+    _FORCES[type(f)](build, f)  # a law of TIME is never a native element's
+
+
+@_builds(POINT_ON_POINT, Expression(SOFT, "AddBallConstraint between the two points on the "
+                                          "discrete plant (its out-of-plane row is void: "
+                                          "every body moves in the plane)",
+                                    expected_failures=SAP_CONSTRAINT_METRICS,
+                                    reason=SAP_CONSTRAINT))
+def _point_on_point(build: _Build, c: PointOnPoint) -> None:
+    build.rec("", build.plant.AddBallConstraint, "plant.AddBallConstraint",
+              build.bodies[c.body_a], [num(c.point_a[0]), num(c.point_a[1]), 0.0],
+              build.bodies[c.body_b], [num(c.point_b[0]), num(c.point_b[1]), 0.0])
+
+
+@_builds(
+    POINT_ON_LINE,
+    Expression(SUBSTITUTE, "no point-on-line constraint: a slider body on a PrismaticJoint "
+                           "along the slot, held to the pin by AddBallConstraint on the "
+                           "discrete plant; it carries a point mass taken out of the pin's "
+                           "body at the pin (exact while the constraints hold: the pin point "
+                           "carries it either way)",
+               when="the pin's body can lend the slider a point mass at the pin",
+               applies=lambda mech, slot: _can_lend(mech, slot),
+               expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
+    Expression(UNSUPPORTED, "Drake has no point-on-line constraint, and the pin's body "
+                            "cannot lend the substitute slider a point mass at the pin "
+                            "(massless, the world, or too little inertia about the pin): a "
+                            "slider without mass makes the plant's mass matrix singular",
+               when="the pin's body cannot lend it"))
+def _point_on_line(build: _Build, c: PointOnLine) -> None:
+    """A slider along the slot, held to the pin, carrying a point mass lent by the pin's
+    body (`_slider_mass`)."""
+    from pydrake.multibody.tree import PrismaticJoint, SpatialInertia, UnitInertia
+
+    rec, plant = build.rec, build.plant
+    slider = rec(f"body_{len(build.bodies) + len(build.slots)}", plant.AddRigidBody,
+                 "plant.AddRigidBody", f"{c.name}_slider",
+                 rec(None, SpatialInertia, "SpatialInertia", _slider_mass(build.mech, c),
+                     [0.0] * 3, rec(None, UnitInertia, "UnitInertia", 0.0, 0.0, 0.0)))
+    axis = np.array([num(c.direction[0]), num(c.direction[1]), 0.0])
+    axis /= np.linalg.norm(axis)
+    line = build.frame(c.line_body, f"{c.name}_line", c.line_point, 0.0)
+    pin = [num(c.point[0]), num(c.point[1]), 0.0]
+    slide = rec(f"slider_{len(build.slots)}", plant.AddJoint, "plant.AddJoint",
+                rec(None, PrismaticJoint, "PrismaticJoint", f"{c.name}_slide", line,
+                    rec(None, slider.body_frame, f"{rec.code(slider)}.body_frame"), axis))
+    rec("", plant.AddBallConstraint, "plant.AddBallConstraint", build.bodies[c.body],
+        pin, slider, [0.0] * 3)
+    build.slots.append((slide, build.bodies[c.body], np.array(pin), line, axis))
+
+
+@_builds(
+    LINEAR_COUPLING,
+    Expression(SOFT, "AddCouplerConstraint v0 = rho v1 + offset on the discrete plant, the "
+                     "coupling written on the engine joint values",
+               when="it relates two joint values",
+               applies=lambda mech, coupling: _coupler(mech, coupling) is not None,
+               expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
+    Expression(UNSUPPORTED, "Drake's coupler constraint relates two joints; this coupling "
+                            "involves one or more than two joint values",
+               when="it relates one or more than two joint values"))
+def _linear_coupling(build: _Build, c: LinearCoupling) -> None:
+    i0, i1, ratio, offset = _coupler(build.mech, c)
+    build.rec("", build.plant.AddCouplerConstraint, "plant.AddCouplerConstraint",
+              build.joints[i0], build.joints[i1], ratio, offset)
+
+
+@_builds(ROLLING_CONTACT, Expression(UNSUPPORTED, "no contact geometry is built: the "
+                                                  "continuous plant's point contact is a "
+                                                  "penalty (compliant) model"))
+def _rolling_contact(build: _Build, c) -> None:
+    raise ValueError(f"drake builds no rolling contact ({c.name}): support() refuses it")
+
+
+@_builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by the LeafSystem's applied "
+                                       "generalized force at every integrator stage (from the "
+                                       "plant's mass matrix and its other generalized forces "
+                                       "at the stage's state and time); that force is the "
+                                       "actuator force"))
+def _prescribed(build: _Build, p) -> None:
+    build.prescribed.append(p)  # nothing in the plant: the LeafSystem imposes it
+
+
+#: per element kind, the expression(s) its registered builder makes, in the kinds' order
+EXPRESSIONS = {kind: _EXPRESSIONS[kind] for kind in ELEMENT_KINDS}
+
 
 
 class DrakeBackend(Backend):
@@ -332,87 +629,7 @@ class DrakeBackend(Backend):
         return version("drake")
 
     # --- support ---------------------------------------------------------------------------
-    EXPRESSIONS = {
-        BODY: (Expression(EXACT, "a rigid body with its mass and central inertia (zero "
-                                 "central inertia accepted: point masses are exact)"),),
-        MASSLESS_BODY: (
-            Expression(EXACT, "a zero-mass body: the articulated inertia stays regular "
-                              "while a massive descendant carries its coordinates",
-                       when="a massive body below it", applies=massive_below),
-            Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the "
-                                    "plant's mass matrix would be singular",
-                       when="only massless bodies below it"),
-        ),
-        REVOLUTE: (Expression(EXACT, "RevoluteJoint about z between frames at the anchors "
-                                     "(the parent's turned by the angle offset)"),),
-        PRISMATIC: (Expression(EXACT, "PrismaticJoint along the unit axis"),),
-        POINT_TO_POINT_LINEAR: (Expression(EXACT, "LinearSpringDamper where the law is a "
-                                                  "spring of positive free length with a "
-                                                  "non-negative damper, an isotropic "
-                                                  "LinearBushingRollPitchYaw without torque "
-                                                  "for a spring of zero free length, "
-                                                  "otherwise the law as externally applied "
-                                                  "spatial forces from a LeafSystem at every "
-                                                  "integrator stage"),),
-        POINT_TO_POINT_CUSTOM: (
-            Expression(EXACT, "externally applied spatial forces on both bodies from a "
-                              "LeafSystem, evaluated at every integrator stage (at the start "
-                              "of each step where the plant is discrete, as for a law that "
-                              "jumps: the error control has no event location)"),),
-        COORDINATE_FORCE_LINEAR: (Expression(EXACT, "RevoluteSpring or PrismaticSpring and "
-                                                    "the joint's damping where the law acts "
-                                                    "on one joint value with non-negative "
-                                                    "stiffness and damping, otherwise the "
-                                                    "plant's applied generalized force"),),
-        COORDINATE_FORCE_CUSTOM: (
-            Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
-                              "evaluated at every integrator stage",
-                       when="the law is continuous",
-                       applies=lambda mech, law: not _jumps(ForceLaw.of(law).expr)),
-            Expression(EXACT, "the plant's applied generalized force from a LeafSystem, "
-                              "evaluated at the start of each step of the discrete plant (the "
-                              "error control cannot cross a jump: it has no event location)",
-                       when="the law jumps (dry friction)")),
-        TIME_LOAD: (Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
-                                      "the stage time"),),
-        POINT_ON_POINT: (Expression(SOFT, "AddBallConstraint between the two points on the "
-                                          "discrete plant (its out-of-plane row is void: "
-                                          "every body moves in the plane)",
-                                    expected_failures=SAP_CONSTRAINT_METRICS,
-                                    reason=SAP_CONSTRAINT),),
-        POINT_ON_LINE: (
-            Expression(SUBSTITUTE, "no point-on-line constraint: a slider body on a "
-                                   "PrismaticJoint along the slot, held to the pin by "
-                                   "AddBallConstraint on the discrete plant; it carries a point "
-                                   "mass taken out of the pin's body at the pin (exact while "
-                                   "the constraints hold: the pin point carries it either way)",
-                       when="the pin's body can lend the slider a point mass at the pin",
-                       applies=lambda mech, slot: _can_lend(mech, slot),
-                       expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
-            Expression(UNSUPPORTED, "Drake has no point-on-line constraint, and the pin's "
-                                    "body cannot lend the substitute slider a point mass at "
-                                    "the pin (massless, the world, or too little inertia "
-                                    "about the pin): a slider without mass makes the plant's "
-                                    "mass matrix singular",
-                       when="the pin's body cannot lend it")),
-        LINEAR_COUPLING: (
-            Expression(SOFT, "AddCouplerConstraint v0 = rho v1 + offset on the discrete "
-                             "plant, the coupling written on the engine joint values",
-                       when="it relates two joint values",
-                       applies=lambda mech, coupling: _coupler(mech, coupling) is not None,
-                       expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
-            Expression(UNSUPPORTED, "Drake's coupler constraint relates two joints; this "
-                                    "coupling involves one or more than two joint values",
-                       when="it relates one or more than two joint values")),
-        ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact geometry is built: the "
-                                                  "continuous plant's point contact is a "
-                                                  "penalty (compliant) model"),),
-        PRESCRIBED: (Expression(EXACT, "the acceleration imposed by the LeafSystem's applied "
-                                       "generalized force at every integrator stage (from the "
-                                       "plant's mass matrix and its other generalized forces "
-                                       "at the stage's state and time); that force is the "
-                                       "actuator force"),),
-    }
+    EXPRESSIONS = EXPRESSIONS
 
     def accuracy_knob(self, mechanism: Mechanism, settings: Mapping | None = None) -> str:
         return "" if _discrete(mechanism, self.resolve_settings(settings)) else \
@@ -438,14 +655,10 @@ class DrakeBackend(Backend):
     # --- building ----------------------------------------------------------------------------
     def _build(self, mech: Mechanism, cfg: dict, dt: float,
                recorder: "_Recorder | None" = None) -> _Built:
-        """The diagram (a discrete plant of step `dt` where `_discrete`); every plant call
-        goes through `recorder` (`export` writes them)."""
-        from pydrake.math import RigidTransform, RotationMatrix
+        """The diagram (a discrete plant of step `dt` where `_discrete`): each element
+        built by the builder registered for its kind; every plant call goes through
+        `recorder` (`export` writes them)."""
         from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
-        from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
-                                            LinearSpringDamper, PrismaticJoint,
-                                            PrismaticSpring, RevoluteJoint, RevoluteSpring,
-                                            SpatialInertia, UnitInertia)
         from pydrake.systems.framework import DiagramBuilder
 
         support = self.support(mech)
@@ -465,115 +678,36 @@ class DrakeBackend(Backend):
                 float(cfg["sap_near_rigid_threshold"]))
         rec("", plant.mutable_gravity_field().set_gravity_vector,
             "plant.mutable_gravity_field().set_gravity_vector", [0.0, -num(mech.gravity), 0.0])
-        bodies = {WORLD: rec("world", plant.world_body, "plant.world_body")}
-        for b in mech.bodies:
-            mass, com, unit = _inertia(mech, b)
-            bodies[b.name] = rec(f"body_{len(bodies)}", plant.AddRigidBody, "plant.AddRigidBody",
-                                 b.name, rec(None, SpatialInertia, "SpatialInertia", mass, com,
-                                             rec(None, UnitInertia, "UnitInertia", *unit)))
         cmap = coordinate_map(mech)
         # on the discrete plant every law is explicit, as semi-implicit Euler's gates
         # assume: its solver would take the joints' damping implicitly
         native = bool(cfg["native_elements"]) and not discrete
-        springs, damping, python_laws = self._coordinate_laws(mech, cmap, native)
-
-        def frame(body: str, name: str, anchor, angle: float):
-            point = [num(anchor[0]), num(anchor[1]), 0.0]
-            pose = rec(None, RigidTransform, "RigidTransform",
-                       rec(None, RotationMatrix.MakeZRotation, "RotationMatrix.MakeZRotation",
-                           angle), point)
-            parent = rec(None, bodies[body].body_frame, f"{rec.code(bodies[body])}.body_frame")
-            return rec(f"frame_{name}", plant.AddFrame, "plant.AddFrame",
-                       rec(None, FixedOffsetFrame, "FixedOffsetFrame", name, parent, pose))
-
-        joints = []
-        for i, j in enumerate(mech.joints):
-            off = num(j.angle_offset)
-            if isinstance(j, Revolute):
-                jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, off)
-                jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, 0.0)
-                made = rec(None, RevoluteJoint, "RevoluteJoint", j.name, jp, jc, [0.0, 0.0, 1.0],
-                           damping=damping[i])
-            else:
-                axis = np.array([num(j.axis[0]), num(j.axis[1]), 0.0])
-                jp = frame(j.parent, f"{j.name}_on_parent", j.parent_anchor, 0.0)
-                jc = frame(j.child, f"{j.name}_on_child", j.child_anchor, -off)
-                made = rec(None, PrismaticJoint, "PrismaticJoint", j.name, jp, jc,
-                           axis / np.linalg.norm(axis), damping=damping[i])
-            joints.append(rec(f"joint_{i}", plant.AddJoint, "plant.AddJoint", made))
-        for i, k, nominal in springs:
-            spring = RevoluteSpring if isinstance(mech.joints[i], Revolute) else PrismaticSpring
-            rec("", plant.AddForceElement, "plant.AddForceElement",
-                rec(None, spring, spring.__name__, joints[i], nominal, k))
-        python_p2p = []
-        for f in mech.forces:
-            if not isinstance(f, PointToPoint) or f.body_a == f.body_b:
-                continue
-            spring = _native_spring(ForceLaw.of(f)) if native else None
-            if spring is None:
-                python_p2p.append(f)
-                continue
-            free_length, stiffness, damper = spring
-            if free_length == 0:
-                # a spring of zero free length pulls each point towards the other with
-                # k times their separation: a bushing with isotropic force stiffness and
-                # no torque, whose force acts on the line between its frames' origins
-                element = rec(None, LinearBushingRollPitchYaw, "LinearBushingRollPitchYaw",
-                              frame(f.body_a, f"{f.name}_a", f.point_a, 0.0),
-                              frame(f.body_b, f"{f.name}_b", f.point_b, 0.0),
-                              [0.0] * 3, [0.0] * 3, [stiffness] * 3, [0.0] * 3)
-            else:
-                element = rec(None, LinearSpringDamper, "LinearSpringDamper",
-                              bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
-                              bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
-                              free_length, stiffness, damper)
-            rec("", plant.AddForceElement, "plant.AddForceElement", element)
-        slots = []
-        for c in mech.constraints:
-            if isinstance(c, PointOnLine):
-                # a slider along the slot, held to the pin, carrying a point mass lent by
-                # the pin's body (`EXPRESSIONS`)
-                slider = rec(f"body_{len(bodies) + len(slots)}", plant.AddRigidBody,
-                             "plant.AddRigidBody", f"{c.name}_slider",
-                             rec(None, SpatialInertia, "SpatialInertia",
-                                 _slider_mass(mech, c), [0.0] * 3,
-                                 rec(None, UnitInertia, "UnitInertia", 0.0, 0.0, 0.0)))
-                axis = np.array([num(c.direction[0]), num(c.direction[1]), 0.0])
-                axis /= np.linalg.norm(axis)
-                line = frame(c.line_body, f"{c.name}_line", c.line_point, 0.0)
-                pin = [num(c.point[0]), num(c.point[1]), 0.0]
-                slide = rec(f"slider_{len(slots)}", plant.AddJoint, "plant.AddJoint",
-                            rec(None, PrismaticJoint, "PrismaticJoint", f"{c.name}_slide", line,
-                                rec(None, slider.body_frame, f"{rec.code(slider)}.body_frame"),
-                                axis))
-                rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body],
-                    pin, slider, [0.0] * 3)
-                slots.append((slide, bodies[c.body], np.array(pin), line, axis))
-            elif isinstance(c, PointOnPoint):
-                rec("", plant.AddBallConstraint, "plant.AddBallConstraint", bodies[c.body_a],
-                    [num(c.point_a[0]), num(c.point_a[1]), 0.0], bodies[c.body_b],
-                    [num(c.point_b[0]), num(c.point_b[1]), 0.0])
-            else:  # a LinearCoupling of two joint values (`EXPRESSIONS`)
-                i0, i1, ratio, offset = _coupler(mech, c)
-                rec("", plant.AddCouplerConstraint, "plant.AddCouplerConstraint", joints[i0],
-                    joints[i1], ratio, offset)
+        springs = _native_coordinate_laws(mech, cmap, native)
+        damping = [0.0] * len(mech.joints)
+        for j, _, _, d in springs.values():
+            damping[j] += d
+        build = _Build(mech, rec, plant, cmap, native,
+                       {WORLD: rec("world", plant.world_body, "plant.world_body")},
+                       damping, springs)
+        for kind, element in elements(mech):
+            _BUILDERS[kind](build, element)
+        python_p2p, python_laws = build.python_p2p, build.python_laws
         rec.python_forces = [f.name for f in mech.forces
-                             if any(f is w for w in python_p2p)
-                             or any(f is g for g in python_laws)]
+                             if any(f is w for w in python_p2p + python_laws)]
         plant.Finalize()
-        python_forces = bool(python_laws or python_p2p or mech.prescribed)
-        positions = np.array([j.position_start() for j in joints], dtype=int)
-        velocities = np.array([j.velocity_start() for j in joints], dtype=int)
+        python_forces = bool(python_laws or python_p2p or build.prescribed)
+        positions = np.array([j.position_start() for j in build.joints], dtype=int)
+        velocities = np.array([j.velocity_start() for j in build.joints], dtype=int)
         forces = None
         if python_forces:
-            forces = builder.AddSystem(_force_system(mech, plant, bodies, cmap, positions,
+            forces = builder.AddSystem(_force_system(mech, plant, build.bodies, cmap, positions,
                                                      velocities, python_laws, python_p2p))
             builder.Connect(plant.get_state_output_port(), forces.get_input_port(0))
             builder.Connect(forces.get_output_port(0),
                             plant.get_applied_generalized_force_input_port())
             builder.Connect(forces.get_output_port(1), plant.get_applied_spatial_force_input_port())
-        return _Built(builder.Build(), plant, joints, positions, velocities, cmap,
-                      python_forces, forces, slots)
+        return _Built(builder.Build(), plant, build.joints, positions, velocities, cmap,
+                      python_forces, forces, build.slots)
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -644,35 +778,6 @@ class DrakeBackend(Backend):
         outside = ([f"the force laws computed by the Python force system: "
                     f"{', '.join(recorder.python_forces)}"] if recorder.python_forces else [])
         return text, outside
-
-    @staticmethod
-    def _coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool):
-        """(springs [(joint, stiffness, nominal value)], damping per joint, the laws
-        (CoordinateForce elements) left to the Python force system). A law goes to Drake's own elements when its
-        coordinate is r v_j, one engine joint value (COORD = sum sign q_i = (sum sign T_i) v
-        + sum sign c_i): then tau_j = r F(r v_j, r v_j') = r a + r^2 b v_j + r^2 c v_j', a
-        spring of stiffness k = -r^2 b >= 0 and nominal value r a / k, and a damper
-        -r^2 c >= 0."""
-        n = len(mech.joints)
-        springs, damping, python_laws = [], [0.0] * n, []
-        for f in mech.forces:
-            if not isinstance(f, CoordinateForce):
-                continue
-            weights = f.weights(mech.coordinates)
-            law = ForceLaw.of(f)
-            target = cmap.law_target(weights)
-            linear = law.linear if native else None
-            if linear is not None and target is not None:
-                j, r = target
-                a, b, c = linear
-                k, d = -r * r * b, -r * r * c
-                if k >= 0 and d >= 0 and (k > 0 or a == 0):
-                    if k > 0:
-                        springs.append((j, k, r * a / k))
-                    damping[j] += d
-                    continue
-            python_laws.append(f)
-        return springs, damping, python_laws
 
     # --- running -----------------------------------------------------------------------------
     def _simulator(self, built: _Built, q0: np.ndarray, qd0: np.ndarray, dt: float, cfg: dict):
@@ -756,13 +861,13 @@ class DrakeBackend(Backend):
         control = None if cfg["fixed_step"] or discrete else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
         # Drake reports no constraint forces (`EXPRESSIONS`)
-        closures = {c.name: np.full((steps + 1, 1 if isinstance(c, LinearCoupling) else 2),
+        closures = {c.name: np.full((steps + 1, 1 if element_kind(c) == LINEAR_COUPLING else 2),
                                     np.nan) for c in mechanism.constraints}
         # Drake books the generalized forces on a joint's own coordinate (its laws, a
         # coupler constraint: unknown, so NaN on a slide it involves) as transmitted
         # through it; the ball constraints and point-to-point forces act on the bodies
         couplings = {c.name: closures[c.name] for c in mechanism.constraints
-                     if isinstance(c, LinearCoupling)}
+                     if element_kind(c) == LINEAR_COUPLING}
         reactions = joint_reactions(mechanism, reaction_joints, forces, t, q, qd,
                                     coupling_forces=couplings)
         return Samples(q, qd, clock, reactions, constraint_forces=closures,
