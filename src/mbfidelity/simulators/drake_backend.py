@@ -251,26 +251,9 @@ def _coupler(mech: Mechanism, coupling: LinearCoupling
 
 @dataclass
 class _Built:
-    """A diagram built from a mechanism, with what the read-out needs."""
-
-    diagram: object
-    plant: object
-    joints: list                      # Drake joints, in description joint order
-    positions: np.ndarray             # plant position index of each joint
-    velocities: np.ndarray            # plant velocity index of each joint
-    cmap: CoordinateMap
-    python_forces: bool               # whether a Python LeafSystem computes forces
-    forces: object = None             # the Python force system, when there is one
-    #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
-    #: slot's unit direction), for the slider's initial state (`_place_slider`)
-    slots: list = field(default_factory=list)
-
-
-@dataclass
-class _Build:
-    """A plant being built: what each element's builder adds to (through the recorder,
-    so that `export` writes every plant call) and what the force system and the read-out
-    need afterwards."""
+    """A diagram built from a mechanism: what each element's builder adds to (every
+    plant call through the recorder, which `export` writes), then what the force system
+    and the read-out need."""
 
     mech: Mechanism
     rec: "_Recorder"
@@ -281,13 +264,24 @@ class _Build:
     bodies: dict                      # description body (and WORLD) -> Drake body
     #: per description joint: the viscous damping its native coordinate laws give it
     damping: list
-    #: per native coordinate law (by name): (its joint, stiffness, nominal value)
+    #: per native coordinate law (by name): (its joint, stiffness, nominal value, damping)
     springs: dict
-    joints: list = field(default_factory=list)
+    joints: list = field(default_factory=list)        # Drake joints, in description order
     python_laws: list = field(default_factory=list)   # CoordinateForce laws of the LeafSystem
     python_p2p: list = field(default_factory=list)    # PointToPoint laws of the LeafSystem
-    prescribed: list = field(default_factory=list)    # motions the LeafSystem imposes
-    slots: list = field(default_factory=list)         # see `_Built.slots`
+    driven: list = field(default_factory=list)        # motions the LeafSystem imposes
+    #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
+    #: slot's unit direction), for the slider's initial state (`_place_slider`)
+    slots: list = field(default_factory=list)
+    diagram: object = None
+    positions: np.ndarray | None = None   # plant position index of each joint
+    velocities: np.ndarray | None = None  # plant velocity index of each joint
+    forces: object = None             # the Python force system, when there is one
+
+    @property
+    def python_forces(self) -> bool:
+        """Whether a Python LeafSystem computes forces."""
+        return bool(self.python_laws or self.python_p2p or self.driven)
 
     def frame(self, body: str, name: str, anchor, angle: float):
         """A frame on `body` at `anchor` (its frame's coordinates), turned by `angle`."""
@@ -328,19 +322,19 @@ def _native_coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool
     return held
 
 
-_BUILDERS: dict[str, Callable[[_Build, object], None]] = {}
+_BUILDERS: dict[str, Callable[[_Built, object], None]] = {}
 _EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
 
 
 def _builds(kind: str, *cases: Expression):
     """Register the builder of one element kind with the expression(s) it declares."""
-    def register(builder: Callable[[_Build, object], None]):
+    def register(builder: Callable[[_Built, object], None]):
         _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
         return builder
     return register
 
 
-def _body(build: _Build, body) -> None:
+def _body(build: _Built, body) -> None:
     from pydrake.multibody.tree import SpatialInertia, UnitInertia
 
     rec = build.rec
@@ -363,7 +357,7 @@ _builds(
                when="only massless bodies below it"))(_body)
 
 
-def _add_joint(build: _Build, made) -> None:
+def _add_joint(build: _Built, made) -> None:
     rec = build.rec
     build.joints.append(rec(f"joint_{len(build.joints)}", build.plant.AddJoint,
                             "plant.AddJoint", made))
@@ -371,7 +365,7 @@ def _add_joint(build: _Build, made) -> None:
 
 @_builds(REVOLUTE, Expression(EXACT, "RevoluteJoint about z between frames at the anchors "
                                      "(the parent's turned by the angle offset)"))
-def _revolute(build: _Build, joint: Revolute) -> None:
+def _revolute(build: _Built, joint: Revolute) -> None:
     from pydrake.multibody.tree import RevoluteJoint
 
     jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor,
@@ -383,7 +377,7 @@ def _revolute(build: _Build, joint: Revolute) -> None:
 
 
 @_builds(PRISMATIC, Expression(EXACT, "PrismaticJoint along the unit axis"))
-def _prismatic(build: _Build, joint) -> None:
+def _prismatic(build: _Built, joint) -> None:
     from pydrake.multibody.tree import PrismaticJoint
 
     axis = np.array([num(joint.axis[0]), num(joint.axis[1]), 0.0])
@@ -395,7 +389,7 @@ def _prismatic(build: _Build, joint) -> None:
         axis / np.linalg.norm(axis), damping=build.damping[len(build.joints)]))
 
 
-def _point_to_point(build: _Build, f: PointToPoint) -> None:
+def _point_to_point(build: _Built, f: PointToPoint) -> None:
     """Drake's own spring element where it expresses the law (`_native_spring`), else
     the law in the LeafSystem; a force between two points of one body is internal."""
     from pydrake.multibody.tree import LinearBushingRollPitchYaw, LinearSpringDamper
@@ -424,7 +418,7 @@ def _point_to_point(build: _Build, f: PointToPoint) -> None:
     rec("", build.plant.AddForceElement, "plant.AddForceElement", element)
 
 
-def _coordinate_force(build: _Build, f: CoordinateForce) -> None:
+def _coordinate_force(build: _Built, f: CoordinateForce) -> None:
     """Drake's joint spring (its damping went to the joint) where the law is held
     natively (`_native_coordinate_laws`), else the law in the LeafSystem."""
     from pydrake.multibody.tree import PrismaticSpring, RevoluteSpring
@@ -470,7 +464,7 @@ _FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
 
 @_builds(TIME_LOAD, Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
                                       "the stage time"))
-def _time_load(build: _Build, f) -> None:
+def _time_load(build: _Built, f) -> None:
     _FORCES[type(f)](build, f)  # a law of TIME is never a native element's
 
 
@@ -479,7 +473,7 @@ def _time_load(build: _Build, f) -> None:
                                           "every body moves in the plane)",
                                     expected_failures=SAP_CONSTRAINT_METRICS,
                                     reason=SAP_CONSTRAINT))
-def _point_on_point(build: _Build, c: PointOnPoint) -> None:
+def _point_on_point(build: _Built, c: PointOnPoint) -> None:
     build.rec("", build.plant.AddBallConstraint, "plant.AddBallConstraint",
               build.bodies[c.body_a], [num(c.point_a[0]), num(c.point_a[1]), 0.0],
               build.bodies[c.body_b], [num(c.point_b[0]), num(c.point_b[1]), 0.0])
@@ -500,7 +494,7 @@ def _point_on_point(build: _Build, c: PointOnPoint) -> None:
                             "(massless, the world, or too little inertia about the pin): a "
                             "slider without mass makes the plant's mass matrix singular",
                when="the pin's body cannot lend it"))
-def _point_on_line(build: _Build, c: PointOnLine) -> None:
+def _point_on_line(build: _Built, c: PointOnLine) -> None:
     """A slider along the slot, held to the pin, carrying a point mass lent by the pin's
     body (`_slider_mass`)."""
     from pydrake.multibody.tree import PrismaticJoint, SpatialInertia, UnitInertia
@@ -532,7 +526,7 @@ def _point_on_line(build: _Build, c: PointOnLine) -> None:
     Expression(UNSUPPORTED, "Drake's coupler constraint relates two joints; this coupling "
                             "involves one or more than two joint values",
                when="it relates one or more than two joint values"))
-def _linear_coupling(build: _Build, c: LinearCoupling) -> None:
+def _linear_coupling(build: _Built, c: LinearCoupling) -> None:
     i0, i1, ratio, offset = _coupler(build.mech, c)
     build.rec("", build.plant.AddCouplerConstraint, "plant.AddCouplerConstraint",
               build.joints[i0], build.joints[i1], ratio, offset)
@@ -541,7 +535,7 @@ def _linear_coupling(build: _Build, c: LinearCoupling) -> None:
 @_builds(ROLLING_CONTACT, Expression(UNSUPPORTED, "no contact geometry is built: the "
                                                   "continuous plant's point contact is a "
                                                   "penalty (compliant) model"))
-def _rolling_contact(build: _Build, c) -> None:
+def _rolling_contact(build: _Built, c) -> None:
     raise ValueError(f"drake builds no rolling contact ({c.name}): support() refuses it")
 
 
@@ -550,8 +544,9 @@ def _rolling_contact(build: _Build, c) -> None:
                                        "plant's mass matrix and its other generalized forces "
                                        "at the stage's state and time); that force is the "
                                        "actuator force"))
-def _prescribed(build: _Build, p) -> None:
-    build.prescribed.append(p)  # nothing in the plant: the LeafSystem imposes it
+def _prescribed(build: _Built, p) -> None:
+    # nothing in the plant: the LeafSystem imposes it
+    build.driven += [m for m in motions(build.mech) if m.element is p]
 
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
@@ -686,28 +681,25 @@ class DrakeBackend(Backend):
         damping = [0.0] * len(mech.joints)
         for j, _, _, d in springs.values():
             damping[j] += d
-        build = _Build(mech, rec, plant, cmap, native,
+        built = _Built(mech, rec, plant, cmap, native,
                        {WORLD: rec("world", plant.world_body, "plant.world_body")},
                        damping, springs)
         for kind, element in elements(mech):
-            _BUILDERS[kind](build, element)
-        python_p2p, python_laws = build.python_p2p, build.python_laws
+            _BUILDERS[kind](built, element)
         rec.python_forces = [f.name for f in mech.forces
-                             if any(f is w for w in python_p2p + python_laws)]
+                             if any(f is w for w in built.python_p2p + built.python_laws)]
         plant.Finalize()
-        python_forces = bool(python_laws or python_p2p or build.prescribed)
-        positions = np.array([j.position_start() for j in build.joints], dtype=int)
-        velocities = np.array([j.velocity_start() for j in build.joints], dtype=int)
-        forces = None
-        if python_forces:
-            forces = builder.AddSystem(_force_system(mech, plant, build.bodies, cmap, positions,
-                                                     velocities, python_laws, python_p2p))
-            builder.Connect(plant.get_state_output_port(), forces.get_input_port(0))
-            builder.Connect(forces.get_output_port(0),
+        built.positions = np.array([j.position_start() for j in built.joints], dtype=int)
+        built.velocities = np.array([j.velocity_start() for j in built.joints], dtype=int)
+        if built.python_forces:
+            built.forces = builder.AddSystem(_force_system(built))
+            builder.Connect(plant.get_state_output_port(), built.forces.get_input_port(0))
+            builder.Connect(built.forces.get_output_port(0),
                             plant.get_applied_generalized_force_input_port())
-            builder.Connect(forces.get_output_port(1), plant.get_applied_spatial_force_input_port())
-        return _Built(builder.Build(), plant, build.joints, positions, velocities, cmap,
-                      python_forces, forces, build.slots)
+            builder.Connect(built.forces.get_output_port(1),
+                            plant.get_applied_spatial_force_input_port())
+        built.diagram = builder.Build()
+        return built
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],
@@ -1003,13 +995,11 @@ def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
     return -a / b, b, c
 
 
-def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
-                  positions: np.ndarray, velocities: np.ndarray, coordinate_laws: list,
-                  point_laws: list):
+def _force_system(built: _Built):
     """A LeafSystem that reads the plant's state and outputs (0) the applied generalized
-    force: tau = T^T Q of the coordinate laws plus the prescribed motions' actuators, and
-    (1) the externally applied spatial forces of the point-to-point laws, all at the
-    stage's time (contract point 6).
+    force: tau = T^T Q of the build's coordinate laws plus its prescribed motions'
+    actuators, and (1) the externally applied spatial forces of its point-to-point laws,
+    all at the stage's time (contract point 6).
 
     The actuators (convention 9) impose each prescribed coordinate's acceleration: with
     the plant's mass matrix M and its generalized forces f without them (force elements,
@@ -1023,14 +1013,16 @@ def _force_system(mech: Mechanism, plant, bodies: dict, cmap: CoordinateMap,
     from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
     from pydrake.systems.framework import BasicVector, LeafSystem
 
+    mech, plant, bodies = built.mech, built.plant, built.bodies
+    positions, velocities = built.positions, built.velocities
     nq, nv = plant.num_positions(), plant.num_velocities()
     n = len(mech.joints)
-    laws = CoordinateLaws(mech, coordinate_laws)
+    laws = CoordinateLaws(mech, built.python_laws)
     points = [(f, ForceLaw.of(f).law, np.array([num(f.point_a[0]), num(f.point_a[1]), 0.0]),
-               np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in point_laws]
+               np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in built.python_p2p]
     kinematics = plant.CreateDefaultContext()
-    T, c = cmap.T, cmap.c
-    driven = motions(mech)
+    T, c = built.cmap.T, built.cmap.c
+    driven = built.driven
     select = np.zeros((n, nv))  # joint values' rates from the plant's velocities
     select[np.arange(n), velocities] = 1.0
     G = T[[m.index for m in driven]] @ select
