@@ -1,7 +1,11 @@
 """Drake backend (pydrake): the continuous-time `MultibodyPlant` integrated by the
 `Simulator` with an error-controlled scheme.
 
-Translation (generic over the description, conventions 1-8 of `systems.model`):
+Translation (generic over the description, conventions 1-8 of `systems.model`): each
+element kind (`plan.ELEMENT_KINDS`) has one builder, registered with `_builds` together
+with the `Expression`(s) it declares (contract point 5), so that the declaration and the
+code that builds the element are one thing; the build runs them over the description's
+elements in order, each adding its plant calls to a `_Built`:
 
 - every description body becomes a rigid body whose frame is the description's
   centre-of-mass frame, with its mass and central inertia (the planar moment on z, a
@@ -358,6 +362,7 @@ _builds(
 
 
 def _add_joint(build: _Built, made) -> None:
+    """A description joint into the plant (the joints come in description order)."""
     rec = build.rec
     build.joints.append(rec(f"joint_{len(build.joints)}", build.plant.AddJoint,
                             "plant.AddJoint", made))
