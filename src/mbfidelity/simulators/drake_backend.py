@@ -117,6 +117,7 @@ from .plan import (
     CoordinateMap,
     ForceLaw,
     coordinate_map,
+    coupling_row,
     element_kind,
     elements,
     motions,
@@ -242,10 +243,7 @@ def _coupler(mech: Mechanism, coupling: LinearCoupling
     """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset: the coupling
     written on the engine joint values (`CoordinateMap.on_engine_values`); None unless it
     relates exactly two of them."""
-    a = np.zeros(len(mech.coordinates))
-    for name, coefficient in coupling.coefficients:
-        a[mech.coordinates.index(name)] += num(coefficient)
-    row, constant = coordinate_map(mech).on_engine_values(a, num(coupling.constant))
+    row, constant = coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
     nonzero = np.flatnonzero(row)
     if len(nonzero) != 2:
         return None
