@@ -1,11 +1,10 @@
 """A spatial closed loop with a redundant constraint: Bricard's mechanism (IFToMM A04,
-examples/iftomm_a04_bricard.py), described with a `HingeClosure` and `redundant = 1`.
+systems/benchmarks/iftomm_a04_bricard.py), described with a `HingeClosure` and `redundant = 1`.
 Expected values come from the loop's geometry and mechanics, never from our output: the
 closure's velocity rows written by hand from the hinge axes (twists), the known mobility
 of the linkage (one, with five tree coordinates: rank 4 of 5 rows), and the conservation
 of energy (no force but gravity does work)."""
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,7 +13,6 @@ from scipy.integrate import solve_ivp
 from mbfidelity import systems
 from mbfidelity.systems.model import HingeClosure, Mechanism, Revolute
 
-EXAMPLE = Path(__file__).parents[1] / "examples" / "iftomm_a04_bricard.py"
 BRICARD = "iftomm_a04_bricard"
 
 #: the initial (cube) position: hinge points and unit axes O1, P2, P3, P4, P5 (L = 1)
@@ -72,11 +70,10 @@ def test_a_spatial_mechanism_takes_hinge_closures_only():
         Mechanism(bodies=(body,), joints=tree, redundant=1)
 
 
-def test_the_closure_rows_are_the_twists_and_one_is_redundant(catalog_with):
+def test_the_closure_rows_are_the_twists_and_one_is_redundant():
     """The derivation's Jacobian at the cube position equals the rows written from the
     hinge twists; its rank is 4 = 5 coordinates less the linkage's one degree of freedom
     (Bricard's: Grübler's count 5 - 5 = 0), at the start and along the motion."""
-    catalog_with(EXAMPLE)
     _, model = _model()
     hand = _hand_jacobian()
     np.testing.assert_allclose(model.constraint_jacobian(np.zeros(5)), hand, atol=1e-12)
@@ -89,12 +86,11 @@ def test_the_closure_rows_are_the_twists_and_one_is_redundant(catalog_with):
         assert model.constraint_rank(q)[0] == 4
 
 
-def test_the_reference_conserves_energy(catalog_with):
+def test_the_reference_conserves_energy():
     """From rest in the cube position the rods fall under gravity alone: T + V keeps its
     initial value -3 m g L (centres at heights 0, -L/2, -L, -L, -L/2) to the integration
     tolerance (DOP853 at 1e-10 over 1 s: the error per unit time stays near the
     tolerance times the energy's scale, m g L = 9.81 J)."""
-    catalog_with(EXAMPLE)
     s, model = _model()
     v = s.parameter_values()
     y0 = np.zeros(2)
@@ -117,9 +113,7 @@ def test_the_reference_conserves_energy(catalog_with):
 
 LONGER_ROD = '''
 from dataclasses import replace
-import sys
-sys.path.insert(0, {folder!r})
-import iftomm_a04_bricard as base
+from mbfidelity.systems.benchmarks import iftomm_a04_bricard as base
 
 def build(P):
     mech = base.build(P)
@@ -137,8 +131,8 @@ def test_a_rod_one_percent_longer_is_caught(catalog_with, tmp_path):
     form Bricard's linkage, the loop cannot close with the rank the description declares
     (a generic 6R loop is rigid: rank 5), and assembling it is refused."""
     module = tmp_path / "bricard_longer_rod.py"
-    module.write_text(LONGER_ROD.format(folder=str(EXAMPLE.parent)))
-    catalog_with(EXAMPLE, module)
+    module.write_text(LONGER_ROD)
+    catalog_with(module)
     from mbfidelity.analytic.numeric import numeric_model
 
     s = systems.get_system("bricard_longer_rod")

@@ -1,8 +1,5 @@
 """IFToMM benchmark A04: Bricard's mechanism, an over-constrained spatial loop of five
-rods and six hinges that moves although Grübler's count gives it no freedom. Not yet a
-catalog row (a row also needs its hand facts, tests/hand/: the equilibria and the
-frequency of the hanging mechanism, and each engine's run or declaration): put through
-the derivation and the engines with ``--system-path examples/iftomm_a04_bricard.py``.
+rods and six hinges that moves although Grübler's count gives it no freedom.
 
 Specification (problem A04 of the benchmark library of the Laboratorio de Ingeniería
 Mecánica, University of A Coruña, lim.ii.udc.es/mbsbenchmark, dist/A04/
@@ -45,9 +42,8 @@ about its length and m (L^2 + a^2) / 12 across it.
 """
 import sympy as sp
 
-from mbfidelity.systems import BenchmarkError, PointOutput, Published, System
-from mbfidelity.systems.model import (Body, HingeClosure, Mechanism, Parameter, Revolute,
-                                      Scenario, Segment)
+from .. import BenchmarkError, PointOutput, Published, System
+from ..model import Body, HingeClosure, Mechanism, Parameter, Revolute, Scenario, Segment
 
 SOURCE = ("IFToMM benchmark A04 (González et al., Multibody System Dynamics 16, 2006); "
           "closed form: conservation of energy from rest")
@@ -71,7 +67,7 @@ def _rod(name, direction, P) -> Body:
     tensor = tuple(tuple(along[i] if i == j else 0 for j in range(3)) for i in range(3))
     half = tuple(P.L * c / 2 for c in direction)
     back = tuple(-c for c in half)
-    return Body.spatial(name, P.m, tensor, (Segment(back[:2], half[:2], width=P.a),))
+    return Body.spatial(name, P.m, tensor, (Segment(back, half, width=P.a),))
 
 
 def build(P) -> Mechanism:
