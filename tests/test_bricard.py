@@ -140,3 +140,18 @@ def test_a_rod_one_percent_longer_is_caught(catalog_with, tmp_path):
     assert np.max(np.abs(model.constraint_values(np.zeros(5)))) == pytest.approx(0.01)
     with pytest.raises(RuntimeError, match="rank|no solution|assembly lost"):
         model.complete(np.zeros(5))
+
+
+@pytest.mark.slow
+def test_analyze_compares_the_published_energy_over_the_whole_run():
+    """`analyze`'s published entry: T + V at the end of the benchmark's 10 s equals its
+    value at the release, -3 m g L, within the reference's own error estimate."""
+    from mbfidelity.analytic.published import compare_published
+
+    s = systems.get_system(BRICARD)
+    values = s.parameter_values()
+    (entry,) = compare_published(s, values)
+    assert entry["quantity"] == "energy" and entry["applies"]
+    assert entry["published_value"] == pytest.approx(-3 * 9.81, rel=1e-15)
+    assert not entry["beyond_reference_error"]
+    assert entry["reference_error"] < 1e-8

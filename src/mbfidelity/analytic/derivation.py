@@ -10,8 +10,9 @@ force element by virtual power (eq. 95):
 A spatial mechanism (model convention 10) takes the same route in three dimensions: each
 body's rotation matrix R(q) is composed along the tree, its angular velocity (body axes) is
 read from the skew matrix R^T R' (never assumed), and T = sum(m v.v/2 + w.I w/2) with the
-full central tensor I; gravity acts along -up. Planar mechanisms keep the planar
-computation unchanged.
+full central tensor I; gravity acts along -up. Its loops close by `HingeClosure` rows:
+the three components of the point's gap and the two of the axes' misalignment. Planar
+mechanisms keep the planar computation unchanged.
 
 Route 2 (energy functions, used to cross-check the linearization, monograph eq. 107-109
 and Italian notes §5.3.3-5.3.4): T, V and Rayleigh's D, whose Hessians at an equilibrium

@@ -12,6 +12,15 @@ The linearization at an equilibrium is taken on the constraint manifold:
 M_r = S^T M S, C_r = S^T C S, K_r = S^T (K + sum_k lam_k Hess(Phi_k)) S, with lam the
 static multipliers. Without constraints S = I and these reduce to eq. 104-109.
 
+An over-constrained loop (`Mechanism.redundant` rows implied by the others) has a
+constraint Jacobian of rank m - redundant everywhere and a singular augmented matrix:
+the dependent coordinates are then solved by least squares (exact, the rows being
+consistent), the accelerations on the constraint manifold (q'' = S a + c with
+S^T M S a = S^T (Q - h - M c)), and of the multipliers, which the redundancy leaves
+undetermined, the least-norm ones are reported. The rank is checked at every
+configuration assembled: a loop whose geometry no longer makes the rows redundant is
+refused.
+
 A driven mechanism (prescribed coordinates q_p = q_p(t), monograph §9.6) is integrated in
 its free coordinates q_f: with the prescribed positions, rates and accelerations given,
 M_ff q_f'' = (Q - h)_f - M_fp q_p''(t). The rows of the prescribed coordinates then give

@@ -46,6 +46,10 @@ Conventions (all backends and the analytic layer honour them):
    of these is planar (`Mechanism.spatial` is false) and follows conventions 1-5 exactly.
    Body frames coincide with the parent's frame at q = 0 (no orientation offset): a body
    whose principal axes are turned gives its tensor in those parent-aligned axes.
+   A spatial loop closes with a `HingeClosure` (a hinge the tree does not hold: the
+   point and the axis, five equations); the planar closures stay planar. An
+   over-constrained loop (Bricard's) states how many of its closure equations the
+   others imply everywhere on its motion (`Mechanism.redundant`).
 """
 from __future__ import annotations
 

@@ -26,9 +26,15 @@ Coordinates: the hinge angles q1..q5 of the tree ground - rod 1 - ... - rod 5 (z
 initial position, body frames parallel to the world's there); the sixth hinge closes the
 loop (`HingeClosure`: five equations, the point and the axis). Grübler's count is
 5 - 5 = 0; the geometry (all six links of length L with their two axes perpendicular, no
-offsets: a line-symmetric Bricard linkage) makes one of the five closure equations follow
-from the others along the whole motion (`redundant = 1`), so the constraint Jacobian has
-rank 4 and the mechanism one degree of freedom; q1 is the independent coordinate.
+offsets: Bricard's linkage) makes one of the five closure equations follow from the
+others along the whole motion (`redundant = 1`), so the constraint Jacobian has rank 4
+and the mechanism one degree of freedom. Why the rank stays 4: the motion is a single
+smooth curve of configurations (one degree of freedom everywhere on it, the linkage's
+own mobility, not a crossing of branches), and with five coordinates the rank is five
+less that mobility; the numeric model checks it at every configuration it assembles.
+A rotation of the cube by a third of a turn about its diagonal maps each hinge on the one
+two further along, so the motion keeps q1 = q3 = q5 and q2 = q4; q1 is the independent
+coordinate (the loop hangs at q1 = pi/2, q2 = -pi/6).
 
 What the sources publish. The benchmark gives P3's trajectory as a reference solution
 file whose numbers the papers show only as a figure (the OpenSim port plots its result
