@@ -126,13 +126,17 @@ def _constraint_rank(system, values: Mapping[str, float], q) -> dict:
     if not model.constrained:
         return {}
     rank, _ = model.constraint_rank(q)
+    # an over-constrained loop's redundant rows lower the rank everywhere, not singularly
+    regular = model.m - model.redundant
     out = {"constraint_rank": rank, "constraint_rows": model.m,
-           "singular": rank < model.m}
-    if rank < model.m:
+           "singular": rank < regular}
+    if model.redundant:
+        out["redundant_rows"] = model.redundant
+    if rank < regular:
         out["warning"] = (
-            f"singular position: the constraint Jacobian has rank {rank} of {model.m} "
+            f"singular position: the constraint Jacobian has rank {rank} of {regular} "
             f"here (assembly branches cross; the mobility is {model.n - rank}, not "
-            f"{model.n - model.m}): the stability and modes are those of the first-order "
+            f"{model.n - regular}): the stability and modes are those of the first-order "
             f"motions allowed here, and a motion through it may change branch")
     return out
 

@@ -10,8 +10,9 @@ force element by virtual power (eq. 95):
 A spatial mechanism (model convention 10) takes the same route in three dimensions: each
 body's rotation matrix R(q) is composed along the tree, its angular velocity (body axes) is
 read from the skew matrix R^T R' (never assumed), and T = sum(m v.v/2 + w.I w/2) with the
-full central tensor I; gravity acts along -up. Planar mechanisms keep the planar
-computation unchanged.
+full central tensor I; gravity acts along -up. Its loops close by `HingeClosure` rows:
+the three components of the point's gap and the two of the axes' misalignment. Planar
+mechanisms keep the planar computation unchanged.
 
 Route 2 (energy functions, used to cross-check the linearization, monograph eq. 107-109
 and Italian notes §5.3.3-5.3.4): T, V and Rayleigh's D, whose Hessians at an equilibrium
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import inspect
 import pickle
+import random
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -37,6 +39,7 @@ from ..systems.model import (
     TIME,
     WORLD,
     CoordinateForce,
+    HingeClosure,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -47,6 +50,7 @@ from ..systems.model import (
     as_column,
     as_column3,
     inertia_matrix,
+    perpendicular_pair,
     rotation,
     rotation3,
 )
@@ -152,9 +156,9 @@ class Derivation:
                     as_column3(j.parent_anchor) + qj * as_column3(j.axis))
             else:  # pragma: no cover - the Joint union is closed
                 raise TypeError(j)
-            R = R.applyfunc(sp.simplify)
+            R = R.applyfunc(self._tidy)
             position = anchor - R * as_column3(j.child_anchor)
-            poses[j.child] = SpatialPose(position.applyfunc(sp.simplify), R)
+            poses[j.child] = SpatialPose(position.applyfunc(self._tidy), R)
         return poses
 
     def _spatial_joint_values(self) -> sp.Matrix:
@@ -164,7 +168,11 @@ class Derivation:
                           for j, qj in zip(self.mechanism.joints, self.q)])
 
     def angular_velocity(self, body: str) -> sp.Matrix:
-        """Angular velocity in the body's axes, from the skew matrix R^T R'."""
+        """Angular velocity in the body's axes, from the skew matrix R^T R'; for a long
+        chain (`Mechanism.simplify` false, where simplifying R^T R' grows exponentially
+        with the depth) composed along the tree instead (`_composed_angular_velocity`)."""
+        if not self.mechanism.simplify:
+            return self._composed_angular_velocity(body)
         R = self.poses[body].rotation
         Rdot = sp.zeros(3, 3)
         for qi, vi in zip(self.q, self.qd):
@@ -174,6 +182,47 @@ class Derivation:
         if any(e != 0 for e in skew):
             raise ValueError(f"R^T R' of {body} is not skew-symmetric: {skew}")
         return sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
+
+    def _composed_angular_velocity(self, body: str) -> sp.Matrix:
+        """w_child = Rot^T w_parent + u q' (body axes; u the unit hinge axis, q' signed as
+        the hinge turns; an absolute hinge: u q' alone; a slide: the parent's, turned by
+        its fixed offset). Checked against R^T R' at one sample of the coordinates and
+        rates, where its skew matrix must equal R^T R' to round-off."""
+        mech = self.mechanism
+        if body == WORLD:
+            return sp.zeros(3, 1)
+        composed = self.__dict__.setdefault("_composed_omega", {})
+        if body in composed:
+            return composed[body]
+        j = mech.joint_of_child(body)
+        i = mech.coordinates.index(j.coordinate)
+        parent = self._composed_angular_velocity(j.parent)
+        if isinstance(j, Revolute):
+            u = as_column3(j.axis if j.axis is not None else (0, 0, 1))
+            u = u / sp.sqrt(sum(c**2 for c in u))
+            rate = -self.qd[i] if j.clockwise else self.qd[i]
+            turn = rotation3(u, (-self.q[i] if j.clockwise else self.q[i]) + j.angle_offset)
+            w = u * rate if j.absolute else turn.T * parent + u * rate
+        else:
+            w = rotation3((0, 0, 1), j.angle_offset).T * parent
+        self._check_angular_velocity(body, w)
+        composed[body] = w
+        return w
+
+    def _check_angular_velocity(self, body: str, w: sp.Matrix) -> None:
+        rng = random.Random(body)
+        sample = {x: rng.uniform(-2, 2) for x in (*self.q, *self.qd)}
+        sample.update({s: rng.uniform(0.5, 2) for s in
+                       (self.poses[body].rotation.free_symbols | w.free_symbols)
+                       - set(sample)})
+        R = self.poses[body].rotation
+        Rdot = sum((R.diff(qi) * vi for qi, vi in zip(self.q, self.qd)), sp.zeros(3, 3))
+        W = (R.T * Rdot).xreplace(sample).evalf()
+        w_num = w.xreplace(sample).evalf()
+        skew = sp.Matrix([[0, -w_num[2], w_num[1]], [w_num[2], 0, -w_num[0]],
+                          [-w_num[1], w_num[0], 0]])
+        if max(abs(e) for e in (W - skew)) > 1e-9:
+            raise ValueError(f"the composed angular velocity of {body} is not R^T R'")
 
     def point(self, body: str, local) -> sp.Matrix:
         pose = self.poses[body]
@@ -337,9 +386,13 @@ class Derivation:
         driven = {names.index(c) for c in self.mechanism.driven_coordinates}
         self.dependent = [i for i in range(self.n)
                           if i not in self.independent and i not in driven]
-        if len(self.dependent) != self.m:
+        # an over-constrained loop: `redundant` rows follow from the others (model.py)
+        independent_rows = self.m - self.mechanism.redundant
+        if len(self.dependent) != independent_rows:
             raise ValueError(
-                f"{self.m} constraint equations but {len(self.dependent)} dependent coordinates")
+                f"{independent_rows} independent constraint equations ({self.m} rows, "
+                f"{self.mechanism.redundant} redundant) but {len(self.dependent)} dependent "
+                "coordinates")
 
     @property
     def explicit_dependent(self) -> dict | None:
@@ -428,6 +481,12 @@ class Derivation:
         return self._reduced
 
     def constraint_rows(self, c) -> list[sp.Expr]:
+        if isinstance(c, HingeClosure):
+            d = self.point(c.body_a, c.point_a) - self.point(c.body_b, c.point_b)
+            n_a = self.poses[c.body_a].rotation * as_column3(c.axis_a)
+            R_b = self.poses[c.body_b].rotation
+            across = [(n_a.T * R_b * u)[0] for u in perpendicular_pair(c.axis_b)]
+            return [self._tidy(e) for e in (*d, *across)]
         if isinstance(c, PointOnPoint):
             d = self.point(c.body_a, c.point_a) - self.point(c.body_b, c.point_b)
             return [d[0], d[1]]
@@ -448,6 +507,8 @@ class Derivation:
         its generalized force."""
         rows = self.constraint_row_slices()[c.name]
         lam = [sp.Symbol(f"_lambda{k}") for k in range(rows.start, rows.stop)]
+        if isinstance(c, HingeClosure):
+            return -sp.Matrix(lam[:3])
         if isinstance(c, PointOnPoint):
             return -sp.Matrix(lam)
         if isinstance(c, PointOnLine):
@@ -460,7 +521,8 @@ class Derivation:
     def constraint_row_slices(self) -> dict[str, slice]:
         out, k = {}, 0
         for c in self.mechanism.constraints:
-            rows = 2 if isinstance(c, PointOnPoint) else 1
+            rows = (5 if isinstance(c, HingeClosure) else 2 if isinstance(c, PointOnPoint)
+                    else 1)
             out[c.name] = slice(k, k + rows)
             k += rows
         return out
@@ -490,11 +552,11 @@ class Derivation:
         force where exactly one side is inside; a coupling's generalized force is a couple
         on revolute coordinates (no net force) and a force along a prismatic axis."""
         mech = self.mechanism
-        if isinstance(c, (PointOnPoint, PointOnLine)):
+        if isinstance(c, (PointOnPoint, PointOnLine, HingeClosure)):
             first, second = c.bodies
             in_first, in_second = first in subtree, second in subtree
             if in_first == in_second:
-                return sp.zeros(2, 1)
+                return sp.zeros(3 if self.spatial else 2, 1)
             force = self.constraint_force(c)  # on the first body
             return force if in_first else -force
         if isinstance(c, LinearCoupling):

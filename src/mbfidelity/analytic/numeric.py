@@ -12,6 +12,15 @@ The linearization at an equilibrium is taken on the constraint manifold:
 M_r = S^T M S, C_r = S^T C S, K_r = S^T (K + sum_k lam_k Hess(Phi_k)) S, with lam the
 static multipliers. Without constraints S = I and these reduce to eq. 104-109.
 
+An over-constrained loop (`Mechanism.redundant` rows implied by the others) has a
+constraint Jacobian of rank m - redundant everywhere and a singular augmented matrix:
+the dependent coordinates are then solved by least squares (exact, the rows being
+consistent), the accelerations on the constraint manifold (q'' = S a + c with
+S^T M S a = S^T (Q - h - M c)), and of the multipliers, which the redundancy leaves
+undetermined, the least-norm ones are reported. The rank is checked at every
+configuration assembled: a loop whose geometry no longer makes the rows redundant is
+refused.
+
 A driven mechanism (prescribed coordinates q_p = q_p(t), monograph §9.6) is integrated in
 its free coordinates q_f: with the prescribed positions, rates and accelerations given,
 M_ff q_f'' = (Q - h)_f - M_fp q_p''(t). The rows of the prescribed coordinates then give
@@ -137,6 +146,8 @@ class NumericModel:
         self.n, self.m = d.n, d.m
         self.independent, self.dependent = list(d.independent), list(d.dependent)
         self.constrained = self.m > 0
+        #: constraint rows implied by the others (an over-constrained loop, model.py)
+        self.redundant = d.mechanism.redundant
         mech = d.mechanism
         self.driven = [mech.coordinates.index(c) for c in mech.driven_coordinates]
         self.actuators = [p.name for p in mech.prescribed]
@@ -305,7 +316,7 @@ class NumericModel:
         for _ in range(NEWTON_MAX):
             phi = self.constraint_values(q)
             J = self.constraint_jacobian(q)[:, dep]
-            step = np.linalg.solve(J, phi)
+            step = self._solve_dependent(J, phi)
             q[dep] -= step
             if np.max(np.abs(step)) <= NEWTON_TOL * max(1.0, np.max(np.abs(q[dep]))):
                 break
@@ -313,7 +324,32 @@ class NumericModel:
             raise RuntimeError("the constraint equations did not converge (assembly lost)")
         if np.max(np.abs(self.constraint_values(q))) > 1e-10:
             raise RuntimeError("the constraint equations have no solution here")
+        if self.redundant:
+            self._check_rank(q)
         return q
+
+    def _solve_dependent(self, J_dep: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+        """x with J_dep x = rhs, for one sample or a batch (leading axis). With redundant
+        rows (an over-constrained loop) J_dep has more rows than columns and full column
+        rank: the system is consistent and its least-squares solution, by the
+        pseudo-inverse, is the exact one (Gauss-Newton converges as Newton does)."""
+        if not self.redundant:
+            if rhs.ndim == J_dep.ndim - 1:
+                return np.linalg.solve(J_dep, rhs[..., None])[..., 0]
+            return np.linalg.solve(J_dep, rhs)
+        pinv = np.linalg.pinv(J_dep, rcond=RANK_TOLERANCE)
+        return pinv @ rhs if rhs.ndim == J_dep.ndim else (pinv @ rhs[..., None])[..., 0]
+
+    def _check_rank(self, q) -> None:
+        """The rank the mechanism declares (rows less its redundant ones) holds at q: a
+        loop whose geometry no longer makes a row redundant (a rod of another length)
+        is rigid or cannot close, and its reduction to n - rank coordinates is wrong."""
+        rank, _ = self.constraint_rank(q)
+        if rank != self.m - self.redundant:
+            raise RuntimeError(
+                f"the constraint Jacobian has rank {rank} here, not the {self.m} rows less "
+                f"the {self.redundant} redundant the mechanism declares: its geometry does "
+                "not make them redundant")
 
     def on_branch(self, q, tol: float = 1e-8) -> bool:
         """Whether the configuration q lies on the mechanism's described assembly branch
@@ -345,7 +381,7 @@ class NumericModel:
         S[ind, np.arange(len(ind))] = 1.0
         if self.constrained:
             J = self.constraint_jacobian(q)
-            S[dep, :] = -np.linalg.solve(J[:, dep], J[:, ind])
+            S[dep, :] = -self._solve_dependent(J[:, dep], J[:, ind])
         return S
 
     def state_from_independent(self, qi, qdi, guess=None) -> tuple[np.ndarray, np.ndarray]:
@@ -379,6 +415,11 @@ class NumericModel:
             return np.linalg.solve(self.mass_matrix(q), rhs), np.zeros(0)
         J = self.constraint_jacobian(q)
         n = self.n
+        if self.redundant:
+            gamma = np.array(self._gamma(*q, *qd), dtype=float).reshape(-1)
+            qdd, lam = self._redundant_dynamics(self.mass_matrix(q)[None], J[None],
+                                                rhs[None], gamma[None])
+            return qdd[0], lam[0]
         A = np.zeros((n + self.m, n + self.m))
         A[:n, :n] = self.mass_matrix(q)
         A[:n, n:] = J.T
@@ -386,6 +427,28 @@ class NumericModel:
         b = np.concatenate([rhs, np.array(self._gamma(*q, *qd), dtype=float).reshape(-1)])
         sol = np.linalg.solve(A, b)
         return sol[: self.n], sol[self.n:]
+
+    def _redundant_dynamics(self, M, J, rhs, gamma) -> tuple[np.ndarray, np.ndarray]:
+        """(q'', lam) of N samples (leading axis) whose constraint Jacobian has redundant
+        rows, where the augmented matrix is singular: q'' = S a + c on the constraint
+        manifold (J S = 0, J c = gamma with c zero in the independent coordinates), the
+        reduced equations S^T M S a = S^T (rhs - M c) (regular: M is positive definite on
+        the motions the constraints allow), and of the multipliers, which the rows'
+        redundancy leaves undetermined (a rigid over-constrained loop is statically
+        indeterminate), the least-norm ones with Phi_q^T lam = rhs - M q''."""
+        ind, dep, N = self.independent, self.dependent, len(M)
+        S = np.zeros((N, self.n, len(ind)))
+        S[:, ind, np.arange(len(ind))] = 1.0
+        S[:, dep, :] = -self._solve_dependent(J[:, :, dep], J[:, :, ind])
+        c = np.zeros((N, self.n))
+        c[:, dep] = self._solve_dependent(J[:, :, dep], gamma)
+        St = np.transpose(S, (0, 2, 1))
+        a = np.linalg.solve(St @ M @ S, (St @ (rhs - (M @ c[..., None])[..., 0])[..., None]))
+        qdd = (S @ a)[..., 0] + c
+        force = rhs - (M @ qdd[..., None])[..., 0]
+        lam = (np.linalg.pinv(np.transpose(J, (0, 2, 1)), rcond=RANK_TOLERANCE)
+               @ force[..., None])[..., 0]
+        return qdd, lam
 
     def acceleration(self, q, qd, t: float) -> np.ndarray:
         if self.driven:
@@ -580,6 +643,10 @@ class NumericModel:
                 A[:, k, :] = 0.0
                 A[:, k, k] = 1.0
                 b[:, k] = qdd_p[:, j]
+        if m and self.redundant:
+            gamma = self._along("gamma", None, (*q.T, *qd.T), N)
+            return self._redundant_dynamics(A[:, :n, :n], self._jacobians_along(q),
+                                            b[:, :n], gamma)
         if m:
             J = self._jacobians_along(q)
             A[:, :n, n:] = np.transpose(J, (0, 2, 1))
@@ -600,7 +667,7 @@ class NumericModel:
             rows = q[active]
             phi = self._along("Phi", None, rows.T, len(rows))
             J = self._jacobians_along(rows)[:, :, dep]
-            step = np.linalg.solve(J, phi[..., None])[..., 0]
+            step = self._solve_dependent(J, phi)
             rows[:, dep] -= step
             q[active] = rows
             done = np.max(np.abs(step), axis=1) <= NEWTON_TOL * np.maximum(
@@ -612,6 +679,9 @@ class NumericModel:
             raise RuntimeError("the constraint equations did not converge (assembly lost)")
         if np.max(np.abs(self._along("Phi", None, q.T, N))) > 1e-10:
             raise RuntimeError("the constraint equations have no solution here")
+        if self.redundant:
+            for row in q:
+                self._check_rank(row)
         return q
 
     def velocities_along(self, q: np.ndarray, qdi: np.ndarray) -> np.ndarray:
@@ -621,7 +691,7 @@ class NumericModel:
         J = self._jacobians_along(q)
         qd = np.zeros((N, self.n))
         qd[:, ind] = qdi
-        qd[:, dep] = -np.linalg.solve(J[:, :, dep], (J[:, :, ind] @ qdi[..., None]))[..., 0]
+        qd[:, dep] = -self._solve_dependent(J[:, :, dep], (J[:, :, ind] @ qdi[..., None])[..., 0])
         return qd
 
     def point_states(self, q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:

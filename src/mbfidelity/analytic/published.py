@@ -4,6 +4,7 @@ A state value is the published expression of the coordinates and velocities at i
 instant, integrated there as the reference is (DOP853 at the reference's tolerance, its
 error estimated by the change at a 10x looser one, which bounds positions and velocities
 alike);
+an energy is the total T + V of that state;
 a period is measured on the reference as the mean spacing of the coordinate's upward
 crossings of its centre value (the mean of its extremes), located on the cubic Hermite
 interpolant of the samples (positions and velocities) to the reference's own tolerance.
@@ -82,6 +83,20 @@ def _state(system: System, item: Published, values, scenario,
     return out[0], abs(out[1] - out[0])
 
 
+def _energy(system: System, item: Published, values, scenario,
+            solved: dict) -> tuple[float, float]:
+    """T + V at the instant, and its error estimate as for a state value."""
+    model = numeric_model(system.id, values)
+    out = []
+    for tol in (TIGHT, LOOSE):
+        key = (scenario.name, item.time, tol)
+        if key not in solved:
+            solved[key] = _state_at(system, scenario, values, item.time, tol)
+        q, qd = solved[key]
+        out.append(float(model.energy(np.atleast_2d(q), np.atleast_2d(qd))[0]))
+    return out[0], abs(out[1] - out[0])
+
+
 def _period(system: System, item: Published, ref) -> tuple[float, float]:
     i = list(system.coordinates).index(item.coordinate)
     q, qd = ref.q[:, i], ref.qd[:, i]
@@ -128,6 +143,8 @@ def compare_published(system: System, values: Mapping[str, float]) -> list[dict]
         if item.kind == "period":
             ref = reference(system, scenario, values, scenario.t_end / SAMPLES)
             got, error = _period(system, item, ref)
+        elif item.kind == "energy":
+            got, error = _energy(system, item, values, scenario, solved)
         else:
             got, error = _state(system, item, values, scenario, solved)
         entry.update(applies=True, published_value=published, reference_value=got,

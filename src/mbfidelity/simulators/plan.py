@@ -45,6 +45,7 @@ from ..systems.model import (
     WORLD,
     Body,
     CoordinateForce,
+    HingeClosure,
     LinearCoupling,
     Mechanism,
     PointOnLine,
@@ -390,6 +391,11 @@ def description_reason(mech: Mechanism) -> str:
             elif isinstance(c, PointOnPoint):
                 for v in (*c.point_a, *c.point_b):
                     num(v)
+            elif isinstance(c, HingeClosure):
+                for v in (*c.point_a, *c.point_b, *c.axis_a, *c.axis_b):
+                    num(v)
+                if not (any(num(v) for v in c.axis_a) and any(num(v) for v in c.axis_b)):
+                    return f"constraint {c.name}: zero hinge axis"
             else:
                 for v in (*c.point, *c.line_point):
                     num(v)
@@ -561,6 +567,9 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str
     prismatic joints."""
     if mech.constraints and not closures:
         return "closure constraints in a spatial mechanism"
+    if any(isinstance(c, HingeClosure) for c in mech.constraints):
+        return ("a hinge closure (a spatial closed loop): the spatial build closes no loop "
+                "by a hinge")
     for j in mech.joints:
         if isinstance(j, Prismatic) and not slides:
             return f"joint {j.name}: the spatial build has hinges only"

@@ -178,7 +178,7 @@ class Condition:
     meaning: str
 
 
-PUBLISHED_KINDS = ("state", "period")
+PUBLISHED_KINDS = ("state", "period", "energy")
 
 
 @dataclass(frozen=True)
@@ -188,7 +188,8 @@ class Published:
 
     kind "state": `expression` (of the coordinate symbols, `coordinate_symbols`, and the
     parameters) at the instant `time` (s); kind "period": the period of `coordinate`
-    (`time` None). `value`: the published number, which holds at the parameters the
+    (`time` None); kind "energy": the total mechanical energy T + V at the instant
+    `time` (a conservative motion's closed form: its initial value). `value`: the published number, which holds at the parameters the
     source publishes it for (the defaults: under other values it is reported as not
     applicable), or a function of the parameter values (name -> value) for a closed form,
     which holds at any. `scenario`: the scenario it belongs to (None: the first)."""
@@ -209,7 +210,12 @@ class Published:
         if self.kind not in PUBLISHED_KINDS:
             raise ValueError(f"published {self.quantity}: kind {self.kind!r} is not one of "
                              f"{', '.join(PUBLISHED_KINDS)}")
-        if (self.kind == "state") != (self.expression is not None and self.time is not None):
+        if self.kind == "energy":
+            if self.time is None or self.expression is not None:
+                raise ValueError(f"published {self.quantity}: an energy value has a time "
+                                 "and no expression")
+        elif (self.kind == "state") != (self.expression is not None
+                                        and self.time is not None):
             raise ValueError(f"published {self.quantity}: a state value has an expression "
                              "and a time, a period neither")
         if self.kind == "period" and self.coordinate is None:

@@ -46,6 +46,10 @@ Conventions (all backends and the analytic layer honour them):
    of these is planar (`Mechanism.spatial` is false) and follows conventions 1-5 exactly.
    Body frames coincide with the parent's frame at q = 0 (no orientation offset): a body
    whose principal axes are turned gives its tensor in those parent-aligned axes.
+   A spatial loop closes with a `HingeClosure` (a hinge the tree does not hold: the
+   point and the axis, five equations); the planar closures stay planar. An
+   over-constrained loop (Bricard's) states how many of its closure equations the
+   others imply everywhere on its motion (`Mechanism.redundant`).
 """
 from __future__ import annotations
 
@@ -428,7 +432,46 @@ class RollingContact:
         return LinearCoupling(self.name, self.coefficients, self.constant)
 
 
-Constraint = Union[PointOnPoint, PointOnLine, LinearCoupling, RollingContact]
+@dataclass(frozen=True)
+class HingeClosure:
+    """Spatial loop closure by a hinge (a revolute pair the joint tree does not hold):
+    point_a of body_a coincides with point_b of body_b, and the hinge axis axis_a fixed in
+    body_a stays parallel to axis_b fixed in body_b (body-frame three-component vectors).
+    Five equations: the three of Phi = p_a - p_b (world axes), then n_a . u_b = 0 and
+    n_a . w_b = 0 with n_a the world direction of axis_a and u_b, w_b two directions of
+    body_b perpendicular to axis_b (`perpendicular_pair`). Its force: -lam[0:3] on body_a
+    at the point (world axes), +lam[0:3] on body_b; the last two multipliers are the
+    couple that keeps the axes parallel."""
+
+    name: str
+    body_a: str
+    point_a: Vec3
+    body_b: str
+    point_b: Vec3
+    axis_a: Vec3
+    axis_b: Vec3
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        """(the body its force is reported on, the other one)."""
+        return self.body_a, self.body_b
+
+
+def perpendicular_pair(axis: Vec3) -> tuple[sp.Matrix, sp.Matrix]:
+    """Two directions perpendicular to `axis` and to each other (3 x 1, of the axis's
+    length): u = axis x e, with e the coordinate axis least aligned with `axis` (the
+    first such), and w = axis x u / |axis|."""
+    a = as_column3(axis)
+    magnitudes = [abs(float(c)) for c in a]
+    e = sp.zeros(3, 1)
+    e[magnitudes.index(min(magnitudes))] = 1
+    norm = sp.sqrt(sum(c**2 for c in a))
+    u = a.cross(e)
+    u = u * norm / sp.sqrt(sum(c**2 for c in u))
+    return u.applyfunc(sp.simplify), (a.cross(u) / norm).applyfunc(sp.simplify)
+
+
+Constraint = Union[PointOnPoint, PointOnLine, LinearCoupling, RollingContact, HingeClosure]
 
 
 def linear_spring_damper(k: Expr, l0: Expr, c: Expr = 0) -> dict:
@@ -478,6 +521,12 @@ class Mechanism:
     #: reduced equations regular there (analytic/derivation.py checks that the
     #: constraints vanish on it identically)
     branch: tuple[tuple[str, Expr], ...] = ()
+    #: the number of constraint equations the others imply everywhere on the motion (an
+    #: over-constrained loop such as Bricard's: Grübler's count gives no mobility, the
+    #: geometry gives some): the constraint Jacobian's rank is the number of rows minus
+    #: this, and the independent coordinates number n - rank. The numeric model checks the
+    #: rank at every configuration it assembles (analytic/numeric.py)
+    redundant: int = 0
 
     @property
     def spatial(self) -> bool:
@@ -487,6 +536,7 @@ class Mechanism:
         return (any(b.inertia_tensor is not None for b in self.bodies)
                 or any(isinstance(j, Revolute) and j.axis is not None for j in self.joints)
                 or any(len(v) == 3 for v in vectors)
+                or any(isinstance(c, HingeClosure) for c in self.constraints)
                 or tuple(sp.sympify(u) for u in self.up) != (0, 1, 0))
 
     def __post_init__(self) -> None:
@@ -551,9 +601,15 @@ class Mechanism:
         if len(driven) == len(coords) and coords:
             raise ValueError("every coordinate is prescribed: nothing is free to move")
         if self.spatial:
-            if self.constraints:
-                raise ValueError("closure constraints in a spatial mechanism are not "
-                                 "supported: describe an open tree")
+            planar_closures = [c.name for c in self.constraints
+                               if not isinstance(c, HingeClosure)]
+            if planar_closures:
+                raise ValueError(f"closure constraints {planar_closures} are planar: a "
+                                 "spatial mechanism closes its loops with HingeClosure")
+            for c in self.constraints:
+                if any(len(v) != 3 for v in (c.point_a, c.point_b, c.axis_a, c.axis_b)):
+                    raise ValueError(f"hinge closure {c.name}: points and axes have three "
+                                     "components")
             if len(self.up) != 3:
                 raise ValueError(f"up must have three components, got {self.up}")
             for j in self.joints:
@@ -568,6 +624,9 @@ class Mechanism:
                 raise ValueError(f"independent coordinates not in the mechanism: {unknown}")
         elif self.constraints:
             raise ValueError("a constrained mechanism must name its independent coordinates")
+        if self.redundant and not (0 < self.redundant and self.constraints):
+            raise ValueError(f"redundant = {self.redundant}: a count of constraint "
+                             "equations, of a mechanism with closure constraints")
         if self.branch:
             given = [name for name, _ in self.branch]
             dependent = [c for c in coords if c not in (self.independent or ())]
@@ -687,6 +746,7 @@ class Mechanism:
             prescribed=tuple(replace(p, motion=ev(p.motion)) for p in self.prescribed),
             up=ev(self.up),
             branch=tuple((name, ev(e)) for name, e in self.branch),
+            redundant=self.redundant,
         )
 
 
