@@ -799,29 +799,43 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
 
 
 def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
-          out: str | Path | None = None, *, dt: float = DEFAULT_DT, progress=None):
+          out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+          workers: int | None = None, progress=None):
     """The power study (comparisons/power.py) of systems x engines (default: all systems,
     every installed engine): per injected model error the smallest relative error the
-    gates reject, per neutralised default whether they reject it. With `out`, power.json
-    and out_of_the_box.json and their pages (power.html, out_of_the_box.html) are written
-    there. Returns the `PowerStudy`."""
+    gates reject, per neutralised default whether they reject it, both from one
+    neutralised run per system x engine (comparisons/out_of_the_box.py); one job per
+    system in a pool of `workers` processes (default: up to 2), the longest first. With
+    `out`, power.json and out_of_the_box.json and their pages (power.html,
+    out_of_the_box.html) are written there; where the folder holds a run's results, its
+    site is written again (as `out_of_the_box`). Returns the `OutOfTheBoxStudy`, whose
+    `power_document()` is power.json."""
     import json
 
-    from .comparisons.power import power_study
+    from .comparisons.matrix import schedule
+    from .comparisons.out_of_the_box import out_of_the_box_study
+    from .comparisons.power import ERROR_KINDS
+    from .comparisons.results_folder import load_job_costs
 
     sys_ids, sim_ids = _matrix(systems, sims, installed_only=True)
-    if not dt > 0:
-        raise ValueError("dt must be positive")
-    study = power_study(sys_ids, sim_ids, dt, progress=progress)
-    if out is not None:
+    checked_duration("dt", dt)
+    folder = checked_output_folder(out) if out is not None else None
+    order = schedule(sys_ids, load_job_costs(folder) if folder is not None else None)
+    study = out_of_the_box_study(sys_ids, sim_ids, dt, workers=workers, order=order,
+                                 progress=progress, kinds=tuple(ERROR_KINDS))
+    if folder is not None:
         from .reports.power_page import OUT_OF_THE_BOX, POWER, write_power_pages
 
-        folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
-        (folder / POWER).write_text(json.dumps(study.as_dict(), indent=1, default=str))
-        (folder / OUT_OF_THE_BOX).write_text(json.dumps(study.out_of_the_box(), indent=1,
-                                                        default=str))
+        (folder / POWER).write_text(json.dumps(study.power_document(), indent=1,
+                                               default=jsonable))
+        (folder / OUT_OF_THE_BOX).write_text(json.dumps(study.as_dict(), indent=1,
+                                                        default=jsonable))
         write_power_pages(folder)
+        if (folder / "results.json").exists():
+            from .reports.html import write_report
+
+            write_report(folder)
     return study
 
 

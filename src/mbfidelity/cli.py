@@ -843,35 +843,41 @@ def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
                   None, "--sims", help="simulator ids (default: every installed one)"),
               dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
               out: Optional[Path] = typer.Option(
-                  None, "--out", help="also write power.json, out_of_the_box.json and their "
-                                      "pages there"),
+                  None, "--out", callback=_out_folder,
+                  help="also write power.json, out_of_the_box.json and their pages there "
+                       "(and the site again, when the folder holds a run)"),
+              workers: Optional[int] = typer.Option(
+                  None, "--workers", min=1, help="processes (default: up to 2)"),
               as_json: bool = typer.Option(False, "--json"),
               ) -> None:
     """What the gates catch: per system x engine, the smallest relative error of a mass,
     an inertia, a length, g, a stiffness and a damping coefficient injected into the
     engine's build (decade grid 1e-6..1e-1) that the gates reject, and each neutralised
-    engine default switched back on: rejected or not, and its effect."""
+    engine default switched back on: rejected, below the gates, or not rejected (a blind
+    gate), with its effect. The out-of-the-box study's document comes from the same runs."""
     from . import api
 
     def progress(entry) -> None:
-        if not as_json:
-            found = ", ".join(f"{p.kind} {p.smallest_rejected:g}" if p.smallest_rejected
-                              else f"{p.kind} {'not rejected' if p.applicable else 'n/a'}"
-                              for p in entry.errors)
-            typer.echo(f"{entry.system:28s} {entry.simulator:9s} "
-                       + (found if entry.supported else f"unsupported: {entry.reason}"))
-            for d in entry.defaults:
-                verdict = ("rejected by " + ", ".join(d.rejected_by[:3]) if d.rejected
-                           else "passes" if d.acts else "does not act here")
-                typer.echo(f"    default {d.setting} = {d.engine_value}: {verdict}")
+        if as_json:
+            return
+        found = ", ".join(f"{p.kind} {p.smallest_rejected:g}" if p.smallest_rejected
+                          else f"{p.kind} {'not rejected' if p.applicable else 'n/a'}"
+                          for p in entry.errors)
+        typer.echo(f"{entry.system:28s} {entry.simulator:9s} "
+                   + (found if entry.supported else f"unsupported: {entry.reason}"))
+        for p in entry.errors:
+            if p.applicable and p.verdict != "rejected":
+                typer.echo(f"    {p.kind} at 1 %: {p.verdict}: {p.why}")
+        for d in entry.defaults:
+            typer.echo(f"    default {d.setting} = {d.engine_value}: {d.verdict}: {d.why}")
 
     try:
         study = api.power(_split(systems) or None, _split(sims) or None, out, dt=dt,
-                          progress=progress)
+                          workers=workers, progress=progress)
     except ValueError as exc:
         _fail(str(exc))
     if as_json:
-        _json(study.as_dict())
+        _json(study.power_document())
     elif out is not None:
         typer.echo(f"pages: {(out / 'power.html').resolve()}, "
                    f"{(out / 'out_of_the_box.html').resolve()}")
@@ -911,8 +917,7 @@ def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--syst
         typer.echo(f"{head} {entry.wall_time_s:.1f} s"
                    + ("" if entry.defaults else ", no default neutralised"))
         for d in entry.defaults:
-            verdict = ("rejected by " + ", ".join(d.rejected_by[:3]) if d.rejected
-                       else "passes" if d.acts else "no effect")
+            verdict = f"{d.verdict}: {d.why}"
             change = d.motion.get("trajectory_change")
             moved = (f"; motion change {change:.3g} (gate {d.motion['trajectory_gate']:.3g}, "
                      f"{d.motion['scenario']})" if change is not None

@@ -1,6 +1,6 @@
 """The out-of-the-box study: what each engine default the harness neutralises does to a
-mechanism when it is switched back on (the defaults-only reading of the power study,
-comparisons/power.py, without its model-error grid), cheap enough for the whole matrix.
+mechanism when it is switched back on, and, with `kinds`, the power study's model errors
+(comparisons/power.py) from the same neutralised run: one study makes both documents.
 
 For every system x engine: the neutralised run (the harness's settings; every declared
 scenario and the frequency checks, `runner.compare(scenarios=declared)`), then each
@@ -9,7 +9,8 @@ setting's note) switched back on alone, and all of them together (the engine as 
 it), each in the same comparison. Recorded per default, in the power study's format
 (`power.DefaultPower`): the gates' verdict (rejected when a metric that holds in the
 neutralised run fails with the default, or the run does not complete:
-`power.rejecting_metrics`), whether anything moved at all, the effect metric by metric
+`power.rejecting_metrics`), whether anything moved at all and what it moved most against
+its gate (`power.largest_change`, `power.classify_default`), the effect metric by metric
 against the neutralised run (trajectory error, energy drift, period, and the frequency and
 damping ratio of the free-vibration fits), and per scenario the motion change: the largest
 difference between the engine's motion with the default and without it, relative to the
@@ -23,8 +24,10 @@ from it (comparisons/isolation.py) with a wall-clock budget (`RUN_BUDGET_FACTOR`
 neutralised run, at least `RUN_BUDGET_FLOOR`): a default that makes its engine crash, or
 run past the budget, costs that run, recorded with its incident (it counts as rejected),
 and nothing else. A job whose own process dies (the neutralised run crashed its engine) is
-made again engine by engine, each in a worker of its own. The near-equilibrium checks and
-the model-error grid of `mbfidelity run` and `mbfidelity power` are not run.
+made again engine by engine, each in a worker of its own. The near-equilibrium checks of
+`mbfidelity run` are not run. With `kinds` (`mbfidelity power`), each model error's runs
+(the first scenario) are judged against the same neutralised run, forked from the same
+process.
 """
 from __future__ import annotations
 
@@ -42,10 +45,11 @@ from ..simulators import get_backend
 from ..systems import get_system
 from .budget import become_worker
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
-from .power import (DefaultPower, PowerEntry, effect_against, engine_defaults,
-                    free_coordinates, metric_named, out_of_the_box_document,
-                    rejecting_metrics, same_metrics, worst_scenario)
-from .runner import DEFAULT_DT, Comparison, compare, failed_comparison
+from .power import (RUN_TIMEOUT_FACTOR, RUN_TIMEOUT_FLOOR, DefaultPower, PowerEntry,
+                    classify_default, effect_against, engine_defaults, error_powers,
+                    free_coordinates, largest_change, metric_named, out_of_the_box_document,
+                    power_document, rejecting_metrics, same_metrics, worst_scenario)
+from .runner import DEFAULT_DT, Comparison, compare, failed_comparison, isolated_compare
 
 #: wall-clock budget of one default's run: this many times the neutralised run's wall
 #: time, at least RUN_BUDGET_FLOOR s. A default can make a run much longer than the
@@ -106,8 +110,9 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
         m["energy_drift_switched_on"] = after.value if after is not None else None
         scenarios[name] = m
     d = DefaultPower(key, value, harness, bool(by), by, run.passed,
-                     acts=not same_metrics(neutral, run), effect=effect_against(neutral, run),
-                     note=note, incidents=run.incidents, wall_time_s=wall_time)
+                     moved=not same_metrics(neutral, run), effect=effect_against(neutral, run),
+                     note=note, incidents=run.incidents, wall_time_s=wall_time,
+                     change=largest_change(neutral, run, scenarios))
     d.motion["scenarios"] = scenarios
     measured = {k: v for k, v in scenarios.items() if "trajectory_change" in v}
     if measured:
@@ -117,13 +122,17 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
         d.motion["error"] = "; ".join(f"{i['outcome']}: {i['message']}"
                                       for i in run.incidents) or "no motion recorded"
     d.motion["beyond_gate"] = any(m.get("beyond_gate", False) for m in scenarios.values())
+    classify_default(d, neutral)
     return d
 
 
 def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
-                   only: Iterable[str] | None = None) -> PowerEntry:
+                   only: Iterable[str] | None = None, kinds: Iterable[str] = ()
+                   ) -> PowerEntry:
     """The out-of-the-box reading of one system on one engine (see the module doc); with
-    `only`, just those of the engine's neutralised defaults, each alone (no "all")."""
+    `only`, just those of the engine's neutralised defaults, each alone (no "all"); with
+    `kinds`, the power study's model errors of those kinds too."""
+    kinds = tuple(kinds)
     started = time.perf_counter()
     system = get_system(system_id)
     backend = get_backend(simulator)
@@ -138,12 +147,15 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     switched = engine_defaults(simulator, dt)
     if only is not None:
         switched = {k: v for k, v in switched.items() if k in set(only)}
-    if not switched:  # nothing to switch on: no run
+    if not switched and not kinds:  # nothing to switch on: no run
         return entry
     values = system.parameter_values(None, scenario=system.scenarios[0])
     free = free_coordinates(system.with_structure(values), values)
     entry.comparisons += 1
-    neutral = compare(system.id, simulator, dt=dt, scenarios=declared, keep_series=True)
+    # the model errors alone need the first scenario only
+    scenarios = declared if switched else declared[:1]
+    neutral = compare(system.id, simulator, dt=dt, scenarios=scenarios,
+                      keep_series=bool(switched))
     entry.engine_time_s += neutral.wall_time
     if not neutral.supported:
         entry.supported, entry.reason = False, neutral.reason
@@ -156,6 +168,17 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     entry.baseline_not_holding = [m.name for m in neutral.metrics
                                   if m.status not in ("pass", "xpass", "measured")]
     budget = max(RUN_BUDGET_FLOOR, RUN_BUDGET_FACTOR * (time.perf_counter() - started))
+    if kinds:
+        error_budget = max(RUN_TIMEOUT_FLOOR, RUN_TIMEOUT_FACTOR * neutral.wall_time)
+
+        def mutated(**kwargs) -> Comparison:
+            entry.comparisons += 1
+            c = isolated_compare(system.id, simulator, dt=dt, scenarios=declared[:1],
+                                 timeout=error_budget, **kwargs)
+            entry.engine_time_s += c.wall_time
+            return c
+
+        entry.errors = error_powers(system, simulator, kinds, neutral, dt, mutated)
     chosen = [(key, {key: value}) for key, value in switched.items()]
     if len(switched) > 1 and only is None:
         chosen.append((ALL, dict(switched)))
@@ -190,19 +213,21 @@ def _cpu_seconds() -> float:
     return time.process_time() + children.ru_utime + children.ru_stime
 
 
-def _system_job(system_id: str, sims: list[str], dt: float, only
+def _system_job(system_id: str, sims: list[str], dt: float, only, kinds=()
                 ) -> tuple[list[PowerEntry], float]:
     """Every engine's reading of one system, and the job's CPU seconds."""
     start = _cpu_seconds()
-    entries = [defaults_entry(system_id, sim, dt, only) for sim in sims]
+    entries = [defaults_entry(system_id, sim, dt, only, kinds) for sim in sims]
     return entries, _cpu_seconds() - start
 
 
-def _isolated_entry(system_id: str, simulator: str, dt: float, only) -> PowerEntry:
+def _isolated_entry(system_id: str, simulator: str, dt: float, only, kinds=()
+                    ) -> PowerEntry:
     """`defaults_entry` in a worker of its own: a process that dies gives an entry that
     says so, with every default unmeasured."""
     try:
-        return isolated(defaults_entry, system_id, simulator, dt, only, timeout=ENTRY_TIMEOUT)
+        return isolated(defaults_entry, system_id, simulator, dt, only, kinds,
+                        timeout=ENTRY_TIMEOUT)
     except (ValueError, KeyError):
         raise
     except Exception as exc:
@@ -220,28 +245,42 @@ class OutOfTheBoxStudy:
     #: system -> CPU seconds of its job (its forked runs included)
     job_cpu_s: dict = field(default_factory=dict)
 
+    def cost(self) -> dict:
+        return {"wall_time_s": self.wall_time_s, "workers": self.workers,
+                "comparisons": sum(e.comparisons for e in self.entries),
+                "cpu_s": sum(self.job_cpu_s.values()), "job_cpu_s": self.job_cpu_s,
+                "per_entry_wall_time_s": {f"{e.system}/{e.simulator}": e.wall_time_s
+                                          for e in self.entries}}
+
     def as_dict(self) -> dict:
         """The document of the out-of-the-box page (`power.out_of_the_box_document`), with
         the study's cost."""
-        doc = out_of_the_box_document({"provenance": self.provenance,
-                                       "entries": [e.as_dict() for e in self.entries]})
-        doc["cost"] = {"wall_time_s": self.wall_time_s, "workers": self.workers,
-                       "comparisons": sum(e.comparisons for e in self.entries),
-                       "cpu_s": sum(self.job_cpu_s.values()), "job_cpu_s": self.job_cpu_s,
-                       "per_entry_wall_time_s": {f"{e.system}/{e.simulator}": e.wall_time_s
-                                                 for e in self.entries}}
-        return doc
+        return out_of_the_box_document({"provenance": self.provenance, "cost": self.cost(),
+                                        "entries": [e.as_dict() for e in self.entries]})
+
+    def power_document(self) -> dict:
+        """The document of the power page (`power.power_document`), with the study's
+        cost."""
+        return power_document([e.as_dict() for e in self.entries], self.provenance,
+                              self.cost())
+
+    def summary(self) -> dict:
+        """The power study's summary (`power.summary_of`)."""
+        return self.power_document()["summary"]
 
 
 def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                          dt: float = DEFAULT_DT, workers: int | None = None,
                          order: Iterable[str] | None = None,
                          progress: Callable[[PowerEntry], None] | None = None,
-                         only: Iterable[str] | None = None) -> OutOfTheBoxStudy:
+                         only: Iterable[str] | None = None, kinds: Iterable[str] = ()
+                         ) -> OutOfTheBoxStudy:
     """`defaults_entry` for every system x engine, in `systems` x `sims` order; one job
     per system in a pool of `workers` processes (default: up to 2), dispatched in `order`
     (default: `systems`; the longest first keeps the pool busy to the end). `only`
-    names the defaults switched on (each engine those of them it neutralises)."""
+    names the defaults switched on (each engine those of them it neutralises); `kinds`
+    adds the power study's model errors of those kinds (`defaults_entry`)."""
+    kinds = tuple(kinds)
     only = None if only is None else tuple(only)
     from .runner import provenance
 
@@ -262,11 +301,11 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
     crashed = []
     if workers == 1:
         for s in order:
-            collect(s, _system_job(s, sims, dt, only))
+            collect(s, _system_job(s, sims, dt, only, kinds))
     else:
         with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
                                  initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(_system_job, s, sims, dt, only): s for s in order}
+            futures = {pool.submit(_system_job, s, sims, dt, only, kinds): s for s in order}
             for fut in as_completed(futures):
                 try:
                     collect(futures[fut], fut.result())
@@ -279,7 +318,7 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                         for sim in sims], 0.0))
     for s in crashed:
         start = _cpu_seconds()
-        entries = [_isolated_entry(s, sim, dt, only) for sim in sims]
+        entries = [_isolated_entry(s, sim, dt, only, kinds) for sim in sims]
         collect(s, (entries, _cpu_seconds() - start))
     entries = [e for s in systems for e in found[s]]
     return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers,

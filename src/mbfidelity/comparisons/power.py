@@ -1,44 +1,56 @@
 """Gate power: what the comparison's gates catch (the mutation study), and what each
 engine default the harness neutralises does when it is switched back on (the out-of-the-box
-reading of the same runs).
+reading, comparisons/out_of_the_box.py, made from the same runs).
 
 Model errors are injected into the engine's build only (`runner.compare(engine_scale=)`):
 one parameter of each kind (a mass, an inertia, a length, g, a spring stiffness, a damping
 coefficient) is multiplied by (1 + eps) while the reference and the gates keep the true
 values. The parameter of a kind is the first one of the system (declaration order) with
 that kind's unit whose change changes the numeric mechanism the engine is given (drawing
-shapes aside); a kind without one is not applicable. A run is rejected when a metric that
-passes in the unmutated run (the baseline) fails in it, or a run that did not complete.
+shapes aside); a kind without one is not applicable.
+
+Rejection (`rejecting_metrics`): a metric that holds in the unmutated, neutralised run (the
+baseline) rejects a run when it fails there, or when its value exceeds the baseline's
+tolerance; a run that did not complete is rejected. The gates are held at the harness's
+configuration: a default that changes the scheme the engine declares (MuJoCo's Euler
+integrator, Exudyn's solver) would otherwise be judged against the a-priori bound of its
+own, lower order, and pass while it moves the motion by far more than the harness's gate.
 
 For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found by
 bisection on the grid, assuming rejection is monotone in eps (a larger error is rejected
-whenever a smaller one is): three runs instead of six. Next to it, the motion change that
-a 1 % error (`PROBE`) makes in the exact model (reference with the mutated parameter
-against the true one, on the first scenario and on the modes) is set against the gates
-it should trip, so that an error too small to move the motion beyond the gate is told
-apart from a blind gate.
+whenever a smaller one is): at most three runs instead of six. The assumption is checked
+at the grid's top: where the bisection did not run the largest eps, it is run, and a
+smallest rejected eps whose largest is not rejected is marked not monotone. Next to it,
+the change that a 1 % error (`PROBE`) makes in the exact model (reference with the mutated
+parameter against the true one: the first scenario's trajectory and actuator forces, and
+the modes' frequencies) is set against the gate of each of those quantities, so that an
+error too small to move a judged quantity beyond its gate ("below the gates") is told apart
+from a blind gate (`classify_error`).
 
 Each neutralised default (`Setting.engine_default`) is switched back on alone, and all
-together (the engine as a user gets it); the gates' verdict and the effect against the
-neutralised run are recorded: the trajectory error, the energy drift and the damping
-ratio each default leaves (the metrics of both runs), and the motion change.
+together (the engine as a user gets it), in comparisons/out_of_the_box.py. A default acts
+when it changes a judged quantity by more than its gate, measured (`largest_change`): the
+engine's motion with the default against the same run without it, relative to the
+amplitude, against the scenario's trajectory gate; and each metric's change against its
+tolerance (a lower bound of the change of the quantity it judges, by the triangle
+inequality). `classify_default` gives each reading its verdict and why.
 
 Cost: a model error's run is the system's first scenario plus the frequency checks
 (free-vibration fits and the engine's linearization; `runner.compare(scenarios=[first])`):
 a small relative error acts linearly at any amplitude. A default's run takes every
 declared scenario and the frequency checks, since a default's effect depends on the
 amplitude (an error-correction bias that is invisible on a small swing acts on a large
-one). The near-equilibrium checks and the checks that build their own mechanisms (a
-stability threshold's trials) are not run. The unmutated run is made in the calling
-process (its solves are shared); every other run is a worker process
+one). The neutralised run over every declared scenario is the baseline of both, made once
+in the calling process (its solves are shared); every other run is a worker process
 (comparisons/isolation.py), so an engine that crashes on a mutated model costs that run.
+The near-equilibrium checks and the checks that build their own mechanisms (a stability
+threshold's trials) are not run.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
 import statistics
-import time
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping
 
@@ -48,10 +60,8 @@ from ..analytic.linear import operating_equilibrium, unexcited_values
 from ..analytic.numeric import numeric_model
 from ..analytic.reference import reference
 from ..simulators import get_backend
-from ..systems import get_system
 from . import metrics
-from .isolation import WorkerCrashed, WorkerTimedOut, isolated
-from .runner import DEFAULT_DT, Comparison, compare, isolated_compare
+from .runner import DEFAULT_DT, Comparison
 
 #: the decade grid of relative model errors, ascending
 EPSILONS = tuple(10.0 ** -k for k in range(6, 0, -1))
@@ -67,11 +77,11 @@ ERROR_KINDS: dict[str, tuple[str, ...]] = {
     "damping": ("N s/m", "N m s"),
 }
 GRAVITY_PARAMETER = "g"
-#: wall-clock budget of one run: this many times the unmutated run's engine stepping, at
-#: least RUN_TIMEOUT_FLOOR s (per scenario run); a run beyond it is recorded as timed out (its `run.completed`
-#: fails, so it counts as rejected). The budget exists for the free-vibration fits, whose
-#: least squares can search for minutes on a motion that no longer oscillates (a joint
-#: locked by a default motor)
+#: wall-clock budget of one model error's run: this many times the baseline's engine
+#: stepping, at least RUN_TIMEOUT_FLOOR s; a run beyond it is recorded as timed out (its
+#: `run.completed` fails, so it counts as rejected). The budget exists for the
+#: free-vibration fits, whose least squares can search for minutes on a motion that no
+#: longer oscillates
 RUN_TIMEOUT_FACTOR = 20.0
 RUN_TIMEOUT_FLOOR = 30.0
 #: statuses of a metric that holds
@@ -81,13 +91,18 @@ FAILS = ("fail", "xfail")
 #: the metrics of the out-of-the-box reading (name suffix or prefix)
 EFFECT_SUFFIXES = (".trajectory_max", ".energy_drift", ".period")
 EFFECT_PREFIXES = ("frequency.", "damping.")
+#: verdicts of a default switched on, or of a 1 % model error (`classify_default`,
+#: `classify_error`): caught; moves nothing; moves the judged quantities, each within its
+#: gate; moves one beyond its gate and is not caught (a defect of the gates)
+REJECTED, NO_EFFECT, BELOW_GATES, NOT_REJECTED = (
+    "rejected", "no effect", "below the gates", "not rejected")
 
 
 @dataclass
 class Trial:
     eps: float
     rejected: bool
-    #: the metrics that hold in the baseline and fail here
+    #: the metrics that hold in the baseline and reject this run
     rejected_by: list[str] = field(default_factory=list)
     passed: bool = True
     wall_time_s: float = 0.0
@@ -102,8 +117,13 @@ class ErrorPower:
     #: smallest eps of the grid the gates reject (None: not even the largest)
     smallest_rejected: float | None = None
     trials: list[Trial] = field(default_factory=list)
+    #: whether the trials agree with rejection monotone in eps (the grid's top checked)
+    monotone: bool = True
     #: the exact model's change at eps = PROBE against the gates (see the module doc)
     motion_change: dict = field(default_factory=dict)
+    #: at eps = PROBE: REJECTED, BELOW_GATES or NOT_REJECTED, and why (`classify_error`)
+    verdict: str = ""
+    why: str = ""
 
 
 @dataclass
@@ -115,8 +135,15 @@ class DefaultPower:
     rejected: bool
     rejected_by: list[str] = field(default_factory=list)
     passed: bool = True
-    #: whether any metric moved at all (False: the setting does not act on this build)
+    #: whether it changes a judged quantity by more than its gate (`largest_change`)
     acts: bool = True
+    #: whether any metric moved at all (False: the setting does not act on this build)
+    moved: bool = True
+    #: the judged quantity it changes most against its gate: quantity, change, gate, ratio
+    change: dict = field(default_factory=dict)
+    #: REJECTED, NO_EFFECT, BELOW_GATES or NOT_REJECTED, and why (`classify_default`)
+    verdict: str = ""
+    why: str = ""
     #: per metric of the out-of-the-box reading: neutralised value, switched-on value,
     #: tolerance, unit
     effect: dict = field(default_factory=dict)
@@ -124,12 +151,10 @@ class DefaultPower:
     #: a run that did not complete (crashed, timed_out, diverged), with its message
     incidents: list = field(default_factory=list)
     wall_time_s: float = 0.0
-    #: each declared scenario run with the default against the same run without it (one
-    #: engine run each, whatever the comparison's fate), under "scenarios":
-    #: `trajectory_change`, the largest |q_on - q_off| relative to the reference's
-    #: amplitude, against the scenario's trajectory gate; `energy_drift` of each run
-    #: (conservative mechanisms), relative to the largest kinetic energy. At the top
-    #: level, the scenario where the change is largest against its gate
+    #: per declared scenario ("scenarios"): `trajectory_change`, the largest
+    #: |q_on - q_off| relative to the amplitude, against the scenario's trajectory gate,
+    #: and the energy drift of both runs; at the top level, the scenario where the change
+    #: is largest against its gate
     motion: dict = field(default_factory=dict)
 
 
@@ -144,8 +169,8 @@ class PowerEntry:
     #: the scenarios the defaults are switched on in (every declared one)
     defaults_scenarios: list[str] = field(default_factory=list)
     dt: float = DEFAULT_DT
-    #: the unmutated run: passed, and the metrics that do not hold in it (they cannot
-    #: reject anything)
+    #: the neutralised, unmutated run: passed, and the metrics that do not hold in it
+    #: (they cannot reject anything)
     baseline_passed: bool = True
     baseline_not_holding: list[str] = field(default_factory=list)
     errors: list[ErrorPower] = field(default_factory=list)
@@ -159,11 +184,112 @@ class PowerEntry:
 
 
 def rejecting_metrics(baseline: Comparison, run: Comparison) -> list[str]:
-    """The metrics of `run` that fail while they hold in `baseline` (a metric the baseline
-    does not have, such as a run's `completed`, counts when it fails)."""
-    before = {m.name: m.status for m in baseline.metrics}
-    return [m.name for m in run.metrics
-            if m.status in FAILS and before.get(m.name, "pass") in HOLDS]
+    """The metrics of `run` that reject it (see the module doc): each metric that holds in
+    `baseline` and fails in `run` or exceeds the baseline's tolerance (a value that is not
+    finite exceeds it); a metric the baseline does not have (a run's `completed`) counts
+    when it fails."""
+    before = {m.name: m for m in baseline.metrics}
+    out = []
+    for m in run.metrics:
+        b = before.get(m.name)
+        if b is None:
+            if m.status in FAILS:
+                out.append(m.name)
+        elif b.status in HOLDS and (m.status in FAILS or not m.value <= b.tolerance):
+            out.append(m.name)
+    return out
+
+
+def largest_change(baseline: Comparison, run: Comparison, scenarios: Mapping[str, dict]
+                   ) -> dict:
+    """The judged quantity `run` changes most against its gate, from `baseline`: each
+    scenario's motion change (`trajectory_change` against `trajectory_gate`, in
+    `scenarios`) and each metric holding in the baseline, |value - baseline's| against the
+    baseline's tolerance. {} when nothing was measured."""
+    found = []
+    for name, m in scenarios.items():
+        if "trajectory_change" in m and m.get("trajectory_gate"):
+            found.append((f"{name}.motion", m["trajectory_change"], m["trajectory_gate"]))
+    after = {m.name: m for m in run.metrics}
+    for b in baseline.metrics:
+        m = after.get(b.name)
+        if m is None or b.status not in HOLDS or not b.tolerance > 0:
+            continue
+        with np.errstate(invalid="ignore"):
+            moved = abs(float(m.value) - float(b.value))
+        found.append((b.name, moved if np.isfinite(moved) else math.inf, b.tolerance))
+    if not found:
+        return {}
+    quantity, change, gate = max(found, key=lambda f: f[1] / f[2])
+    return {"quantity": quantity, "change": change, "gate": gate, "ratio": change / gate}
+
+
+def classify_default(d: DefaultPower, baseline: Comparison) -> None:
+    """`d.acts`, `d.verdict` and `d.why` from its reading (in place): rejected; no effect
+    (no metric moved); below the gates (its largest change against a gate is within it);
+    not rejected (a judged quantity moved beyond its gate and no gate caught it: the
+    metric that judges it, named, and its status in the baseline)."""
+    c = d.change
+    d.acts = bool(c and c["ratio"] > 1.0) or bool(d.incidents)
+    if d.rejected:
+        d.verdict = REJECTED
+        d.why = (f"rejected by {', '.join(d.rejected_by[:4])}"
+                 + (f" (+{len(d.rejected_by) - 4})" if len(d.rejected_by) > 4 else ""))
+    elif not d.moved:
+        d.verdict, d.why = NO_EFFECT, "no metric moved: the setting does not act on this build"
+    elif not d.acts:
+        d.verdict = BELOW_GATES
+        d.why = (f"largest change {c['change']:.3g} of {c['quantity']}, within its gate "
+                 f"{c['gate']:.3g}" if c else "nothing measured beyond a gate")
+    else:
+        d.verdict = NOT_REJECTED
+        d.why = f"{c['quantity']} changes by {c['change']:.3g} against a gate of {c['gate']:.3g}, " + (
+            _why_not_caught(c["quantity"], baseline))
+
+
+def _why_not_caught(quantity: str, baseline: Comparison) -> str:
+    """Why the metric judging `quantity` did not reject the change."""
+    if quantity.endswith(".motion"):
+        name = quantity[:-len(".motion")] + ".trajectory_max"
+        m = metric_named(baseline, name)
+        if m is None:
+            return "and no trajectory metric judges that scenario"
+        if m.status not in HOLDS:
+            return f"and {name} is {m.status} without it, so it cannot reject"
+        return (f"yet {name} stays within its gate: the change offsets the engine's own "
+                f"error ({m.value:.3g} without it)")
+    m = metric_named(baseline, quantity)
+    return f"and {quantity} is {m.status if m is not None else 'absent'} without it"
+
+
+def classify_error(power: ErrorPower) -> None:
+    """`power.verdict` and `why` at eps = PROBE (in place): rejected when the smallest
+    rejected eps is at most PROBE; otherwise below the gates when the exact model's change
+    at PROBE is within the gate of each quantity measured (named, with its change), and
+    not rejected (a blind gate) when one of them is beyond its gate."""
+    if not power.applicable:
+        return
+    mc = power.motion_change
+    if power.smallest_rejected is not None and power.smallest_rejected <= PROBE:
+        power.verdict = REJECTED
+        power.why = f"rejected from eps = {power.smallest_rejected:.0e}"
+        return
+    ratios = mc.get("against_gates", {})
+    worst = max(ratios.items(), key=lambda kv: kv[1]["ratio"], default=None)
+    if worst is None:
+        power.verdict = NOT_REJECTED
+        power.why = ("no judged quantity's change could be measured in the exact model"
+                     + (f" ({mc['error']})" if "error" in mc else ""))
+    elif not mc.get("beyond_gate"):
+        power.verdict = BELOW_GATES
+        name, w = worst
+        power.why = (f"a {PROBE:.0%} error moves no judged quantity beyond its gate: "
+                     f"largest {name} {w['change']:.3g} against {w['gate']:.3g}")
+    else:
+        power.verdict = NOT_REJECTED
+        name, w = worst
+        power.why = (f"a {PROBE:.0%} error moves {name} by {w['change']:.3g} against a gate "
+                     f"of {w['gate']:.3g} ({w['status']}), and no gate rejects it")
 
 
 def _dynamics(mech):
@@ -203,10 +329,13 @@ def metric_named(c: Comparison, name: str):
 
 def motion_change(system, scenario, values, parameter: str, baseline: Comparison,
                   dt: float) -> dict:
-    """The exact model's change when `parameter` is PROBE off: the largest trajectory
-    difference on `scenario` relative to the amplitude (as the trajectory gate measures)
-    and the largest relative change of a mode's frequency, each against the baseline's
-    gate (its tolerance)."""
+    """The exact model's change when `parameter` is PROBE off, each judged quantity
+    against the baseline's gate of the metric that judges it ("against_gates": change,
+    gate, the metric's status, ratio): the largest trajectory difference on `scenario`
+    relative to the amplitude (the trajectory gate's measure), each actuator's force
+    relative to its largest (its `actuator_*` metric's) and the largest relative change of
+    a mode's frequency (the tightest judged frequency gate). `beyond_gate`: a quantity
+    beyond the gate of a metric that holds in the baseline."""
     ref = reference(system, scenario, values, dt)
     mutated = {**values, parameter: values[parameter] * (1 + PROBE)}
     other = reference(system, scenario, mutated, dt)
@@ -216,17 +345,29 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
     n = min(len(ref.t), len(other.t))
     trajectory, _ = metrics.trajectory_errors(other.q[:n, free], ref.q[:n, free], scale)
     out: dict = {"eps": PROBE, "trajectory": trajectory}
+    against: dict = {}
+
+    def judged(quantity: str, change: float, metric_name: str) -> None:
+        m = metric_named(baseline, metric_name)
+        if m is not None and m.tolerance > 0:
+            against[quantity] = {"change": change, "gate": m.tolerance, "metric": m.name,
+                                 "status": m.status, "ratio": change / m.tolerance}
+
+    judged("trajectory", trajectory, f"{scenario.name}.trajectory_max")
     gate = metric_named(baseline, f"{scenario.name}.trajectory_max")
     if gate is not None:
         out["trajectory_gate"] = gate.tolerance
         out["trajectory_gate_status"] = gate.status
-    # a driven mechanism: the actuator force the motion takes (judged on the same gate)
-    forces = [float(np.max(np.abs(other.actuator_forces[a][:n] - f[:n])))
-              / max(float(np.max(np.abs(f))), 1e-300)
-              for a, f in (ref.actuator_forces or {}).items()
-              if a in (other.actuator_forces or {})]
+    forces = {}
+    for a, f in (ref.actuator_forces or {}).items():
+        if a not in (other.actuator_forces or {}):
+            continue
+        ok = np.isfinite(f[:n]) & np.isfinite(other.actuator_forces[a][:n])
+        forces[a] = (float(np.max(np.abs(other.actuator_forces[a][:n][ok] - f[:n][ok])))
+                     / max(float(np.max(np.abs(f[:n][ok]))), 1e-300))
+        judged(f"actuator {a}", forces[a], f"{scenario.name}.actuator_{a}")
     if forces:
-        out["actuator_force"] = max(forces)
+        out["actuator_force"] = max(forces.values())
     unexcited = unexcited_values(system, values) if system.mechanism.prescribed else values
     try:
         before = [m.frequency_hz for m in operating_equilibrium(system, unexcited).modes]
@@ -237,15 +378,15 @@ def motion_change(system, scenario, values, parameter: str, baseline: Comparison
     except (ValueError, RuntimeError, np.linalg.LinAlgError):
         out["frequency"] = None
     gates = [m for m in baseline.metrics if m.name.startswith("frequency.")
-             and m.status != "unresolved"]
+             and m.status in HOLDS]
     if gates:
-        out["frequency_gate"] = min(m.tolerance for m in gates)
-    judged = gate is not None and gate.status != "unresolved"
-    out["beyond_gate"] = bool(
-        (judged and trajectory > gate.tolerance)
-        or (judged and forces and out["actuator_force"] > gate.tolerance)
-        or (out.get("frequency") is not None and gates
-            and out["frequency"] > out["frequency_gate"]))
+        tightest = min(gates, key=lambda m: m.tolerance)
+        out["frequency_gate"] = tightest.tolerance
+        if out["frequency"] is not None:
+            judged("frequency", out["frequency"], tightest.name)
+    out["against_gates"] = against
+    out["beyond_gate"] = any(v["ratio"] > 1.0 and v["status"] in HOLDS
+                             for v in against.values())
     return out
 
 
@@ -275,69 +416,35 @@ def same_metrics(a: Comparison, b: Comparison) -> bool:
 def power_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
                 kinds: Iterable[str] = tuple(ERROR_KINDS), defaults: bool = True
                 ) -> PowerEntry:
-    """The power study of one system on one engine (see the module doc)."""
-    started = time.perf_counter()
-    system = get_system(system_id)
-    backend = get_backend(simulator)
+    """The power study of one system on one engine (see the module doc): the model
+    errors of `kinds`, and with `defaults` the out-of-the-box reading from the same
+    baseline (`out_of_the_box.defaults_entry`)."""
+    from .out_of_the_box import defaults_entry  # it builds on this module's readings
+
+    return defaults_entry(system_id, simulator, dt, only=None if defaults else (),
+                          kinds=tuple(kinds))
+
+
+def error_powers(system, simulator: str, kinds: Iterable[str], baseline: Comparison,
+                 dt: float, run) -> list[ErrorPower]:
+    """Each kind's smallest rejected eps against `baseline` (the neutralised, unmutated
+    run); `run(engine_scale=)` makes one mutated comparison of the first scenario."""
     scenario = system.scenarios[0]
-    entry = PowerEntry(system.id, simulator, scenario=scenario.name, dt=dt)
-    ok, why = backend.available()
-    if not ok:
-        entry.supported, entry.reason = False, f"engine not available: {why}"
-        return entry
-    entry.engine_version = backend.version()
     values = system.parameter_values(None, scenario=scenario)
     system = system.with_structure(values)  # built for its number of elements
-
-    # the unmutated run in this process: the reference solve, the derivations and the
-    # equilibria it computes are then shared by every worker forked after it
-    entry.comparisons += 1
-    baseline = compare(system.id, simulator, dt=dt, scenarios=[scenario.name])
-    entry.engine_time_s += baseline.wall_time
-    budget = max(RUN_TIMEOUT_FLOOR, RUN_TIMEOUT_FACTOR * baseline.wall_time)
-
-    def run(**kwargs) -> Comparison:
-        entry.comparisons += 1
-        c = isolated_compare(system.id, simulator, dt=dt, scenarios=[scenario.name],
-                             timeout=budget, **kwargs)
-        entry.engine_time_s += c.wall_time
-        return c
-    if not baseline.supported:
-        entry.supported, entry.reason = False, baseline.reason
-        entry.wall_time_s = time.perf_counter() - started
-        return entry
-    entry.baseline_passed = baseline.passed
-    entry.baseline_not_holding = [m.name for m in baseline.metrics if m.status not in HOLDS
-                                  and m.status != "measured"]
-    for kind in kinds:
-        entry.errors.append(_error_power(system, kind, values, scenario, baseline, dt, run))
-    if defaults:
-        declared = [sc.name for sc in system.scenarios]
-        entry.defaults_scenarios = declared
-        whole = (baseline if len(declared) == 1
-                 else compare(system.id, simulator, dt=dt, scenarios=declared))
-        entry.comparisons += len(declared) > 1
-
-        def run_declared(**kwargs) -> Comparison:
-            entry.comparisons += 1
-            c = isolated_compare(system.id, simulator, dt=dt, scenarios=declared,
-                                 timeout=budget * len(declared), **kwargs)
-            entry.engine_time_s += c.wall_time
-            return c
-
-        entry.defaults = _defaults_power(system, backend, whole, dt, run_declared,
-                                         budget)
-    entry.wall_time_s = time.perf_counter() - started
-    return entry
+    return [_error_power(system, kind, values, scenario, baseline, dt, run) for kind in kinds]
 
 
 def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPower:
+    import time
+
     parameter = mutated_parameter(system, kind, values)
     if parameter is None:
         return ErrorPower(kind, None, False,
                           f"no parameter of this kind enters the mechanism "
                           f"({', '.join(ERROR_KINDS[kind]) or GRAVITY_PARAMETER})")
     power = ErrorPower(kind, parameter, True)
+    tried: dict[int, bool] = {}
 
     def trial(i: int) -> bool:
         eps = EPSILONS[i]
@@ -346,7 +453,8 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
         by = rejecting_metrics(baseline, c)
         power.trials.append(Trial(eps, bool(by), by, c.passed,
                                   time.perf_counter() - started))
-        return bool(by)
+        tried[i] = bool(by)
+        return tried[i]
 
     # bisection on the grid: the first index rejected, assuming monotone rejection
     lo, hi = 0, len(EPSILONS)
@@ -356,42 +464,19 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
             hi = mid
         else:
             lo = mid + 1
+    top = len(EPSILONS) - 1
+    if hi < len(EPSILONS) and top not in tried:  # the assumption checked at the top
+        trial(top)
+    power.monotone = all(tried[j] for j in tried if j >= hi) and not any(
+        tried[j] for j in tried if j < hi)
     power.smallest_rejected = EPSILONS[hi] if hi < len(EPSILONS) else None
     power.trials.sort(key=lambda t: t.eps)
     try:
         power.motion_change = motion_change(system, scenario, values, parameter, baseline, dt)
     except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
         power.motion_change = {"eps": PROBE, "error": str(exc)}
+    classify_error(power)
     return power
-
-
-def _defaults_power(system, backend, baseline: Comparison, dt: float, run,
-                    budget: float) -> list[DefaultPower]:
-    switched = engine_defaults(backend.id, dt)
-    out = [_default_power(key, {key: value}, backend.SETTINGS[key].default, baseline, run,
-                          backend.SETTINGS[key].note) for key, value in switched.items()]
-    if len(switched) > 1:
-        out.append(_default_power("all", switched, None, baseline, run,
-                                  "every neutralised default switched back on together: "
-                                  "the engine as it comes"))
-    for scenario in system.scenarios:
-        values = system.parameter_values(None, scenario=scenario)
-        neutral = _scenario_run(system, backend, scenario, values, dt, {}, budget)
-        gate = metric_named(baseline, f"{scenario.name}.trajectory_max")
-        for d in out:
-            chosen = switched if d.setting == "all" else {d.setting: switched[d.setting]}
-            motion = _motion_against(neutral, _scenario_run(system, backend, scenario, values,
-                                                            dt, chosen, budget))
-            if gate is not None and "trajectory_change" in motion:
-                motion["trajectory_gate"] = gate.tolerance
-                motion["beyond_gate"] = bool(motion["trajectory_change"] > gate.tolerance)
-            d.motion.setdefault("scenarios", {})[scenario.name] = motion
-    for d in out:
-        name, worst = worst_scenario(d.motion["scenarios"])
-        d.motion.update(worst, scenario=name,
-                        beyond_gate=any(m.get("beyond_gate", False)
-                                        for m in d.motion["scenarios"].values()))
-    return out
 
 
 def engine_defaults(simulator: str, dt: float = DEFAULT_DT) -> dict[str, object]:
@@ -413,102 +498,41 @@ def worst_scenario(scenarios: Mapping[str, dict]) -> tuple[str, dict]:
         / max(item[1].get("trajectory_gate", 1.0), 1e-300)))
 
 
-def _default_power(key, settings, harness, baseline, run, note) -> DefaultPower:
-    started = time.perf_counter()
-    c = run(settings=settings)
-    by = rejecting_metrics(baseline, c)
-    return DefaultPower(key, settings[key] if key in settings else settings, harness,
-                        bool(by), by, c.passed, acts=not same_metrics(baseline, c),
-                        effect=effect_against(baseline, c), note=note, incidents=c.incidents,
-                        wall_time_s=time.perf_counter() - started)
-
-
-def _simulate_scenario(system, backend, scenario, values, dt, settings) -> dict:
-    """One scenario on the engine with `settings` (a worker's task): the free
-    coordinates relative to the reference's amplitude, and the energy drift."""
-    ref = reference(system, scenario, values, dt)
-    mech = system.numeric_mechanism(values)
-    run = backend.simulate(mech, ref.q[0], ref.qd[0], scenario.t_end, dt,
-                           backend.resolve_settings(settings), ())
-    free = free_coordinates(system, values)
-    eq = operating_equilibrium(system, values)
-    scale = metrics.amplitude(ref.q[:, free], eq.q[free])
-    n = min(len(ref.t), len(run.t))
-    out = {"q": run.q[:n, free] / scale, "energy_drift": None}
-    if ref.energy is not None:
-        model = numeric_model(system.id, values)
-        energy = model.energy(run.q[:n], run.qd[:n])
-        kinetic = max(max(0.5 * v @ model.mass_matrix(x) @ v
-                          for x, v in zip(ref.q[::10], ref.qd[::10])), 1e-300)
-        out["energy_drift"] = float(np.max(np.abs(energy - energy[0]))) / kinetic
-    return out
-
-
-def _scenario_run(system, backend, scenario, values, dt, settings, budget) -> dict:
-    try:
-        return isolated(_simulate_scenario, system, backend, scenario, values, dt, settings,
-                        timeout=budget)
-    except (WorkerCrashed, WorkerTimedOut, ValueError, RuntimeError) as exc:
-        return {"error": f"{type(exc).__name__}: {exc}"}
-
-
-def _motion_against(neutral: dict, switched: dict) -> dict:
-    if "error" in neutral or "error" in switched:
-        return {"error": neutral.get("error") or switched.get("error")}
-    q_off, q_on = neutral["q"], switched["q"]
-    n = min(len(q_off), len(q_on))
-    with np.errstate(invalid="ignore"):
-        change = float(np.max(np.abs(q_on[:n] - q_off[:n]))) if n else float("nan")
-    return {"trajectory_change": change if np.isfinite(change) else float("inf"),
-            "energy_drift_neutralised": neutral["energy_drift"],
-            "energy_drift_switched_on": switched["energy_drift"]}
-
-
-@dataclass
-class PowerStudy:
-    entries: list[PowerEntry]
-    provenance: dict = field(default_factory=dict)
-
-    def summary(self) -> dict:
-        """See `summary_of`."""
-        return summary_of([e.as_dict() for e in self.entries])
-
-    def as_dict(self) -> dict:
-        return {"provenance": self.provenance, "epsilons": list(EPSILONS), "probe": PROBE,
-                "error_kinds": {k: list(v) or [GRAVITY_PARAMETER]
-                                for k, v in ERROR_KINDS.items()},
-                "summary": self.summary(), "entries": [e.as_dict() for e in self.entries]}
-
-    def out_of_the_box(self) -> dict:
-        """The out-of-the-box reading (see `out_of_the_box_document`)."""
-        return out_of_the_box_document(self.as_dict())
-
-
 def summary_of(entries: list[dict]) -> dict:
     """Per engine and error kind, over the saved entries where the kind applies: the median
     (the lower one of an even count) smallest rejected eps, where an error the gates
-    rejected not even at the largest eps counts as above the grid; how many systems, and
-    how many of them rejected nothing. Per engine, how many switched-on defaults that act
-    (alone) were rejected, and those that were not."""
+    rejected not even at the largest eps counts as above the grid; how many systems, how
+    many of them rejected nothing, and at eps = PROBE how many rejected, below the gates
+    and not rejected (named: the blind spots). Per engine, the defaults switched on alone:
+    how many act (beyond a gate), how many of those were rejected, the acting ones not
+    rejected (blind spots), and how many moved within the gates."""
     out: dict = {}
     for sim in dict.fromkeys(e["simulator"] for e in entries):
         mine = [e for e in entries if e["simulator"] == sim and e["supported"]]
         row = {}
         for kind in ERROR_KINDS:
-            found = [p["smallest_rejected"] for e in mine for p in e["errors"]
+            found = [(e["system"], p) for e in mine for p in e["errors"]
                      if p["kind"] == kind and p["applicable"]]
-            ranked = [math.inf if x is None else x for x in found]
+            ranked = [math.inf if p["smallest_rejected"] is None else p["smallest_rejected"]
+                      for _, p in found]
             median = statistics.median_low(ranked) if ranked else None
             row[kind] = {"median_smallest_rejected": "above grid" if median == math.inf
                          else median,
                          "systems": len(found),
-                         "not_rejected_at_largest": sum(x is None for x in found)}
-        acting = [(e["system"], d) for e in mine for d in e["defaults"]
-                  if d["acts"] and d["setting"] != "all"]
+                         "not_rejected_at_largest": sum(
+                             p["smallest_rejected"] is None for _, p in found),
+                         "at_probe": {v: sum(p.get("verdict") == v for _, p in found)
+                                      for v in (REJECTED, BELOW_GATES, NOT_REJECTED)},
+                         "not_rejected": [s for s, p in found
+                                          if p.get("verdict") == NOT_REJECTED]}
+        alone = [(e["system"], d) for e in mine for d in e["defaults"] if d["setting"] != "all"]
+        acting = [(s, d) for s, d in alone if d["acts"]]
         row["defaults"] = {"acting": len(acting),
                            "rejected": sum(d["rejected"] for _, d in acting),
-                           "not_rejected": [f"{system}:{d['setting']}"
-                                            for system, d in acting if not d["rejected"]]}
+                           "not_rejected": [f"{s}:{d['setting']}" for s, d in acting
+                                            if not d["rejected"]],
+                           "below_gates": [f"{s}:{d['setting']}" for s, d in alone
+                                           if d.get("verdict") == BELOW_GATES]}
         out[sim] = row
     return out
 
@@ -517,25 +541,24 @@ def out_of_the_box_document(power: dict) -> dict:
     """The out-of-the-box reading of a power study (its saved document): per system x
     engine, each default switched on, its verdict and its effect against the neutralised
     run."""
-    keep = ("setting", "engine_value", "harness_value", "acts", "rejected", "rejected_by",
-            "effect", "motion", "incidents", "note")
-    return {"provenance": power["provenance"], "entries": [
+    keep = ("setting", "engine_value", "harness_value", "acts", "moved", "change", "verdict",
+            "why", "rejected", "rejected_by", "effect", "motion", "incidents", "note")
+    doc = {"provenance": power["provenance"], "entries": [
         {**{k: e[k] for k in ("system", "simulator", "engine_version", "scenario",
                               "defaults_scenarios", "dt", "supported", "reason")},
-         "defaults": [{k: d[k] for k in keep} for d in e["defaults"]]}
+         "defaults": [{k: d.get(k) for k in keep} for d in e["defaults"]]}
         for e in power["entries"]]}
+    if "cost" in power:
+        doc["cost"] = power["cost"]
+    return doc
 
 
-def power_study(systems: Iterable[str], sims: Iterable[str], dt: float = DEFAULT_DT,
-                progress=None) -> PowerStudy:
-    """`power_entry` for every system x engine (in that order)."""
-    from .runner import provenance
-
-    entries = []
-    for system_id in systems:
-        for sim in sims:
-            entry = power_entry(system_id, sim, dt)
-            entries.append(entry)
-            if progress is not None:
-                progress(entry)
-    return PowerStudy(entries, provenance())
+def power_document(entries: list[dict], provenance: dict, cost: dict | None = None) -> dict:
+    """The saved power study (power.json): the grid, the error kinds, the summary, the
+    entries and the study's cost."""
+    doc = {"provenance": provenance, "epsilons": list(EPSILONS), "probe": PROBE,
+           "error_kinds": {k: list(v) or [GRAVITY_PARAMETER] for k, v in ERROR_KINDS.items()},
+           "summary": summary_of(entries), "entries": entries}
+    if cost is not None:
+        doc["cost"] = cost
+    return doc
