@@ -152,8 +152,16 @@ def test_power_command_writes_both_documents_and_pages(tmp_path):
         assert kinds[kind]["smallest_rejected"] in power.EPSILONS
         # a 1 % error of any of them moves the pendulum beyond its gates
         assert kinds[kind]["motion_change"]["beyond_gate"]
+    for kind in ("mass", "inertia", "length", "gravity"):
+        assert kinds[kind]["verdict"] == power.REJECTED, kinds[kind]
+        assert kinds[kind]["monotone"]
     defaults = {d["setting"]: d for d in entry["defaults"]}
     assert set(defaults) == {"error_bias", "iterations", "all"}
+    # a single pin joint leaves the solver's iterations nothing to resolve: the change of
+    # every judged quantity is within its gate (rounding), so it acts on nothing
+    assert defaults["iterations"]["verdict"] in (power.BELOW_GATES, power.NO_EFFECT)
+    assert not defaults["iterations"]["acts"]
+    assert doc["summary"]["pymunk"]["defaults"]["not_rejected"] == []
     # Pymunk's error bias drains the 2 rad swing (invisible on the small one)
     assert defaults["error_bias"]["rejected"]
     assert any(name.startswith("large.") for name in defaults["error_bias"]["rejected_by"])
@@ -162,3 +170,31 @@ def test_power_command_writes_both_documents_and_pages(tmp_path):
     assert box["entries"][0]["defaults"][0]["setting"] == "error_bias"
     for page in ("power.html", "out_of_the_box.html"):
         assert "compound_pendulum" in (tmp_path / page).read_text()
+
+
+def test_mujoco_euler_is_rejected_at_the_harness_gates():
+    """MuJoCo's default integrator, Euler (semi-implicit: the velocity first), switched
+    back on: on a harmonic swing from rest the conserved modified energy is
+    E - (h w^2 / 2) q v, so the energy departs from its start by up to h w / 2 of the
+    largest kinetic energy (|q v| <= A^2 w / 2), within (w h + A^2) of itself (the next
+    order and the pendulum's anharmonicity). Its own verdict judges it against the bound of
+    a first-order scheme, which it meets; the power study holds the gates at the
+    harness's RK4 run, which is wrong by orders less, and rejects it there."""
+    _installed("mujoco")
+    assert power.engine_defaults("mujoco")["integrator"] == "Euler"
+    system = get_system("compound_pendulum")
+    values = system.parameter_values(None, scenario=system.scenarios[0])
+    w, h, A = math.sqrt(values["m"] * values["g"] * values["l"] / values["I_O"]), 1e-3, 0.05
+    assert values["phi0"] == A
+    baseline = compare("compound_pendulum", "mujoco", scenarios=["small"])
+    euler = compare("compound_pendulum", "mujoco", scenarios=["small"],
+                    settings={"integrator": "Euler"})
+    assert baseline.passed
+    drift = power.metric_named(euler, "small.energy_drift")
+    neutral = power.metric_named(baseline, "small.energy_drift")
+    assert abs(drift.value - w * h / 2) <= w * h / 2 * (w * h + A**2) + neutral.value
+    assert drift.status == "pass" and euler.passed  # its own, first-order, gate
+    assert drift.value > neutral.tolerance  # the harness's gate
+    rejected_by = power.rejecting_metrics(baseline, euler)
+    assert {"small.energy_drift", "small.trajectory_max"} <= set(rejected_by)
+    assert power.rejecting_metrics(baseline, baseline) == []

@@ -220,15 +220,17 @@ def _out_of_the_box_rows(out: Path) -> dict[str, list[dict]]:
             energy = max(drifts, key=lambda item: item[1]["energy_drift_switched_on"],
                          default=None)
             damping = d.get("effect", {}).get("damping.fit_mode1")
-            verdict = ("rejected" if d["rejected"] else "passes" if d["acts"]
-                       else "no effect")
+            # the power study's classification (power.classify_default), where saved
+            verdict = d.get("verdict") or ("rejected" if d["rejected"] else "passes"
+                                           if d["acts"] else "no effect")
             defaults.append({
                 "setting": d["setting"], "note": d.get("note", ""),
                 "engine_value": "each above" if d["setting"] == "all"
                 else json.dumps(d["engine_value"]),
                 "harness_value": "" if d.get("harness_value") is None
                 else json.dumps(d["harness_value"]),
-                "verdict": verdict, "cls": {"rejected": "fail", "passes": "pass"}.get(
+                "verdict": verdict, "cls": {"rejected": "fail", "passes": "pass", "below the gates": "pass",
+                        "not rejected": "pass"}.get(
                     verdict, "unsupported"),
                 "rejected_by": ", ".join(d.get("rejected_by", [])),
                 "incidents": [i["outcome"] for i in d.get("incidents", [])],

@@ -27,34 +27,46 @@ _ENV.filters["num"] = lambda x: "-" if x is None else (x if isinstance(x, str) e
 POWER_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="utf-8">
 <title>mbfidelity gate power</title><style>{{ style }}</style></head><body>
 <h1>Gate power: the smallest model error each engine's gates reject</h1>
-<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}. One parameter of each kind is
+<p>{{ doc.provenance.git_describe }} · {{ doc.provenance.date }}.{% if doc.cost %} {{ doc.entries|length }}
+system x engine entries, {{ doc.cost.comparisons }} comparisons, {{ "%.0f"|format(doc.cost.wall_time_s) }} s of wall time
+on {{ doc.cost.workers }} worker processes.{% endif %} One parameter of each kind is
 multiplied by (1 + eps) in the engine's build only (the reference keeps the true value);
 eps on the decade grid {{ doc.epsilons|map("eps")|join(", ") }}, searched by bisection
-assuming a larger error is rejected whenever a smaller one is. Each run is the system's
-first scenario and the frequency checks (a default's: every declared scenario). A cell gives the smallest rejected eps and the
-parameter; "not rejected" means not even eps = {{ doc.epsilons[-1]|eps }}; its colour is
-yellow where a {{ doc.probe|eps }} error moves the exact motion beyond the gate (a blind
-spot), grey where it does not (the error is below what the gates can see).</p>
+assuming a larger error is rejected whenever a smaller one is (checked at the grid's top:
+a cell marked "not monotone" breaks it). Each run is the system's first scenario and the
+frequency checks (a default's: every declared scenario). A run is rejected when a metric
+that holds in the neutralised run fails, or exceeds that run's tolerance (the gates are
+held at the harness's configuration). A cell gives the smallest rejected eps and the
+parameter. At a {{ doc.probe|eps }} error each kind is classified: rejected; below the
+gates (grey: the exact model's change of each judged quantity, trajectory, actuator force
+and frequency, is within its gate, so no sound gate could reject it); not rejected (yellow:
+a judged quantity moves beyond its gate and no gate catches it, a defect). A default
+switched on is classified the same way from the engine's runs with and without it: it
+acts when it moves a judged quantity by more than its gate.</p>
 <h2>Summary: median smallest rejected eps</h2>
 <table><tr><th>engine</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults that act: rejected</th></tr>
 {% for sim, row in doc.summary.items() %}<tr><td>{{ sim }}</td>
-{% for k in kinds %}<td>{{ row[k].median_smallest_rejected|eps }} <small>({{ row[k].systems }} systems{% if row[k].not_rejected_at_largest %}, {{ row[k].not_rejected_at_largest }} not rejected{% endif %})</small></td>{% endfor %}
-<td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}</td></tr>{% endfor %}</table>
+{% for k in kinds %}<td>{{ row[k].median_smallest_rejected|eps }} <small>({{ row[k].systems }} systems{% if row[k].not_rejected_at_largest %}, {{ row[k].not_rejected_at_largest }} not rejected at {{ doc.epsilons[-1]|eps }}{% endif %}{% if row[k].at_probe %}; at {{ doc.probe|eps }}: {{ row[k].at_probe['rejected'] }} rejected, {{ row[k].at_probe['below the gates'] }} below the gates{% if row[k].at_probe['not rejected'] %}, <b>{{ row[k].at_probe['not rejected'] }} not rejected</b>{% endif %}{% endif %})</small></td>{% endfor %}
+<td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}{% if row.defaults.not_rejected %} <small><b>not rejected: {{ row.defaults.not_rejected|join(', ') }}</b></small>{% endif %}{% if row.defaults.below_gates %} <small>({{ row.defaults.below_gates|length }} below the gates)</small>{% endif %}</td></tr>{% endfor %}</table>
 <h2>Per system and engine</h2>
 <table><tr><th>system</th><th>engine</th><th>baseline</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults switched on</th></tr>
 {% for e in doc.entries %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td>
 {% if not e.supported %}<td class="na" colspan="{{ kinds|length + 2 }}">unsupported: {{ e.reason }}</td>
 {% else %}<td class="{{ 'pass' if e.baseline_passed else 'fail' }}" title="{{ e.baseline_not_holding|join(', ') }}">{{ 'passes' if e.baseline_passed else 'fails' }}</td>
 {% for p in e.errors %}{% if not p.applicable %}<td class="na" title="{{ p.reason }}">n/a</td>
-{% elif p.smallest_rejected is not none %}<td class="pass" title="{{ p.trials|map(attribute='rejected_by')|map('join', ', ')|join(' | ') }}">{{ p.smallest_rejected|eps }} <small>{{ p.parameter }}</small></td>
-{% else %}<td class="{{ 'weak' if p.motion_change.beyond_gate else 'na' }}" title="1 %: trajectory change {{ p.motion_change.trajectory|num }} (gate {{ p.motion_change.trajectory_gate|num }}), frequency change {{ p.motion_change.frequency|num }} (gate {{ p.motion_change.frequency_gate|num }})">not rejected <small>{{ p.parameter }}</small></td>{% endif %}{% endfor %}
-<td>{% for d in e.defaults %}<span class="{{ 'pass' if d.rejected else ('weak' if d.acts else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ d.setting }}: {{ 'rejected' if d.rejected else ('passes' if d.acts else 'no effect') }}</span>{% if not loop.last %}; {% endif %}{% endfor %}</td>{% endif %}</tr>{% endfor %}
+{% else %}<td class="{{ 'pass' if p.verdict == 'rejected' else ('weak' if p.verdict == 'not rejected' else 'na') }}" title="{{ p.why }}">{{ p.smallest_rejected|eps if p.smallest_rejected is not none else 'not rejected' }} <small>{{ p.parameter }}{% if p.verdict and p.verdict != 'rejected' %}; 1 %: {{ p.verdict }}{% endif %}{% if p.monotone is false %}; not monotone{% endif %}</small></td>{% endif %}{% endfor %}
+<td>{% for d in e.defaults %}<span class="{{ 'pass' if d.rejected else ('weak' if d.verdict == 'not rejected' else 'na') }}" title="{{ d.why }}">{{ d.setting }}: {{ d.verdict }}</span>{% if not loop.last %}; {% endif %}{% endfor %}</td>{% endif %}</tr>{% endfor %}
 </table>
-<h2>Motion change of a {{ doc.probe|eps }} error against the gates</h2>
-<table><tr><th>system</th><th>engine</th><th>kind</th><th>parameter</th><th>trajectory change</th><th>trajectory gate</th><th>frequency change</th><th>frequency gate</th><th>beyond a gate</th><th>smallest rejected</th></tr>
-{% for e in doc.entries if e.supported %}{% for p in e.errors if p.applicable %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td><td>{{ p.kind }}</td><td>{{ p.parameter }}</td>
-<td>{{ p.motion_change.trajectory|num }}</td><td>{{ p.motion_change.trajectory_gate|num }} {{ p.motion_change.trajectory_gate_status }}</td><td>{{ p.motion_change.frequency|num }}</td><td>{{ p.motion_change.frequency_gate|num }}</td>
-<td>{{ 'yes' if p.motion_change.beyond_gate else 'no' }}</td><td class="{{ 'pass' if p.smallest_rejected is not none else ('weak' if p.motion_change.beyond_gate else 'na') }}">{{ p.smallest_rejected|eps if p.smallest_rejected is not none else 'not rejected' }}</td></tr>{% endfor %}{% endfor %}
+<h2>Errors not rejected at {{ doc.probe|eps }}: the exact model's change against the gates</h2>
+<table><tr><th>system</th><th>engine</th><th>kind</th><th>parameter</th><th>smallest rejected</th><th>verdict at {{ doc.probe|eps }}</th><th>why</th><th>judged quantities: change / gate (metric's status)</th></tr>
+{% for e in doc.entries if e.supported %}{% for p in e.errors if p.applicable and p.verdict != 'rejected' %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td><td>{{ p.kind }}</td><td>{{ p.parameter }}</td>
+<td>{{ p.smallest_rejected|eps if p.smallest_rejected is not none else 'not rejected' }}</td><td class="{{ 'weak' if p.verdict == 'not rejected' else 'na' }}">{{ p.verdict }}</td><td>{{ p.why }}</td>
+<td>{% for q, g in (p.motion_change.against_gates or {}).items() %}{{ q }} {{ g.change|num }} / {{ g.gate|num }} <small>({{ g.status }})</small>{% if not loop.last %}; {% endif %}{% endfor %}</td></tr>{% endfor %}{% endfor %}
+</table>
+<h2>Defaults switched on and not rejected</h2>
+<table><tr><th>system</th><th>engine</th><th>default</th><th>value</th><th>verdict</th><th>largest change against its gate</th><th>why</th></tr>
+{% for e in doc.entries if e.supported %}{% for d in e.defaults if not d.rejected %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ 'each above' if d.setting == 'all' else d.engine_value }}</td>
+<td class="{{ 'weak' if d.verdict == 'not rejected' else 'na' }}">{{ d.verdict }}</td><td>{% if d.change %}{{ d.change.quantity }}: {{ d.change.change|num }} / {{ d.change.gate|num }}{% else %}-{% endif %}</td><td>{{ d.why }}</td></tr>{% endfor %}{% endfor %}
 </table>
 <p><a href="out_of_the_box.html">What each engine default does out of the box</a></p>
 </body></html>""")
@@ -84,7 +96,7 @@ verdict counts it as rejected; its effect is not measured).</p><ul>
 <table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate)</th><th>energy drift: harness → default</th><th>damping ratio added (mode 1)</th><th>frequency error (mode 1)</th></tr>
 {% for d in e.defaults %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
 <tr><td title="{{ d.note }}">{{ d.setting }}</td><td>{{ 'each above' if d.setting == 'all' else d.engine_value }}</td><td>{{ d.harness_value if d.harness_value is not none else '-' }}</td>
-<td class="{{ 'pass' if d.rejected else ('weak' if d.motion.beyond_gate else 'na') }}" title="{{ d.rejected_by|join(', ') }}">{{ 'rejected' if d.rejected else ('passes the gates' if d.acts else 'no effect') }}{% for i in d.incidents %} ({{ i.outcome }}){% endfor %}</td>
+<td class="{{ 'pass' if d.rejected else ('weak' if d.verdict == 'not rejected' else 'na') }}" title="{{ d.why }}">{{ d.verdict }}{% for i in d.incidents %} ({{ i.outcome }}){% endfor %}{% if not d.rejected %}<br><small>{{ d.why }}</small>{% endif %}</td>
 <td>{% if d.motion.error %}{{ d.motion.error }}{% else %}{{ d.motion.trajectory_change|num }} <small>(gate {{ d.motion.trajectory_gate|num }}, {{ d.motion.scenario }})</small>{% endif %}</td>
 <td>{% if d.motion.energy_drift_switched_on is not none and not d.motion.error %}{{ d.motion.energy_drift_neutralised|num }} → {{ d.motion.energy_drift_switched_on|num }}{% else %}-{% endif %}</td>
 {% for m in (damp, freq) %}<td>{% if m %}{{ m.neutralised|num }} → {{ m.switched_on|num }} <small>(gate {{ m.tolerance|num }})</small>{% else %}-{% endif %}</td>{% endfor %}</tr>{% endfor %}
