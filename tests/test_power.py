@@ -198,3 +198,30 @@ def test_mujoco_euler_is_rejected_at_the_harness_gates():
     rejected_by = power.rejecting_metrics(baseline, euler)
     assert {"small.energy_drift", "small.trajectory_max"} <= set(rejected_by)
     assert power.rejecting_metrics(baseline, baseline) == []
+
+
+def test_a_declared_failure_rejects_what_moves_beyond_the_engines_own_error():
+    """MuJoCo fails the slotted link's trajectory gates by declaration (the massless pin
+    carries a substitute mass on soft equalities), so they cannot judge a default by the
+    gate alone. MuJoCo's default diagexact (False) moves the undamped run by far more than
+    the gate; the trajectory metric rejects it because its value exceeds the neutralised
+    run's by more than the tolerance, which by the triangle inequality bounds the change
+    of the motion itself from below."""
+    _installed("mujoco")
+    system, scenario = "slotted_link_spring_damper", "undamped"
+    off = compare(system, "mujoco", scenarios=[scenario], keep_series=True)
+    on = compare(system, "mujoco", scenarios=[scenario], keep_series=True,
+                 settings={"diagexact": power.engine_defaults("mujoco")["diagexact"]})
+    name = f"{scenario}.trajectory_max"
+    before, after = power.metric_named(off, name), power.metric_named(on, name)
+    assert before.status == "xfail"
+    values = get_system(system).parameter_values()
+    free = power.free_coordinates(get_system(system), values)
+    q_off, q_on = (np.asarray(c.series[scenario]["q"], dtype=float) for c in (off, on))
+    scale = np.asarray(off.series[scenario]["scale"], dtype=float)
+    n = min(len(q_off), len(q_on))
+    change = float(np.max(np.abs(q_on[:n, free] - q_off[:n, free]) / scale[free]))
+    assert change >= after.value - before.value - 1e-12  # the triangle inequality
+    assert after.value > before.value + before.tolerance
+    assert name + power.BEYOND_BASELINE in power.rejecting_metrics(off, on)
+    assert power.rejecting_metrics(off, off) == []
