@@ -18,11 +18,12 @@ configuration: a default that changes the scheme the engine declares (MuJoCo's E
 integrator, Exudyn's solver) would otherwise be judged against the a-priori bound of its
 own, lower order, and pass while it moves the motion by far more than the harness's gate.
 
-For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found by
-bisection on the grid, assuming rejection is monotone in eps (a larger error is rejected
-whenever a smaller one is): at most three runs instead of six. The assumption is checked
-at the grid's top: where the bisection did not run the largest eps, it is run, and a
-smallest rejected eps whose largest is not rejected is marked not monotone. Next to it,
+For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found
+assuming rejection is monotone in eps (a larger error is rejected whenever a smaller one
+is): the grid's ends first (the largest eps not rejected: none is; the smallest rejected:
+it is the answer), then bisection between them: one run where no gate catches the
+largest error, two where one catches the smallest, at most five. `ErrorPower.monotone` records whether the runs
+made agree with the assumption. Next to it,
 the change that a 1 % error (`PROBE`) makes in the exact model (reference with the mutated
 parameter against the true one: the first scenario's trajectory and actuator forces, and
 the modes' frequencies) is set against the gate of each of those quantities, so that an
@@ -53,6 +54,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import statistics
+import time
 from dataclasses import dataclass, field
 from typing import Iterable, Mapping
 
@@ -299,7 +301,10 @@ def classify_error(power: ErrorPower) -> None:
     elif not mc.get("beyond_gate"):
         power.verdict = BELOW_GATES
         name, w = worst
-        power.why = (f"a {PROBE:.0%} error moves no judged quantity beyond its gate: "
+        power.why = (f"the exact model's judged quantities ({', '.join(ratios)}) do not "
+                     f"depend on {power.parameter}: each changes by 0 at {PROBE:.0%}"
+                     if all(v["change"] == 0 for v in ratios.values()) else
+                     f"a {PROBE:.0%} error moves no judged quantity beyond its gate: "
                      f"largest {name} {w['change']:.3g} against {w['gate']:.3g}")
     else:
         power.verdict = NOT_REJECTED
@@ -452,8 +457,6 @@ def error_powers(system, simulator: str, kinds: Iterable[str], baseline: Compari
 
 
 def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPower:
-    import time
-
     parameter = mutated_parameter(system, kind, values)
     if parameter is None:
         return ErrorPower(kind, None, False,
@@ -472,17 +475,21 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
         tried[i] = bool(by)
         return tried[i]
 
-    # bisection on the grid: the first index rejected, assuming monotone rejection
-    lo, hi = 0, len(EPSILONS)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if trial(mid):
-            hi = mid
-        else:
-            lo = mid + 1
+    # the grid's ends first, then bisection between them: the first index rejected,
+    # assuming rejection monotone in eps
     top = len(EPSILONS) - 1
-    if hi < len(EPSILONS) and top not in tried:  # the assumption checked at the top
-        trial(top)
+    if not trial(top):
+        hi = len(EPSILONS)
+    elif trial(0):
+        hi = 0
+    else:
+        lo, hi = 1, top
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if trial(mid):
+                hi = mid
+            else:
+                lo = mid + 1
     power.monotone = all(tried[j] for j in tried if j >= hi) and not any(
         tried[j] for j in tried if j < hi)
     power.smallest_rejected = EPSILONS[hi] if hi < len(EPSILONS) else None

@@ -23,7 +23,8 @@ COLOURS = {"exact": "rgba(0,0,0,0.35)", "mujoco": "#1f77b4", "pybullet": "#ff7f0
 OTHER_PAGES = (("errata.html", "Errata: the printed formulas against the derivation"),
                ("convergence.html", "Convergence and work-precision of every engine"),
                ("out_of_the_box.html", "Out of the box: each engine's defaults switched back on"),
-               ("power.html", "Power of the gates against the engines' defaults"),
+               ("power.html", "Power of the gates: the smallest model error each rejects, "
+                              "and the engines' defaults"),
                )
 #: whole-catalogue figures shown on the index when present
 INDEX_FIGURES = (("strutt.png", "The Strutt chart of eq. 83: stability of Mathieu's equation as "
