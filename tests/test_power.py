@@ -225,3 +225,21 @@ def test_a_declared_failure_rejects_what_moves_beyond_the_engines_own_error():
     assert after.value > before.value + before.tolerance
     assert name + power.BEYOND_BASELINE in power.rejecting_metrics(off, on)
     assert power.rejecting_metrics(off, off) == []
+
+
+def test_an_error_the_motion_does_not_depend_on_is_below_the_gates():
+    """The mass-spring-damper slides on a horizontal guide: g is normal to its only
+    coordinate, so an error of g changes no judged quantity of the exact model (trajectory
+    and frequency change by exactly 0). The study classifies it below the gates with that
+    reason, not as a blind gate, after the single run the grid's top needs (a gate that
+    rejected an error the motion does not see would be a false alarm)."""
+    _installed("mujoco")
+    entry = power.power_entry("mass_spring_damper", "mujoco", kinds=("gravity",),
+                              defaults=False)
+    (found,) = entry.errors
+    assert found.parameter == "g" and found.smallest_rejected is None
+    assert [t.eps for t in found.trials] == [power.EPSILONS[-1]]
+    changes = found.motion_change["against_gates"]
+    assert {"trajectory", "frequency"} <= set(changes)
+    assert all(v["change"] == 0.0 for v in changes.values())
+    assert found.verdict == power.BELOW_GATES and "do not depend on g" in found.why

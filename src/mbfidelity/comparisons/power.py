@@ -13,17 +13,18 @@ Rejection (`rejecting_metrics`): a metric that holds in the unmutated, neutralis
 baseline) rejects a run when it fails there, or when its value exceeds the baseline's
 tolerance; a metric that does not hold in the baseline (a declared failure) rejects it when
 its value exceeds the baseline's by more than the tolerance (the run is then farther from
-the neutralised engine than the gate); a run that did not complete is rejected. The gates are held at the harness's
-configuration: a default that changes the scheme the engine declares (MuJoCo's Euler
-integrator, Exudyn's solver) would otherwise be judged against the a-priori bound of its
-own, lower order, and pass while it moves the motion by far more than the harness's gate.
+the neutralised engine than the gate); a run that did not complete is rejected. The gates
+are held at the harness's configuration: a default that changes the scheme the engine
+declares (MuJoCo's Euler integrator, Exudyn's solver) would otherwise be judged against
+the a-priori bound of its own, lower order, and pass while it moves the motion by far more
+than the harness's gate.
 
 For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found
 assuming rejection is monotone in eps (a larger error is rejected whenever a smaller one
 is): the grid's ends first (the largest eps not rejected: none is; the smallest rejected:
 it is the answer), then bisection between them: one run where no gate catches the
-largest error, two where one catches the smallest, at most five. `ErrorPower.monotone` records whether the runs
-made agree with the assumption. Next to it,
+largest error, two where one catches the smallest, at most five. `ErrorPower.monotone`
+records whether the runs made agree with the assumption. Next to it,
 the change that a 1 % error (`PROBE`) makes in the exact model (reference with the mutated
 parameter against the true one: the first scenario's trajectory and actuator forces, and
 the modes' frequencies) is set against the gate of each of those quantities, so that an
@@ -100,6 +101,9 @@ EFFECT_PREFIXES = ("frequency.", "damping.")
 #: gate; moves one beyond its gate and is not caught (a defect of the gates)
 REJECTED, NO_EFFECT, BELOW_GATES, NOT_REJECTED = (
     "rejected", "no effect", "below the gates", "not rejected")
+#: a default that moves the motion beyond the gate toward the reference: the metric
+#: judging what it moves has a smaller error with it (nothing for a gate to reject)
+CLOSER = "closer to the reference"
 
 
 @dataclass
@@ -244,8 +248,10 @@ def largest_change(baseline: Comparison, run: Comparison, scenarios: Mapping[str
 def classify_default(d: DefaultPower, baseline: Comparison) -> None:
     """`d.acts`, `d.verdict` and `d.why` from its reading (in place): rejected; no effect
     (no metric moved); below the gates (its largest change against a gate is within it);
-    not rejected (a judged quantity moved beyond its gate and no gate caught it: the
-    metric that judges it, named, and its status in the baseline)."""
+    closer to the reference (the quantity it moves most beyond its gate is judged with a
+    smaller error with it); not rejected (a judged quantity moved beyond its gate, away
+    from the reference or unjudged, and no gate caught it: the metric that judges it,
+    named, and its status in the baseline)."""
     c = d.change
     d.acts = bool(c and c["ratio"] > 1.0) or bool(d.incidents)
     if d.rejected:
@@ -259,9 +265,17 @@ def classify_default(d: DefaultPower, baseline: Comparison) -> None:
         d.why = (f"largest change {c['change']:.3g} of {c['quantity']}, within its gate "
                  f"{c['gate']:.3g}" if c else "nothing measured beyond a gate")
     else:
-        d.verdict = NOT_REJECTED
-        d.why = f"{c['quantity']} changes by {c['change']:.3g} against a gate of {c['gate']:.3g}, " + (
-            _why_not_caught(c["quantity"], baseline))
+        name = (c["quantity"][:-len(".motion")] + ".trajectory_max"
+                if c["quantity"].endswith(".motion") else c["quantity"])
+        judged = d.effect.get(name)
+        moved = f"{c['quantity']} changes by {c['change']:.3g} against a gate of {c['gate']:.3g}"
+        if judged is not None and judged["switched_on"] < judged["neutralised"]:
+            d.verdict = CLOSER
+            d.why = (f"{moved}, toward the reference: {name} {judged['neutralised']:.3g} "
+                     f"without it, {judged['switched_on']:.3g} with it")
+        else:
+            d.verdict = NOT_REJECTED
+            d.why = f"{moved}, {_why_not_caught(c['quantity'], baseline)}"
 
 
 def _why_not_caught(quantity: str, baseline: Comparison) -> str:
@@ -527,8 +541,9 @@ def summary_of(entries: list[dict]) -> dict:
     rejected not even at the largest eps counts as above the grid; how many systems, how
     many of them rejected nothing, and at eps = PROBE how many rejected, below the gates
     and not rejected (named: the blind spots). Per engine, the defaults switched on alone:
-    how many act (beyond a gate), how many of those were rejected, the acting ones not
-    rejected (blind spots), and how many moved within the gates."""
+    how many act (beyond a gate), how many of those were rejected, those not rejected
+    (blind spots), those that move the engine closer to the reference, and those that move
+    it within the gates."""
     out: dict = {}
     for sim in dict.fromkeys(e["simulator"] for e in entries):
         mine = [e for e in entries if e["simulator"] == sim and e["supported"]]
@@ -553,7 +568,9 @@ def summary_of(entries: list[dict]) -> dict:
         row["defaults"] = {"acting": len(acting),
                            "rejected": sum(d["rejected"] for _, d in acting),
                            "not_rejected": [f"{s}:{d['setting']}" for s, d in acting
-                                            if not d["rejected"]],
+                                            if d.get("verdict") == NOT_REJECTED],
+                           "closer_to_reference": [f"{s}:{d['setting']}" for s, d in acting
+                                                   if d.get("verdict") == CLOSER],
                            "below_gates": [f"{s}:{d['setting']}" for s, d in alone
                                            if d.get("verdict") == BELOW_GATES]}
         out[sim] = row

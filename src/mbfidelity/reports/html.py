@@ -229,9 +229,8 @@ def _out_of_the_box_rows(out: Path) -> dict[str, list[dict]]:
                 else json.dumps(d["engine_value"]),
                 "harness_value": "" if d.get("harness_value") is None
                 else json.dumps(d["harness_value"]),
-                "verdict": verdict, "cls": {"rejected": "fail", "passes": "pass", "below the gates": "pass",
-                        "not rejected": "pass"}.get(
-                    verdict, "unsupported"),
+                "verdict": verdict, "cls": {"rejected": "fail", "passes": "pass"}.get(
+                    verdict, "pass" if d["acts"] or d.get("moved") else "unsupported"),
                 "rejected_by": ", ".join(d.get("rejected_by", [])),
                 "incidents": [i["outcome"] for i in d.get("incidents", [])],
                 "motion": ({"error": motion["error"]} if "error" in motion else {

@@ -31,23 +31,26 @@ POWER_TEMPLATE = _ENV.from_string("""<!doctype html><html><head><meta charset="u
 system x engine entries, {{ doc.cost.comparisons }} comparisons, {{ "%.0f"|format(doc.cost.wall_time_s) }} s of wall time
 on {{ doc.cost.workers }} worker processes.{% endif %} One parameter of each kind is
 multiplied by (1 + eps) in the engine's build only (the reference keeps the true value);
-eps on the decade grid {{ doc.epsilons|map("eps")|join(", ") }}, searched by bisection
-assuming a larger error is rejected whenever a smaller one is (checked at the grid's top:
-a cell marked "not monotone" breaks it). Each run is the system's first scenario and the
+eps on the decade grid {{ doc.epsilons|map("eps")|join(", ") }}, searched at the grid's
+ends first and by bisection between them, assuming a larger error is rejected whenever a
+smaller one is (a cell marked "not monotone" has runs that break it). Each run is the system's first scenario and the
 frequency checks (a default's: every declared scenario). A run is rejected when a metric
 that holds in the neutralised run fails, or exceeds that run's tolerance (the gates are
-held at the harness's configuration). A cell gives the smallest rejected eps and the
+held at the harness's configuration), or when a metric the neutralised run fails by
+declaration exceeds its value there by more than the tolerance (marked "beyond the
+baseline's error"). A cell gives the smallest rejected eps and the
 parameter. At a {{ doc.probe|eps }} error each kind is classified: rejected; below the
 gates (grey: the exact model's change of each judged quantity, trajectory, actuator force
 and frequency, is within its gate, so no sound gate could reject it); not rejected (yellow:
 a judged quantity moves beyond its gate and no gate catches it, a defect). A default
 switched on is classified the same way from the engine's runs with and without it: it
-acts when it moves a judged quantity by more than its gate.</p>
+acts when it moves a judged quantity by more than its gate; one that moves it toward the
+reference (a smaller error with it) is "closer to the reference".</p>
 <h2>Summary: median smallest rejected eps</h2>
 <table><tr><th>engine</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults that act: rejected</th></tr>
 {% for sim, row in doc.summary.items() %}<tr><td>{{ sim }}</td>
 {% for k in kinds %}<td>{{ row[k].median_smallest_rejected|eps }} <small>({{ row[k].systems }} systems{% if row[k].not_rejected_at_largest %}, {{ row[k].not_rejected_at_largest }} not rejected at {{ doc.epsilons[-1]|eps }}{% endif %}{% if row[k].at_probe %}; at {{ doc.probe|eps }}: {{ row[k].at_probe['rejected'] }} rejected, {{ row[k].at_probe['below the gates'] }} below the gates{% if row[k].at_probe['not rejected'] %}, <b>{{ row[k].at_probe['not rejected'] }} not rejected</b>{% endif %}{% endif %})</small></td>{% endfor %}
-<td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}{% if row.defaults.not_rejected %} <small><b>not rejected: {{ row.defaults.not_rejected|join(', ') }}</b></small>{% endif %}{% if row.defaults.below_gates %} <small>({{ row.defaults.below_gates|length }} below the gates)</small>{% endif %}</td></tr>{% endfor %}</table>
+<td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}{% if row.defaults.not_rejected %} <small><b>not rejected: {{ row.defaults.not_rejected|join(', ') }}</b></small>{% endif %}{% if row.defaults.closer_to_reference %} <small>closer to the reference: {{ row.defaults.closer_to_reference|join(', ') }}</small>{% endif %}{% if row.defaults.below_gates %} <small>({{ row.defaults.below_gates|length }} below the gates)</small>{% endif %}</td></tr>{% endfor %}</table>
 <h2>Per system and engine</h2>
 <table><tr><th>system</th><th>engine</th><th>baseline</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults switched on</th></tr>
 {% for e in doc.entries %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td>
