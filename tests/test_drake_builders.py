@@ -5,7 +5,8 @@ elements, and a builder that builds nothing is caught."""
 import numpy as np
 import pytest
 
-from mbfidelity.simulators.plan import (COORDINATE_FORCE_LINEAR, ELEMENT_KINDS, LINEAR_COUPLING, POINT_ON_LINE,
+from mbfidelity.simulators.plan import (COORDINATE_FORCE_LINEAR, ELEMENT_KINDS, HINGE_CLOSURE,
+                                        LINEAR_COUPLING, POINT_ON_LINE,
                                         POINT_ON_POINT, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
                                         element_kind, elements, num)
 from mbfidelity.systems import all_systems, get_system
@@ -65,8 +66,8 @@ def test_every_element_kind_has_one_builder_with_its_declaration():
 def test_every_supported_mechanism_builds_and_holds_its_elements():
     """Over the catalog and its variants, every mechanism Drake supports builds (default
     settings) and its build with every law in the Python force system holds each element;
-    between them every element kind but the unsupported rolling contact is built, on both
-    the continuous and the discrete plant."""
+    between them every element kind but the unsupported rolling contact and hinge closure
+    is built, on both the continuous and the discrete plant."""
     kinds, plants = set(), set()
     for label, mech in _mechanisms():
         if not BACKEND.support(mech).ok:
@@ -75,7 +76,7 @@ def test_every_supported_mechanism_builds_and_holds_its_elements():
         plants.add(built.plant.time_step() > 0)
         assert _missing(mech) == [], label
         kinds |= {kind for kind, _ in elements(mech)}
-    assert kinds == set(ELEMENT_KINDS) - {ROLLING_CONTACT} and plants == {True, False}
+    assert kinds == set(ELEMENT_KINDS) - {ROLLING_CONTACT, HINGE_CLOSURE} and plants == {True, False}
 
 
 #: one mechanism per element kind that holds it
@@ -91,7 +92,7 @@ COVERING = {"body": "compound_pendulum", "massless body": "elastic_pendulum",
 
 @pytest.mark.parametrize("kind", sorted(COVERING))
 def test_a_builder_that_builds_nothing_is_caught(kind, monkeypatch):
-    assert set(COVERING) == set(ELEMENT_KINDS) - {ROLLING_CONTACT}  # all Drake builds
+    assert set(COVERING) == set(ELEMENT_KINDS) - {ROLLING_CONTACT, HINGE_CLOSURE}  # all Drake builds
     system = get_system(COVERING[kind])
     mech = system.numeric_mechanism(system.parameter_values())
     assert kind in {k for k, _ in elements(mech)} and _missing(mech) == []

@@ -110,6 +110,7 @@ from .plan import (
     POINT_TO_POINT_CUSTOM,
     POINT_TO_POINT_LINEAR,
     PRESCRIBED,
+    HINGE_CLOSURE,
     PRISMATIC,
     REVOLUTE,
     ROLLING_CONTACT,
@@ -550,6 +551,12 @@ def _rolling_contact(build: _Built, c) -> None:
 def _prescribed(build: _Built, p) -> None:
     # nothing in the plant: the LeafSystem imposes it
     build.driven += [m for m in motions(build.mech) if m.element is p]
+
+
+@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "the build is planar: a spatial closed loop "
+                                                "has no constraint in it"))
+def _hinge_closure(build: _Built, c) -> None:
+    raise ValueError(f"drake builds no hinge closure ({c.name}): support() refuses it")
 
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order

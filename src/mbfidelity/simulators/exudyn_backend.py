@@ -79,7 +79,7 @@ from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backe
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, LINEAR_COUPLING,
                    MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT, POINT_TO_POINT_CUSTOM,
                    POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
-                   TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
+                   HINGE_CLOSURE, TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
                    constrained_bodies, coordinate_map, driven_start, element_kind,
                    massive_below, num, rot, spatial_tree_reason)
 from .reactions import joint_reactions, subtree_force
@@ -722,6 +722,8 @@ class ExudynBackend(Backend):
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
                                                   "Exudyn holds the rolling coupling exactly "
                                                   "(LinearCoupling)"),),
+        HINGE_CLOSURE: (Expression(UNSUPPORTED, "the spatial tree closes no loop: a spatial "
+                                                "closed loop has no constraint in it"),),
     }
 
     SPATIAL_REASON = ""

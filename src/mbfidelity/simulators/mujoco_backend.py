@@ -113,8 +113,10 @@ class _Compiled:
         self.slider_vadr = np.array([m.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
         self.slider_body = np.array([m.body(cl.slider).id for cl in sliders], dtype=int)
         self.slider_sites = [(m.site(cl.site1).id, m.site(cl.site2).id) for cl in sliders]
-        self.eq_id = [m.equality(cl.element.name).id if cl.kind != "contact" else -1
-                      for cl in build.closures]
+        #: each closure's equalities (a hinge closure has two connects)
+        self.eq_id = [[m.equality(cl.element.name).id]
+                      + ([m.equality(f"{cl.element.name}:axis").id] if cl.kind == "hinge" else [])
+                      if cl.kind != "contact" else [] for cl in build.closures]
         contacts = [cl for cl in build.closures if cl.kind == "contact"]
         self.radial_qadr = np.array([m.joint(cl.slider).qposadr[0] for cl in contacts], dtype=int)
         self.radial_vadr = np.array([m.joint(cl.slider).dofadr[0] for cl in contacts], dtype=int)
@@ -371,8 +373,9 @@ class _Compiled:
 
 class _ClosureSamples:
     """Each closure's force in the contract's physical terms and its violation
-    (PointOnPoint: distance of the two points, m; PointOnLine: signed distance of the pin
-    from the slot line, m; LinearCoupling: Phi) over the sampled states. `record(k)`,
+    (PointOnPoint: distance of the two points, m; HingeClosure: the larger distance of its
+    two connects' points, m, its force NaN; PointOnLine: signed distance of the pin from
+    the slot line, m; LinearCoupling: Phi) over the sampled states. `record(k)`,
     after mj_forward at sample k, copies what the closures need (their equality rows'
     force and position, the sliders' acceleration and axis, the contacts' state);
     `result()` forms the physical terms over all samples at once."""
@@ -400,7 +403,7 @@ class _ClosureSamples:
         if len(eq_rows) != d.ne or not np.array_equal(eq_rows, np.arange(d.ne)):
             raise RuntimeError("mujoco: the equality rows do not come first")
         eq_ids = d.efc_id[:nefc][eq_rows]
-        self.rows = [eq_rows[eq_ids == eid] for eid in self.comp.eq_id]
+        self.rows = [eq_rows[np.isin(eq_ids, eids)] for eids in self.comp.eq_id]
         self.ne = d.ne
         self.force = np.empty((self.n, self.ne))
         self.pos = np.empty((self.n, self.ne))
@@ -439,6 +442,13 @@ class _ClosureSamples:
                 # the row's Jacobian in description coordinates is c: J^T f = c f = -c lam
                 forces[name] = f[:, :1]
                 violation[name] = pos[:, 0]
+            elif cl.kind == "hinge":
+                # the force is not determined by the motion (mujoco_mjcf's
+                # HINGE_FORCE_INDETERMINATE); the violation is the larger distance of the
+                # two connects' points (the hinge point's and the axis point's)
+                forces[name] = np.full((self.n, 3), np.nan)
+                violation[name] = np.maximum(np.linalg.norm(pos[:, :3], axis=1),
+                                             np.linalg.norm(pos[:, 3:6], axis=1))
             elif cl.kind == "connect":
                 # rows p1 - p2 (world), J = J1 - J2: f acts on body_a at site1
                 forces[name] = f[:, :2]

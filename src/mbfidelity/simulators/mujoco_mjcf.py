@@ -22,6 +22,7 @@ from ..systems.model import (
     WORLD,
     Circle,
     CoordinateForce,
+    HingeClosure,
     Mechanism,
     PointOnLine,
     PointOnPoint,
@@ -37,6 +38,7 @@ from .plan import (
     ELEMENT_KINDS,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
+    HINGE_CLOSURE,
     LINEAR_COUPLING,
     MASSLESS_BODY,
     POINT_ON_LINE,
@@ -114,7 +116,8 @@ class _Coord:
 @dataclass
 class Closure:
     """A closure constraint and its MJCF equality: ``connect`` (PointOnPoint: site1 on
-    body_a, site2 on body_b), ``slider`` (PointOnLine: a connect between the pin's site1 and
+    body_a, site2 on body_b), ``hinge`` (HingeClosure: that connect at the hinge point and
+    a second one, ``{name}:axis``, at a point on the hinge axis), ``slider`` (PointOnLine: a connect between the pin's site1 and
     the origin site2 of a slider body that slides along the slot on the slot body),
     ``tendon`` (LinearCoupling: a fixed tendon sum(w_j v_j) over the engine joint values
     held at ``offset`` by a tendon equality) or ``contact`` (RollingContact: the same
@@ -429,6 +432,51 @@ def _point_on_point(build: Build, c: PointOnPoint) -> None:
         build.sites.setdefault(body, []).append(_site(site, point))
 
 
+#: the second connect of a hinge closure sits this many times the mechanism's length
+#: scale (`_hinge_span`) along the hinge axis: the couple that keeps the axes parallel is
+#: the two connects' forces times their distance, so a span of the bodies' own size
+#: conditions its rows like the point's
+HINGE_SPAN_FACTOR = 1.0
+#: why a hinge closure's force is not reported (contract point 6: NaN)
+HINGE_FORCE_INDETERMINATE = (
+    "the hinge closure's force is not reported (NaN): a loop whose closure equations are "
+    "redundant is statically indeterminate, so the constraint force is not determined by "
+    "the motion (a self-stress of the loop can be added to it without changing any "
+    "acceleration); the reference reports the least-norm multipliers and MuJoCo's soft "
+    "equalities a split of their own, neither of them the mechanism's")
+
+
+def _hinge_span(mech: Mechanism) -> float:
+    """A length of the mechanism's own size: the largest distance of a joint anchor or a
+    closure point from its body's frame (the bodies' half-lengths)."""
+    points = [a for j in mech.joints for a in (j.parent_anchor, j.child_anchor)]
+    points += [p for c in mech.constraints if isinstance(c, HingeClosure)
+               for p in (c.point_a, c.point_b)]
+    return max((math.sqrt(sum(num(v) ** 2 for v in p)) for p in points), default=1.0) or 1.0
+
+
+@_builds(HINGE_CLOSURE, Expression(SOFT, "two connect equalities, one at the hinge point and "
+                                         "one at a point on the hinge axis (axis_a on body_a "
+                                         "and axis_b on body_b, taken pointing the same way): "
+                                         "together they hold the point and the axis's "
+                                         "direction (six rows, one of them, the axial "
+                                         "distance, implied by the others; a loop's redundant "
+                                         "equations more), which soft equalities tolerate "
+                                         "(their regularisation splits the force among "
+                                         "dependent rows). " + HINGE_FORCE_INDETERMINATE,
+                                   expected_failures=SOFT_EQUALITY_METRICS,
+                                   reason=SOFT_EQUALITY))
+def _hinge_closure(build: Build, c: HingeClosure) -> None:
+    span = HINGE_SPAN_FACTOR * _hinge_span(build.mech)
+    build.closures.append(Closure(c, "hinge", f"{c.name}:a", f"{c.name}:b"))
+    for tag, body, point, axis in (("a", c.body_a, c.point_a, c.axis_a),
+                                   ("b", c.body_b, c.point_b, c.axis_b)):
+        p, n = (np.array([num(v) for v in x], dtype=float) for x in (point, axis))
+        build.sites.setdefault(body, []).extend([
+            f'<site name="{c.name}:{tag}" pos="{fmt(*p)}"/>',
+            f'<site name="{c.name}:axis:{tag}" pos="{fmt(*(p + span * n / np.linalg.norm(n)))}"/>'])
+
+
 def _slider_masses(build: Build, pin_body: str) -> None:
     """The sliders' masses of the slots whose pin is on `pin_body`. The slider follows the
     pin point, so its mass is taken out of the pin body (mass, centre of mass and inertia
@@ -610,11 +658,12 @@ def _shape_geom(shape) -> str:
 
 
 def _segment_geom(shape: Segment) -> str:
-    a, b = [num(v) for v in shape.a], [num(v) for v in shape.b]
+    # a spatial segment has three-component ends; a planar one lies at z = 0
+    a, b = ([num(v) for v in end] + [0.0] * (3 - len(end)) for end in (shape.a, shape.b))
     r = num(shape.width) / 2
     if a == b:
-        return f'<geom type="sphere" size="{fmt(r)}" pos="{fmt(a[0], a[1], 0)}"/>'
-    return f'<geom type="capsule" size="{fmt(r)}" fromto="{fmt(a[0], a[1], 0, b[0], b[1], 0)}"/>'
+        return f'<geom type="sphere" size="{fmt(r)}" pos="{fmt(*a)}"/>'
+    return f'<geom type="capsule" size="{fmt(r)}" fromto="{fmt(*a, *b)}"/>'
 
 
 def _rectangle_geom(shape: Rectangle) -> str:
@@ -715,6 +764,9 @@ def mjcf(build: Build) -> str:
                        f'polycoef="{fmt(cl.offset, 0, 0, 0, 0)}"{soft}/>' if cl.kind == "tendon"
                        else f'    <connect name="{name}" site1="{cl.site1}" '
                             f'site2="{cl.site2}"{soft}/>')
+            if cl.kind == "hinge":
+                out.append(f'    <connect name="{name}:axis" site1="{name}:axis:a" '
+                           f'site2="{name}:axis:b"{soft}/>')
         out.append("  </equality>")
     out.append("</mujoco>")
     return "\n".join(out) + "\n"

@@ -105,12 +105,13 @@ POINT_ON_LINE = "PointOnLine"
 LINEAR_COUPLING = "LinearCoupling"
 ROLLING_CONTACT = "RollingContact"
 PRESCRIBED = "Prescribed"
+HINGE_CLOSURE = "HingeClosure"
 
 #: every kind of element a description holds, in the order backends declare them
 ELEMENT_KINDS = (BODY, MASSLESS_BODY, REVOLUTE, PRISMATIC, POINT_TO_POINT_LINEAR,
                  POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR, COORDINATE_FORCE_CUSTOM,
                  TIME_LOAD, POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING, ROLLING_CONTACT,
-                 PRESCRIBED)
+                 PRESCRIBED, HINGE_CLOSURE)
 
 
 @singledispatch
@@ -167,6 +168,11 @@ def _(element: RollingContact) -> str:
 @element_kind.register
 def _(element: Prescribed) -> str:
     return PRESCRIBED
+
+
+@element_kind.register
+def _(element: HingeClosure) -> str:
+    return HINGE_CLOSURE
 
 
 def rigid_body(mech: Mechanism, body: Body) -> bool:
@@ -563,13 +569,10 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str
     """Why an engine's spatial build (model convention 10) cannot hold a spatial
     mechanism, empty when it can: every such build takes relative, counter-clockwise
     hinges without an angle offset, folds no massless body and has no point-to-point
-    element; `closures` and `slides` say whether it takes closure constraints and
-    prismatic joints."""
+    element; `closures` and `slides` say whether it takes closure constraints (a
+    spatial mechanism's are hinge closures) and prismatic joints."""
     if mech.constraints and not closures:
         return "closure constraints in a spatial mechanism"
-    if any(isinstance(c, HingeClosure) for c in mech.constraints):
-        return ("a hinge closure (a spatial closed loop): the spatial build closes no loop "
-                "by a hinge")
     for j in mech.joints:
         if isinstance(j, Prismatic) and not slides:
             return f"joint {j.name}: the spatial build has hinges only"

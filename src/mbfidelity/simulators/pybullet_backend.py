@@ -127,6 +127,7 @@ from .base import (
 )
 from .reactions import joint_reactions
 from .plan import (
+    HINGE_CLOSURE,
     CoordinateLaws,
     Motion,
     spatial_tree_reason,
@@ -908,6 +909,12 @@ def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray
                                  "it", when="otherwise"))
 def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
     model.driven.append(Motion(prescribed, model.mech.coordinates.index(prescribed.coordinate)))
+
+
+@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "the spatial build closes no loop: a spatial "
+                                                "closed loop has no constraint in it"))
+def _hinge_closure(model: _Translation, c) -> None:
+    raise ValueError(f"pybullet builds no hinge closure ({c.name}): support() refuses it")
 
 
 @dataclass

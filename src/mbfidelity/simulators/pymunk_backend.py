@@ -134,6 +134,7 @@ from .base import (
 )
 from .plan import (
     BODY,
+    HINGE_CLOSURE,
     PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
@@ -1436,6 +1437,8 @@ class PymunkBackend(Backend):
                                        "on the child subtree) converge at first order, the "
                                        "scheme's (setting prescribed_motion). Refused "
                                        "(support) on a joint with a massless body"),),
+        HINGE_CLOSURE: (Expression(UNSUPPORTED, "Pymunk is a planar (2-D) engine: a spatial "
+                                                "closed loop has no expression in it"),),
     }
 
     SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
