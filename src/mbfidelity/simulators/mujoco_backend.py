@@ -24,7 +24,10 @@ the builders add MJCF fragments to a `Build`, which is assembled into the MJCF t
   clamps the impedance at 0.9999, so each row transmits at most 99.99 % of the needed
   force at once and a small violation makes up the rest). Each closure's force (contract
   point 6) and violation are read after ``mj_forward`` at every sample; the violation is
-  returned as ``RunResult.constraint_violation``.
+  returned as ``RunResult.constraint_violation``. A spatial loop's hinge closure is two
+  ``connect`` equalities on the hinge axis (the point and the axis's direction); its
+  force is reported as NaN (a loop with redundant closure equations is statically
+  indeterminate: the force is not determined by the motion).
 - ``Prescribed`` coordinates (setting ``prescribed_motion``): a control callback
   (``mujoco.set_mjcb_control``, installed with the passive callback and restored after,
   both being process-global) imposes the acceleration (`_Compiled._make_control`). Joint

@@ -434,8 +434,9 @@ def _point_on_point(build: Build, c: PointOnPoint) -> None:
 
 #: the second connect of a hinge closure sits this many times the mechanism's length
 #: scale (`_hinge_span`) along the hinge axis: the couple that keeps the axes parallel is
-#: the two connects' forces times their distance, so a span of the bodies' own size
-#: conditions its rows like the point's
+#: the two connects' forces times their distance, so a span much shorter than the bodies
+#: softens the axis's rows (a given violation of the points is a larger tilt); a span of
+#: the bodies' own size conditions them like the point's
 HINGE_SPAN_FACTOR = 1.0
 #: why a hinge closure's force is not reported (contract point 6: NaN)
 HINGE_FORCE_INDETERMINATE = (
