@@ -48,7 +48,7 @@ about its length and m (L^2 + a^2) / 12 across it.
 """
 import sympy as sp
 
-from .. import BenchmarkError, PointOutput, Published, System
+from .. import BenchmarkError, Expectation, PointOutput, Published, System
 from ..model import Body, HingeClosure, Mechanism, Parameter, Revolute, Scenario, Segment
 
 SOURCE = ("IFToMM benchmark A04 (González et al., Multibody System Dynamics 16, 2006); "
@@ -107,6 +107,15 @@ def published(P):
                            "value at the release"),)
 
 
+#: why the closing hinge's force cannot be judged on an engine that reports it NaN
+STATICALLY_INDETERMINATE = (
+    "the closing hinge's force is not determined by the motion: one of the loop's closure "
+    "equations follows from the others, so a self-stress of the loop can be added to the "
+    "force without changing any acceleration (the reference reports the least-norm "
+    "multipliers, a choice); MuJoCo's soft equalities split it by their regularisation, "
+    "so it reports the force as NaN")
+
+
 #: the specification's measure of a solution's error: its reference solution is the time
 #: history of P3's position; every sample of the run counts here
 ERROR = BenchmarkError(
@@ -128,6 +137,7 @@ SYSTEM = System(
     ),
     published=published,
     benchmark_error=ERROR,
+    expectations=(Expectation("mujoco", "*.constraint_O6", "xfail", STATICALLY_INDETERMINATE),),
     points=lambda P: (PointOutput("P3", "rod2", (0, -P.L / 2, 0),
                                   "the hinge of rods 2 and 3: the published trajectory"),),
 )
