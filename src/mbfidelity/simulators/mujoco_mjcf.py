@@ -117,8 +117,9 @@ class _Coord:
 class Closure:
     """A closure constraint and its MJCF equality: ``connect`` (PointOnPoint: site1 on
     body_a, site2 on body_b), ``hinge`` (HingeClosure: that connect at the hinge point and
-    a second one, ``{name}:axis``, at a point on the hinge axis), ``slider`` (PointOnLine: a connect between the pin's site1 and
-    the origin site2 of a slider body that slides along the slot on the slot body),
+    a second one, ``{name}:axis``, at a point on the hinge axis), ``slider`` (PointOnLine:
+    a connect between the pin's site1 and the origin site2 of a slider body that slides
+    along the slot on the slot body),
     ``tendon`` (LinearCoupling: a fixed tendon sum(w_j v_j) over the engine joint values
     held at ``offset`` by a tendon equality) or ``contact`` (RollingContact: the same
     weights, no equality)."""
@@ -449,7 +450,7 @@ HINGE_FORCE_INDETERMINATE = (
 
 def _hinge_span(mech: Mechanism) -> float:
     """A length of the mechanism's own size: the largest distance of a joint anchor or a
-    closure point from its body's frame (the bodies' half-lengths)."""
+    hinge closure's point from the frame it is given in."""
     points = [a for j in mech.joints for a in (j.parent_anchor, j.child_anchor)]
     points += [p for c in mech.constraints if isinstance(c, HingeClosure)
                for p in (c.point_a, c.point_b)]
