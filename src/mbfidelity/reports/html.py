@@ -67,6 +67,36 @@ def _cell(c) -> dict:
     return {"cls": worst, "text": ", ".join(counts)}
 
 
+#: the order in which the summary counts metrics by verdict
+VERDICT_ORDER = ("pass", "fail", "xfail", "xpass", "unresolved", "measured")
+
+
+def verdict_summary(results) -> dict:
+    """The metrics of the run counted by verdict: in all ("total", "counts"), per engine
+    ("engines": simulator -> verdict -> count), and the unresolved ones (their share of
+    all metrics, and how many of them are declared with their reason)."""
+    counts: dict[str, int] = {}
+    engines: dict[str, dict[str, int]] = {}
+    unresolved = declared = 0
+    for c in results:
+        mine = engines.setdefault(c.simulator, {})
+        for m in c.metrics:
+            counts[m.status] = counts.get(m.status, 0) + 1
+            mine[m.status] = mine.get(m.status, 0) + 1
+            if m.status == "unresolved":
+                unresolved += 1
+                declared += bool(m.expected)
+
+    def ordered(found: dict[str, int]) -> dict[str, int]:
+        return {s: found[s] for s in sorted(found, key=lambda s: (
+            VERDICT_ORDER.index(s) if s in VERDICT_ORDER else len(VERDICT_ORDER), s))}
+    total = sum(counts.values())
+    return {"total": total, "counts": ordered(counts),
+            "engines": {sim: ordered(found) for sim, found in engines.items()},
+            "unresolved": unresolved, "declared": declared,
+            "unresolved_share": unresolved / total if total else 0.0}
+
+
 #: points per line in the figures: a 10 in, 80 dpi axis is 800 pixels wide, so a line of
 #: 10^4 samples is drawn as its envelope over 2 x ENVELOPE_BINS points (see `_envelope`)
 ENVELOPE_BINS = 1000
@@ -191,6 +221,7 @@ def write_report(out: Path, workers: int | None = None) -> Path:
         pages={r: site.page_name(base_id(r)) for r in rows},
         anchors={r: site.anchor(r) for r in rows}, titles={r: _title(r) for r in rows},
         others=others, explanations=EXPLANATIONS, incidents=incidents,
+        summary=verdict_summary(results),
         figures=[(name, caption) for name, caption in site.INDEX_FIGURES
                  if (out / name).exists()], strutt_engines=_strutt_engines(out),
         discretizations=sorted(p.name for p in out.glob("discretization-*.png")))

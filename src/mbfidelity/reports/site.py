@@ -68,6 +68,11 @@ for trajectories, and for semi-implicit Euler (w h) + (w h)^2 (1 + w T) + zeta (
 worst one (pass, xfail: an expected failure declared with its physical reason, measured: not
 gated, fail).</p>
 <h2>The matrix</h2>
+<p id="verdicts">{{ summary.total }} metrics: {% for verdict, n in summary.counts.items() %}{{ n }} {{ verdict }}{% if not loop.last %}, {% endif %}{% endfor %}.
+Unresolved: {{ summary.unresolved }} ({{ "%.2f"|format(100 * summary.unresolved_share) }} % of the metrics), {{ summary.declared }} of them declared with their reason.</p>
+<table><tr><th>engine</th>{% for verdict in summary.counts %}<th>{{ verdict }}</th>{% endfor %}</tr>
+{% for sim, found in summary.engines.items() %}<tr><td>{{ sim|e }}</td>{% for verdict in summary.counts %}<td>{{ found.get(verdict, 0) }}</td>{% endfor %}</tr>{% endfor %}
+</table>
 <table><tr><th>mechanism</th>{% for sim in sims %}<th>{{ sim }}</th>{% endfor %}</tr>
 {% for row in rows %}<tr><td><a href="{{ pages[row]|url }}">{{ row|e }}</a><br><small>{{ titles[row]|e }}</small></td>
 {% for sim in sims %}{% set c = cells[row].get(sim) %}{% if c %}<td class="{{ c.cls }}"><a href="{{ pages[row]|url }}#{{ anchors[row] }}">{{ c.text|e }}</a></td>{% else %}<td class="unsupported">-</td>{% endif %}{% endfor %}</tr>{% endfor %}
