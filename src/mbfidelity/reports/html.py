@@ -6,9 +6,11 @@ expected failures."""
 from __future__ import annotations
 
 import fnmatch
+import hashlib
 import json
 import os
 from concurrent.futures import ProcessPoolExecutor
+from functools import lru_cache
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -20,6 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Circle as CirclePatch  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
 
+from ..comparisons import file_cache  # noqa: E402
 from ..comparisons.results_folder import (base_id, load_animation, load_deviations,  # noqa: E402
                                           load_errata, load_results, load_series,
                                           load_system, row_id, rows_of, series_path)
@@ -366,9 +369,23 @@ def _figure_incident(rows: dict[str, list], row: str, exc: BaseException) -> Non
                             "message": f"{type(exc).__name__}: {exc}"[:500]})
 
 
+@lru_cache(maxsize=None)
+def _drawing_code() -> bytes:
+    """The digest of the code that draws the figures (file_cache): every module of
+    `reports/`, and the Matplotlib and NumPy versions."""
+    h = hashlib.sha256(f"matplotlib {matplotlib.__version__}|numpy {np.__version__}".encode())
+    for path in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.digest()
+
+
 def _draw_saved(out: Path, system_id: str) -> list[str]:
     try:
-        return [draw_mechanism(load_system(out, system_id)["drawing"], out)]
+        drawing = load_system(out, system_id)["drawing"]
+        # the same geometry draws the same file: kept in the cache (file_cache)
+        return file_cache.made("drawing", drawing, _drawing_code(), out,
+                               lambda: [draw_mechanism(drawing, out)])
     except Exception as exc:  # shown as an incident by the caller
         return [f"!{type(exc).__name__}: {exc}"]
 
@@ -378,7 +395,13 @@ def _plot_saved(out: Path, row: str, comps) -> list[str]:
         series = load_series(out, row)
         for c in comps:
             c.series = series.get(c.simulator, {})
-        return _figures(row, comps, out)
+        system = get_system(base_id(row))
+        # what `_figures` draws from, alone: the same inputs draw the same files, kept in
+        # the cache (file_cache)
+        inputs = (row, [c.simulator for c in comps], series, tuple(system.coordinates),
+                  tuple(system.mechanism.driven_coordinates))
+        return file_cache.made("plots", inputs, _drawing_code(), out,
+                               lambda: _figures(row, comps, out))
     except Exception as exc:  # one row's figures fail; the report stands
         return [f"!{type(exc).__name__}: {exc}"]
 
