@@ -156,12 +156,13 @@ def published(P):
 
 #: why no gate can judge the engines at the default step (1 ms)
 _UNRESOLVED = (
-    "At the default step the published run is only a few dozen steps long while the crank "
-    "turns more than twice, and the stiff spring's mode about the equilibrium lies beyond "
-    "the range of w h where a fixed-step scheme's error bound holds: no bound says "
-    "anything there, and the run is too short for the engine's own refinement to reach its "
-    "asymptotic regime (the benchmark asks for steps well below the default); the engines "
-    "are judged at the steps of the convergence study")
+    "At the default step every run of this mechanism is only a few dozen steps long: the "
+    "published one, in which the crank turns more than twice, and the releases near the "
+    "other stable equilibria, which last as long; the stiff spring's mode about the "
+    "equilibrium lies beyond the range of w h where a fixed-step scheme's error bound "
+    "holds, so no bound says anything there, and the runs are too short for the engine's "
+    "own refinement to reach its asymptotic regime (the benchmark asks for steps well "
+    "below the default); the engines are judged at the steps of the convergence study")
 
 #: the error as the test set measures a solver's accuracy: at the end of the run
 #: (t = 0.03 s, where it publishes the solution), on the seven angles; here the largest
