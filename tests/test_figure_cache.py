@@ -43,12 +43,14 @@ def _pngs(out) -> dict[str, str]:
 def test_figures_come_from_the_cache_bitwise_and_only_for_the_same_inputs(tmp_path,
                                                                          monkeypatch):
     monkeypatch.setenv("MBFIDELITY_CACHE_DIR", str(tmp_path / "cache"))
+    # the frames are another test's (they need the derivation: seconds in an empty cache)
+    monkeypatch.setattr(results_folder, "save_animation", lambda out, row: None)
     out = tmp_path / "results"
     _save(out, _comparisons())
     html.write_report(out, workers=1)
     drawn = _pngs(out)
     assert f"{ROW}-small.png" in drawn
-    assert list((tmp_path / "cache").glob("report-figures/plots-*.figures"))
+    assert list((tmp_path / "cache").glob("report-files/plots-*.figures"))
 
     # the same inputs: the files come from the cache, the drawing is not called
     calls = []
@@ -83,3 +85,29 @@ def test_inputs_are_named_exactly():
     assert names == [entry_name("plots", v, b"code") for v in values]
     assert entry_name("drawing", values[0], b"code") != names[0]
     assert entry_name("plots", values[0], b"other code") != names[0]
+
+
+def test_animation_frames_come_from_the_cache_bitwise(tmp_path, monkeypatch):
+    monkeypatch.setenv("MBFIDELITY_CACHE_DIR", str(tmp_path / "cache"))
+    out = tmp_path / "results"
+    _save(out, _comparisons())
+    path = results_folder.animation_path(out, ROW)
+    frames = path.read_bytes()
+    assert b'"scenarios"' in frames
+    assert list((tmp_path / "cache").glob("report-files/animation-*.figures"))
+
+    # the same series: the frames come from the cache, the animation is not computed
+    path.unlink()
+    real = results_folder.animation
+    monkeypatch.setattr(results_folder, "animation", lambda *a: 1 / 0)
+    results_folder.save_animation(out, ROW)
+    assert path.read_bytes() == frames
+    monkeypatch.setattr(results_folder, "animation", real)
+
+    # without the cache, the same bytes; another series, other frames
+    monkeypatch.setenv("MBFIDELITY_NO_CACHE", "1")
+    results_folder.save_animation(out, ROW)
+    assert path.read_bytes() == frames
+    monkeypatch.delenv("MBFIDELITY_NO_CACHE")
+    _save(out, _comparisons(bias=0.05))
+    assert path.read_bytes() != frames

@@ -1,4 +1,4 @@
-"""Files made from saved results (the report's figures) kept in the persistent cache
+"""Files made from saved results (the report's figures, the animation frames) kept in the persistent cache
 (`analytic.cache`: its folder, its switch ``MBFIDELITY_NO_CACHE``, its checksums and
 atomic writes), named by the content they are made from.
 
@@ -7,7 +7,8 @@ the row's name, its engines in drawing order, the mechanism's coordinate names) 
 the code that makes it is kept under a name that is the digest of all of these: every
 array by its dtype, shape and bytes, every number by its type and bits, and the caller's
 digest of its code (for the figures: the source of `reports/` and the Matplotlib and
-NumPy versions). Any change to them gives another name, so an entry is never stale, and
+NumPy versions; for the animation frames: the animation module and the system's
+description and derivation). Any change to them gives another name, so an entry is never stale, and
 a file taken from the cache is the one the maker wrote, byte for byte (the maker must be
 deterministic: Matplotlib's PNG output of the same drawing is bitwise the same). An entry
 holds every file one call wrote; a call that failed is not stored.
@@ -24,7 +25,7 @@ import numpy as np
 from ..analytic import cache
 
 #: the cache folder of these files (beside the mechanisms' folders)
-FOLDER = "report-figures"
+FOLDER = "report-files"
 #: bump when the layout or the meaning of an entry changes
 FORMAT = "1"
 

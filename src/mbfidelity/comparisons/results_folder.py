@@ -27,8 +27,10 @@ A row is the system id, with the variant in brackets for a variant's comparisons
 """
 from __future__ import annotations
 
+import hashlib
 import json
 from contextlib import contextmanager
+from functools import lru_cache
 from pathlib import Path
 from typing import Iterable, Iterator
 
@@ -42,7 +44,7 @@ from ..analytic.published import compare_published
 from ..simulators import all_backends
 from ..systems import get_system
 from ..systems.model import WORLD, Circle, Rectangle, Segment
-from . import typeset
+from . import file_cache, typeset
 from .animation import animation
 from .runner import Comparison, Metric, provenance
 
@@ -117,15 +119,45 @@ def animation_path(out: Path, row: str) -> Path:
 
 def save_animation(out: Path, row: str) -> None:
     """The row's motion as drawn frames (`animation.animation`), from its saved series;
-    a mechanism whose drawing cannot follow its coordinates gets the reason instead."""
+    a mechanism whose drawing cannot follow its coordinates gets the reason instead.
+    The file is kept in the persistent cache by what it is made from (`file_cache`: the
+    row, its series, the animation code and the system's description and derivation)."""
+    path = animation_path(out, row)
     try:
-        doc = animation(base_id(row), load_series(out, row))
+        series = load_series(out, row)
     except (TypeError, ValueError, NameError, KeyError) as exc:
-        doc = {"error": f"{type(exc).__name__}: {exc}"}
-    if doc is None:
-        doc = {"error": "the variant's coordinates are not the mechanism's drawn ones"}
-    # compact: the frames are the page's largest data
-    animation_path(out, row).write_text(json.dumps(doc, separators=(",", ":")))
+        path.write_text(json.dumps({"error": f"{type(exc).__name__}: {exc}"}))
+        return
+
+    def make() -> list[str]:
+        try:
+            doc = animation(base_id(row), series)
+        except (TypeError, ValueError, NameError, KeyError) as exc:
+            doc = {"error": f"{type(exc).__name__}: {exc}"}
+        if doc is None:
+            doc = {"error": "the variant's coordinates are not the mechanism's drawn ones"}
+        # compact: the frames are the page's largest data
+        path.write_text(json.dumps(doc, separators=(",", ":")))
+        return [path.name]
+    file_cache.made("animation", (row, series), _animation_code(base_id(row)), path.parent,
+                    make)
+
+
+@lru_cache(maxsize=None)
+def _animation_code(system_id: str) -> bytes:
+    """What a system's frames depend on beside the series (file_cache): the animation
+    module, the system's description and derivation (its cache key), the analytic code
+    and the libraries that evaluate them."""
+    import scipy
+
+    from ..analytic.cache import analytic_digest
+    from ..analytic.derivation import cache_key
+    from . import animation as animation_module
+
+    h = hashlib.sha256(Path(animation_module.__file__).read_bytes())
+    h.update("|".join((cache_key(get_system(system_id)), analytic_digest(), np.__version__,
+                       sp.__version__, scipy.__version__)).encode())
+    return h.digest()
 
 
 def load_animation(out: Path, row: str) -> dict | None:
