@@ -1,6 +1,8 @@
 """Pymunk (Chipmunk 2) backend: planar rigid bodies in maximal coordinates.
 
-Translation of the description (conventions of `mbfidelity.systems.model`):
+Translation of the description (conventions of `mbfidelity.systems.model`). Each element
+kind has one builder, registered with the expressions it declares (`_builds`;
+`EXPRESSIONS` is read from that registry):
 
 * every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the
   description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
@@ -134,6 +136,7 @@ from .base import (
 )
 from .plan import (
     BODY,
+    ELEMENT_KINDS,
     HINGE_CLOSURE,
     PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
@@ -332,61 +335,6 @@ _GROOVE_LIMIT = (
     "drift, divergence for large offsets)")
 
 
-def _grooves(mech: Mechanism, folds: dict[str, _Fold],
-             skip: frozenset[int] = frozenset()) -> list[_Groove]:
-    """The GrooveJoints of the prismatic joints (except those in `skip`, joints of
-    eliminated massless groups) and of the folded links; refused when one of them would
-    not be exact in Chipmunk."""
-    out: list[_Groove] = []
-
-    def ends(j: Prismatic) -> tuple[float | None, float | None]:
-        return tuple(None if v is None else num(v) for v in j.limits)  # type: ignore[return-value]
-
-    folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
-    for j in mech.joints:
-        if not isinstance(j, Prismatic) or id(j) in folded or id(j) in skip:
-            continue
-        # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
-        # with the rotation locked the pin can be the child's centre of mass
-        base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
-        axis = _vec(j.axis)
-        if j.parent != WORLD and not _through_origin(base, axis):
-            raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
-                           f"parent's centre of mass. {_GROOVE_LIMIT}")
-        out.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *ends(j), (0.0, 0.0),
-                           num(j.angle_offset)))
-    for fold in folds.values():
-        if isinstance(fold.inner, Revolute):
-            # the link turns with its child: the pivot (a point of the parent) slides on a
-            # line of the child, base + q direction in the child's frame
-            rev, pri = fold.inner, fold.outer
-            back = rot(-num(pri.angle_offset))
-            base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
-            direction = -back @ _vec(pri.axis)
-            anchor = _vec(rev.parent_anchor)
-            slot_ok = _through_origin(base, direction)
-            pin_ok = rev.parent == WORLD or not anchor.any()
-        else:
-            # the link turns with its parent: the pin (a point of the child) slides on a
-            # line of the parent
-            pri, rev = fold.inner, fold.outer
-            base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
-                _vec(rev.parent_anchor) - _vec(pri.child_anchor))
-            direction = _vec(pri.axis)
-            anchor = _vec(rev.child_anchor)
-            slot_ok = pri.parent == WORLD or _through_origin(base, direction)
-            pin_ok = not anchor.any()
-        if not (slot_ok and pin_ok):
-            where = ("slot line off the slot body's centre of mass" if not slot_ok
-                     else "pin off the pin body's centre of mass")
-            raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
-                           f"{_GROOVE_LIMIT}")
-        out.append(_Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
-                           *ends(pri), tuple(anchor), None))
-    return out
-
-
-
 def _closure_bodies(c) -> tuple[str, ...]:
     return c.bodies if isinstance(c, (PointOnPoint, PointOnLine)) else ()
 
@@ -552,17 +500,180 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
                    "belt, rolling: a pivot at the pitch point)")
 
 
-#: closure kind -> (its builder: (plan context, constraint) -> None, refusing what it cannot
-#: build; the expressions it declares)
-_CLOSURES: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
+# --- element builders, registered per element kind with their expressions ------------------
+
+#: element kind -> (its builder, the expressions it declares: contract point 5). A body's,
+#: joint's, closure's or prescribed motion's builder takes (plan context, element) and adds
+#: its part to the layout (`_plan`), refusing (`_Refused`) what Chipmunk cannot express; a
+#: force element's takes (mechanism, element) and gives its loads as a function of the
+#: frames and t, which the compiled body forces sum (`_Compiled`).
+_ELEMENTS: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
 
 
-def _closure(kind: str, *expressions: Expression) -> Callable:
-    """Register the builder of a closure kind with the expressions it declares."""
+def _builds(kind: str, *expressions: Expression) -> Callable:
+    """Register the decorated function as the builder of `kind`, with its expressions."""
     def register(build: Callable) -> Callable:
-        _CLOSURES[kind] = (build, expressions)
+        _ELEMENTS[kind] = (build, expressions)
         return build
     return register
+
+
+def _builder(element) -> Callable:
+    return _ELEMENTS[element_kind(element)][0]
+
+
+@_builds(BODY,
+         Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
+                           "(centre of gravity at its origin), no shapes",
+                    when="mass and inertia > 0", applies=rigid_body),
+         Expression(SUBSTITUTE, "a point mass: pymunk.Body(mass, m r^2), r the setting "
+                                "point_mass_gyration. Chipmunk divides by the moment "
+                                "(its constraint solver uses the inverse moment, "
+                                "infinite at zero); the substitute changes the body's "
+                                "moment about any point by m r^2, relative (r/d)^2 at "
+                                "a distance d",
+                    when="mass > 0, inertia 0", applies=point_mass),
+         Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
+                                 "for a massless link that can be eliminated)",
+                    when="mass 0, inertia > 0"))
+def _engine_body(ctx, body) -> None:
+    """A body with mass is an engine body (a point mass gets its substitute moment,
+    `_moment`); one whose rotation is fixed gets an infinite moment: it is taken out of
+    every rotational equation, where a GearJoint holding its angle would be solved only
+    iteratively (two such bodies in a chain drift apart under a velocity-level groove
+    without error correction)."""
+    if not num(body.mass) > 0:
+        raise _Refused(f"body {body.name}: mass 0 and inertia {num(body.inertia)}; Chipmunk "
+                       "needs a mass > 0 (or both 0 for a massless link that can be "
+                       "eliminated)")
+    ctx.layout.dynamic.append(body.name)
+    if _rotation_fixed(ctx.mech, body.name):
+        ctx.layout.infinite.add(body.name)
+
+
+@_builds(MASSLESS_BODY, Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
+                                          "folded into one GrooveJoint (a revolute and a "
+                                          "prismatic joint), an arm PinJoint (revolute joints "
+                                          "at two points), or a free group whose positions "
+                                          "solve its joint equations; other shapes are "
+                                          "refused (support)"))
+def _eliminated(ctx, body) -> None:
+    """The constraint that stands for an eliminated link (`_eliminate` found its shape): a
+    folded link's GrooveJoint, an arm's PinJoint and the PivotJoints between bodies hinged
+    at the same point of it; a free group's links impose none."""
+    layout = ctx.layout
+    if body.name in layout.folds:
+        layout.grooves.append(_folded_groove(layout.folds[body.name]))
+    elif body.name in layout.links:
+        link = layout.links[body.name]
+        (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
+        for other, point in link.at_alpha[1:]:
+            layout.pivots.append((ra, other, pa, point))
+        for other, point in link.at_beta[1:]:
+            layout.pivots.append((rb, other, pb, point))
+        length = float(np.linalg.norm(np.subtract(link.beta, link.alpha)))
+        layout.pins.append((ra, rb, pa, pb, length, link.link))
+
+
+def _folded_groove(fold: _Fold) -> _Groove:
+    """The GrooveJoint of a folded link; refused when it would not be exact in Chipmunk."""
+    if isinstance(fold.inner, Revolute):
+        # the link turns with its child: the pivot (a point of the parent) slides on a
+        # line of the child, base + q direction in the child's frame
+        rev, pri = fold.inner, fold.outer
+        back = rot(-num(pri.angle_offset))
+        base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
+        direction = -back @ _vec(pri.axis)
+        anchor = _vec(rev.parent_anchor)
+        slot_ok = _through_origin(base, direction)
+        pin_ok = rev.parent == WORLD or not anchor.any()
+    else:
+        # the link turns with its parent: the pin (a point of the child) slides on a
+        # line of the parent
+        pri, rev = fold.inner, fold.outer
+        base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
+            _vec(rev.parent_anchor) - _vec(pri.child_anchor))
+        direction = _vec(pri.axis)
+        anchor = _vec(rev.child_anchor)
+        slot_ok = pri.parent == WORLD or _through_origin(base, direction)
+        pin_ok = not anchor.any()
+    if not (slot_ok and pin_ok):
+        where = ("slot line off the slot body's centre of mass" if not slot_ok
+                 else "pin off the pin body's centre of mass")
+        raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
+                       f"{_GROOVE_LIMIT}")
+    return _Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
+                   *_limits(pri), tuple(anchor), None)
+
+
+def _limits(j: Prismatic) -> tuple[float | None, float | None]:
+    return tuple(None if v is None else num(v) for v in j.limits)  # type: ignore[return-value]
+
+
+@_builds(REVOLUTE, Expression(EXACT, "PivotJoint at the two anchors"))
+def _hinge(ctx, j: Revolute) -> None:
+    if id(j) not in ctx.eliminated:
+        ctx.layout.pivots.append((j.parent, j.child, tuple(_vec(j.parent_anchor)),
+                                  tuple(_vec(j.child_anchor))))
+
+
+@_builds(PRISMATIC, Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and "
+                                      "a GearJoint locking the rotation; refused (support) "
+                                      "unless the path passes through the parent's centre "
+                                      "of mass or the parent is the world. " + _GROOVE_LIMIT))
+def _slide(ctx, j: Prismatic) -> None:
+    if id(j) in ctx.eliminated:
+        return
+    # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
+    # with the rotation locked the pin can be the child's centre of mass
+    base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
+    axis = _vec(j.axis)
+    if j.parent != WORLD and not _through_origin(base, axis):
+        raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
+                       f"parent's centre of mass. {_GROOVE_LIMIT}")
+    ctx.layout.grooves.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *_limits(j),
+                                      (0.0, 0.0), num(j.angle_offset)))
+
+
+@_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
+@_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
+@_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
+@_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
+@_builds(TIME_LOAD, Expression(EXACT, _ELEMENT_FORCE + ", at t + h"))
+def _force(mech: Mechanism, f) -> Callable[..., list[Load]]:
+    """A force element's loads on the description bodies (`plan.element_loads`)."""
+    return element_loads(mech, f)
+
+
+@_builds(PRESCRIBED, Expression(EXACT, "on the world: a Body.KINEMATIC child whose velocity "
+                                       "is set every step to (q(t + 2h) - q(t + h))/h after "
+                                       "the position update; on a free body: a constraint "
+                                       "between the two bodies whose target (a slide: "
+                                       "PivotJoint to parent_anchor + q axis; a hinge: "
+                                       "GearJoint phase) is set to q(t + 2h) with error_bias "
+                                       "0. The coordinate is on q(t) at every sample; the "
+                                       "free coordinates and the actuator force (Newton-Euler "
+                                       "on the child subtree) converge at first order, the "
+                                       "scheme's (setting prescribed_motion). Refused "
+                                       "(support) on a joint with a massless body"))
+def _drive(ctx, p) -> None:
+    """A prescribed coordinate's `_Drive`: on the world (with the default route) a
+    kinematic child, turning about its centre of gravity, which is put on the hinge; a
+    prescribed slide is held by a moving PivotJoint instead of a groove."""
+    mech, layout = ctx.mech, ctx.layout
+    index = mech.coordinates.index(p.coordinate)
+    j = mech.joints[index]
+    if not (ctx.engine_ok(j.child) and j.child != WORLD and ctx.engine_ok(j.parent)):
+        raise _Refused(f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
+                       "the constraint that imposes the motion acts between bodies with mass "
+                       "(or the world)")
+    kinematic = (ctx.cfg.get("prescribed_motion", _DRIVE_ROUTES[0]) == _DRIVE_ROUTES[0]
+                 and j.parent == WORLD)
+    layout.drives.append(_Drive(p.name, j, index, kinematic))
+    if isinstance(j, Prismatic) or kinematic:  # its joint is the drive's constraint
+        ctx.eliminated.add(id(j))
+    if kinematic and isinstance(j, Revolute) and _vec(j.child_anchor).any():
+        layout.cog[j.child] = tuple(_vec(j.child_anchor))
 
 
 def _massless_end(ctx, c, bodies) -> None:
@@ -572,14 +683,14 @@ def _massless_end(ctx, c, bodies) -> None:
                        "eliminated with it")
 
 
-@_closure(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
+@_builds(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
 def _pivot(ctx, c: PointOnPoint) -> None:
     _massless_end(ctx, c, (c.body_a, c.body_b))
     ctx.layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
                               tuple(_vec(c.point_b))))
 
 
-@_closure(
+@_builds(
     POINT_ON_LINE,
     Expression(EXACT, "GrooveJoint", when="the slot line passes through the slot body's "
                                            "centre of mass (or the slot is on the world or a "
@@ -626,7 +737,7 @@ def _slot(ctx, c: PointOnLine) -> None:
                                   tuple(anchor), None))
 
 
-@_closure(ROLLING_CONTACT, Expression(
+@_builds(ROLLING_CONTACT, Expression(
     SUBSTITUTE, "the pitch circles collide (a Circle inside a ring of contact_segments "
                 "Segments) with Coulomb friction, the carrier arm removed: what a "
                 "game-physics user would build. Measured on the disc of Fig. 39: trajectory "
@@ -640,7 +751,7 @@ def _contact(ctx, c: RollingContact) -> None:
     ctx.layout.pitches.append(value)
 
 
-@_closure(
+@_builds(
     LINEAR_COUPLING,
     Expression(EXACT, "GearJoint on the absolute angles of two bodies",
                when="two body angles",
@@ -655,6 +766,13 @@ def _gear(ctx, c: LinearCoupling) -> None:
     (ctx.layout.gears if kind == "gear" else ctx.layout.pitches).append(value)
 
 
+@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "Pymunk is a planar (2-D) engine: a spatial "
+                                              "closed loop has no expression in it"))
+def _hinge_closure(ctx, c) -> None:
+    raise _Refused(f"hinge closure {c.name}: Pymunk is a planar (2-D) engine, a spatial "
+                   "closed loop has no expression in it")
+
+
 def _moment(body, cfg: Mapping) -> float:
     """The engine moment of a body: its central inertia, or for a point mass (inertia 0,
     which Chipmunk inverts to an infinite angular response) m r^2 with r the setting
@@ -666,61 +784,66 @@ def _moment(body, cfg: Mapping) -> float:
 
 
 def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
-    """The engine layout (bodies, folded links, pivots, grooves, substitutes); refused
-    (`_Refused`, with the reason) when the mechanism cannot be expressed."""
+    """The engine layout (bodies, folded links, pivots, grooves, substitutes), built by
+    each element's registered builder; refused (`_Refused`, with the reason) when the
+    mechanism cannot be expressed. The bodies and prescribed motions come first (which
+    bodies are engine bodies, which joints a drive holds), then the eliminated links'
+    shapes (`_eliminate`), the joints, the links, the closures."""
     cfg = cfg or {}
     reason = description_reason(mech)
     if reason:
         raise _Refused(reason)
-    dynamic: list[str] = []
-    massless: list[str] = []
-    for b in mech.bodies:
-        m, i = num(b.mass), num(b.inertia)
-        if m == 0 and i == 0:
-            massless.append(b.name)
-        elif m > 0:  # a point mass (i == 0) gets its substitute moment (_moment)
-            dynamic.append(b.name)
-        else:
-            raise _Refused(f"body {b.name}: mass 0 and inertia {i}; Chipmunk needs a mass > 0 "
-                           "(or both 0 for a massless link that can be eliminated)")
-    constraints = mech.constraints
-    drives: list[_Drive] = []
+    layout = _Layout(dynamic=[], folds={}, pivots=[], grooves=[])
+    massless = [b for b in mech.bodies if num(b.mass) == 0 and num(b.inertia) == 0]
+    ctx = SimpleNamespace(mech=mech, cfg=cfg, layout=layout,
+                          massless={b.name for b in massless},
+                          engine_ok=lambda b: b == WORLD or b in layout.dynamic,
+                          eliminated=set(),  # ids of joints that build no constraint of their own
+                          half=float(cfg.get("groove_half_length", 1000.0)),
+                          fraction=float(cfg.get("slider_mass_fraction", 0.5)))
+    for body in mech.bodies:
+        if body.name not in ctx.massless:
+            _builder(body)(ctx, body)
     for p in mech.prescribed:
-        index = mech.coordinates.index(p.coordinate)
-        j = mech.joints[index]
-        if j.child not in dynamic or (j.parent != WORLD and j.parent not in dynamic):
-            raise _Refused(f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
-                           "the constraint that imposes the motion acts between bodies with mass "
-                           "(or the world)")
-        kinematic = (cfg.get("prescribed_motion", _DRIVE_ROUTES[0]) == _DRIVE_ROUTES[0]
-                     and j.parent == WORLD)
-        drives.append(_Drive(p.name, j, index, kinematic))
-    # a prescribed slide is held by a moving PivotJoint instead of a groove
-    driven = frozenset(id(d.joint) for d in drives if isinstance(d.joint, Prismatic))
+        _builder(p)(ctx, p)
+    consumed = _eliminate(ctx)
+    for element in (*mech.joints, *massless):
+        _builder(element)(ctx, element)
+    for c in mech.constraints:
+        if id(c) not in consumed:
+            _builder(c)(ctx, c)
+    _engine_masses(mech, layout, cfg)
+    return layout
 
-    # --- massless bodies: fold (revolute + prismatic), arm (revolutes), free group ------
-    geometric = [c for c in constraints if isinstance(c, (PointOnPoint, PointOnLine))]
+
+def _eliminate(ctx) -> set[int]:
+    """The shapes of the massless links (`_Fold`, `_RevLink`, `_Component`) put in the
+    layout, their joints in `ctx.eliminated`; returns the ids of the closures that a free
+    group consumes (its positions solve them)."""
+    mech, layout, mset = ctx.mech, ctx.layout, ctx.massless
+    geometric = [c for c in mech.constraints if isinstance(c, (PointOnPoint, PointOnLine))]
     touched = {b for c in geometric for b in _closure_bodies(c)}
-    mset = set(massless)
-    folds: dict[str, _Fold] = {}
-    links: dict[str, _RevLink] = {}
-    for name in massless:
-        if name in touched:
-            continue
+    rest = []
+    for name in (b.name for b in mech.bodies if b.name in mset):
         inner = mech.joint_of_child(name)
         children = [j for j in mech.joints if j.parent == name]
-        if (len(children) == 1 and {type(inner), type(children[0])} == {Revolute, Prismatic}
+        if name in touched:
+            rest.append(name)
+        elif (len(children) == 1 and {type(inner), type(children[0])} == {Revolute, Prismatic}
                 and inner.parent not in mset and children[0].child not in mset):
             outer = children[0]
             if isinstance(inner, Revolute):
-                folds[name] = _Fold(name, inner, outer, partner=outer.child, pin_body=inner.parent)
+                layout.folds[name] = _Fold(name, inner, outer, partner=outer.child,
+                                           pin_body=inner.parent)
             else:
-                folds[name] = _Fold(name, inner, outer, partner=inner.parent, pin_body=outer.child)
-            continue
-        if all(isinstance(j, Revolute) for j in [inner, *children]):
-            links[name] = _rev_link(mech, name, mset)
-    rest = [n for n in massless if n not in folds and n not in links]
-    components: list[_Component] = []
+                layout.folds[name] = _Fold(name, inner, outer, partner=inner.parent,
+                                           pin_body=outer.child)
+            ctx.eliminated |= {id(inner), id(outer)}
+        elif all(isinstance(j, Revolute) for j in [inner, *children]):
+            layout.links[name] = _rev_link(mech, name, mset)
+            ctx.eliminated |= {id(inner), *map(id, children)}
+        else:
+            rest.append(name)
     remaining = set(rest)
     while remaining:
         group = {remaining.pop()}
@@ -735,48 +858,16 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
                         group.add(y)
                         remaining.discard(y)
                         grown = True
-        components.append(_component(mech, group, set(dynamic), geometric))
-    consumed = {id(c) for comp in components for c in comp.closures}
-    in_component = frozenset(id(j) for comp in components for j in comp.joints)
-    grooves = _grooves(mech, folds, in_component | driven)
-    folded = {id(f.outer) for f in folds.values()} | {id(f.inner) for f in folds.values()}
-    linked = {id(j) for j in mech.joints if j.parent in links or j.child in links}
-    # a kinematic driver on the world needs no joint to it (it moves as it is told)
-    held = {id(d.joint) for d in drives if d.kinematic}
-    pivots = [(j.parent, j.child, tuple(_vec(j.parent_anchor)), tuple(_vec(j.child_anchor)))
-              for j in mech.joints if isinstance(j, Revolute)
-              and id(j) not in folded and id(j) not in linked and id(j) not in in_component
-              and id(j) not in held]
-    layout = _Layout(dynamic, folds, pivots, grooves, links, components, drives=drives)
-    # a body that every joint from the world slides (no hinge) cannot turn: an infinite
-    # moment takes it out of every rotational equation, where a GearJoint holding its
-    # angle would be solved only iteratively (two such bodies in a chain drift apart
-    # under a velocity-level groove without error correction)
-    layout.infinite |= {b for b in dynamic if _rotation_fixed(mech, b)}
-    for d in drives:
-        if d.kinematic and isinstance(d.joint, Revolute) and _vec(d.joint.child_anchor).any():
-            # a kinematic body turns about its centre of gravity: put it on the hinge
-            layout.cog[d.joint.child] = tuple(_vec(d.joint.child_anchor))
-    for link in links.values():
-        (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
-        for other, point in link.at_alpha[1:]:
-            layout.pivots.append((ra, other, pa, point))
-        for other, point in link.at_beta[1:]:
-            layout.pivots.append((rb, other, pb, point))
-        length = float(np.linalg.norm(np.subtract(link.beta, link.alpha)))
-        layout.pins.append((ra, rb, pa, pb, length, link.link))
+        layout.components.append(_component(mech, group, set(layout.dynamic), geometric))
+    ctx.eliminated |= {id(j) for comp in layout.components for j in comp.joints}
+    return {id(c) for comp in layout.components for c in comp.closures}
 
-    # --- closure constraints: each kind's registered builder ---------------------------
-    ctx = SimpleNamespace(mech=mech, layout=layout, massless=mset,
-                          engine_ok=lambda b: b == WORLD or b in dynamic,
-                          half=float(cfg.get("groove_half_length", 1000.0)),
-                          fraction=float(cfg.get("slider_mass_fraction", 0.5)))
-    for c in constraints:
-        if id(c) not in consumed:
-            _CLOSURES[element_kind(c)][0](ctx, c)
 
-    # --- engine masses; compensation of the slider substitutes -------------------------
-    for name in dynamic:
+def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
+    """The engine (mass, moment) of every engine body, the slider substitutes' taken out
+    of their hosts (setting slider_compensation) where every groove stays exact; refused
+    when a groove is not exact."""
+    for name in layout.dynamic:
         b = mech.body(name)
         layout.engine_mass[name] = (num(b.mass),
                                     math.inf if name in layout.infinite else _moment(b, cfg))
@@ -811,7 +902,6 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
     for g in layout.grooves:
         if not (_slot_exact(layout, g) and _pin_exact(layout, g)):
             raise _Refused(f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}")
-    return layout
 
 
 def _slot_exact(layout: _Layout, g: _Groove) -> bool:
@@ -1027,7 +1117,7 @@ class _Compiled:
             for name in bodies:
                 self.kind[name] = ("group", i)
                 self._follow(name, {p[1] for points, _ in group[3] for p in points} - bodies)
-        self.elements = [element_loads(mech, f) for f in mech.forces]
+        self.elements = [_builder(f)(mech, f) for f in mech.forces]
         loaded: set[int] = set()
         for f in mech.forces:
             ends = ((f.body_a, f.body_b) if isinstance(f, PointToPoint) else
@@ -1393,53 +1483,7 @@ class PymunkBackend(Backend):
 
         return f"{pymunk.version} (Chipmunk {pymunk.chipmunk_version.split('-')[0]})"
 
-    EXPRESSIONS = {
-        BODY: (
-            Expression(EXACT, "pymunk.Body(mass, moment) whose frame is the description's "
-                              "(centre of gravity at its origin), no shapes",
-                       when="mass and inertia > 0", applies=rigid_body),
-            Expression(SUBSTITUTE, "a point mass: pymunk.Body(mass, m r^2), r the setting "
-                                   "point_mass_gyration. Chipmunk divides by the moment "
-                                   "(its constraint solver uses the inverse moment, "
-                                   "infinite at zero); the substitute changes the body's "
-                                   "moment about any point by m r^2, relative (r/d)^2 at "
-                                   "a distance d",
-                       when="mass > 0, inertia 0", applies=point_mass),
-            Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
-                                    "for a massless link that can be eliminated)",
-                       when="mass 0, inertia > 0"),
-        ),
-        MASSLESS_BODY: (Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
-                                          "folded into one GrooveJoint (a revolute and a "
-                                          "prismatic joint), an arm PinJoint (revolute joints "
-                                          "at two points), or a free group whose positions "
-                                          "solve its joint equations; other shapes are "
-                                          "refused (support)"),),
-        REVOLUTE: (Expression(EXACT, "PivotJoint at the two anchors"),),
-        PRISMATIC: (Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and a "
-                                      "GearJoint locking the rotation; refused (support) "
-                                      "unless the path passes through the parent's centre "
-                                      "of mass or the parent is the world. " + _GROOVE_LIMIT),),
-        POINT_TO_POINT_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
-        POINT_TO_POINT_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
-        COORDINATE_FORCE_LINEAR: (Expression(EXACT, _ELEMENT_FORCE),),
-        COORDINATE_FORCE_CUSTOM: (Expression(EXACT, _ELEMENT_FORCE),),
-        TIME_LOAD: (Expression(EXACT, _ELEMENT_FORCE + ", at t + h"),),
-        **{kind: expressions for kind, (_, expressions) in _CLOSURES.items()},
-        PRESCRIBED: (Expression(EXACT, "on the world: a Body.KINEMATIC child whose velocity "
-                                       "is set every step to (q(t + 2h) - q(t + h))/h after "
-                                       "the position update; on a free body: a constraint "
-                                       "between the two bodies whose target (a slide: "
-                                       "PivotJoint to parent_anchor + q axis; a hinge: "
-                                       "GearJoint phase) is set to q(t + 2h) with error_bias "
-                                       "0. The coordinate is on q(t) at every sample; the "
-                                       "free coordinates and the actuator force (Newton-Euler "
-                                       "on the child subtree) converge at first order, the "
-                                       "scheme's (setting prescribed_motion). Refused "
-                                       "(support) on a joint with a massless body"),),
-        HINGE_CLOSURE: (Expression(UNSUPPORTED, "Pymunk is a planar (2-D) engine: a spatial "
-                                                "closed loop has no expression in it"),),
-    }
+    EXPRESSIONS = {kind: _ELEMENTS[kind][1] for kind in ELEMENT_KINDS if kind in _ELEMENTS}
 
     SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
                       "tensor, hinges about horizontal axes) has no expression in it")
