@@ -134,6 +134,7 @@ from .base import (
     Stopwatch,
     Setting,
 )
+from .reactions import PAIR_ELEMENTS, joint_reactions, subtree_force
 from .plan import (
     BODY,
     ELEMENT_KINDS,
@@ -1905,8 +1906,7 @@ class PymunkBackend(Backend):
             joint_forces, constraint_forces = self._forces(mechanism, comp, S, H, shift, h, t)
             reactions = {j: joint_forces[j] for j in reaction_joints}
         else:
-            reactions = {j: self._reaction(mechanism, comp, j, S, H, shift, h, t)
-                         for j in reaction_joints}
+            reactions = self._tree_reactions(mechanism, comp, reaction_joints, S, H, shift, h, t)
         actuator_forces = {d.name: _actuator_force(comp, d.joint, S, h, H, shift, t)
                            for d in comp.layout.drives}
         return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
@@ -1925,27 +1925,38 @@ class PymunkBackend(Backend):
         return q, qd
 
     @staticmethod
-    def _reaction(mech: Mechanism, comp: _Compiled, joint: str, S: np.ndarray,
-                  H: float, shift: int, h: float, t: np.ndarray) -> np.ndarray:
-        """Force the parent exerts on the child: Newton on the child's subtree over the
-        step n -> n+1, sum m (v(n+1) - v(n))/h - m g - (element forces from outside, as
-        applied in that step). Chipmunk computes that impulse at the position-updated
-        configuration x(n+1), so it is given to sample n+1 (measured on the pendulums:
-        3.5-40x closer to the model's reaction at that sample than at sample n); sample 0
-        has no step before it and is NaN. A start with angular velocity shows an O(1)
-        transient at sample 1: the first step also builds the steady O(h^2) joint gap of
-        the position update, and its impulse contains that correction."""
-        bodies, loads, _ = _subtree(comp, mech.joint(joint), S, H, shift, h, t)
-        total = np.zeros((len(t) - 1, 2))
-        for _, _, fx, fy, _ in bodies:
-            total[:, 0] += fx
-            total[:, 1] += fy
-        for _, force, _, _ in loads:
-            if force is not None:
-                for i in range(2):
-                    total[:, i] -= force[i]
-        out = np.full((len(t), 2), np.nan)
-        out[1:] = total
+    def _tree_reactions(mech: Mechanism, comp: _Compiled, joints: Sequence[str], S: np.ndarray,
+                        H: float, shift: int, h: float, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Force the parent exerts on the child (`reactions.joint_reaction`): Newton on the
+        child's subtree over the step n -> n+1, sum m (v(n+1) - v(n))/h - m g, minus the
+        element forces from outside as applied in that step (evaluated at the
+        position-updated state x + H v and t + shift h). Chipmunk computes that impulse at
+        the position-updated configuration x(n+1), so it is given to sample n+1 (measured
+        on the pendulums: 3.5-40x closer to the model's reaction at that sample than at
+        sample n); sample 0 has no step before it and is NaN. A start with angular
+        velocity shows an O(1) transient at sample 1: the first step also builds the
+        steady O(h^2) joint gap of the position update, and its impulse contains that
+        correction."""
+        if not joints:
+            return {}
+        frames, ahead = comp.frames(S), comp.frames(S[:-1], H)
+        accelerations = {name: np.column_stack([np.diff(frames[name][3]) / h,
+                                                np.diff(frames[name][4]) / h])
+                         for name in comp.layout.dynamic}
+        t_applied = t[:-1] + shift * h
+        # a pair element's force on its first body as applied (`plan.element_loads`: the
+        # second load of a PointToPoint is the one on body_a)
+        pairs = {f.name: np.column_stack([np.broadcast_to(np.asarray(v, float), t_applied.shape)
+                                          for v in loads(ahead, t_applied)[1][1]])
+                 for f, loads in zip(mech.forces, comp.elements) if isinstance(f, PAIR_ELEMENTS)}
+        q, qd = (np.column_stack([np.broadcast_to(np.asarray(c, float), t_applied.shape)
+                                  for c in cols]) for cols in joint_coordinates(mech, ahead))
+        transmitted = {j: subtree_force(mech, j, t[1:], accelerations) for j in joints}
+        out = {}
+        for name, force in joint_reactions(mech, joints, transmitted, t_applied, q, qd,
+                                           pair_forces=pairs).items():
+            out[name] = np.full((len(t), 2), np.nan)
+            out[name][1:] = force
         return out
 
     def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, H: float, shift: int,
