@@ -187,13 +187,45 @@ _FORCE_MODES = ("position_updated", "step_start")
 
 @dataclass(frozen=True)
 class _Fold:
-    """A massless link folded into a GrooveJoint between `partner` and `pin_body`."""
+    """A massless link with one revolute and one prismatic joint, folded into a
+    GrooveJoint between `partner`, the body it turns with (the far side of its prismatic
+    joint), and `pin_body`, which carries its revolute point (the near side)."""
 
     link: str
-    inner: Revolute | Prismatic  # parent -> link
-    outer: Revolute | Prismatic  # link -> child
-    partner: str  # body the link turns with (the far side of its prismatic joint)
-    pin_body: str  # body that carries the revolute point (the near side of it)
+    revolute: Revolute
+    prismatic: Prismatic
+
+    @property
+    def turns_with_child(self) -> bool:
+        """Whether the revolute joint is the link's inner one (the link turns with the
+        prismatic joint's child, the pin is a point of the revolute joint's parent)."""
+        return self.revolute.child == self.link
+
+    @property
+    def partner(self) -> str:
+        return self.prismatic.child if self.turns_with_child else self.prismatic.parent
+
+    @property
+    def pin_body(self) -> str:
+        return self.revolute.parent if self.turns_with_child else self.revolute.child
+
+    @property
+    def offset(self) -> float:
+        """The link's angle minus its partner's."""
+        offset = num(self.prismatic.angle_offset)
+        return -offset if self.turns_with_child else offset
+
+    @property
+    def pin_point(self) -> tuple[float, float]:
+        """The revolute point in the pin body's frame."""
+        j = self.revolute
+        return _pt(j.parent_anchor if self.turns_with_child else j.child_anchor)
+
+    @property
+    def link_point(self) -> tuple[float, float]:
+        """The revolute point in the link's frame."""
+        j = self.revolute
+        return _pt(j.child_anchor if self.turns_with_child else j.parent_anchor)
 
 
 @dataclass(frozen=True)
@@ -578,10 +610,10 @@ def _eliminated(ctx, body) -> None:
 
 def _folded_groove(fold: _Fold) -> _Groove:
     """The GrooveJoint of a folded link; refused when it would not be exact in Chipmunk."""
-    if isinstance(fold.inner, Revolute):
+    rev, pri = fold.revolute, fold.prismatic
+    if fold.turns_with_child:
         # the link turns with its child: the pivot (a point of the parent) slides on a
         # line of the child, base + q direction in the child's frame
-        rev, pri = fold.inner, fold.outer
         back = rot(-num(pri.angle_offset))
         base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
         direction = -back @ _vec(pri.axis)
@@ -591,7 +623,6 @@ def _folded_groove(fold: _Fold) -> _Groove:
     else:
         # the link turns with its parent: the pin (a point of the child) slides on a
         # line of the parent
-        pri, rev = fold.inner, fold.outer
         base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
             _vec(rev.parent_anchor) - _vec(pri.child_anchor))
         direction = _vec(pri.axis)
@@ -833,12 +864,8 @@ def _eliminate(ctx) -> set[int]:
         elif (len(children) == 1 and {type(inner), type(children[0])} == {Revolute, Prismatic}
                 and inner.parent not in mset and children[0].child not in mset):
             outer = children[0]
-            if isinstance(inner, Revolute):
-                layout.folds[name] = _Fold(name, inner, outer, partner=outer.child,
-                                           pin_body=inner.parent)
-            else:
-                layout.folds[name] = _Fold(name, inner, outer, partner=inner.parent,
-                                           pin_body=outer.child)
+            revolute, prismatic = (inner, outer) if isinstance(inner, Revolute) else (outer, inner)
+            layout.folds[name] = _Fold(name, revolute, prismatic)
             ctx.eliminated |= {id(inner), id(outer)}
         elif all(isinstance(j, Revolute) for j in [inner, *children]):
             layout.links[name] = _rev_link(mech, name, mset)
@@ -932,6 +959,11 @@ def _place(pose: tuple, local) -> tuple:
 
 def _pt(v) -> tuple[float, float]:
     return (num(v[0]), num(v[1]))
+
+
+def _columns(values: Sequence, n: int) -> np.ndarray:
+    """(n, len(values)): each value, a number or n samples, as a column."""
+    return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])
 
 
 def _group(comp: _Component) -> tuple:
@@ -1097,16 +1129,9 @@ class _Compiled:
             cog = layout.cog.get(name)
             self.kind[name] = ("body", self.index[name], tuple(map(float, cog)) if cog else None)
         for name, fold in layout.folds.items():
-            if isinstance(fold.inner, Revolute):  # turns with its child, pin on the parent
-                turner, off = fold.outer.child, -num(fold.outer.angle_offset)
-                pin, pin_local, local = (fold.inner.parent, fold.inner.parent_anchor,
-                                         fold.inner.child_anchor)
-            else:  # turns with its parent, pin on the child
-                turner, off = fold.inner.parent, num(fold.inner.angle_offset)
-                pin, pin_local, local = (fold.outer.child, fold.outer.child_anchor,
-                                         fold.outer.parent_anchor)
-            self.kind[name] = ("fold", turner, off, pin, _pt(pin_local), _pt(local))
-            self._follow(name, (turner, pin))
+            self.kind[name] = ("fold", fold.partner, fold.offset, fold.pin_body, fold.pin_point,
+                               fold.link_point)
+            self._follow(name, (fold.partner, fold.pin_body))
         for name, link in layout.links.items():
             (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
             ell = (link.beta[0] - link.alpha[0], link.beta[1] - link.alpha[1])
@@ -1320,8 +1345,7 @@ def _wrenches(bodies: list[str], loads: list[Load], frames: _Frames, n: int) -> 
     for load in loads:
         if load[0] != WORLD:
             i = bodies.index(load[0])
-            out[:, 3 * i:3 * i + 3] += np.column_stack(np.broadcast_arrays(
-                *wrench(load, frames.state(load[0])[:2]), np.zeros(n))[:3])
+            out[:, 3 * i:3 * i + 3] += _columns(wrench(load, frames.state(load[0])[:2]), n)
     return out
 
 
@@ -1916,8 +1940,7 @@ class PymunkBackend(Backend):
                      t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine body states (rows of `S`) -> the description's coordinates and rates;
         the angles of eliminated links, which come from atan2, continued from q0."""
-        q, qd = (np.column_stack([np.broadcast_to(np.asarray(c, float), t.shape) for c in cols])
-                 for cols in joint_coordinates(mechanism, comp.frames(S)))
+        q, qd = (_columns(cols, len(t)) for cols in joint_coordinates(mechanism, comp.frames(S)))
         for i, j in enumerate(mechanism.joints):
             if isinstance(j, Revolute):
                 col = np.unwrap(q[:, i])
@@ -1946,11 +1969,9 @@ class PymunkBackend(Backend):
         t_applied = t[:-1] + shift * h
         # a pair element's force on its first body as applied (`plan.element_loads`: the
         # second load of a PointToPoint is the one on body_a)
-        pairs = {f.name: np.column_stack([np.broadcast_to(np.asarray(v, float), t_applied.shape)
-                                          for v in loads(ahead, t_applied)[1][1]])
+        pairs = {f.name: _columns(loads(ahead, t_applied)[1][1], len(t_applied))
                  for f, loads in zip(mech.forces, comp.elements) if isinstance(f, PAIR_ELEMENTS)}
-        q, qd = (np.column_stack([np.broadcast_to(np.asarray(c, float), t_applied.shape)
-                                  for c in cols]) for cols in joint_coordinates(mech, ahead))
+        q, qd = (_columns(cols, len(t_applied)) for cols in joint_coordinates(mech, ahead))
         transmitted = {j: subtree_force(mech, j, t[1:], accelerations) for j in joints}
         out = {}
         for name, force in joint_reactions(mech, joints, transmitted, t_applied, q, qd,
@@ -1977,9 +1998,6 @@ class PymunkBackend(Backend):
         m_steps = len(t) - 1
         bodies = [b.name for b in mech.bodies]
 
-        def arrays(values) -> list[np.ndarray]:
-            return [np.broadcast_to(np.asarray(v, float), (m_steps,)) for v in values]
-
         frames = comp.frames(S[1:])
         columns = _balance_columns(mech, frames)
         A = np.stack([_wrenches(bodies, loads, frames, m_steps) for _, _, loads, _ in columns],
@@ -1996,7 +2014,7 @@ class PymunkBackend(Backend):
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
                 inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
-            cx, cy = arrays(frames.state(host)[:2])
+            cx, cy = _columns(frames.state(host)[:2], m_steps).T
             rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
@@ -2017,7 +2035,7 @@ class PymunkBackend(Backend):
         def assemble(indices: list[int]) -> np.ndarray:
             direction = columns[indices[0]][3]
             if len(indices) == 1 and direction is not None:  # magnitude along its direction
-                val = x[:, indices] * np.column_stack(arrays(direction))
+                val = x[:, indices] * _columns(direction, m_steps)
             else:
                 val = x[:, indices]
             out = np.full((len(t), val.shape[1]), np.nan)
