@@ -61,35 +61,23 @@ kind has one builder, registered with the expressions it declares (`_builds`;
     carrier arm is removed (the contact holds the disc).
     Other couplings (three bodies without a common carrier, prismatic coordinates) are
     refused with the reason.
-* ``Prescribed`` (a coordinate imposed as q(t), setting ``prescribed_motion``). Chipmunk
-  moves positions with the previous step's velocities, so the velocity solved in step k
-  (at the positions of t_(k+1)) is the one that must carry the coordinate to q(t_(k+2)).
-  On the world the joint's child is a ``Body.KINEMATIC`` body (its centre of gravity on
-  the hinge, no joint to the world) whose ``velocity_func`` sets that velocity; infinite
-  inertia keeps the solve of its children exact. On a free body (a frame carrying a
-  rotor) the driven body stays dynamic, so the frame feels its inertia: a constraint
-  between the two bodies whose target is moved before every step, with error_bias 0
-  (bias velocity -gap/h): a slide is a ``PivotJoint`` from the parent's point
-  parent_anchor + q axis to the child (no groove; plus the rotation-locking
-  ``GearJoint``), a hinge keeps its ``PivotJoint`` and gets a ``GearJoint`` (ratio 1)
-  whose phase is the relative angle. The coordinate starts with the rate of its first
-  step, (q(h) - q0)/h. Chipmunk reports only the
-  magnitude of an impulse; the actuator force is Newton-Euler on the joint's child
-  subtree over each step, at sample n + 1 like the reactions.
+* ``Prescribed`` (a coordinate imposed as q(t)): on the world a ``Body.KINEMATIC``
+  child whose velocity is set every step, on a free body a constraint whose target is
+  moved before every step (setting ``prescribed_motion``: how and why; `_drive`,
+  `PymunkBackend._schedule`). Chipmunk reports only the magnitude of an impulse; the
+  actuator force is Newton-Euler on the joint's child subtree over each step, at sample
+  n + 1 like the reactions.
 * Force elements are applied as body forces and torques, evaluated every step by one
   compiled function of the body states (a Python call per step). A CoordinateForce is
   the generalized force Q on its coordinate: on a revolute joint the torque s Q on the
   child (s = -1 for a clockwise coordinate) and -s Q on the parent unless the angle is
   absolute (virtual power of Q q').
-* Constraint forces and reactions of constrained mechanisms: Chipmunk reports only the
-  magnitude of an impulse, so the forces are reconstructed from momentum balance of every
-  description body over each step, m (v(n+1) - v(n))/h - m g - applied loads, solved in
-  least squares for all joint reactions and closure multipliers at the configuration
-  where Chipmunk computed them (sample n+1). A start with velocity shows a transient at
-  sample 1: Chipmunk's velocity is staggered (v_n ~ v(t_n + h/2), whose constraint
-  component is -h times the curvature term), the exact initial velocity is not, and the
-  first impulse makes up the difference: 1.5 times the centripetal part (eccentric cam
-  spinning at 40 rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2).
+* Reactions and constraint forces: Chipmunk reports only the magnitude of an impulse,
+  so the forces are reconstructed from momentum balance over each step, at the
+  configuration where Chipmunk computed them (sample n + 1): in a tree, Newton on the
+  joint child's subtree (the shared `reactions.joint_reaction`); with closure
+  constraints, the balance of every description body solved in least squares for all
+  joint reactions and closure multipliers together (`PymunkBackend._forces`).
 
 Chipmunk's step (cpSpaceStep): positions x += h v (old velocity); constraints pre-step at
 the new positions; v += h (g + F/m); warm-started Gauss-Seidel velocity iterations that
@@ -1993,7 +1981,14 @@ class PymunkBackend(Backend):
         description at the configuration x(n+1) where Chipmunk computed its impulses.
         Solved in least squares (pseudo-inverse) per sample; the same sample convention
         as the reactions (n+1; sample 0 NaN). Massless bodies enter with zero inertia, so
-        the force in a joint of an eliminated link is its static balance."""
+        the force in a joint of an eliminated link is its static balance. The reactions
+        are unknowns of the same solve as the closure forces (these cannot be had without
+        them), so the subtree balance of `reactions.joint_reaction` would be a second
+        path, not a replacement. A start with velocity shows a transient at sample 1:
+        Chipmunk's velocity is staggered (v_n ~ v(t_n + h/2), whose constraint component
+        is -h times the curvature term), the exact initial velocity is not, and the first
+        impulse makes up the difference: 1.5 times the centripetal part (eccentric cam
+        spinning at 40 rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2)."""
         layout = comp.layout
         m_steps = len(t) - 1
         bodies = [b.name for b in mech.bodies]
