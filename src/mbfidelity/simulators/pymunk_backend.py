@@ -814,7 +814,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
     if reason:
         raise _Refused(reason)
     layout = _Layout(dynamic=[], folds={}, pivots=[], grooves=[])
-    massless = [b for b in mech.bodies if num(b.mass) == 0 and num(b.inertia) == 0]
+    massless = [b for b in mech.bodies if element_kind(b) == MASSLESS_BODY]
     ctx = SimpleNamespace(mech=mech, cfg=cfg, layout=layout,
                           massless={b.name for b in massless},
                           engine_ok=lambda b: b == WORLD or b in layout.dynamic,
@@ -822,7 +822,7 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
                           half=float(cfg.get("groove_half_length", 1000.0)),
                           fraction=float(cfg.get("slider_mass_fraction", 0.5)))
     for body in mech.bodies:
-        if body.name not in ctx.massless:
+        if body.name not in ctx.massless:  # a massless body's builder runs after the joints
             _builder(body)(ctx, body)
     for p in mech.prescribed:
         _builder(p)(ctx, p)
