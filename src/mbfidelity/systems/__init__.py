@@ -257,6 +257,20 @@ EXPECTATION_KINDS = ("xfail", "unsupported", "unresolved", "judged")
 
 
 @dataclass(frozen=True)
+class OrderCap:
+    """The order at which an engine's solution converges on this system where a physical
+    property of its model, not its scheme, sets it (comparisons/tolerances.py, "A
+    posteriori", a declared order cap): e.g. an equality constraint the engine makes soft
+    with a time constant that follows the step. `simulator` is an fnmatch pattern; the
+    refinement judges the engine's metrics at `order` (the scheme's fastest order still
+    bounds the observed one), and `reason` says why."""
+
+    simulator: str
+    order: int
+    reason: str
+
+
+@dataclass(frozen=True)
 class Expectation:
     """An exception as data (scikit-learn's common-check pattern).
 
@@ -319,6 +333,9 @@ class System:
     #: named body points whose positions and velocities are reported and judged
     points: Callable[[SimpleNamespace], tuple[PointOutput, ...]] = lambda P: ()
     expectations: tuple[Expectation, ...] = ()
+    #: orders below the scheme's at which an engine converges on this system, each with
+    #: its physical reason (OrderCap; the refinement judges at the lowest that matches)
+    order_caps: tuple[OrderCap, ...] = ()
     variants: tuple[Variant, ...] = ()
     #: conditions on the parameters for the geometry to exist (checked on every set)
     validity: tuple[Condition, ...] = ()

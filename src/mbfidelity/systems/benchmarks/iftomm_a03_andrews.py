@@ -40,7 +40,8 @@ leave the loops unable to close at the published initial state).
 """
 import sympy as sp
 
-from .. import BenchmarkError, Expectation, Published, System, coordinate_symbols
+from .. import (BenchmarkError, Expectation, OrderCap, Published, System,
+                coordinate_symbols)
 from ..model import (COORD, Body, CoordinateForce, Mechanism, Parameter, PointOnPoint,
                      PointToPoint, Revolute, Scenario, Segment, linear_spring_damper)
 
@@ -164,6 +165,27 @@ _UNRESOLVED = (
     "own refinement to reach its asymptotic regime (the benchmark asks for steps well "
     "below the default); the engines are judged at the steps of the convergence study")
 
+#: why MuJoCo's solution converges at second order here (comparisons/tolerances.py, "A
+#: declared order cap")
+_SOFT_CLOSURE = (
+    "the three closures at E are MuJoCo equality constraints, which are soft: a "
+    "spring-damper towards the constraint whose time constant follows the step, so the "
+    "solved dynamics differ from the rigid ones by a violation of second order in the "
+    "step, beside RK4's fourth-order error")
+
+#: why MuJoCo's motion is judged although its backend expects a soft closure to fail
+_SOFT_MOTION_JUDGED = (
+    "MuJoCo's soft closures keep the motion's error of second order in the step (the "
+    "declared order cap): its own refinement at that order bounds it, and the motion and "
+    "energy are judged against that bound, which a limit other than the rigid motion fails")
+
+#: why MuJoCo's closure forces do not converge to the rigid multipliers
+_SOFT_CONSTRAINT_FORCE = (
+    "MuJoCo's closure force is its soft constraint's spring-damper force, a stiffness "
+    "that grows as the step falls times a violation that shrinks as fast: it converges to "
+    "a regularised value set by the constraint's impedance, not to the rigid Lagrange "
+    "multiplier, so its difference from the reference does not shrink with the step")
+
 #: the error as the test set measures a solver's accuracy: at the end of the run
 #: (t = 0.03 s, where it publishes the solution), on the seven angles; here the largest
 #: absolute error among them
@@ -205,11 +227,14 @@ SYSTEM = System(
                     "Exudyn's implicit scheme solves each step by Newton's method, which "
                     "does not converge when the crank turns about a radian within one "
                     "step: the solver stops (a step well below a millisecond runs)"),
+        Expectation("mujoco", "*.constraint_*", "xfail", _SOFT_CONSTRAINT_FORCE),
+        Expectation("mujoco", "*", "judged", _SOFT_MOTION_JUDGED),
         # Pymunk's and Exudyn's refinements reach their asymptotic range within the step
-        # budget and judge every metric; the others' do not
+        # budget and judge every metric, MuJoCo's at its declared order; the others' do not
         *(Expectation(engine, "*", "unresolved", _UNRESOLVED)
-          for engine in ("mujoco", "pybullet", "drake")),
+          for engine in ("pybullet", "drake")),
     ),
+    order_caps=(OrderCap("mujoco", 2, _SOFT_CLOSURE),),
     # releases near the other stable equilibria last as long as the published run
     near_equilibrium_t_end=0.03,
 )
