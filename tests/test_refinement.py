@@ -185,3 +185,35 @@ def test_the_floquet_growth_rate_is_refined_and_rejects_g_off():
     assert correct.tolerance >= correct.detail["reference_error"]
     wrong = growth({"g": 1.05})
     assert wrong.rule.startswith("refinement") and wrong.status == "fail"
+
+
+def test_a_declared_order_cap_judges_mujocos_soft_closures_and_rejects_a_model_error():
+    """Andrews' squeezer on MuJoCo: its soft closures make the motion converge at second
+    order (the declared cap, tolerances.py "A declared order cap"), not RK4's fourth; at
+    that order the refinement judges the published run and passes, while a crank 1 %
+    heavier in the engine's build (the reference untouched) fails, and so does a spring
+    1 % stiffer on the release near the second equilibrium. The closure forces, which
+    converge to a regularised value, are declared failures, not left unresolved."""
+    def run(scenario, scale=None):
+        result = compare("iftomm_a03_andrews", "mujoco", scenarios=[scenario],
+                         engine_scale=scale)
+        return {m.name: m for m in result.metrics}
+
+    correct = run("published")["published.trajectory_max"]
+    assert correct.rule.startswith("refinement") and correct.status == "pass"
+    assert correct.refinement["declared_order"] == 2  # the cap, not RK4's 4
+    assert run("published", {"m1": 1.01})["published.trajectory_max"].status == "fail"
+    released = run("eq2_small")
+    assert released["eq2_small.trajectory_max"].status == "pass"
+    assert {m.status for name, m in released.items() if ".constraint_" in name} == {"xfail"}
+    assert run("eq2_small", {"c0": 1.01})["eq2_small.trajectory_max"].status == "fail"
+
+
+def test_a_declared_cap_widens_the_observed_order_up_to_the_schemes():
+    """With a cap q below the scheme's p the observed order may lie anywhere from q to p
+    (a mix of both terms); r stays q's, the conservative one."""
+    d = [1e-2, 1e-2 * 2.0 ** -3]  # order 3: between the cap 2 and RK4's 4
+    assert tolerances.refinement_gate(d, 2, 0.0).unresolved
+    capped = tolerances.refinement_gate(d, 2, 0.0, top=4)
+    assert not capped.unresolved
+    assert capped.tolerance == pytest.approx(d[0] + d[1] / (1 - 2.0 ** -1.5))
