@@ -155,15 +155,13 @@ def published(P):
     return tuple(out)
 
 
-#: why no gate can judge the engines at the default step (1 ms)
+#: why no gate can judge PyBullet's and Drake's published run at the default step (1 ms)
 _UNRESOLVED = (
-    "At the default step every run of this mechanism is only a few dozen steps long: the "
-    "published one, in which the crank turns more than twice, and the releases near the "
-    "other stable equilibria, which last as long; the stiff spring's mode about the "
-    "equilibrium lies beyond the range of w h where a fixed-step scheme's error bound "
-    "holds, so no bound says anything there, and the runs are too short for the engine's "
-    "own refinement to reach its asymptotic regime (the benchmark asks for steps well "
-    "below the default); the engines are judged at the steps of the convergence study")
+    "In the published run the crank turns more than twice within a few dozen steps of "
+    "the default: the first-order engine's own error bound there, from its refinement, "
+    "exceeds what the metric can tell apart, and the bound on its limit is predicted to "
+    "stay above that down to the step budget, so the metric is measured and shown; the "
+    "engines are judged on this run at the steps of the convergence study")
 
 #: why MuJoCo's solution converges at second order here (comparisons/tolerances.py, "A
 #: declared order cap")
@@ -178,6 +176,20 @@ _SOFT_MOTION_JUDGED = (
     "MuJoCo's soft closures keep the motion's error of second order in the step (the "
     "declared order cap): its own refinement at that order bounds it, and the motion and "
     "energy are judged against that bound, which a limit other than the rigid motion fails")
+
+#: why PyBullet's forces in two of the closures at E do not converge
+_CORRECTED_CLOSURE_FORCE = (
+    "PyBullet's closure force is the impulse of its velocity-level solve, which also "
+    "removes the position error the previous step left (erp Phi / dt): a violation of "
+    "second order in the step over the step squared, a part that does not shrink with the "
+    "step; the rod's end E carries three closures, and this share of it does not converge "
+    "to the rigid multiplier")
+
+#: why Drake's motion is judged although its backend expects compliant closures to fail
+_COMPLIANT_MOTION_JUDGED = (
+    "Drake's compliant closures follow the step, so the motion's error stays of the first "
+    "order its discrete plant declares: the refinement at that order judges the releases' "
+    "motion and energy, which a limit other than the rigid motion fails")
 
 #: why MuJoCo's closure forces do not converge to the rigid multipliers
 _SOFT_CONSTRAINT_FORCE = (
@@ -229,10 +241,17 @@ SYSTEM = System(
                     "step: the solver stops (a step well below a millisecond runs)"),
         Expectation("mujoco", "*.constraint_*", "xfail", _SOFT_CONSTRAINT_FORCE),
         Expectation("mujoco", "*", "judged", _SOFT_MOTION_JUDGED),
+        *(Expectation("pybullet", f"*.constraint_{closure}", "xfail", _CORRECTED_CLOSURE_FORCE)
+          for closure in ("E_EG", "E_HE")),
         # Pymunk's and Exudyn's refinements reach their asymptotic range within the step
-        # budget and judge every metric, MuJoCo's at its declared order; the others' do not
-        *(Expectation(engine, "*", "unresolved", _UNRESOLVED)
-          for engine in ("pybullet", "drake")),
+        # budget and judge every metric, MuJoCo's at its declared order; PyBullet's and
+        # Drake's do on the releases, not on the published run
+        Expectation("pybullet", "published.trajectory_rms", "unresolved", _UNRESOLVED),
+        Expectation("drake", "published.trajectory_*", "unresolved", _UNRESOLVED),
+        Expectation("drake", "*.constraint_*", "xfail",
+                    "Drake's discrete plant holds the closures with compliant constraints "
+                    "and does not report their forces: there is nothing to compare"),
+        Expectation("drake", "*", "judged", _COMPLIANT_MOTION_JUDGED),
     ),
     order_caps=(OrderCap("mujoco", 2, _SOFT_CLOSURE),),
     # releases near the other stable equilibria last as long as the published run
