@@ -84,6 +84,20 @@ def _from_source(source: str, modules: str, label: str) -> Callable:
     return namespace["_lambdifygenerated"]
 
 
+def _residual_at_rest_terms(d: Derivation) -> sp.Matrix:
+    """The part of the autonomous residual M q'' + h - Q_aut whose Jacobians in q and q'
+    at rest (q' = q'' = 0) are the linearization's stiffness and damping. With M a
+    function of q alone, M q'' is linear in q'' and h = M' q' - dT/dq homogeneous
+    quadratic in q': both Jacobians of both vanish at rest, and what remains is -Q_aut
+    (differentiating h of a long spatial chain is what would cost; route 2, the Hessians
+    of T, V and D, still checks the result). A mass matrix that depends on anything
+    else keeps the whole residual."""
+    rates = set(d.qd) | set(d.qdd) | {TIME}
+    if any(sp.sympify(e).free_symbols & rates for e in d.M):
+        return d.M * d.qdd + d.h - d.Q_autonomous
+    return -d.Q_autonomous
+
+
 class CompiledSystem:
     """Every numeric function of one system's derivation, compiled once, with the
     parameter values as leading arguments (`NumericModel` binds them): a new parameter
@@ -173,8 +187,8 @@ class NumericModel:
         self._energy = fn("energy", lambda: (q + qd, d.T + d.V, "numpy") if energy_route
                           else None)
         self._V = fn("V", lambda: (q, d.V, "numpy") if energy_route else None)
-        # route 1 linearization: Jacobians of the autonomous residual (eq. 104-109)
-        r_aut = d.M * d.qdd + d.h - d.Q_autonomous
+        # route 1 linearization: Jacobians of the autonomous residual at rest (eq. 104-109)
+        r_aut = _residual_at_rest_terms(d)
         self._lin_C = fn("lin_C", lambda: (q, r_aut.jacobian(d.qd).xreplace(zero_vel), "numpy"))
         self._lin_K = fn("lin_K", lambda: (q, r_aut.jacobian(d.q).xreplace(zero_vel), "numpy"))
         if energy_route:
