@@ -760,12 +760,11 @@ def diff_cmd(old: Path = typer.Argument(..., metavar="OLD", help="results folder
     settings, metrics that moved, gates that flipped, new and vanished metrics. Exit 1
     when a gate got worse."""
     from . import api
-    from .comparisons.diff import diff_runs
 
     try:
         if html_page is not None:
             api.checked_output_file(html_page, "--html")
-        changes = diff_runs(old, new)
+        changes = api.diff(old, new)
     except ValueError as exc:
         _fail(str(exc))
     if html_page is not None:
