@@ -265,7 +265,10 @@ faster forcing).
   such error, so the expansion Q_h = Q* + C h^q + ... holds with q = min(p, the event's
   order) while the events keep their sequence (the ranges of those bounds); a scenario's
   check names that order (comparisons/checks, `refinement_order`) and the refinement
-  judges at q: its range q - margin to p_top + margin, its r from q.
+  judges at q: its range q - margin to q_top + margin (q_top the fastest order of an
+  order-q scheme, `highest_order`: differences falling faster than the event's order
+  are not yet the asymptotic ones, the event's term being the one that remains as h
+  falls), its r from q.
   A declared order cap. A property of the engine's model rather than of its scheme can
   set the order too: an equality constraint the engine makes soft, its force a stiff
   spring-damper towards the constraint with a time constant tau that follows the step
