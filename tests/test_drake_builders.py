@@ -59,7 +59,7 @@ def _missing(mech, settings=PYTHON_LAWS) -> list[str]:
 
 def test_every_element_kind_has_one_builder_with_its_declaration():
     assert set(drake_backend._BUILDERS) == set(ELEMENT_KINDS)
-    assert BACKEND.EXPRESSIONS == {kind: drake_backend._EXPRESSIONS[kind]
+    assert BACKEND.EXPRESSIONS == {kind: drake_backend._BUILDERS.expressions[kind]
                                    for kind in ELEMENT_KINDS}
 
 

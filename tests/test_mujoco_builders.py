@@ -14,7 +14,7 @@ from mbfidelity.simulators.mujoco_backend import BACKEND  # noqa: E402
 
 def test_every_element_kind_has_one_builder_with_its_declaration():
     assert list(mujoco_mjcf._BUILDERS) and set(mujoco_mjcf._BUILDERS) == set(ELEMENT_KINDS)
-    assert BACKEND.EXPRESSIONS == {kind: mujoco_mjcf._EXPRESSIONS[kind]
+    assert BACKEND.EXPRESSIONS == {kind: mujoco_mjcf._BUILDERS.expressions[kind]
                                    for kind in ELEMENT_KINDS}
 
 

@@ -48,7 +48,7 @@ def _missing(mech) -> list[str]:
 
 def test_every_element_kind_has_one_builder_with_its_declaration():
     assert set(pymunk_backend._ELEMENTS) == set(ELEMENT_KINDS)
-    assert BACKEND.EXPRESSIONS == {kind: pymunk_backend._ELEMENTS[kind][1]
+    assert BACKEND.EXPRESSIONS == {kind: pymunk_backend._ELEMENTS.expressions[kind]
                                    for kind in ELEMENT_KINDS}
 
 
@@ -71,8 +71,7 @@ def test_each_supported_mechanism_layout_holds_its_elements():
 @pytest.mark.parametrize("kind", [REVOLUTE, PRISMATIC])
 def test_a_joint_builder_that_builds_nothing_is_caught(kind, monkeypatch):
     """The check above rejects a layout whose joint builder adds nothing."""
-    monkeypatch.setitem(pymunk_backend._ELEMENTS, kind,
-                        (lambda ctx, element: None, pymunk_backend._ELEMENTS[kind][1]))
+    monkeypatch.setitem(pymunk_backend._ELEMENTS, kind, lambda ctx, element: None)
     caught = [label for label, mech in _mechanisms()
               if any(element_kind(j) == kind for j in mech.joints)
               and BACKEND.support(mech).ok and _missing(mech)]

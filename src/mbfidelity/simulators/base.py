@@ -123,7 +123,7 @@ import numpy as np
 from ..systems import Expectation
 from ..systems._continua import Beam
 from ..systems.model import Mechanism
-from .plan import description_reason, element_kind, elements
+from .plan import ELEMENT_KINDS, description_reason, element_kind, elements
 
 EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
 LEVELS = (EXACT, SOFT, SUBSTITUTE, UNSUPPORTED)
@@ -210,6 +210,33 @@ def _has_type(value: object, kind: type) -> bool:
     if kind is list:
         return isinstance(value, (list, tuple)) and all(_has_type(v, float) for v in value)
     return isinstance(value, kind)
+
+
+class ElementBuilders(dict):
+    """A backend's builders, one per element kind of the description
+    (`plan.ELEMENT_KINDS`), each registered with `builds` together with the expressions it
+    declares (contract point 5: the declaration and the code that builds the element are
+    one thing). A mapping kind -> builder; `declared()` is the backend's `EXPRESSIONS`."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.expressions: dict[str, tuple[Expression, ...]] = {}
+
+    def builds(self, kind: str, *expressions: Expression) -> Callable:
+        """Register the decorated function as the builder of `kind`, with its expressions."""
+        def register(builder: Callable) -> Callable:
+            self[kind], self.expressions[kind] = builder, expressions
+            return builder
+        return register
+
+    def of(self, element) -> Callable:
+        """The builder of an element of the description."""
+        return self[element_kind(element)]
+
+    def declared(self) -> dict[str, tuple[Expression, ...]]:
+        """The registered expressions per kind, in the order of `plan.ELEMENT_KINDS`."""
+        return {kind: self.expressions[kind] for kind in ELEMENT_KINDS
+                if kind in self.expressions}
 
 
 @dataclass(frozen=True)

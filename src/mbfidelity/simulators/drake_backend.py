@@ -72,13 +72,14 @@ from __future__ import annotations
 import inspect
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Callable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointOnLine,
                              PointOnPoint, PointToPoint, Revolute)
 from .base import (
+    ElementBuilders,
     EXACT,
     RK3_STABILITY,
     SEMI_IMPLICIT_EULER_STABILITY,
@@ -100,7 +101,6 @@ from .plan import (
     CoordinateLaws,
     driven_start,
     BODY,
-    ELEMENT_KINDS,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     LINEAR_COUPLING,
@@ -325,16 +325,9 @@ def _native_coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool
     return held
 
 
-_BUILDERS: dict[str, Callable[[_Built, object], None]] = {}
-_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
-
-
-def _builds(kind: str, *cases: Expression):
-    """Register the builder of one element kind with the expression(s) it declares."""
-    def register(builder: Callable[[_Built, object], None]):
-        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
-        return builder
-    return register
+#: element kind -> its builder (taking the `_Built` and the element), with its expressions
+_BUILDERS = ElementBuilders()
+_builds = _BUILDERS.builds
 
 
 def _body(build: _Built, body) -> None:
@@ -560,7 +553,7 @@ def _hinge_closure(build: _Built, c) -> None:
 
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
-EXPRESSIONS = {kind: _EXPRESSIONS[kind] for kind in ELEMENT_KINDS}
+EXPRESSIONS = _BUILDERS.declared()
 
 
 

@@ -73,14 +73,14 @@ from ..systems._continua import Beam
 from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mechanism,
                              PointOnLine, PointOnPoint, PointToPoint, Prescribed, Prismatic,
                              Revolute, inertia_matrix)
-from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
+from .base import (EXACT, ElementBuilders, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
                    BeamElement, BeamModes, Expression, Linearization, Samples, Scheme, Setting,
                    Stopwatch)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, LINEAR_COUPLING,
                    MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT, POINT_TO_POINT_CUSTOM,
                    POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
                    HINGE_CLOSURE, TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
-                   constrained_bodies, coordinate_map, driven_start, element_kind,
+                   constrained_bodies, coordinate_map, driven_start,
                    massive_below, num, rot, spatial_tree_reason)
 from .reactions import joint_reactions, subtree_force
 
@@ -207,19 +207,8 @@ def _spatial_reason(mech: Mechanism) -> str:
 #: element kind -> (its builder, the expressions it declares: contract point 5). A body's
 #: builder gives its link's mass and central tensor, a joint's its link frame, any other
 #: element's adds its items to the `_System` being built.
-_ELEMENTS: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
-
-
-def _builds(kind: str, *expressions: Expression) -> Callable:
-    """Register the decorated function as the builder of `kind`, with its expressions."""
-    def register(build: Callable) -> Callable:
-        _ELEMENTS[kind] = (build, expressions)
-        return build
-    return register
-
-
-def _builder(element) -> Callable:
-    return _ELEMENTS[element_kind(element)][0]
+_ELEMENTS = ElementBuilders()
+_builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
 
 
 @_builds(BODY, Expression(EXACT, "a link of the ObjectKinematicTree with its mass, centre "
@@ -718,7 +707,7 @@ class ExudynBackend(Backend):
 
     # --- support ---------------------------------------------------------------------------
     EXPRESSIONS = {
-        **{kind: expressions for kind, (_, expressions) in _ELEMENTS.items()},
+        **_ELEMENTS.declared(),
         ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
                                                   "Exudyn holds the rolling coupling exactly "
                                                   "(LinearCoupling)"),),

@@ -32,10 +32,9 @@ from ..systems.model import (
     Segment,
     inertia_matrix,
 )
-from .base import EXACT, SOFT, SUBSTITUTE, UNSUPPORTED, Expression
+from .base import EXACT, SOFT, SUBSTITUTE, UNSUPPORTED, ElementBuilders, Expression
 from .plan import (
     BODY,
-    ELEMENT_KINDS,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
     HINGE_CLOSURE,
@@ -253,16 +252,9 @@ class Build:
 
 # --- element builders, each registered with its declared expression (contract point 5) --
 
-_BUILDERS: dict[str, Callable[[Build, object], None]] = {}
-_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
-
-
-def _builds(kind: str, *cases: Expression):
-    """Register the builder of one element kind together with the expression(s) it builds."""
-    def register(builder: Callable[[Build, object], None]):
-        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, cases
-        return builder
-    return register
+#: element kind -> its builder (taking the `Build` and the element), with its expressions
+_BUILDERS = ElementBuilders()
+_builds = _BUILDERS.builds
 
 
 def _point_loaded_bodies(mech: Mechanism) -> set[str]:
@@ -617,7 +609,7 @@ _builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by a control cal
     lambda build, p: None)  # nothing in the MJCF: the backend's control callback imposes it
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
-EXPRESSIONS = {kind: _EXPRESSIONS[kind] for kind in ELEMENT_KINDS if kind in _EXPRESSIONS}
+EXPRESSIONS = _BUILDERS.declared()
 
 
 def translate(mech: Mechanism, settings: dict, autonomous: bool = False,

@@ -110,6 +110,7 @@ from ..systems.model import (
 )
 from ..analytic.linear import quadratic_eigenvalues
 from .base import (
+    ElementBuilders,
     SEMI_IMPLICIT_EULER_STABILITY,
     Scheme,
     EXACT,
@@ -573,17 +574,8 @@ class _Translation:
 
 #: per element kind of the description, the function that builds an element of it into
 #: the `_Translation` (contract point 5), and the expressions it builds
-_BUILDERS: dict[str, Callable[[_Translation, object], None]] = {}
-_EXPRESSIONS: dict[str, tuple[Expression, ...]] = {}
-
-
-def _builds(kind: str, *expressions: Expression):
-    """Register the decorated function as the builder of `kind`, which builds the
-    declared `expressions` (the declaration and the code that builds it are one thing)."""
-    def register(builder):
-        _BUILDERS[kind], _EXPRESSIONS[kind] = builder, expressions
-        return builder
-    return register
+_BUILDERS = ElementBuilders()
+_builds = _BUILDERS.builds
 
 
 @_builds(BODY, Expression(EXACT, "a link of the reduced-coordinate multibody with the "
@@ -1104,7 +1096,7 @@ class PyBulletBackend(Backend):
             import pybullet
             return f"api {pybullet.getAPIVersion()}"
 
-    EXPRESSIONS = _EXPRESSIONS
+    EXPRESSIONS = _BUILDERS.declared()
 
     SPATIAL_REASON = ""
 

@@ -107,6 +107,7 @@ from ..systems.model import (
     RollingContact,
 )
 from .base import (
+    ElementBuilders,
     SEMI_IMPLICIT_EULER_STABILITY,
     Scheme,
     EXACT,
@@ -125,7 +126,6 @@ from .base import (
 from .reactions import PAIR_ELEMENTS, joint_reactions, subtree_force
 from .plan import (
     BODY,
-    ELEMENT_KINDS,
     HINGE_CLOSURE,
     PRESCRIBED,
     COORDINATE_FORCE_CUSTOM,
@@ -528,19 +528,8 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
 #: its part to the layout (`_plan`), refusing (`_Refused`) what Chipmunk cannot express; a
 #: force element's takes (mechanism, element) and gives its loads as a function of the
 #: frames and t, which the compiled body forces sum (`_Compiled`).
-_ELEMENTS: dict[str, tuple[Callable, tuple[Expression, ...]]] = {}
-
-
-def _builds(kind: str, *expressions: Expression) -> Callable:
-    """Register the decorated function as the builder of `kind`, with its expressions."""
-    def register(build: Callable) -> Callable:
-        _ELEMENTS[kind] = (build, expressions)
-        return build
-    return register
-
-
-def _builder(element) -> Callable:
-    return _ELEMENTS[element_kind(element)][0]
+_ELEMENTS = ElementBuilders()
+_builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
 
 
 @_builds(BODY,
@@ -1496,7 +1485,7 @@ class PymunkBackend(Backend):
 
         return f"{pymunk.version} (Chipmunk {pymunk.chipmunk_version.split('-')[0]})"
 
-    EXPRESSIONS = {kind: _ELEMENTS[kind][1] for kind in ELEMENT_KINDS if kind in _ELEMENTS}
+    EXPRESSIONS = _ELEMENTS.declared()
 
     SPATIAL_REASON = ("Pymunk is a planar (2-D) engine: a spatial mechanism (full inertia "
                       "tensor, hinges about horizontal axes) has no expression in it")
