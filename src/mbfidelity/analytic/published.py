@@ -64,37 +64,37 @@ def _state_at(system: System, scenario, values, time: float, tol: float):
     return model.state_from_independent(y[:k], y[k:])
 
 
-def _state(system: System, item: Published, values, scenario,
-           solved: dict) -> tuple[float, float]:
-    """The expression at the instant, and its error estimate: its change from the
-    reference's tolerance to a 10x looser one (as the reference's own estimate). `solved`
-    keeps the states already integrated (one solve per instant and tolerance)."""
-    names = list(system.coordinates)
-    symbols = [s for c in names for s in coordinate_symbols(c)[:2]]
-    expr = sp.sympify(item.expression).xreplace(system.subs(values))
-    law = sp.lambdify(symbols, expr, modules="math")
+def _at_instant(system: System, item: Published, values, scenario, solved: dict,
+                read) -> tuple[float, float]:
+    """`read(q, qd)` of the state at the item's instant, and its error estimate: its change
+    from the reference's tolerance to a 10x looser one (as the reference's own estimate).
+    `solved` keeps the states already integrated (one solve per instant and tolerance)."""
     out = []
     for tol in (TIGHT, LOOSE):
         key = (scenario.name, item.time, tol)
         if key not in solved:
             solved[key] = _state_at(system, scenario, values, item.time, tol)
-        q, qd = solved[key]
-        out.append(float(law(*[x for pair in zip(q, qd) for x in pair])))
+        out.append(float(read(*solved[key])))
     return out[0], abs(out[1] - out[0])
+
+
+def _state(system: System, item: Published, values, scenario,
+           solved: dict) -> tuple[float, float]:
+    """The expression at the instant, and its error estimate (`_at_instant`)."""
+    names = list(system.coordinates)
+    symbols = [s for c in names for s in coordinate_symbols(c)[:2]]
+    expr = sp.sympify(item.expression).xreplace(system.subs(values))
+    law = sp.lambdify(symbols, expr, modules="math")
+    return _at_instant(system, item, values, scenario, solved,
+                       lambda q, qd: law(*[x for pair in zip(q, qd) for x in pair]))
 
 
 def _energy(system: System, item: Published, values, scenario,
             solved: dict) -> tuple[float, float]:
     """T + V at the instant, and its error estimate as for a state value."""
     model = numeric_model(system.id, values)
-    out = []
-    for tol in (TIGHT, LOOSE):
-        key = (scenario.name, item.time, tol)
-        if key not in solved:
-            solved[key] = _state_at(system, scenario, values, item.time, tol)
-        q, qd = solved[key]
-        out.append(float(model.energy(np.atleast_2d(q), np.atleast_2d(qd))[0]))
-    return out[0], abs(out[1] - out[0])
+    return _at_instant(system, item, values, scenario, solved,
+                       lambda q, qd: model.energy(np.atleast_2d(q), np.atleast_2d(qd))[0])
 
 
 def _period(system: System, item: Published, ref) -> tuple[float, float]:
