@@ -128,8 +128,8 @@ def test_traced_step_function_is_the_numeric_one():
 
 
 def _body_states_on_symbols(mech, q, qd) -> dict:
-    """body_states on symbols: the planar tree by `moving_point` (plan.py)."""
-    from mbfidelity.simulators.plan import cos_sin, moving_point, num
+    """body_states on symbols: the planar tree by `point_state` (plan.py)."""
+    from mbfidelity.simulators.plan import cos_sin, point_state, num
     from mbfidelity.systems.model import WORLD, Revolute
 
     st = {WORLD: (0.0,) * 6}
@@ -142,11 +142,11 @@ def _body_states_on_symbols(mech, q, qd) -> dict:
             s = -1.0 if j.clockwise else 1.0
             th = (0.0 if j.absolute else parent[2]) + s * qj + off
             w = (0.0 if j.absolute else parent[5]) + s * qdj
-            ax, ay, avx, avy = moving_point(parent, pa)
+            ax, ay, avx, avy = point_state(parent, pa)
         else:
             th, w = parent[2] + off, parent[5]
             axis = (num(j.axis[0]), num(j.axis[1]))
-            ax, ay, avx, avy = moving_point(parent, (pa[0] + qj * axis[0], pa[1] + qj * axis[1]))
+            ax, ay, avx, avy = point_state(parent, (pa[0] + qj * axis[0], pa[1] + qj * axis[1]))
             c, s = cos_sin(parent[2])
             avx += qdj * (c * axis[0] - s * axis[1])
             avy += qdj * (s * axis[0] + c * axis[1])

@@ -556,11 +556,12 @@ def body_states(mech: Mechanism, q, qd) -> dict[str, tuple[float, ...]]:
     return st
 
 
-def point_state(st: tuple[float, ...], local) -> tuple[float, float, float, float]:
-    """World position and velocity of a body point, from the body frame's state
-    (x, y, theta, vx, vy, omega)."""
+def point_state(st: tuple, local) -> tuple:
+    """World position and velocity (x, y, vx, vy) of a body point, from the body frame's
+    state (x, y, theta, vx, vy, omega), whose entries are numbers, arrays of samples or
+    SymPy expressions (`cos_sin`)."""
     x, y, th, vx, vy, w = st
-    c, s = math.cos(th), math.sin(th)
+    c, s = cos_sin(th)
     rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
     return x + rx, y + ry, vx - w * ry, vy + w * rx
 
@@ -656,15 +657,6 @@ def traced(fn: Callable[..., Sequence], n_args: int) -> Callable[..., list]:
     return sp.lambdify(args, [sp.sympify(v) for v in fn(*args)], modules="math", cse=True)
 
 
-def moving_point(state, local) -> tuple:
-    """World position and velocity (x, y, vx, vy) of a body point from the body frame's
-    state (x, y, theta, vx, vy, omega), whose entries are numbers or arrays of samples."""
-    x, y, th, vx, vy, w = state
-    c, s = cos_sin(th)
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return x + rx, y + ry, vx - w * ry, vy + w * rx
-
-
 def coordinate_reader(joint: Revolute | Prismatic) -> Callable[[tuple, tuple], tuple]:
     """A function giving a joint's coordinate and rate (q, qd) from the frame states
     (x, y, theta, vx, vy, omega) of its parent and its child, numbers or arrays of
@@ -684,8 +676,8 @@ def coordinate_reader(joint: Revolute | Prismatic) -> Callable[[tuple, tuple], t
     norm2 = a[0] * a[0] + a[1] * a[1]
 
     def read(parent: tuple, child: tuple) -> tuple:
-        xa, ya, vxa, vya = moving_point(parent, pa)
-        xb, yb, vxb, vyb = moving_point(child, ca)
+        xa, ya, vxa, vya = point_state(parent, pa)
+        xb, yb, vxb, vyb = point_state(child, ca)
         c, s = cos_sin(parent[2])
         ax, ay = c * a[0] - s * a[1], s * a[0] + c * a[1]  # the axis in world axes
         dx, dy = xb - xa, yb - ya
@@ -737,7 +729,7 @@ def coordinate_load(joint: Revolute | Prismatic) -> Callable[[Mapping, object], 
     def loads(states: Mapping, value) -> list[Load]:
         c, s = cos_sin(states[joint.parent][2])
         force = (value * (c * a[0] - s * a[1]) / norm2, value * (s * a[0] + c * a[1]) / norm2)
-        w = moving_point(states[joint.child], anchor)[:2]
+        w = point_state(states[joint.child], anchor)[:2]
         return [(joint.child, force, w, 0.0), (joint.parent, (-force[0], -force[1]), w, 0.0)]
 
     return loads
@@ -756,7 +748,7 @@ def element_loads(mech: Mechanism, element: PointToPoint | CoordinateForce
         pb = (num(f.point_b[0]), num(f.point_b[1]))
 
         def point_to_point(states: Mapping, t) -> list[Load]:
-            a, b = moving_point(states[f.body_a], pa), moving_point(states[f.body_b], pb)
+            a, b = point_state(states[f.body_a], pa), point_state(states[f.body_b], pb)
             dx, dy = b[0] - a[0], b[1] - a[1]
             length = sqrt(dx * dx + dy * dy)
             rate = (dx * (b[2] - a[2]) + dy * (b[3] - a[3])) / length
