@@ -229,3 +229,22 @@ def test_andrews_releases_get_a_verdict_on_pybullet_and_drake():
         assert "unresolved" not in statuses.values(), engine
         assert statuses["eq2_small.constraint_E_EG"] == "xfail"
         assert statuses["eq2_small.trajectory_max"] == "pass"
+
+
+def test_the_step_budget_confirms_an_order_h8_does_not_and_rejects_a_stiffness_off():
+    """Pymunk's steady amplitude at half the resonance: its error at h is not yet in the
+    asymptotic regime at h/8 (the differences grow from h/4 to h/8), and the run at h/16,
+    the step budget, confirms the first order: the metric is judged and passes. A spring
+    stiffness 1 % off in the engine's build moves the amplitude by about 1.3 % (eq. 86:
+    A ~ r^2 / (1 - r^2) at r = 0.5), which the same gate rejects."""
+    def amplitude(scale):
+        result = compare("unbalanced_rotor", "pymunk", scenarios=["ratio_0_5"],
+                         engine_scale=scale)
+        return next(m for m in result.metrics if m.name == "ratio_0_5.steady_state_x")
+
+    correct = amplitude(None)
+    assert correct.rule == "refinement" and correct.status == "pass"
+    assert len(correct.refinement["differences"]) == 4  # h/2, h/4, h/8 and h/16
+    assert correct.refinement["a_priori_tolerance"] > tolerances.MAX_TRAJECTORY_TOLERANCE
+    wrong = amplitude({"k": 1.01})
+    assert wrong.status == "fail" and wrong.value > wrong.tolerance

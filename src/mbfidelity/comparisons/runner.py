@@ -1113,8 +1113,8 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
 
 #: the refinement's steps, as divisors of the comparison's: h/8 only where the pair
 #: before it does not show the order or the engine's limit is not yet within the ceiling,
-#: h/16 only where the limit's observed order brings it within (tolerances.py, "A
-#: posteriori": the step budget)
+#: h/16 (the step budget) only where the order is still not shown or the limit's observed
+#: order brings it within the ceiling (tolerances.py, "A posteriori")
 REFINEMENT_DIVISORS = (2, 4, 8, 16)
 
 
@@ -1167,7 +1167,10 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
                 or limit_gates[name].limit_tolerance <= _ceiling(name))
                 for name, g in gates.items()):
             break
-        if k > 8 and not any(_limit_within_reach(name, g, limit_gates.get(name))
+        # h/16, the step budget: where the order is still not confirmed, or where the
+        # engine's limit is predicted to come within the ceiling
+        if k > 8 and not any((g.unresolved and g.observed_order is not None)
+                             or _limit_within_reach(name, g, limit_gates.get(name))
                              for name, g in gates.items()):
             break
         fine = _guarded_run(backend, scratch, f"{sc.name}.refinement", t_end, mech, ref.q[0],

@@ -218,9 +218,11 @@ faster forcing).
   conservative ratio in between. An order outside that range says the pair is not in
   the asymptotic regime (a difference that does not shrink: a floor; one that collapses:
   an error of the coarse run alone, e.g. its first step, that the finer runs do not
-  share on the samples of h). Then the engine is run at h/8 too and the last pair
-  confirms the order instead: the bound is d1 + d2 + d3 / (1 - r), the same sum with the
-  unconfirmed difference taken as it is, and e(h) = d1 + d2 / (1 - 2^-p). A pass also
+  share on the samples of h). Then the engine is run at h/8 too (and at h/16, the step
+  budget, where that pair does not confirm it either) and the last pair confirms the
+  order instead: the bound is d1 + d2 + d3 / (1 - r) (d1 + d2 + d3 + d4 / (1 - r)), the
+  same sum with the unconfirmed differences taken as they are, and e(h) the same sum with
+  the last pair's Richardson term d / (1 - 2^-p). A pass also
   needs the bound below the ceiling the metric can discriminate (as for the a-priori
   gates, 0.1 of the amplitude, 0.05 of a frequency): a wider bound says the engine's own
   error at h leaves no room to tell its limit from the reference (a model error that
@@ -292,7 +294,7 @@ faster forcing).
   Where the bound holds: in the engine's asymptotic regime, which the observed order confirms on the last pair of halvings (the
   next terms of the expansion shrink faster; a cancellation exactly at the finest pair
   would overstate the order, which the max norm over a run makes unlikely). Where the
-  order falls short down to h/8 (the differences stop shrinking with the step: a
+  order falls short down to h/16 (the differences stop shrinking with the step: a
   constraint's compliance, an event located to the step, a motion too fast), the metric
   stays `unresolved`, the observed order stated. The refinement runs cost six times the
   engine's run at h (h/2 and h/4; fourteen with h/8, thirty with h/16), only on the
