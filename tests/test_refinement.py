@@ -248,3 +248,31 @@ def test_the_step_budget_confirms_an_order_h8_does_not_and_rejects_a_stiffness_o
     assert correct.refinement["a_priori_tolerance"] > tolerances.MAX_TRAJECTORY_TOLERANCE
     wrong = amplitude({"k": 1.01})
     assert wrong.status == "fail" and wrong.value > wrong.tolerance
+
+
+def test_gates_held_from_a_baseline_reject_what_the_engines_own_refinement_rejects():
+    """The power study judges a mutated run at the neutralised run's gates instead of
+    refining it again (`compare(held_gates=)`). Pymunk at 0.9 of resonance: the motor
+    torque is judged on the engine's limit (its bound at h is above the ceiling) and the
+    trajectory by the refinement at h. Held at the correct run's gates, the correct run
+    passes them, and an eccentricity 1 % off fails the torque on the mutated engine's
+    run at the baseline's finest step, as its own refinement does (the test above)."""
+    baseline = compare("unbalanced_rotor", "pymunk", scenarios=["ratio_0_9"])
+    held = {m.name: m.as_dict() for m in baseline.metrics}
+    torque = next(m for m in baseline.metrics if m.name == "ratio_0_9.actuator_motor")
+    assert torque.rule == "refinement_limit"
+
+    def judged(scale):
+        result = compare("unbalanced_rotor", "pymunk", scenarios=["ratio_0_9"],
+                         engine_scale=scale, held_gates=held)
+        return {m.name: m for m in result.metrics}
+
+    same = judged(None)
+    for name, m in same.items():
+        assert m.status == held[name]["status"] and m.value == held[name]["value"], name
+        if held[name]["rule"].startswith("refinement"):
+            assert m.refinement["held"] and m.tolerance == held[name]["tolerance"]
+    wrong = judged({"e": 1.01})["ratio_0_9.actuator_motor"]
+    assert wrong.value <= wrong.tolerance  # within the bound at h: the limit catches it
+    assert wrong.status == "fail" and wrong.refinement["limit"]["value"] > \
+        wrong.refinement["limit"]["tolerance"]

@@ -170,11 +170,13 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     budget = max(RUN_BUDGET_FLOOR, RUN_BUDGET_FACTOR * (time.perf_counter() - started))
     if kinds:
         error_budget = max(RUN_TIMEOUT_FLOOR, RUN_TIMEOUT_FACTOR * neutral.wall_time)
+        # a mutated run is judged at the neutralised run's gates (comparisons/power.py)
+        held = {m.name: m.as_dict() for m in neutral.metrics}
 
         def mutated(**kwargs) -> Comparison:
             entry.comparisons += 1
             c = isolated_compare(system.id, simulator, dt=dt, scenarios=declared[:1],
-                                 timeout=error_budget, **kwargs)
+                                 timeout=error_budget, held_gates=held, **kwargs)
             entry.engine_time_s += c.wall_time
             return c
 

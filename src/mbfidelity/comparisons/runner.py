@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import datetime
 import fnmatch
+import math
 import platform
 import subprocess
 from contextlib import contextmanager
@@ -136,13 +137,23 @@ _COMPARED_VALUES: ContextVar[Mapping[str, float] | None] = ContextVar("compared_
 _ENGINE_SCALE: ContextVar[Mapping[str, float]] = ContextVar("engine_scale", default={})
 
 
+#: metric name -> that metric of a baseline comparison (`Metric.as_dict`): the gates a
+#: comparison's a-priori unresolved metrics are judged by instead of the engine's own
+#: refinement (`compare(held_gates=)`: the power study's mutated runs, comparisons/power.py)
+_HELD_GATES: ContextVar[Mapping[str, dict] | None] = ContextVar("held_gates", default=None)
+
+
 @contextmanager
-def _engine_scaled(scale: Mapping[str, float]):
-    token = _ENGINE_SCALE.set(dict(scale))
+def _context(variable: ContextVar, value):
+    token = variable.set(value)
     try:
         yield
     finally:
-        _ENGINE_SCALE.reset(token)
+        variable.reset(token)
+
+
+def _engine_scaled(scale: Mapping[str, float]):
+    return _context(_ENGINE_SCALE, dict(scale))
 
 
 def _engine_mechanism(system: System, values: Mapping[str, float], variant=None):
@@ -151,13 +162,8 @@ def _engine_mechanism(system: System, values: Mapping[str, float], variant=None)
         {k: v * scale.get(k, 1.0) for k, v in values.items()} if scale else values, variant)
 
 
-@contextmanager
 def _declarations_judged_at(values: Mapping[str, float]):
-    token = _COMPARED_VALUES.set(values)
-    try:
-        yield
-    finally:
-        _COMPARED_VALUES.reset(token)
+    return _context(_COMPARED_VALUES, values)
 
 
 def expectations(system: System, simulator: str) -> tuple[tuple[Expectation, ...], ...]:
@@ -264,17 +270,22 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
             dt: float = DEFAULT_DT, t_end: float | None = None,
             settings: Mapping | None = None, scenarios: Iterable[str] | None = None,
             keep_series: bool = False, variant: str | None = None,
-            engine_scale: Mapping[str, float] | None = None) -> Comparison:
+            engine_scale: Mapping[str, float] | None = None,
+            held_gates: Mapping[str, dict] | None = None) -> Comparison:
     """One system on one engine, every scenario and the frequency checks. With `variant`
     the engine builds the system's named variant (its settings first, then `settings`);
     the metrics are then measurements of the variant's own error (status "measured"
     where the description's gate is not met). `engine_scale` multiplies parameters in the
     engine's build only (an injected model error; the reference and gates keep the true
-    values)."""
+    values). `held_gates` (name -> a baseline comparison's metric, `Metric.as_dict`):
+    the metrics unresolved a priori are judged by the baseline's refinement gates instead
+    of the engine's own refinement, and where the baseline judged the engine's limit, on
+    one run at the baseline's finest step (`_judge_held`)."""
     system = get_system(system_id)
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
-    with _declarations_judged_at(base_values), _engine_scaled(engine_scale or {}):
+    with _declarations_judged_at(base_values), _engine_scaled(engine_scale or {}), \
+            _context(_HELD_GATES, held_gates):
         backend = get_backend(simulator)
         system = system.with_structure(base_values)  # built for the user's number of elements
         ok, why = backend.available()
@@ -1127,7 +1138,7 @@ NOT_REFINED = ("growth_rate",)
 def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, settings,
                      result, eq, measured_here: list) -> None:
     """Judge the scenario's unresolved metrics (of `measured_here`) by the engine's own
-    refinement: the engine re-run at h/2, h/4 (h/8 where needed) from the same state, the
+    refinement: the engine re-run at h/2, h/4 (h/8, h/16 where needed) from the same state, the
     scenario's metrics measured between successive runs on the samples of h
     (`_measure_scenario` with the finer run in the reference's place), and each metric
     judged by `tolerances.refinement_gate`. The a-priori verdicts stay as they are."""
@@ -1152,6 +1163,11 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     wanted = {m.name for m in pending}
     refined_checks = tuple(c for c in sc.checks if any(
         f"{sc.name}.{label}" in wanted for label in checks.refinable(c)))
+    held = _HELD_GATES.get()
+    if held is not None:
+        _judge_held(system, backend, sc, values, mech, ref, t_end, dt, settings, eq, joints,
+                    refined_checks, pending, held)
+        return
     runs, differences = [run], {m.name: [] for m in pending}
     # the same differences on the samples of h, for the engine's limit
     on_h = {m.name: [] for m in pending}
@@ -1210,6 +1226,51 @@ def _refine_scenario(system, backend, sc, values, mech, ref, run, t_end, dt, set
     for m in pending:
         if m.name in gates:
             _judge_refined(system, backend.id, m, gates[m.name], limits.get(m.name))
+
+
+def _held_gate(baseline: dict | None) -> "tolerances.RefinementGate | None":
+    """The refinement gate a baseline's metric (`Metric.as_dict`) was judged by, or None
+    where the baseline did not judge it by its refinement."""
+    numbers = (baseline or {}).get("refinement")
+    if not numbers or not baseline["rule"].startswith("refinement"):
+        return None
+    return tolerances.RefinementGate(
+        baseline["tolerance"], numbers["observed_order"], numbers["declared_order"],
+        numbers["predicted_error"], tuple(numbers["differences"]),
+        numbers["reference_error"], numbers.get("unresolved", ""),
+        (numbers.get("limit") or {}).get("tolerance", math.inf))
+
+
+def _judge_held(system, backend, sc, values, mech, ref, t_end, dt, settings, eq, joints,
+                refined_checks, pending, held: Mapping[str, dict]) -> None:
+    """`pending` judged by the baseline's refinement gates (`compare(held_gates=)`): a
+    metric the baseline judged at h against that bound; one whose limit the baseline
+    judged on its run at h/K, on the engine's run at h/K (the same K) against the
+    baseline's bound on the limit. A metric the baseline did not judge by its refinement
+    stays unresolved."""
+    gates = {m.name: _held_gate(held.get(m.name)) for m in pending}
+    divisors = {name: held[name]["refinement"]["limit"]["divisor"]
+                for name, g in gates.items()
+                if g is not None and "limit" in held[name]["refinement"]}
+    measured: dict = {}
+    if divisors:
+        k = max(divisors.values())
+        scratch = Comparison(system.id, backend.id, "", dict(settings), dict(values), dt)
+        fine = _guarded_run(backend, scratch, f"{sc.name}.refinement", t_end, mech,
+                            ref.q[0], ref.qd[0], t_end, dt / k, settings, joints)
+        if fine is not None and not scratch.incidents:
+            _measure_scenario(system, backend, sc, values, mech, ref, _on_steps_of(fine, k),
+                              dt, settings, scratch, False, eq, refinement=True,
+                              refined_checks=refined_checks)
+            measured = {m.name: m.value for m in scratch.metrics}
+    for m in pending:
+        gate = gates[m.name]
+        if gate is None:
+            continue
+        limit = ((measured.get(m.name, math.inf), gate.limit_tolerance, divisors[m.name])
+                 if m.name in divisors else None)
+        _judge_refined(system, backend.id, m, gate, limit)
+        m.refinement["held"] = True
 
 
 def _limit_within_reach(name: str, gate, limit_gate) -> bool:
@@ -1288,6 +1349,14 @@ def _refine_fit(system, backend, mech, q0, qd0, t_end, dt, settings, result, fit
     where needed) fitted alike; d_k are the differences of successive fits, relative to
     the mode's frequency (the damping ratio's, absolute), tolerances.refinement_gate."""
     pending = [m for m in fitted if m.status == "unresolved" and np.isfinite(m.value)]
+    held = _HELD_GATES.get()
+    if held is not None:
+        for metric in pending:
+            gate = _held_gate(held.get(metric.name))
+            if gate is not None:
+                _judge_refined(system, backend.id, metric, gate)
+                metric.refinement["held"] = True
+        return
     if not pending or not np.all(np.isfinite(first_fit)):
         return
     w_ref = abs(mode.eigenvalue)

@@ -563,9 +563,12 @@ class RefinementGate:
     limit_tolerance: float = math.inf
 
     def as_dict(self) -> dict:
-        return {"observed_order": self.observed_order, "declared_order": self.declared_order,
-                "predicted_error": self.predicted_error, "differences": list(self.differences),
-                "reference_error": self.reference_error}
+        out = {"observed_order": self.observed_order, "declared_order": self.declared_order,
+               "predicted_error": self.predicted_error, "differences": list(self.differences),
+               "reference_error": self.reference_error}
+        if self.unresolved:
+            out["unresolved"] = self.unresolved
+        return out
 
 
 def highest_order(order: int) -> int:
