@@ -6,7 +6,8 @@ For every system x engine: the neutralised run (the harness's settings; every de
 scenario and the frequency checks, `runner.compare(scenarios=declared)`), then each
 neutralised default (`Setting.engine_default`: the engine's documented value, cited in the
 setting's note) switched back on alone, and all of them together (the engine as a user gets
-it), each in the same comparison. Recorded per default, in the power study's format
+it), each in the same comparison, judged at the neutralised run's gates (the harness's
+gates at its configuration, `runner.compare(held_gates=)`). Recorded per default, in the power study's format
 (`power.DefaultPower`): the gates' verdict (rejected when a metric that holds in the
 neutralised run fails with the default, or the run does not complete:
 `power.rejecting_metrics`), whether anything moved at all and what it moved most against
@@ -82,12 +83,13 @@ def _motion_change(neutral: Mapping[str, tuple], on: Comparison, free: list[int]
 
 
 def _switched_on(system_id: str, simulator: str, dt: float, declared: list[str],
-                 settings: dict, neutral: Mapping[str, tuple], free: list[int]
-                 ) -> tuple[Comparison, dict]:
-    """One default's comparison (a worker's task): the comparison without its series and
-    the motion change against the neutralised run per scenario."""
+                 settings: dict, neutral: Mapping[str, tuple], free: list[int],
+                 held: Mapping[str, dict]) -> tuple[Comparison, dict]:
+    """One default's comparison (a worker's task), judged at the neutralised run's gates
+    (`held`): the comparison without its series and the motion change against the
+    neutralised run per scenario."""
     c = compare(system_id, simulator, dt=dt, scenarios=declared, settings=settings,
-                keep_series=True)
+                keep_series=True, held_gates=held)
     motion = _motion_change(neutral, c, free)
     c.series = {}
     return c, motion
@@ -168,10 +170,11 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
     entry.baseline_not_holding = [m.name for m in neutral.metrics
                                   if m.status not in ("pass", "xpass", "measured")]
     budget = max(RUN_BUDGET_FLOOR, RUN_BUDGET_FACTOR * (time.perf_counter() - started))
+    # a default's or a model error's run is judged at the neutralised run's gates
+    # (comparisons/power.py)
+    held = {m.name: m.as_dict() for m in neutral.metrics}
     if kinds:
         error_budget = max(RUN_TIMEOUT_FLOOR, RUN_TIMEOUT_FACTOR * neutral.wall_time)
-        # a mutated run is judged at the neutralised run's gates (comparisons/power.py)
-        held = {m.name: m.as_dict() for m in neutral.metrics}
 
         def mutated(**kwargs) -> Comparison:
             entry.comparisons += 1
@@ -189,7 +192,7 @@ def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
         entry.comparisons += 1
         try:
             run, motion = isolated(_switched_on, system.id, simulator, dt, declared, settings,
-                                   series, free, timeout=budget)
+                                   series, free, held, timeout=budget)
         except (ValueError, KeyError):
             raise
         except Exception as exc:  # crashed or past its budget: the run's incident

@@ -17,14 +17,14 @@ the neutralised engine than the gate); a run that did not complete is rejected. 
 are held at the harness's configuration: a default that changes the scheme the engine
 declares (MuJoCo's Euler integrator, Exudyn's solver) would otherwise be judged against
 the a-priori bound of its own, lower order, and pass while it moves the motion by far more
-than the harness's gate. A model error's run is judged at the baseline's gates outright
-(`runner.compare(held_gates=)`): a metric the baseline judged by the engine's refinement
-keeps that gate instead of refining the mutated run again (a relative error of at most
-0.1 leaves the engine's own convergence as it is; the rule above rejects a value beyond
-the baseline's tolerance either way), and one whose limit the baseline judged on its run
-at h/K is judged on the mutated engine's run at h/K against the baseline's bound on the
-limit (an error that moves the engine's limit off the reference is caught there, where the
-bound at h is too wide to catch it).
+than the harness's gate. A model error's or a default's run is judged at the baseline's
+gates outright (`runner.compare(held_gates=)`): a metric the baseline judged by the
+engine's refinement keeps that gate instead of refining the run again (the gate is the
+harness configuration's convergence; the rule above rejects a value beyond the baseline's
+tolerance either way), and one whose limit the baseline judged on its run at h/K is
+judged on the run at h/K against the baseline's bound on the limit (an error that moves
+the engine's limit off the reference is caught there, where the bound at h is too wide
+to catch it).
 
 For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found
 assuming rejection is monotone in eps (a larger error is rejected whenever a smaller one
@@ -48,9 +48,9 @@ inequality). `classify_default` gives each reading its verdict and why.
 
 Cost: a model error's run is the system's first scenario plus the frequency checks
 (free-vibration fits and the engine's linearization; `runner.compare(scenarios=[first])`):
-a small relative error acts linearly at any amplitude; held at the baseline's gates, it
-adds no refinement runs but the one at the finest step where the baseline judged the
-engine's limit. A default's run takes every
+a small relative error acts linearly at any amplitude. Held at the baseline's gates, a
+model error's or a default's run adds no refinement runs but the one at the finest step
+where the baseline judged the engine's limit. A default's run takes every
 declared scenario and the frequency checks, since a default's effect depends on the
 amplitude (an error-correction bias that is invisible on a small swing acts on a large
 one). The neutralised run over every declared scenario is the baseline of both, made once
