@@ -90,77 +90,25 @@ import math
 from types import SimpleNamespace
 from dataclasses import dataclass, field
 from functools import cached_property
-from operator import itemgetter
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (
-    WORLD,
-    LinearCoupling,
-    Mechanism,
-    PointOnLine,
-    PointOnPoint,
-    PointToPoint,
-    Prismatic,
-    Revolute,
-    RollingContact,
-)
-from .base import (
-    ElementBuilders,
-    SEMI_IMPLICIT_EULER_STABILITY,
-    Scheme,
-    EXACT,
-    SUBSTITUTE,
-    UNSUPPORTED,
-    NO_BEAM_ELEMENT,
-    Backend,
-    BeamElement,
-    Expression,
-    Linearization,
-    BareLoop,
-    Samples,
-    Stopwatch,
-    Setting,
-)
-from .reactions import PAIR_ELEMENTS, joint_reactions, subtree_force
-from .plan import (
-    BODY,
-    HINGE_CLOSURE,
-    PRESCRIBED,
-    COORDINATE_FORCE_CUSTOM,
-    COORDINATE_FORCE_LINEAR,
-    LINEAR_COUPLING,
-    MASSLESS_BODY,
-    POINT_ON_LINE,
-    POINT_ON_POINT,
-    POINT_TO_POINT_CUSTOM,
-    POINT_TO_POINT_LINEAR,
-    PRISMATIC,
-    REVOLUTE,
-    ROLLING_CONTACT,
-    TIME_LOAD,
-    Load,
-    element_kind,
-    atan2,
-    body_states,
-    cos_sin,
-    linear_solver,
-    traced,
-    wrench,
-    coupled,
-    coordinate_load,
-    coordinate_reader,
-    element_loads,
-    joint_coordinates,
-    motions,
-    description_reason,
-    num,
-    point_state,
-    rot,
-    rigid_body,
-    point_mass,
-)
+from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, PointOnPoint,
+                             Prismatic, Revolute, RollingContact)
+from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
+                   UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
+                   Linearization, Samples, Scheme, Setting, Stopwatch)
+from .reactions import joint_reactions, pair_element_names, subtree_force
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+                   LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
+                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
+                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold,
+                   Load, NotEliminable, body_states, cos_sin,
+                   coordinate_load, coordinate_reader, coupled, description_reason,
+                   element_kind, element_loads, force_bodies, joint_coordinates,
+                   motions, num, point_mass, point_state, rigid_body, rot,
+                   traced, wrench)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -171,49 +119,6 @@ _ELEMENT_FORCE = ("body forces and torques from one compiled function of the bod
                   "consistent semi-implicit Euler step")
 #: how element forces are evaluated within a Chipmunk step
 _FORCE_MODES = ("position_updated", "step_start")
-
-
-@dataclass(frozen=True)
-class _Fold:
-    """A massless link with one revolute and one prismatic joint, folded into a
-    GrooveJoint between `partner`, the body it turns with (the far side of its prismatic
-    joint), and `pin_body`, which carries its revolute point (the near side)."""
-
-    link: str
-    revolute: Revolute
-    prismatic: Prismatic
-
-    @property
-    def turns_with_child(self) -> bool:
-        """Whether the revolute joint is the link's inner one (the link turns with the
-        prismatic joint's child, the pin is a point of the revolute joint's parent)."""
-        return self.revolute.child == self.link
-
-    @property
-    def partner(self) -> str:
-        return self.prismatic.child if self.turns_with_child else self.prismatic.parent
-
-    @property
-    def pin_body(self) -> str:
-        return self.revolute.parent if self.turns_with_child else self.revolute.child
-
-    @property
-    def offset(self) -> float:
-        """The link's angle minus its partner's."""
-        offset = num(self.prismatic.angle_offset)
-        return -offset if self.turns_with_child else offset
-
-    @property
-    def pin_point(self) -> tuple[float, float]:
-        """The revolute point in the pin body's frame."""
-        j = self.revolute
-        return _pt(j.parent_anchor if self.turns_with_child else j.child_anchor)
-
-    @property
-    def link_point(self) -> tuple[float, float]:
-        """The revolute point in the link's frame."""
-        j = self.revolute
-        return _pt(j.child_anchor if self.turns_with_child else j.parent_anchor)
 
 
 @dataclass(frozen=True)
@@ -230,30 +135,6 @@ class _Groove:
     hi: float | None
     anchor: tuple[float, float]
     phase: float | None
-
-
-@dataclass(frozen=True)
-class _RevLink:
-    """A massless link with revolute joints only, at two distinct points alpha, beta of
-    the link. `at_alpha`/`at_beta`: (body, point of that body) hinged there; the first is
-    the representative (the world if it is one of them)."""
-
-    link: str
-    alpha: tuple[float, float]
-    beta: tuple[float, float]
-    at_alpha: tuple[tuple[str, tuple[float, float]], ...]
-    at_beta: tuple[tuple[str, tuple[float, float]], ...]
-
-
-@dataclass(frozen=True)
-class _Component:
-    """Massless bodies that impose no constraint on the real bodies around them: their
-    angles follow prismatic joints, their positions solve the (linear) joint equations."""
-
-    bodies: tuple[str, ...]
-    joints: tuple  # description joints with an end in `bodies`
-    closures: tuple  # PointOnPoint / PointOnLine with an end in `bodies`
-    angles: tuple[tuple[str, str, float], ...]  # (body, known body, offset): theta = theta_known + offset
 
 
 @dataclass(frozen=True)
@@ -307,11 +188,10 @@ class _Drive:
 @dataclass
 class _Layout:
     dynamic: list[str]  # bodies with mass, in description order
-    folds: dict[str, _Fold]
     pivots: list[tuple[str, str, tuple[float, float], tuple[float, float]]]
     grooves: list[_Groove]
-    links: dict[str, _RevLink] = field(default_factory=dict)
-    components: list[_Component] = field(default_factory=list)
+    #: the massless links eliminated, and how their frames follow
+    elimination: Elimination | None = None
     carriers: list[_Carrier] = field(default_factory=list)
     #: engine centre of gravity (description frame) of compensated hosts
     cog: dict[str, tuple[float, float]] = field(default_factory=dict)
@@ -356,16 +236,12 @@ _GROOVE_LIMIT = (
     "drift, divergence for large offsets)")
 
 
-def _closure_bodies(c) -> tuple[str, ...]:
-    return c.bodies if isinstance(c, (PointOnPoint, PointOnLine)) else ()
-
-
 def _rotation_fixed(mech: Mechanism, body: str) -> bool:
     """Whether the body's angle is constant: every joint from the world to it is
     prismatic (its moment of inertia then enters no equation of motion)."""
     while body != WORLD:
         j = mech.joint_of_child(body)
-        if not isinstance(j, Prismatic):
+        if element_kind(j) != PRISMATIC:
             return False
         body = j.parent
     return True
@@ -375,77 +251,6 @@ def _effective_mass(m: float, inertia: float, d: float) -> float:
     """Mass of a rigid body felt at a point at distance d from its centre of mass, across
     the radius: m I / (I + m d^2)."""
     return m * inertia / (inertia + m * d * d)
-
-
-def _rev_link(mech: Mechanism, name: str, massless: set[str]) -> _RevLink:
-    joints = [j for j in mech.joints if name in (j.parent, j.child)]
-    groups: list[tuple[np.ndarray, list[tuple[str, tuple[float, float]]]]] = []
-    for j in joints:
-        if j.parent == name:
-            own, other, at = _vec(j.parent_anchor), j.child, _vec(j.child_anchor)
-        else:
-            own, other, at = _vec(j.child_anchor), j.parent, _vec(j.parent_anchor)
-        if other in massless:
-            raise _Refused(f"massless body {name} is hinged to another massless body {other}")
-        for point, members in groups:
-            if np.allclose(point, own, rtol=0, atol=1e-12):
-                members.append((other, tuple(at)))
-                break
-        else:
-            groups.append((own, [(other, tuple(at))]))
-    if len(groups) != 2:
-        raise _Refused(f"massless body {name} has revolute joints at {len(groups)} distinct "
-                       "points; only a link with two (an arm, a PinJoint in Chipmunk) can be "
-                       "eliminated")
-    for _, members in groups:  # the world first: its point is exact
-        members.sort(key=lambda m: m[0] != WORLD)
-    seen = [m[0] for _, ms in groups for m in ms]
-    if len(set(seen)) != len(seen):
-        raise _Refused(f"massless body {name} is hinged twice to the same body")
-    (pa, ma), (pb, mb) = groups
-    return _RevLink(name, tuple(pa), tuple(pb), tuple(ma), tuple(mb))
-
-
-def _component(mech: Mechanism, group: set[str], real: set[str],
-               closures: list) -> _Component:
-    joints = tuple(j for j in mech.joints if j.parent in group or j.child in group)
-    mine = tuple(c for c in closures if set(_closure_bodies(c)) & group)
-    ends = ({b for j in joints for b in (j.parent, j.child)}
-            | {b for c in mine for b in _closure_bodies(c)}) - group
-    bad = [b for b in ends if b != WORLD and b not in real]
-    if bad:
-        raise _Refused(f"massless bodies {sorted(group)} are attached to other massless bodies "
-                       f"{bad}")
-    known = set(ends) | {WORLD}
-    angles: list[tuple[str, str, float]] = []
-    changed = True
-    while changed:
-        changed = False
-        for j in joints:
-            if not isinstance(j, Prismatic):
-                continue
-            off = num(j.angle_offset)
-            if j.parent in known and j.child not in known:
-                angles.append((j.child, j.parent, off))
-                known.add(j.child)
-                changed = True
-            elif j.child in known and j.parent not in known:
-                angles.append((j.parent, j.child, -off))
-                known.add(j.parent)
-                changed = True
-    loose = sorted(group - known)
-    if loose:
-        raise _Refused(f"massless bodies {loose}: rotation not fixed by prismatic joints, and not "
-                       "a foldable link or arm (Chipmunk has no massless bodies)")
-    unknowns = (2 * len(group) + sum(isinstance(j, Prismatic) for j in joints)
-                + sum(isinstance(c, PointOnLine) for c in mine))
-    equations = 2 * (len(joints) + len(mine))
-    if unknowns != equations:
-        raise _Refused(f"massless bodies {sorted(group)}: their joints and constraints impose "
-                       f"{equations - unknowns:+d} conditions on the bodies around them; only "
-                       "massless groups that leave them free (or fold into one joint) can be "
-                       "eliminated (Chipmunk has no massless bodies)")
-    return _Component(tuple(sorted(group)), joints, mine, tuple(angles))
 
 
 def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
@@ -458,7 +263,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     k0 = num(c.constant)
     for name, coef in c.coefficients:
         j = mech.joints[mech.coordinates.index(name)]
-        if isinstance(j, Prismatic):
+        if element_kind(j) == PRISMATIC:
             raise _Refused(f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
                            "only angles (GearJoint)")
         s = -1.0 if j.clockwise else 1.0
@@ -481,7 +286,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
         others = [b for b in bodies if b != K]
         hubs: dict[str, tuple[tuple, tuple]] = {}  # body -> (its hub point, K's hub point)
         for j in mech.joints:
-            if isinstance(j, Revolute) and K in (j.parent, j.child):
+            if element_kind(j) == REVOLUTE and K in (j.parent, j.child):
                 if j.parent == K:
                     hubs[j.child] = (tuple(_vec(j.child_anchor)), tuple(_vec(j.parent_anchor)))
                 else:
@@ -568,14 +373,14 @@ def _engine_body(ctx, body) -> None:
                                           "solve its joint equations; other shapes are "
                                           "refused (support)"))
 def _eliminated(ctx, body) -> None:
-    """The constraint that stands for an eliminated link (`_eliminate` found its shape): a
-    folded link's GrooveJoint, an arm's PinJoint and the PivotJoints between bodies hinged
-    at the same point of it; a free group's links impose none."""
-    layout = ctx.layout
-    if body.name in layout.folds:
-        layout.grooves.append(_folded_groove(layout.folds[body.name]))
-    elif body.name in layout.links:
-        link = layout.links[body.name]
+    """The constraint that stands for an eliminated link (`plan.Elimination` found its
+    shape): a folded link's GrooveJoint, an arm's PinJoint and the PivotJoints between
+    bodies hinged at the same point of it; a free group's links impose none."""
+    layout, eliminated = ctx.layout, ctx.layout.elimination
+    if body.name in eliminated.folds:
+        layout.grooves.append(_folded_groove(eliminated.folds[body.name]))
+    elif body.name in eliminated.arms:
+        link = eliminated.arms[body.name]
         (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
         for other, point in link.at_alpha[1:]:
             layout.pivots.append((ra, other, pa, point))
@@ -585,7 +390,7 @@ def _eliminated(ctx, body) -> None:
         layout.pins.append((ra, rb, pa, pb, length, link.link))
 
 
-def _folded_groove(fold: _Fold) -> _Groove:
+def _folded_groove(fold: Fold) -> _Groove:
     """The GrooveJoint of a folded link; refused when it would not be exact in Chipmunk."""
     rev, pri = fold.revolute, fold.prismatic
     if fold.turns_with_child:
@@ -679,9 +484,9 @@ def _drive(ctx, p) -> None:
     kinematic = (ctx.cfg.get("prescribed_motion", _DRIVE_ROUTES[0]) == _DRIVE_ROUTES[0]
                  and j.parent == WORLD)
     layout.drives.append(_Drive(p.name, j, index, kinematic))
-    if isinstance(j, Prismatic) or kinematic:  # its joint is the drive's constraint
+    if element_kind(j) == PRISMATIC or kinematic:  # its joint is the drive's constraint
         ctx.eliminated.add(id(j))
-    if kinematic and isinstance(j, Revolute) and _vec(j.child_anchor).any():
+    if kinematic and element_kind(j) == REVOLUTE and _vec(j.child_anchor).any():
         layout.cog[j.child] = tuple(_vec(j.child_anchor))
 
 
@@ -797,12 +602,12 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
     each element's registered builder; refused (`_Refused`, with the reason) when the
     mechanism cannot be expressed. The bodies and prescribed motions come first (which
     bodies are engine bodies, which joints a drive holds), then the eliminated links'
-    shapes (`_eliminate`), the joints, the links, the closures."""
+    shapes (`plan.Elimination`), the joints, the links, the closures."""
     cfg = cfg or {}
     reason = description_reason(mech)
     if reason:
         raise _Refused(reason)
-    layout = _Layout(dynamic=[], folds={}, pivots=[], grooves=[])
+    layout = _Layout(dynamic=[], pivots=[], grooves=[])
     massless = [b for b in mech.bodies if element_kind(b) == MASSLESS_BODY]
     ctx = SimpleNamespace(mech=mech, cfg=cfg, layout=layout,
                           massless={b.name for b in massless},
@@ -815,57 +620,18 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
             _builder(body)(ctx, body)
     for p in mech.prescribed:
         _builder(p)(ctx, p)
-    consumed = _eliminate(ctx)
+    try:
+        layout.elimination = Elimination(mech)
+    except NotEliminable as reason:
+        raise _Refused(f"{reason} (Chipmunk has no massless bodies)") from None
+    ctx.eliminated |= layout.elimination.joints
     for element in (*mech.joints, *massless):
         _builder(element)(ctx, element)
     for c in mech.constraints:
-        if id(c) not in consumed:
+        if id(c) not in layout.elimination.closures:
             _builder(c)(ctx, c)
     _engine_masses(mech, layout, cfg)
     return layout
-
-
-def _eliminate(ctx) -> set[int]:
-    """The shapes of the massless links (`_Fold`, `_RevLink`, `_Component`) put in the
-    layout, their joints in `ctx.eliminated`; returns the ids of the closures that a free
-    group consumes (its positions solve them)."""
-    mech, layout, mset = ctx.mech, ctx.layout, ctx.massless
-    geometric = [c for c in mech.constraints if isinstance(c, (PointOnPoint, PointOnLine))]
-    touched = {b for c in geometric for b in _closure_bodies(c)}
-    rest = []
-    for name in (b.name for b in mech.bodies if b.name in mset):
-        inner = mech.joint_of_child(name)
-        children = [j for j in mech.joints if j.parent == name]
-        if name in touched:
-            rest.append(name)
-        elif (len(children) == 1 and {type(inner), type(children[0])} == {Revolute, Prismatic}
-                and inner.parent not in mset and children[0].child not in mset):
-            outer = children[0]
-            revolute, prismatic = (inner, outer) if isinstance(inner, Revolute) else (outer, inner)
-            layout.folds[name] = _Fold(name, revolute, prismatic)
-            ctx.eliminated |= {id(inner), id(outer)}
-        elif all(isinstance(j, Revolute) for j in [inner, *children]):
-            layout.links[name] = _rev_link(mech, name, mset)
-            ctx.eliminated |= {id(inner), *map(id, children)}
-        else:
-            rest.append(name)
-    remaining = set(rest)
-    while remaining:
-        group = {remaining.pop()}
-        grown = True
-        while grown:
-            grown = False
-            pairs = [(j.parent, j.child) for j in mech.joints] + [
-                _closure_bodies(c) for c in geometric]
-            for a, b in pairs:
-                for x, y in ((a, b), (b, a)):
-                    if x in group and y in remaining:
-                        group.add(y)
-                        remaining.discard(y)
-                        grown = True
-        layout.components.append(_component(mech, group, set(layout.dynamic), geometric))
-    ctx.eliminated |= {id(j) for comp in layout.components for j in comp.joints}
-    return {id(c) for comp in layout.components for c in comp.closures}
 
 
 def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
@@ -923,13 +689,13 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
 
 
 def _rot(pose: tuple, v) -> tuple:
-    """A body-frame vector in world axes, from the body's `_Frames.state`."""
+    """A body-frame vector in world axes, from the body's `EliminatedFrames.state`."""
     c, s = pose[3], pose[4]
     return c * v[0] - s * v[1], s * v[0] + c * v[1]
 
 
 def _place(pose: tuple, local) -> tuple:
-    """World position of a body point from the body's `_Frames.state`."""
+    """World position of a body point from the body's `EliminatedFrames.state`."""
     rx, ry = _rot(pose, local)
     return pose[0] + rx, pose[1] + ry
 
@@ -943,138 +709,8 @@ def _columns(values: Sequence, n: int) -> np.ndarray:
     return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])
 
 
-def _group(comp: _Component) -> tuple:
-    """A free massless group's joint equations, read once: (column of each body's x,
-    the number of unknowns, the angles (body, known body, offset), per equation pair the
-    points (sign, body, local) whose sum vanishes and the travel (column, body,
-    direction, sign) of a slide or a slot along a direction of a body, if any)."""
-    column = {body: 2 * i for i, body in enumerate(comp.bodies)}
-    extra, equations = 2 * len(comp.bodies), []
-    for j in comp.joints:
-        slide = None
-        if isinstance(j, Prismatic):
-            slide, extra = (extra, j.parent, _pt(j.axis), 1.0), extra + 1
-        equations.append((((1.0, j.parent, _pt(j.parent_anchor)),
-                           (-1.0, j.child, _pt(j.child_anchor))), slide))
-    for c in comp.closures:
-        if isinstance(c, PointOnPoint):
-            equations.append((((1.0, c.body_a, _pt(c.point_a)),
-                               (-1.0, c.body_b, _pt(c.point_b))), None))
-        else:
-            equations.append((((1.0, c.body, _pt(c.point)),
-                               (-1.0, c.line_body, _pt(c.line_point))),
-                              (extra, c.line_body, _pt(c.direction), -1.0)))
-            extra += 1
-    return column, extra, comp.angles, tuple(equations)
-
-
 _ZERO = (0.0, 0.0, 0.0)
 _UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-
-
-class _Frames:
-    """The frame state of each description body, computed when asked: `state` gives
-    (x, y, theta, cos theta, sin theta, vx, vy, omega), `frames[body]` the frame state
-    (x, y, theta, vx, vy, omega) of plan.py; `rates` gives the frames at other engine
-    rates (the columns of a velocity Jacobian)."""
-
-    def __init__(self, comp: "_Compiled", P: Sequence, V: Sequence):
-        self.comp, self.P, self.V = comp, P, V
-        self.cache: dict[str, tuple] = {WORLD: (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0)}
-
-    def rates(self, V: Sequence) -> "_Frames":
-        return _Frames(self.comp, self.P, V)
-
-    def __getitem__(self, body: str) -> tuple:
-        state = self.state(body)
-        return state[:3] + state[5:]
-
-    def state(self, body: str) -> tuple:
-        if body in self.cache:
-            return self.cache[body]
-        kind = self.comp.kind[body]
-        if kind[0] == "body":
-            _, k, cog = kind
-            (x, y, th), (vx, vy, w) = self.P[k], self.V[k]
-            c, s = cos_sin(th)
-            if cog:  # the frame origin from the centre of gravity
-                rx, ry = c * cog[0] - s * cog[1], s * cog[0] + c * cog[1]
-                x, y, vx, vy = x - rx, y - ry, vx + w * ry, vy - w * rx
-            state = (x, y, th, c, s, vx, vy, w)
-        elif kind[0] == "fold":  # turns with `turner`, its point `local` on the pin
-            _, turner, off, pin, pin_local, local = kind
-            turning = self.state(turner)
-            state = _hung(_moving(self.state(pin), pin_local), turning[2] + off, turning[7],
-                          local)
-        elif kind[0] == "link":  # its alpha on the point a, its beta towards b
-            _, ra, pa, rb, pb, ell, alpha = kind
-            a, b = _moving(self.state(ra), pa), _moving(self.state(rb), pb)
-            wx, wy = b[0] - a[0], b[1] - a[1]
-            th = atan2(ell[0] * wy - ell[1] * wx, ell[0] * wx + ell[1] * wy)
-            w = (wx * (b[3] - a[3]) - wy * (b[2] - a[2])) / (wx * wx + wy * wy)
-            state = _hung(a, th, w, alpha)
-        else:
-            self._group(kind[1])
-            return self.cache[body]
-        self.cache[body] = state
-        return state
-
-    def _group(self, i: int) -> None:
-        """A free group's positions (and its slides' and slots' travels) from its joint
-        equations, then its rates from the same equations differentiated in time."""
-        column, m, angles, equations = self.comp.groups[i]
-        turn: dict[str, tuple] = {}  # body -> (theta, omega)
-        for body, known, off in angles:
-            th, w = turn[known] if known in turn else itemgetter(2, 7)(self.state(known))
-            turn[body] = (th + off, w)
-        A = [[0.0] * m for _ in range(m)]
-        known_p, known_v, slides = [], [], []
-        for r, (points, slide) in enumerate(equations):
-            gap = (0.0, 0.0, 0.0, 0.0)  # the known points' position and velocity
-            for sign, body, local in points:
-                if body in column:
-                    A[2 * r][column[body]] += sign
-                    A[2 * r + 1][column[body] + 1] += sign
-                    th, w = turn[body]
-                    c, s = cos_sin(th)
-                    p = _moving((0.0, 0.0, th, c, s, 0.0, 0.0, w), local)
-                else:
-                    p = _moving(self.state(body), local)
-                gap = tuple(g + sign * v for g, v in zip(gap, p))
-            if slide is not None:  # the travel u along sign R d
-                k, body, d, sign = slide
-                th, w = turn[body] if body in turn else itemgetter(2, 7)(self.state(body))
-                c, s = cos_sin(th)
-                A[2 * r][k] = sign * (c * d[0] - s * d[1])
-                A[2 * r + 1][k] = sign * (s * d[0] + c * d[1])
-                slides.append((r, k, w))
-            known_p += gap[:2]
-            known_v += gap[2:]
-        solve = linear_solver(A)
-        x = solve([-v for v in known_p])
-        for r, k, w in slides:  # d/dt (u sign R d) = u' sign R d + u omega perp(sign R d)
-            known_v[2 * r] -= w * A[2 * r + 1][k] * x[k]
-            known_v[2 * r + 1] += w * A[2 * r][k] * x[k]
-        v = solve([-g for g in known_v])
-        for body, c in column.items():
-            th, w = turn[body]
-            self.cache[body] = (x[c], x[c + 1], th, *cos_sin(th), v[c], v[c + 1], w)
-
-
-def _moving(state: tuple, local) -> tuple:
-    """World position and velocity (x, y, vx, vy) of a body point from the body's
-    `_Frames.state`."""
-    x, y, _, c, s, vx, vy, w = state
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return x + rx, y + ry, vx - w * ry, vy + w * rx
-
-
-def _hung(pin: tuple, th, w, local) -> tuple:
-    """The `_Frames.state` of a body at angle th turning at w, whose point `local` is at
-    the moving point `pin` (x, y, vx, vy)."""
-    c, s = cos_sin(th)
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return pin[0] - rx, pin[1] - ry, th, c, s, pin[2] + w * ry, pin[3] - w * rx, w
 
 
 def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
@@ -1090,56 +726,47 @@ class _Compiled:
     """What the runs of one mechanism on one layout use, read once. How every description
     body's frame follows from the engine bodies' states (centre of gravity, angle and
     their rates; `frames`): a body with mass is an engine body (its frame placed from the
-    centre of gravity); a folded link turns with its partner about its pin; an arm points
-    from its end at alpha to its end at beta; a free massless group solves its joint
-    equations, linear once its angles are known, and their time derivative for the
-    rates. And the force elements' loads, and the engine bodies they reach (`loaded`)."""
+    centre of gravity); an eliminated massless link follows them
+    (`plan.EliminatedFrames`). And the force elements' loads, and the engine bodies they
+    reach (`loaded`)."""
 
     def __init__(self, mech: Mechanism, layout: _Layout):
         self.mech, self.layout = mech, layout
         self.index = {name: k for k, name in enumerate(layout.engine)}
         self.n = len(layout.engine)
-        self.kind: dict[str, tuple] = {}
+        self.cogs = {name: tuple(map(float, layout.cog[name])) for name in layout.dynamic
+                     if layout.cog.get(name)}
         #: per eliminated body, the engine bodies it follows
-        self.follows: dict[str, tuple[int, ...]] = {}
-        for name in layout.dynamic:
-            cog = layout.cog.get(name)
-            self.kind[name] = ("body", self.index[name], tuple(map(float, cog)) if cog else None)
-        for name, fold in layout.folds.items():
-            self.kind[name] = ("fold", fold.partner, fold.offset, fold.pin_body, fold.pin_point,
-                               fold.link_point)
-            self._follow(name, (fold.partner, fold.pin_body))
-        for name, link in layout.links.items():
-            (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
-            ell = (link.beta[0] - link.alpha[0], link.beta[1] - link.alpha[1])
-            self.kind[name] = ("link", ra, pa, rb, pb, ell, link.alpha)
-            self._follow(name, (ra, rb))
-        self.groups = [_group(comp) for comp in layout.components]
-        for i, group in enumerate(self.groups):
-            bodies = group[0].keys()
-            for name in bodies:
-                self.kind[name] = ("group", i)
-                self._follow(name, {p[1] for points, _ in group[3] for p in points} - bodies)
+        self.follows = {name: tuple(sorted(self.index[b] for b in set(bodies)
+                                           if b in self.index))
+                        for name, bodies in layout.elimination.follows.items()}
         self.elements = [_builder(f)(mech, f) for f in mech.forces]
         loaded: set[int] = set()
         for f in mech.forces:
-            ends = ((f.body_a, f.body_b) if isinstance(f, PointToPoint) else
-                    [b for i in f.weights(mech.coordinates)
-                     for b in (mech.joints[i].parent, mech.joints[i].child)])
-            for body in set(ends) - {WORLD}:
-                kind = self.kind[body]
-                loaded |= {kind[1]} if kind[0] == "body" else set(self.follows[body])
+            for body in set(force_bodies(mech, f)) - {WORLD}:
+                loaded |= set(self.follows[body]) if body in self.follows else {self.index[body]}
         self.loaded = sorted(loaded)  # engine bodies that receive element loads
         self.phis: dict[str, Callable] = {}  # compiled `pitch_phi`s
 
-    def _follow(self, name: str, bodies) -> None:
-        self.follows[name] = tuple(sorted(self.index[b] for b in set(bodies) if b in self.index))
+    def at(self, P: Sequence, V: Sequence) -> EliminatedFrames:
+        """The frames from the engine bodies' positions P and rates V (x, y, theta of the
+        centre of gravity and their rates, per engine body)."""
+        def massive(body: str) -> tuple:
+            k, cog = self.index[body], self.cogs.get(body)
+            (x, y, th), (vx, vy, w) = P[k], V[k]
+            c, s = cos_sin(th)
+            if cog:  # the frame origin from the centre of gravity
+                rx, ry = c * cog[0] - s * cog[1], s * cog[0] + c * cog[1]
+                x, y, vx, vy = x - rx, y - ry, vx + w * ry, vy - w * rx
+            return (x, y, th, c, s, vx, vy, w)
 
-    def frames(self, S: np.ndarray, H: float = 0.0) -> _Frames:
+        return EliminatedFrames(self.layout.elimination, massive)
+
+    def frames(self, S: np.ndarray, H: float = 0.0) -> EliminatedFrames:
         """The frames over state rows S (one sample per row) at x + H v."""
-        return _Frames(self, *_rows(S, H))
+        return self.at(*_rows(S, H))
 
-    def body_loads(self, frames: _Frames, t) -> list[Load]:
+    def body_loads(self, frames: EliminatedFrames, t) -> list[Load]:
         """The element loads on the description bodies."""
         return [load for element in self.elements for load in element(frames, t)]
 
@@ -1154,8 +781,7 @@ class _Compiled:
                  for i in [self.mech.coordinates.index(name)]]
 
         def phi(*pos: float) -> list:
-            frames = _Frames(self, [pos[k:k + 3] for k in range(0, len(pos), 3)],
-                             [_ZERO] * self.n)
+            frames = self.at([pos[k:k + 3] for k in range(0, len(pos), 3)], [_ZERO] * self.n)
             return [sum(coef * read(frames[j.parent], frames[j.child])[0]
                         for coef, read, j in terms) - num(c.constant)]
 
@@ -1180,14 +806,14 @@ class _Compiled:
         P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3))
              for k in range(0, len(row), 6)]
         V = [tuple(row[k + 3:k + 6]) for k in range(0, len(row), 6)]
-        frames = _Frames(self, P, V)
+        frames = self.at(P, V)
         out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
         for load in self.body_loads(frames, t):
             body, force, point, torque = load
             if body == WORLD:
                 continue
-            if self.kind[body][0] == "body":
-                k = self.kind[body][1]
+            if body not in self.follows:
+                k = self.index[body]
                 out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
                 continue
             x, y = frames.state(body)[:2]
@@ -1195,7 +821,7 @@ class _Compiled:
                 for i, unit in enumerate(_UNITS):
                     rates = [_ZERO] * len(P)
                     rates[k] = unit
-                    vx, vy, w = frames.rates(rates).state(body)[5:]
+                    vx, vy, w = self.at(P, rates).state(body)[5:]
                     out[k][i] += torque * w if force is None else (
                         torque * w + force[0] * (vx - w * (point[1] - y))
                         + force[1] * (vy + w * (point[0] - x)))
@@ -1217,7 +843,7 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
 
 
 def _subtree(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, H: float,
-             shift: int, h: float, t: np.ndarray) -> tuple[list, list, _Frames]:
+             shift: int, h: float, t: np.ndarray) -> tuple[list, list, EliminatedFrames]:
     """Newton-Euler on a joint's child subtree over each step n -> n+1: per body with mass
     (massless links carry nothing), its centre of mass (its frame's origin; a kinematic
     driver's engine centre of gravity is its hinge point) at n+1, m (a - g) and I alpha;
@@ -1248,10 +874,10 @@ def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray,
     the same of the element loads on the subtree. d is the slide's axis in world axes
     (dq = 1 moves the child by d)."""
     n = len(t) - 1
-    slide = isinstance(joint, Prismatic)
+    slide = element_kind(joint) == PRISMATIC
     sign = -1.0 if not slide and joint.clockwise else 1.0
 
-    def geometry(frames: _Frames) -> tuple:  # the slide's axis in world axes, or the hinge
+    def geometry(frames: EliminatedFrames) -> tuple:  # a slide's world axis, or the hinge
         if slide:
             return _rot(frames.state(joint.parent), _pt(joint.axis))
         return _place(frames.state(joint.child), _pt(joint.child_anchor))
@@ -1276,7 +902,7 @@ def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray,
     return out
 
 
-def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
+def _balance_columns(mech: Mechanism, frames: EliminatedFrames) -> list[tuple]:
     """The unknowns of the momentum balance (see `PymunkBackend._forces`), one column
     each: (kind, name, its loads on the description bodies at unit value, its direction
     in world axes or None): two force components of a hinge or a point-on-point
@@ -1294,7 +920,7 @@ def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
 
     for j in mech.joints:
         w = _place(frames.state(j.child), _pt(j.child_anchor))
-        if isinstance(j, Revolute):
+        if element_kind(j) == REVOLUTE:
             for e in ((1.0, 0.0), (0.0, 1.0)):
                 pair("joint", j.name, j.child, j.parent, e, w)
         else:
@@ -1302,11 +928,12 @@ def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
             out.append(("moment", j.name, [(j.child, None, None, 1.0),
                                            (j.parent, None, None, -1.0)], None))
     for c in mech.constraints:
-        if isinstance(c, PointOnPoint):
+        kind = element_kind(c)
+        if kind == POINT_ON_POINT:
             w = _place(frames.state(c.body_a), _pt(c.point_a))
             for e in ((1.0, 0.0), (0.0, 1.0)):
                 pair("closure", c.name, c.body_a, c.body_b, e, w)
-        elif isinstance(c, PointOnLine):
+        elif kind == POINT_ON_LINE:
             pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
                  _place(frames.state(c.body), _pt(c.point)))
         else:
@@ -1316,7 +943,8 @@ def _balance_columns(mech: Mechanism, frames: _Frames) -> list[tuple]:
     return out
 
 
-def _wrenches(bodies: list[str], loads: list[Load], frames: _Frames, n: int) -> np.ndarray:
+def _wrenches(bodies: list[str], loads: list[Load], frames: EliminatedFrames,
+              n: int) -> np.ndarray:
     """(n, 3 per body): the loads' wrenches on every body about its frame origin."""
     out = np.zeros((n, 3 * len(bodies)))
     for load in loads:
@@ -1593,7 +1221,7 @@ class PymunkBackend(Backend):
                 continue
             child = bodies[j.child]
             q = float(q0[d.index])
-            if isinstance(j, Prismatic):
+            if element_kind(j) == PRISMATIC:
                 pa, axis = _vec(j.parent_anchor), _vec(j.axis)
                 parent = bodies[j.parent]
                 pivot = pymunk.PivotJoint(parent, child, tuple(pa + q * axis),
@@ -1643,7 +1271,7 @@ class PymunkBackend(Backend):
         Its engine centre of gravity is the hinge point (or it does not turn)."""
         rates = np.diff([position(h), *targets]) / h
         j = d.joint
-        if isinstance(j, Revolute):
+        if element_kind(j) == REVOLUTE:
             values = [(0.0, 0.0, -r if j.clockwise else r) for r in rates]
         else:
             axis = _vec(j.axis)
@@ -1919,7 +1547,7 @@ class PymunkBackend(Backend):
         the angles of eliminated links, which come from atan2, continued from q0."""
         q, qd = (_columns(cols, len(t)) for cols in joint_coordinates(mechanism, comp.frames(S)))
         for i, j in enumerate(mechanism.joints):
-            if isinstance(j, Revolute):
+            if element_kind(j) == REVOLUTE:
                 col = np.unwrap(q[:, i])
                 q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
         return q, qd
@@ -1946,8 +1574,9 @@ class PymunkBackend(Backend):
         t_applied = t[:-1] + shift * h
         # a pair element's force on its first body as applied (`plan.element_loads`: the
         # second load of a PointToPoint is the one on body_a)
+        paired = pair_element_names(mech)
         pairs = {f.name: _columns(loads(ahead, t_applied)[1][1], len(t_applied))
-                 for f, loads in zip(mech.forces, comp.elements) if isinstance(f, PAIR_ELEMENTS)}
+                 for f, loads in zip(mech.forces, comp.elements) if f.name in paired}
         q, qd = (_columns(cols, len(t_applied)) for cols in joint_coordinates(mech, ahead))
         transmitted = {j: subtree_force(mech, j, t[1:], accelerations) for j in joints}
         out = {}

@@ -150,3 +150,9 @@ def joint_reactions(mech: Mechanism, joints: Sequence[str],
                                  pair_forces=pair_forces, coupling_forces=coupling_forces,
                                  cmap=cmap)
             for name in joints}
+
+
+def pair_element_names(mech: Mechanism) -> set[str]:
+    """The names of the mechanism's pair elements (`PAIR_ELEMENTS`: force elements and
+    closure constraints whose force is a pair of opposite forces on two bodies)."""
+    return {e.name for e in (*mech.forces, *mech.constraints) if isinstance(e, PAIR_ELEMENTS)}
