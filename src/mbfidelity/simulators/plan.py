@@ -1153,3 +1153,8 @@ class EliminatedFrames:
         for body, c in column.items():
             th, w = turn[body]
             self.cache[body] = (x[c], x[c + 1], th, *cos_sin(th), v[c], v[c + 1], w)
+
+
+def sample_columns(values: Sequence, n: int) -> np.ndarray:
+    """(n, len(values)): each value, a number or n samples, as a column."""
+    return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])

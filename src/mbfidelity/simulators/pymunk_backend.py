@@ -94,21 +94,21 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, PointOnPoint,
-                             Prismatic, Revolute, RollingContact)
-from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
-                   UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
-                   Linearization, Samples, Scheme, Setting, Stopwatch)
-from .reactions import joint_reactions, pair_element_names, subtree_force
+from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, PointOnPoint, Prismatic,
+                             Revolute, RollingContact)
+from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE, UNSUPPORTED,
+                   Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
+                   Samples, Scheme, Setting, Stopwatch)
+from .reactions import (actuator_force, balance_forces, body_wrenches, joint_reactions,
+                        pair_element_names, subtree_force)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
-                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
-                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold,
-                   Load, NotEliminable, body_states, cos_sin,
-                   coordinate_load, coordinate_reader, coupled, description_reason,
-                   element_kind, element_loads, force_bodies, joint_coordinates,
-                   motions, num, point_mass, point_state, rigid_body, rot,
-                   traced, wrench)
+                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
+                   ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
+                   NotEliminable, body_states, cos_sin, coordinate_reader, coupled,
+                   description_reason, element_kind, element_loads, force_bodies,
+                   joint_coordinates, motions, num, point_mass, point_state, rigid_body, rot,
+                   sample_columns, traced, wrench)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -688,25 +688,17 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
 
-def _rot(pose: tuple, v) -> tuple:
-    """A body-frame vector in world axes, from the body's `EliminatedFrames.state`."""
-    c, s = pose[3], pose[4]
-    return c * v[0] - s * v[1], s * v[0] + c * v[1]
-
-
-def _place(pose: tuple, local) -> tuple:
-    """World position of a body point from the body's `EliminatedFrames.state`."""
-    rx, ry = _rot(pose, local)
-    return pose[0] + rx, pose[1] + ry
-
-
 def _pt(v) -> tuple[float, float]:
     return (num(v[0]), num(v[1]))
 
 
-def _columns(values: Sequence, n: int) -> np.ndarray:
-    """(n, len(values)): each value, a number or n samples, as a column."""
-    return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])
+def _after_first(values: np.ndarray) -> np.ndarray:
+    """Forces over the steps n -> n+1 given to samples 1..N (where Chipmunk computed the
+    impulses); sample 0 has no step before it and is NaN."""
+    values = np.asarray(values)
+    out = np.full((len(values) + 1, *values.shape[1:]), np.nan)
+    out[1:] = values
+    return out
 
 
 _ZERO = (0.0, 0.0, 0.0)
@@ -840,118 +832,6 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
             _CACHE.clear()
         _CACHE[key] = _Compiled(mech, layout)
     return _CACHE[key]
-
-
-def _subtree(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, H: float,
-             shift: int, h: float, t: np.ndarray) -> tuple[list, list, EliminatedFrames]:
-    """Newton-Euler on a joint's child subtree over each step n -> n+1: per body with mass
-    (massless links carry nothing), its centre of mass (its frame's origin; a kinematic
-    driver's engine centre of gravity is its hinge point) at n+1, m (a - g) and I alpha;
-    the element loads on the subtree as applied in the step (at the position-updated
-    state x + H v and t + shift h), and the frames they act at."""
-    mech, g = comp.mech, num(comp.mech.gravity)
-    subtree = mech.subtree(joint.child)
-    frames, bodies = comp.frames(S), []
-    for name in subtree:
-        if name in comp.layout.dynamic:
-            x, y, _, vx, vy, w = frames[name]
-            m, inertia = num(mech.body(name).mass), num(mech.body(name).inertia)
-            bodies.append((x[1:], y[1:], m * np.diff(vx) / h, m * (np.diff(vy) / h + g),
-                           inertia * np.diff(w) / h))
-    ahead = comp.frames(S[:-1], H)
-    loads = [load for load in comp.body_loads(ahead, t[:-1] + shift * h) if load[0] in subtree]
-    return bodies, loads, ahead
-
-
-def _actuator_force(comp: _Compiled, joint: Revolute | Prismatic, S: np.ndarray, h: float,
-                    H: float, shift: int, t: np.ndarray) -> np.ndarray:
-    """Shape (N+1,): a prescribed coordinate's actuator force over step n -> n+1 at sample
-    n+1 (where Chipmunk computed the impulses, as the reactions; sample 0 is NaN), from
-    Newton-Euler on the joint's child subtree (`_subtree`): the joint's reaction has no
-    component along a slide and no moment about a hinge's point, so the actuator's
-    generalized force is, for a slide, d . sum m (a - g) and, for a hinge, s sum (I alpha
-    + (r - A) x m (a - g)) (A the hinge point, s = -1 for a clockwise coordinate), minus
-    the same of the element loads on the subtree. d is the slide's axis in world axes
-    (dq = 1 moves the child by d)."""
-    n = len(t) - 1
-    slide = element_kind(joint) == PRISMATIC
-    sign = -1.0 if not slide and joint.clockwise else 1.0
-
-    def geometry(frames: EliminatedFrames) -> tuple:  # a slide's world axis, or the hinge
-        if slide:
-            return _rot(frames.state(joint.parent), _pt(joint.axis))
-        return _place(frames.state(joint.child), _pt(joint.child_anchor))
-
-    gx, gy = (np.broadcast_to(np.asarray(v, float), (n,)) for v in geometry(comp.frames(S[1:])))
-    bodies, loads, ahead = _subtree(comp, joint, S, H, shift, h, t)
-    total = np.zeros(n)
-    for x, y, fx, fy, spin in bodies:
-        if slide:
-            total += gx * fx + gy * fy
-        else:
-            total += sign * (spin + (x - gx) * fy - (y - gy) * fx)
-    ax, ay = geometry(ahead)
-    external = np.zeros(n)
-    for load in loads:
-        if not slide:
-            external = external + wrench(load, (ax, ay))[2]
-        elif load[1] is not None:
-            external = external + ax * load[1][0] + ay * load[1][1]
-    out = np.full(len(t), np.nan)
-    out[1:] = total - sign * external
-    return out
-
-
-def _balance_columns(mech: Mechanism, frames: EliminatedFrames) -> list[tuple]:
-    """The unknowns of the momentum balance (see `PymunkBackend._forces`), one column
-    each: (kind, name, its loads on the description bodies at unit value, its direction
-    in world axes or None): two force components of a hinge or a point-on-point
-    closure; the normal force and the moment of a slide; the normal force of a slot;
-    the generalized force of a coupling."""
-    out = []
-
-    def pair(kind, name, a, b, force, w):
-        out.append((kind, name, [(a, force, w, 0.0), (b, (-force[0], -force[1]), w, 0.0)],
-                    force))
-
-    def normal(body, d):  # the unit normal of direction d of `body`, in world axes
-        dx, dy = _rot(frames.state(body), np.array(_pt(d)) / float(np.linalg.norm(_pt(d))))
-        return -dy, dx
-
-    for j in mech.joints:
-        w = _place(frames.state(j.child), _pt(j.child_anchor))
-        if element_kind(j) == REVOLUTE:
-            for e in ((1.0, 0.0), (0.0, 1.0)):
-                pair("joint", j.name, j.child, j.parent, e, w)
-        else:
-            pair("joint", j.name, j.child, j.parent, normal(j.parent, j.axis), w)
-            out.append(("moment", j.name, [(j.child, None, None, 1.0),
-                                           (j.parent, None, None, -1.0)], None))
-    for c in mech.constraints:
-        kind = element_kind(c)
-        if kind == POINT_ON_POINT:
-            w = _place(frames.state(c.body_a), _pt(c.point_a))
-            for e in ((1.0, 0.0), (0.0, 1.0)):
-                pair("closure", c.name, c.body_a, c.body_b, e, w)
-        elif kind == POINT_ON_LINE:
-            pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
-                 _place(frames.state(c.body), _pt(c.point)))
-        else:
-            out.append(("closure", c.name, [
-                load for name, coef in c.coefficients for load in coordinate_load(
-                    mech.joints[mech.coordinates.index(name)])(frames, num(coef))], None))
-    return out
-
-
-def _wrenches(bodies: list[str], loads: list[Load], frames: EliminatedFrames,
-              n: int) -> np.ndarray:
-    """(n, 3 per body): the loads' wrenches on every body about its frame origin."""
-    out = np.zeros((n, 3 * len(bodies)))
-    for load in loads:
-        if load[0] != WORLD:
-            i = bodies.index(load[0])
-            out[:, 3 * i:3 * i + 3] += _columns(wrench(load, frames.state(load[0])[:2]), n)
-    return out
 
 
 def _default_layout(mech: Mechanism) -> _Layout | None:
@@ -1536,7 +1416,10 @@ class PymunkBackend(Backend):
             reactions = {j: joint_forces[j] for j in reaction_joints}
         else:
             reactions = self._tree_reactions(mechanism, comp, reaction_joints, S, H, shift, h, t)
-        actuator_forces = {d.name: _actuator_force(comp, d.joint, S, h, H, shift, t)
+        frames, ahead = comp.frames(S), comp.frames(S[:-1], H)
+        loads = comp.body_loads(ahead, t[:-1] + shift * h) if comp.layout.drives else []
+        actuator_forces = {d.name: _after_first(actuator_force(mechanism, d.joint, frames, ahead,
+                                                               loads, h))
                            for d in comp.layout.drives}
         return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
 
@@ -1545,7 +1428,8 @@ class PymunkBackend(Backend):
                      t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Engine body states (rows of `S`) -> the description's coordinates and rates;
         the angles of eliminated links, which come from atan2, continued from q0."""
-        q, qd = (_columns(cols, len(t)) for cols in joint_coordinates(mechanism, comp.frames(S)))
+        q, qd = (sample_columns(cols, len(t))
+                 for cols in joint_coordinates(mechanism, comp.frames(S)))
         for i, j in enumerate(mechanism.joints):
             if element_kind(j) == REVOLUTE:
                 col = np.unwrap(q[:, i])
@@ -1575,34 +1459,26 @@ class PymunkBackend(Backend):
         # a pair element's force on its first body as applied (`plan.element_loads`: the
         # second load of a PointToPoint is the one on body_a)
         paired = pair_element_names(mech)
-        pairs = {f.name: _columns(loads(ahead, t_applied)[1][1], len(t_applied))
+        pairs = {f.name: sample_columns(loads(ahead, t_applied)[1][1], len(t_applied))
                  for f, loads in zip(mech.forces, comp.elements) if f.name in paired}
-        q, qd = (_columns(cols, len(t_applied)) for cols in joint_coordinates(mech, ahead))
+        q, qd = (sample_columns(cols, len(t_applied)) for cols in joint_coordinates(mech, ahead))
         transmitted = {j: subtree_force(mech, j, t[1:], accelerations) for j in joints}
-        out = {}
-        for name, force in joint_reactions(mech, joints, transmitted, t_applied, q, qd,
-                                           pair_forces=pairs).items():
-            out[name] = np.full((len(t), 2), np.nan)
-            out[name][1:] = force
-        return out
+        return {name: _after_first(force) for name, force in joint_reactions(
+            mech, joints, transmitted, t_applied, q, qd, pair_forces=pairs).items()}
 
     def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, H: float, shift: int,
                 h: float, t: np.ndarray):
         """Joint reactions and closure-constraint forces of a constrained mechanism.
 
         Chipmunk's `impulse` is a magnitude, and a closure may be a substitute (slider,
-        pitch pivot, contact), so the forces are taken from momentum balance: for every
+        pitch pivot, contact), so the forces are taken from momentum balance
+        (`reactions.balance_forces`, which also says why not `joint_reaction`): for every
         description body, over the step n -> n+1, the engine parts that make it up give
         sum m (a - g) and sum (I alpha + r x m (a - g)) about its centre of mass; minus the
         element loads as applied in that step, that is the wrench of the unknown joint
-        reactions and closure multipliers, whose directions and points are those of the
-        description at the configuration x(n+1) where Chipmunk computed its impulses.
-        Solved in least squares (pseudo-inverse) per sample; the same sample convention
-        as the reactions (n+1; sample 0 NaN). Massless bodies enter with zero inertia, so
-        the force in a joint of an eliminated link is its static balance. The reactions
-        are unknowns of the same solve as the closure forces (these cannot be had without
-        them), so the subtree balance of `reactions.joint_reaction` would be a second
-        path, not a replacement. A start with velocity shows a transient at sample 1:
+        reactions and closure multipliers at the configuration x(n+1) where Chipmunk
+        computed its impulses (sample n+1, as the reactions; sample 0 NaN). A start with
+        velocity shows a transient at sample 1:
         Chipmunk's velocity is staggered (v_n ~ v(t_n + h/2), whose constraint component
         is -h times the curvature term), the exact initial velocity is not, and the first
         impulse makes up the difference: 1.5 times the centripetal part (eccentric cam
@@ -1610,12 +1486,8 @@ class PymunkBackend(Backend):
         layout = comp.layout
         m_steps = len(t) - 1
         bodies = [b.name for b in mech.bodies]
-
         frames = comp.frames(S[1:])
-        columns = _balance_columns(mech, frames)
-        A = np.stack([_wrenches(bodies, loads, frames, m_steps) for _, _, loads, _ in columns],
-                     axis=-1)
-        rhs = np.zeros(A.shape[:2])
+        rhs = np.zeros((m_steps, 3 * len(bodies)))
         g = num(mech.gravity)
         carriers = {c.name: c for c in layout.carriers}
         for k, name in enumerate(layout.engine):
@@ -1627,39 +1499,17 @@ class PymunkBackend(Backend):
             alpha = np.diff(S[:, 6 * k + 5]) / h
             if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
                 inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
-            cx, cy = _columns(frames.state(host)[:2], m_steps).T
+            cx, cy = sample_columns(frames.state(host)[:2], m_steps).T
             rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
             rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
         ahead = comp.frames(S[:-1], H)
-        rhs -= _wrenches(bodies, comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
-        x = (np.linalg.pinv(A) @ rhs[..., None])[..., 0]
-        resid = np.linalg.norm(np.einsum("nij,nj->ni", A, x) - rhs, axis=1)
-        self.diagnostics = {
-            "balance_residual": float(np.max(resid) / max(float(np.max(np.abs(rhs))), 1e-300)),
-            "notes": list(layout.notes),
-        }
-        grouped: dict[tuple[str, str], list[int]] = {}
-        for i, (kind, name, _, _) in enumerate(columns):
-            if kind != "moment":
-                grouped.setdefault((kind, name), []).append(i)
-
-        def assemble(indices: list[int]) -> np.ndarray:
-            direction = columns[indices[0]][3]
-            if len(indices) == 1 and direction is not None:  # magnitude along its direction
-                val = x[:, indices] * _columns(direction, m_steps)
-            else:
-                val = x[:, indices]
-            out = np.full((len(t), val.shape[1]), np.nan)
-            out[1:] = val
-            return out
-
-        joint_forces = {name: assemble(ix) for (kind, name), ix in grouped.items()
-                        if kind == "joint"}
-        constraint_forces = {c.name: assemble(grouped["closure", c.name])
-                             for c in mech.constraints}
-        return joint_forces, constraint_forces
+        rhs -= body_wrenches(bodies, comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
+        joint_forces, constraint_forces, residual = balance_forces(mech, frames, rhs)
+        self.diagnostics = {"balance_residual": residual, "notes": list(layout.notes)}
+        return ({name: _after_first(f) for name, f in joint_forces.items()},
+                {name: _after_first(f) for name, f in constraint_forces.items()})
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:

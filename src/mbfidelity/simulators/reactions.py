@@ -25,7 +25,11 @@ An engine measures either the first sum (its centre-of-mass accelerations:
 reaction, an inverse-dynamics force, an internal force of its recursive algorithm). Such
 a force holds the outside forces that the engine's build applies as joint forces or does
 not see; `joint_reaction` takes out the ones the engine hands in, and the coordinate laws
-of a prismatic joint's own slide, which every build applies as joint forces.
+of a prismatic joint's own slide, which every build applies as joint forces. An engine
+that reports no force at all (only an impulse's magnitude) measures the bodies' motion
+over each step: a prescribed coordinate's actuator force is Newton-Euler on its child
+subtree (`actuator_force`), and with closure constraints the joint reactions and the
+closure forces come together from the momentum balance of every body (`balance_forces`).
 
 Sign convention of every force handed in (the contract's, base.py point 6), by element
 name: a pair element (PointToPoint, PointOnPoint, PointOnLine) gives the force on its first
@@ -41,6 +45,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..systems.model import (
+    WORLD,
     CoordinateForce,
     LinearCoupling,
     Mechanism,
@@ -48,8 +53,14 @@ from ..systems.model import (
     PointOnPoint,
     PointToPoint,
     Prismatic,
+    Revolute,
 )
-from .plan import CoordinateMap, ForceLaw, coordinate_map, num
+from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin, num,
+                   point_state, sample_columns, wrench)
+
+
+def _point(v) -> tuple[float, float]:
+    return (num(v[0]), num(v[1]))
 
 #: the elements whose force is a pair of opposite forces on two bodies
 PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
@@ -156,3 +167,154 @@ def pair_element_names(mech: Mechanism) -> set[str]:
     """The names of the mechanism's pair elements (`PAIR_ELEMENTS`: force elements and
     closure constraints whose force is a pair of opposite forces on two bodies)."""
     return {e.name for e in (*mech.forces, *mech.constraints) if isinstance(e, PAIR_ELEMENTS)}
+
+
+# --- forces from Newton-Euler over each step, for an engine that reports none ----------
+#
+# `frames`: the description bodies' frame states (x, y, theta, vx, vy, omega) by body
+# (plan.EliminatedFrames; a body with mass has its frame origin at its centre of mass),
+# as arrays over the samples; `loads`: the element loads (`plan.Load`) as applied in each
+# step, at the frames `ahead` where the engine evaluated them.
+
+
+def _world_axis(states: Mapping, body: str, v) -> tuple:
+    """A body-frame vector of `body` in world axes."""
+    c, s = cos_sin(states[body][2])
+    return c * v[0] - s * v[1], s * v[0] + c * v[1]
+
+
+def actuator_force(mech: Mechanism, joint: Revolute | Prismatic, frames: Mapping,
+                   ahead: Mapping, loads: Sequence[Load], h: float) -> np.ndarray:
+    """Shape (N,): a prescribed coordinate's actuator force over each step n -> n+1 of h
+    (frames over the samples 0..N), from Newton-Euler on the joint's child subtree: per
+    body with mass (massless links carry nothing), at n+1, m (a - g) and I alpha. The
+    joint's reaction has no component along a slide and no moment about a hinge's point,
+    so the actuator's generalized force is, for a slide, d . sum m (a - g) and, for a
+    hinge, s sum (I alpha + (r - A) x m (a - g)) (A the hinge point, s = -1 for a
+    clockwise coordinate), minus the same of the element loads on the subtree. d is the
+    slide's axis in world axes (dq = 1 moves the child by d)."""
+    g = num(mech.gravity)
+    subtree = mech.subtree(joint.child)
+    slide = isinstance(joint, Prismatic)
+    sign = -1.0 if not slide and joint.clockwise else 1.0
+
+    def geometry(states: Mapping) -> tuple:  # a slide's world axis, or the hinge point
+        if slide:
+            return _world_axis(states, joint.parent, _point(joint.axis))
+        return point_state(states[joint.child], _point(joint.child_anchor))[:2]
+
+    n = len(frames[joint.child][0]) - 1
+    gx, gy = (np.broadcast_to(np.asarray(v, float), (n + 1,))[1:] for v in geometry(frames))
+    total = np.zeros(n)
+    for name in subtree:
+        if mech.body(name).massless:
+            continue
+        x, y, _, vx, vy, w = frames[name]
+        m, inertia = num(mech.body(name).mass), num(mech.body(name).inertia)
+        fx, fy = m * np.diff(vx) / h, m * (np.diff(vy) / h + g)
+        if slide:
+            total += gx * fx + gy * fy
+        else:
+            total += sign * (inertia * np.diff(w) / h + (x[1:] - gx) * fy - (y[1:] - gy) * fx)
+    ax, ay = geometry(ahead)
+    external = np.zeros(n)
+    for load in loads:
+        if load[0] not in subtree:
+            continue
+        if not slide:
+            external = external + wrench(load, (ax, ay))[2]
+        elif load[1] is not None:
+            external = external + ax * load[1][0] + ay * load[1][1]
+    return total - sign * external
+
+
+def _balance_columns(mech: Mechanism, frames: Mapping) -> list[tuple]:
+    """The unknowns of the momentum balance (`balance_forces`), one column each: (kind,
+    name, its loads on the description bodies at unit value, its direction in world axes
+    or None): two force components of a hinge or a point-on-point closure; the normal
+    force and the moment of a slide; the normal force of a slot; the generalized force of
+    a coupling."""
+    out = []
+
+    def pair(kind, name, a, b, force, w):
+        out.append((kind, name, [(a, force, w, 0.0), (b, (-force[0], -force[1]), w, 0.0)],
+                    force))
+
+    def normal(body, d):  # the unit normal of direction d of `body`, in world axes
+        dx, dy = _world_axis(frames, body, np.array(_point(d)) / float(np.linalg.norm(_point(d))))
+        return -dy, dx
+
+    def place(body, local):
+        return point_state(frames[body], _point(local))[:2]
+
+    for j in mech.joints:
+        w = place(j.child, j.child_anchor)
+        if isinstance(j, Revolute):
+            for e in ((1.0, 0.0), (0.0, 1.0)):
+                pair("joint", j.name, j.child, j.parent, e, w)
+        else:
+            pair("joint", j.name, j.child, j.parent, normal(j.parent, j.axis), w)
+            out.append(("moment", j.name, [(j.child, None, None, 1.0),
+                                           (j.parent, None, None, -1.0)], None))
+    for c in mech.constraints:
+        if isinstance(c, PointOnPoint):
+            w = place(c.body_a, c.point_a)
+            for e in ((1.0, 0.0), (0.0, 1.0)):
+                pair("closure", c.name, c.body_a, c.body_b, e, w)
+        elif isinstance(c, PointOnLine):
+            pair("closure", c.name, c.body, c.line_body, normal(c.line_body, c.direction),
+                 place(c.body, c.point))
+        else:
+            out.append(("closure", c.name, [
+                load for name, coef in c.coefficients for load in coordinate_load(
+                    mech.joints[mech.coordinates.index(name)])(frames, num(coef))], None))
+    return out
+
+
+def body_wrenches(bodies: list[str], loads: Sequence[Load], frames: Mapping,
+                  n: int) -> np.ndarray:
+    """(n, 3 per body): the loads' wrenches on every body about its frame origin."""
+    out = np.zeros((n, 3 * len(bodies)))
+    for load in loads:
+        if load[0] != WORLD:
+            i = bodies.index(load[0])
+            out[:, 3 * i:3 * i + 3] += sample_columns(wrench(load, frames[load[0]][:2]), n)
+    return out
+
+
+def balance_forces(mech: Mechanism, frames: Mapping, needed: np.ndarray
+                   ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], float]:
+    """(joint reactions, closure-constraint forces, relative residual) from the momentum
+    balance of every description body at n samples: `needed` (n, 3 per body, in
+    `mech.bodies` order) is the wrench (fx, fy, moment about the frame origin) that the
+    unknown joint reactions and closure multipliers exert on each body, at the frames
+    `frames` that give their directions and points. Solved in least squares
+    (pseudo-inverse) per sample; massless bodies enter with zero inertia, so the force in
+    a joint of a massless link is its static balance. The reactions are unknowns of the
+    same solve as the closure forces (these cannot be had without them), so the subtree
+    balance of `joint_reaction` would be a second path, not a replacement. The forces
+    follow the contract's conventions (the reaction on the joint's child; a pair
+    closure's on its first body; a coupling's generalized force)."""
+    n = needed.shape[0]
+    bodies = [b.name for b in mech.bodies]
+    columns = _balance_columns(mech, frames)
+    A = np.stack([body_wrenches(bodies, loads, frames, n) for _, _, loads, _ in columns],
+                 axis=-1)
+    x = (np.linalg.pinv(A) @ needed[..., None])[..., 0]
+    resid = np.linalg.norm(np.einsum("nij,nj->ni", A, x) - needed, axis=1)
+    residual = float(np.max(resid) / max(float(np.max(np.abs(needed))), 1e-300))
+    grouped: dict[tuple[str, str], list[int]] = {}
+    for i, (kind, name, _, _) in enumerate(columns):
+        if kind != "moment":
+            grouped.setdefault((kind, name), []).append(i)
+
+    def assemble(indices: list[int]) -> np.ndarray:
+        direction = columns[indices[0]][3]
+        if len(indices) == 1 and direction is not None:  # magnitude along its direction
+            return x[:, indices] * sample_columns(direction, n)
+        return x[:, indices]
+
+    joint_forces = {name: assemble(ix) for (kind, name), ix in grouped.items()
+                    if kind == "joint"}
+    constraint_forces = {c.name: assemble(grouped["closure", c.name]) for c in mech.constraints}
+    return joint_forces, constraint_forces, residual
