@@ -815,9 +815,10 @@ def _closure_bodies(c) -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class Fold:
-    """A massless link with one revolute and one prismatic joint: it turns with `partner`,
-    the body on the far side of its prismatic joint, about its revolute point, a point of
-    `pin_body` (the near side); the pair of joints is one pin-in-slot between them."""
+    """A massless link with one revolute and one prismatic joint (a guide arm carrying a
+    slider, or a slider carrying a pin): it turns with `partner`, the body on the far side
+    of its prismatic joint, about its revolute point, a point of `pin_body` (the near
+    side); the pair of joints is one pin-in-slot between them."""
 
     link: str
     revolute: Revolute

@@ -2,82 +2,42 @@
 
 Translation of the description (conventions of `mbfidelity.systems.model`). Each element
 kind has one builder, registered with the expressions it declares (`_builds`;
-`EXPRESSIONS` is read from that registry):
+`EXPRESSIONS` is read from that registry); what each builds is stated there once:
 
-* every body with mass becomes a ``pymunk.Body(mass, moment)`` whose frame is the
-  description frame (Chipmunk's centre of gravity at the frame origin, unless a slider
-  substitute is compensated, below); the world is ``space.static_body`` (at the origin,
-  angle 0). No shapes are created (except for a RollingContact's circles),
-  so nothing can collide. A point mass (central inertia 0) gets the substitute moment
-  m r^2 (setting ``point_mass_gyration``): Chipmunk divides by the moment.
-* ``Revolute`` -> ``PivotJoint`` at the two local anchors.
-* ``Prismatic`` -> ``GrooveJoint`` whose slot is the path of the child's centre of mass
-  in the parent's frame (pa - R(offset) ca + q axis, q between the limits, or
-  +-``groove_half_length`` where a side is unbounded) with the pin at the child's centre
-  of mass, plus a ``GearJoint`` (ratio 1, phase = angle_offset) that locks the relative
-  rotation.
-* Chipmunk has no massless bodies. Massless bodies are eliminated:
-  - a link with one revolute and one prismatic joint (a guide arm carrying a slider, or a
-    slider carrying a pin) is folded: the link turns with the body on the far side of its
-    prismatic joint (its "partner") and its revolute point (the "pin") is a point of the
-    other body, so the pair of joints is one ``GrooveJoint``;
-  - a link with revolute joints only, at two distinct points of the link (an arm), is a
-    ``PinJoint`` (fixed distance) between the bodies at its two ends plus ``PivotJoint``s
-    between bodies hinged at the same point of it; its angle is the direction of the
-    line between its two points;
-  - massless bodies whose angles are fixed by prismatic joints and whose joints and
-    closure constraints leave the bodies around them free (three relative degrees of
-    freedom, e.g. two crossed carriages, or a pin running in two slots) impose no
-    Chipmunk constraint at all; their positions are solved from the joint equations.
-  Loads on eliminated links are moved to the real bodies by virtual power.
-* Closure constraints (model.py):
-  - ``PointOnPoint`` -> ``PivotJoint`` (exact).
-  - ``PointOnLine`` -> ``GrooveJoint``. Chipmunk's groove impulse is exact only when the
-    slot passes through the slot body's centre of mass and the pin is the pin body's
-    centre of mass (or either is the world, or a body whose rotation is fixed by
-    prismatic joints to the world, which then gets an infinite moment of inertia: its
-    moment enters no equation): it solves the full 2x2 point problem and projects the
-    impulse on the slot normal (`_GROOVE_LIMIT`). Otherwise a slider substitute is
-    inserted: a point-mass "pin slider" (infinite moment) pinned to the pin point by a
-    ``PivotJoint`` and running in the groove at its own centre of mass, and/or a "slot
-    carrier" glued to the slot body (``PivotJoint`` + ``GearJoint``) with its centre of
-    mass on the slot line. Its mass is ``slider_mass_fraction`` of the host's effective
-    mass at that point, and with ``slider_compensation`` that mass (and its moment) is
-    taken out of the host body (mass, centre of gravity, moment), so the composite host
-    + substitute has exactly the described inertia: the substitute is exact up to the
-    iterative solve.
-  - ``LinearCoupling``: written on absolute body angles, sum k_b theta_b = const. Two
-    bodies -> ``GearJoint`` (exact). Three bodies A, B, K with sum k = 0, A and B hinged
-    on the carrier K (belt pulleys on an arm, a disc rolling in a moving track): that is
-    an internal/external gear pair on the carrier, i.e. rolling of the pitch circles at
-    the pitch point C = a + lam (b - a), lam = k_A / (k_A + k_B), on the line of the hubs
-    a, b. It is a ``PivotJoint`` between A and B whose anchors are moved to C before every
-    solve (pre-solve callback, at the position-updated configuration): its tangential
-    row is the coupling, its normal row is implied by the carrier (redundant), and the
-    coupling's position error is put into the tangential anchor gap so that Chipmunk's
-    own error correction removes it. A ``RollingContact`` (a variant's stand-in for such
-    a coupling) makes the pitch circles colliding shapes instead (a Circle in a ring of
-    ``contact_segments`` Segments) with friction ``contact_friction``, and the massless
-    carrier arm is removed (the contact holds the disc).
-    Other couplings (three bodies without a common carrier, prismatic coordinates) are
-    refused with the reason.
-* ``Prescribed`` (a coordinate imposed as q(t)): on the world a ``Body.KINEMATIC``
-  child whose velocity is set every step, on a free body a constraint whose target is
-  moved before every step (setting ``prescribed_motion``: how and why; `_drive`,
-  `PymunkBackend._schedule`). Chipmunk reports only the magnitude of an impulse; the
-  actuator force is Newton-Euler on the joint's child subtree over each step, at sample
-  n + 1 like the reactions.
-* Force elements are applied as body forces and torques, evaluated every step by one
-  compiled function of the body states (a Python call per step). A CoordinateForce is
-  the generalized force Q on its coordinate: on a revolute joint the torque s Q on the
-  child (s = -1 for a clockwise coordinate) and -s Q on the parent unless the angle is
-  absolute (virtual power of Q q').
-* Reactions and constraint forces: Chipmunk reports only the magnitude of an impulse,
-  so the forces are reconstructed from momentum balance over each step, at the
-  configuration where Chipmunk computed them (sample n + 1): in a tree, Newton on the
-  joint child's subtree (the shared `reactions.joint_reaction`); with closure
-  constraints, the balance of every description body solved in least squares for all
-  joint reactions and closure multipliers together (`PymunkBackend._forces`).
+* Bodies with mass are ``pymunk.Body``s; the world is ``space.static_body`` (at the
+  origin, angle 0). No shapes are created (except for a RollingContact's circles), so
+  nothing can collide. Hinges are ``PivotJoint``s, slides ``GrooveJoint``s with a
+  ``GearJoint`` locking the rotation, point-on-point closures ``PivotJoint``s.
+* Chipmunk has no massless bodies: they are eliminated (`plan.Elimination`: folded
+  links, arms, free groups) and stand for one constraint between the bodies around them
+  (`_eliminated`); their frames follow from the engine bodies (`plan.EliminatedFrames`),
+  and loads on them reach the engine bodies by virtual power (`_Compiled.engine_loads`).
+* ``PointOnLine`` -> ``GrooveJoint``, exact only in the poses `_GROOVE_LIMIT` states;
+  otherwise a slider substitute runs in an exact groove, its mass taken out of its host
+  (settings ``slider_mass_fraction``, ``slider_compensation``), so that the composite
+  host + substitute has exactly the described inertia: exact up to the iterative solve.
+* ``LinearCoupling``: written on absolute body angles, sum k_b theta_b = const. Two
+  bodies -> ``GearJoint`` (exact). Three bodies A, B, K with sum k = 0, A and B hinged
+  on the carrier K (belt pulleys on an arm, a disc rolling in a moving track): that is
+  an internal/external gear pair on the carrier, i.e. rolling of the pitch circles at
+  the pitch point C = a + lam (b - a), lam = k_A / (k_A + k_B), on the line of the hubs
+  a, b. It is a ``PivotJoint`` between A and B whose anchors are moved to C before every
+  solve (pre-solve callback, at the position-updated configuration): its tangential
+  row is the coupling, its normal row is implied by the carrier (redundant), and the
+  coupling's position error is put into the tangential anchor gap so that Chipmunk's
+  own error correction removes it. A ``RollingContact`` (a variant's stand-in for such
+  a coupling) makes the pitch circles colliding shapes instead, and the massless carrier
+  arm is removed (the contact holds the disc). Other couplings (three bodies without a
+  common carrier, prismatic coordinates) are refused with the reason.
+* ``Prescribed``: a kinematic driver or a moving constraint target (setting
+  ``prescribed_motion``; `_drive`, `PymunkBackend._schedule`).
+* Force elements are body forces and torques from one compiled function of the body
+  states, evaluated every step (a Python call per step; setting ``element_forces``).
+* Reactions, constraint and actuator forces: Chipmunk reports only the magnitude of an
+  impulse, so the forces are reconstructed from Newton-Euler over each step, at the
+  configuration where Chipmunk computed them (sample n + 1): in a tree, on the joint
+  child's subtree (`reactions.joint_reaction`, `reactions.actuator_force`); with closure
+  constraints, the balance of every description body (`reactions.balance_forces`).
 
 Chipmunk's step (cpSpaceStep): positions x += h v (old velocity); constraints pre-step at
 the new positions; v += h (g + F/m); warm-started Gauss-Seidel velocity iterations that
@@ -859,44 +819,41 @@ class PymunkBackend(Backend):
     SETTINGS = {
         "point_mass_gyration": Setting(
             POINT_MASS_GYRATION, float,
-            "Radius of gyration (m) of the moment given to a point mass (central inertia "
-            "0): Chipmunk needs a moment > 0. The body's moment about a pivot at d grows "
+            "Radius of gyration r (m) of the moment m r^2 given to a point mass (central "
+            "inertia 0; Chipmunk needs a moment > 0): its moment about a pivot at d grows "
             "by the relative (r/d)^2 (1e-12 at d = 1 m)."),
         "error_bias": Setting(
             0.0, float,
-            "Fraction of a joint's position error left after 1 s, on every constraint. "
-            "Pymunk's default (1-0.1)^60 = 1.8e-3 removes only part of the error per step "
-            "and its correction velocity enters the real velocity: measured on the 2 rad "
-            "compound pendulum, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory error and "
-            "5 % energy drift in 10 s at h = 1e-3. 0 removes the whole error in the next "
-            "step (bias velocity -error/h): gap 1e-5 m (O(h^2)), 3.6e-3 rad. Engine "
-            "default: Pymunk API reference, Constraint.error_bias 'Defaults to "
+            "Fraction of a joint's position error left after 1 s, on every constraint. 0 "
+            "removes the whole error in the next step (bias velocity -error/h). Pymunk's "
+            "default (1-0.1)^60 = 1.8e-3 removes only part of it per step, and its "
+            "correction velocity enters the real velocity: measured on the 2 rad compound "
+            "pendulum, 10 s at h = 1e-3, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory "
+            "error and 5 % energy drift, against 1e-5 m (O(h^2)) and 3.6e-3 rad with 0. "
+            "Engine default: Pymunk API reference, Constraint.error_bias 'Defaults to "
             "pow(1.0 - 0.1, 60.0)'.",
             engine_default=0.9 ** 60),
         "iterations": Setting(
             50, int,
-            "Gauss-Seidel velocity iterations per step (space.iterations; Pymunk default "
-            "10). A single joint is solved in one iteration; a chain is not: on the small "
-            "double-pendulum swing the reaction error was 1.8e-3 (relative) with 10 and "
-            "1.4e-4 with 20 or more (20, 30, 50, 100 identical; trajectories identical "
-            "from 10 on, reactions 65 % off with 1). 50 keeps a margin at negligible "
-            "cost. Closed loops with slider substitutes need it: the scotch yoke diverged "
-            "with 10 at slider_mass_fraction 0.1. Engine default: Pymunk API reference, "
-            "Space.iterations 'Defaults to 10'.",
+            "Gauss-Seidel velocity iterations per step (space.iterations). A single joint "
+            "is solved in one iteration, a chain is not: the small double-pendulum swing's "
+            "reaction error was 65 % with 1, 1.8e-3 (relative) with 10 and 1.4e-4 with 20, "
+            "30, 50 or 100 (trajectories identical from 10 on); the scotch yoke with slider "
+            "substitutes diverged with 10 at slider_mass_fraction 0.1. 50 keeps a margin at "
+            "negligible cost. Engine default: Pymunk API reference, Space.iterations "
+            "'Defaults to 10'.",
             engine_default=10),
         "start_iterations": Setting(
             1000, int,
-            "Gauss-Seidel iterations of the first step only. Chipmunk warm-starts every "
-            "step from the previous step's impulses; the first step has none, and a "
-            "closed loop or a slider substitute then leaves it unconverged: with 50 "
-            "iterations the rhombus's slot force at samples 1-3 was 0.07 N off (9e-3 of "
-            "the force scale), with 1000 on the first step 1e-5 of it. Later steps are "
-            "unchanged (they converge from the warm start). Tree mechanisms were already "
-            "converged (bit-identical results)."),
+            "Gauss-Seidel iterations of the first step only, which has no previous "
+            "impulses to warm-start from: with 50, a closed loop or a slider substitute is "
+            "left unconverged (the rhombus's slot force at samples 1-3 0.07 N off, 9e-3 of "
+            "its scale; 1e-5 with 1000). Later steps converge from the warm start; tree "
+            "mechanisms were already converged (bit-identical results)."),
         "damping": Setting(
             1.0, float,
-            "space.damping, the fraction of velocity kept after 1 s. Pymunk's default is "
-            "already 1 (no damping); stated explicitly so it is recorded."),
+            "space.damping, the fraction of velocity kept after 1 s: Pymunk's default 1 (no "
+            "damping), stated so that it is recorded."),
         "sleep_time_threshold": Setting(
             None, (float, type(None)),
             "space.sleep_time_threshold in s; null = never sleep (Pymunk default inf). "
@@ -904,35 +861,30 @@ class PymunkBackend(Backend):
         "element_forces": Setting(
             "position_updated", _FORCE_MODES,
             "When force elements are evaluated in a step. Chipmunk moves positions (x += "
-            "h v) before it applies body.force, so a force computed from the sampled "
-            "state before space.step() ('step_start', what user code usually does) makes "
-            "the step explicit Euler for that force: energy grew by 114 % (elastic "
-            "pendulum) and 90 % (sliding block) in 10 s at h = 1e-3. 'position_updated' "
-            "(default) evaluates the laws at x + h v and t + h, the configuration at "
-            "which Chipmunk pre-steps its constraints and its own DampedSpring: a "
-            "consistent semi-implicit Euler step (energy drift 0.4-0.5 %). No engine "
-            "default is replaced: Pymunk has no hook for laws of length rate or time, so "
-            "the backend applies body forces and torques."),
+            "h v) before it applies body.force, so a force from the state sampled before "
+            "space.step() ('step_start', what user code usually does) makes the step "
+            "explicit Euler for it: energy grew by 114 % (elastic pendulum) and 90 % "
+            "(sliding block) in 10 s at h = 1e-3. 'position_updated' evaluates the laws at "
+            "x + h v and t + h, where Chipmunk pre-steps its constraints and its own "
+            "DampedSpring: a consistent semi-implicit Euler step (energy drift 0.4-0.5 %). "
+            "Pymunk has no hook for laws of length rate or time, so the backend applies "
+            "body forces and torques (no engine default is replaced)."),
         "groove_half_length": Setting(
             1000.0, float,
-            "Chipmunk grooves are finite segments: a prismatic side without a limit (and "
-            "every point-on-line slot) is given this extent in m (the groove ends act as "
-            "stops). Finite limits of the description are used as the groove ends."),
+            "Extent (m) of a Chipmunk groove (a finite segment whose ends act as stops) on "
+            "a prismatic side without a limit and on every point-on-line slot; the "
+            "description's finite limits are the groove ends."),
         "slider_mass_fraction": Setting(
             0.5, float,
-            "Substitute for a pin-in-slot (PointOnLine) whose GrooveJoint would not be "
-            "exact (pin off the pin body's centre of mass, or slot line off the slot "
-            "body's): a 'pin slider' (point mass pinned to the pin point) and/or a 'slot "
-            "carrier' (glued to the slot body, centre on the slot line) runs in an exact "
-            "groove. Its mass is this fraction of the host body's effective mass at that "
-            "point, m I / (I + m d^2). Chipmunk has no such substitute and no massless "
-            "bodies. With compensation (below) the fraction does not enter the dynamics "
-            "(scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and 0.5), only the "
-            "convergence of the Gauss-Seidel solve, since a light body between heavy ones "
-            "converges slowly: from the cold start (no cached impulses) the slot force at "
-            "samples 1-3 was 0.23 off at 0.1 and 6.6e-3 at 0.5 with 50 iterations; the "
-            "rhombus loop diverged at 0.05 with 50 iterations (exact with 500). Must stay "
-            "below 1 (the host keeps a positive moment)."),
+            "Mass of a slider substitute (a pin-in-slot whose GrooveJoint would not be "
+            "exact: the POINT_ON_LINE expression) as this fraction of the host body's "
+            "effective mass at its point, m I / (I + m d^2); must stay below 1 (the host "
+            "keeps a positive moment). With slider_compensation it does not enter the "
+            "dynamics (scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and 0.5), "
+            "only the convergence of the Gauss-Seidel solve, slow for a light body between "
+            "heavy ones: from the cold start the slot force at samples 1-3 was 0.23 off at "
+            "0.1 and 6.6e-3 at 0.5 with 50 iterations; the rhombus loop diverged at 0.05 "
+            "with 50 iterations (exact with 500)."),
         "slider_compensation": Setting(
             True, bool,
             "true: the substitute's mass (and a slot carrier's moment) is taken out of "
@@ -944,37 +896,29 @@ class PymunkBackend(Backend):
             "3-10e-3 compensated)."),
         "prescribed_motion": Setting(
             _DRIVE_ROUTES[0], _DRIVE_ROUTES,
-            "How a Prescribed coordinate q(t) is imposed (Pymunk has no driven joint). "
-            "'kinematic_on_world' (default): a joint on the world makes its child a "
-            "Body.KINEMATIC body (centre of gravity on the hinge) whose velocity_func sets, "
-            "after the position update of step k, the velocity (q(t_(k+2)) - q(t_(k+1)))/h "
-            "that the next position update uses; a joint on a free body (a rotor on a "
-            "frame, an inner mass in a frame) is a constraint between the joint's two "
-            "bodies whose target is set to q(t_(k+2)) before step k with error_bias 0 "
-            "(slide: PivotJoint to parent_anchor + q axis, plus the rotation lock; hinge: "
-            "GearJoint of ratio 1, phase s q + angle_offset), so the frame feels the "
+            "How a Prescribed coordinate q(t) is imposed (Pymunk has no driven joint; the "
+            "PRESCRIBED expression says how each route builds it). 'kinematic_on_world' "
+            "(default): a joint on the world makes its child a Body.KINEMATIC driver (its "
+            "centre of gravity on the hinge); a joint on a free body (a rotor on a frame, "
+            "an inner mass in a frame) is a moving constraint, so the frame feels the "
             "driven body's inertia. 'moving_constraint': the constraint on the world too "
             "(a light driven body between the world and a heavy child makes the "
             "Gauss-Seidel solve diverge: a block running out of the slot of a disc turned "
             "at 10.5 rad/s, 2 s, 0.79 of the amplitude off at 50 iterations, 1.3e-2 with "
-            "5000). Either way the "
-            "coordinate is on q(t) at every sample (it starts with the rate (q(h) - "
-            "q0)/h), and the actuator force is Newton-Euler on the joint's child subtree "
-            "over each step (Chipmunk reports only an impulse's magnitude). First order "
-            "like the rest of the step. Measured with the default, dt 1e-3 -> 1e-4 (max "
-            "error; force relative to its max; 2 s): a block on a base moved at its "
-            "natural frequency, free 1.4e-4 -> 1.4e-5 m, force 3.0e-3 -> 3.0e-4; a block "
-            "on a spring in the slot of a disc turned at 5, 9.5, 10.5 rad/s, free 3.0e-4 -> 3.1e-5, 2.2e-3 -> 2.3e-4, 0.43 -> 0.041 m (of 34 m), "
-            "force 2.9e-3 -> 3.0e-4, 4.5e-3 -> 4.5e-4, 2.8e-2 -> 2.7e-3; "
-            "a frame on a spring shaken by an unbalanced rotor (kept turning relative "
-            "to it) at the natural frequency, free 1.1e-4 -> 8.8e-6 m, force 3.7e-2 -> 3.7e-3; "
-            "prescribed coordinate error 0 (round-off) in all."),
+            "5000). Either way the coordinate starts with the rate (q(h) - q0)/h. "
+            "Measured with the default, dt 1e-3 -> 1e-4 (max error; force relative to its "
+            "max; 2 s): a block on a base moved at its natural frequency, free 1.4e-4 -> "
+            "1.4e-5 m, force 3.0e-3 -> 3.0e-4; a block on a spring in the slot of a disc "
+            "turned at 5, 9.5, 10.5 rad/s, free 3.0e-4 -> 3.1e-5, 2.2e-3 -> 2.3e-4, 0.43 "
+            "-> 0.041 m (of 34 m), force 2.9e-3 -> 3.0e-4, 4.5e-3 -> 4.5e-4, 2.8e-2 -> "
+            "2.7e-3; a frame on a spring shaken by an unbalanced rotor (kept turning "
+            "relative to it) at the natural frequency, free 1.1e-4 -> 8.8e-6 m, force "
+            "3.7e-2 -> 3.7e-3; prescribed coordinate error 0 (round-off) in all."),
         "contact_friction": Setting(
             10.0, float,
-            "Friction coefficient of a RollingContact; Chipmunk "
-            "multiplies the two shapes' coefficients, this one goes on the inner shape "
-            "and 1 on the ring. Must exceed |friction| / normal force at all times or the "
-            "disc slides."),
+            "Friction coefficient of a RollingContact (Chipmunk multiplies the two shapes' "
+            "coefficients: this one on the inner shape, 1 on the ring). Must exceed "
+            "|friction| / normal force at all times or the disc slides."),
         "contact_segments": Setting(
             720, int,
             "Number of Segment shapes of a RollingContact's ring, inscribed in the "
