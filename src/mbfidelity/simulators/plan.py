@@ -1159,3 +1159,80 @@ class EliminatedFrames:
 def sample_columns(values: Sequence, n: int) -> np.ndarray:
     """(n, len(values)): each value, a number or n samples, as a column."""
     return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])
+
+
+# --- a coupling of hinge angles on the bodies' absolute angles --------------------------
+
+
+def angle_coupling(mech: Mechanism, coupling: LinearCoupling) -> tuple[dict[str, float], float]:
+    """A coupling of hinge coordinates, sum c_i q_i = C, written on the absolute body
+    angles as sum k_b theta_b = k0: (k per body, the world included, k0). Every coordinate
+    it weighs must be a hinge's."""
+    k: dict[str, float] = {}
+    k0 = num(coupling.constant)
+    for name, coef in coupling.coefficients:
+        j = mech.joints[mech.coordinates.index(name)]
+        s = -1.0 if j.clockwise else 1.0
+        coef = num(coef)
+        k[j.child] = k.get(j.child, 0.0) + coef * s
+        if not j.absolute:
+            k[j.parent] = k.get(j.parent, 0.0) - coef * s
+        k0 += coef * s * num(j.angle_offset)
+    return k, k0
+
+
+@dataclass(frozen=True)
+class PitchPair:
+    """Two bodies a, b hinged on a common carrier (the world as b: a hinged on a carrier
+    hinged on the world) whose angle coupling k_a theta_a + k_b theta_b + k_carrier
+    theta_carrier = const has sum k = 0: an internal/external gear pair on the carrier,
+    i.e. rolling of the pitch circles at the pitch point a + lam (b - a), lam = k_a /
+    (k_a + k_b), on the line of the hubs, `d` apart on the carrier."""
+
+    carrier: str
+    a: str
+    b: str
+    hub_a: tuple[float, float]  # a's point at its hinge on the carrier
+    hub_b: tuple[float, float]
+    d: float
+    k_a: float
+    k_b: float
+
+    @property
+    def lam(self) -> float:
+        return self.k_a / (self.k_a + self.k_b)
+
+
+def pitch_pairs(mech: Mechanism, k: Mapping[str, float], bodies: Sequence[str],
+                scale: float) -> Iterator[PitchPair]:
+    """The pitch pairs (`PitchPair`) that a coupling on the absolute angles of `bodies`
+    (`angle_coupling`; coefficients k, of size `scale`) can be, one per carrier among
+    them, in the order of `bodies`."""
+    for K in bodies:
+        others = [b for b in bodies if b != K]
+        hubs: dict[str, tuple[tuple, tuple]] = {}  # body -> (its hub point, K's hub point)
+        for j in mech.joints:
+            if isinstance(j, Revolute) and K in (j.parent, j.child):
+                if j.parent == K:
+                    hubs[j.child] = (tuple(np.array(_pt(j.child_anchor))),
+                                     tuple(np.array(_pt(j.parent_anchor))))
+                else:
+                    hubs[j.parent] = (tuple(np.array(_pt(j.parent_anchor))),
+                                      tuple(np.array(_pt(j.child_anchor))))
+        if not set(others) <= set(hubs):
+            continue
+        if len(others) == 2:
+            A, B = others
+            if abs(sum(k[b] for b in bodies)) > 1e-12 * scale:
+                continue
+            ka, kb = k[A], k[B]
+        elif len(others) == 1 and WORLD in hubs:
+            A, B = others[0], WORLD
+            ka = k[A]
+            kb = -(k[K] + ka)
+        else:
+            continue
+        d = float(np.linalg.norm(np.subtract(hubs[B][1], hubs[A][1])))
+        if d == 0.0 or abs(ka + kb) <= 1e-12 * scale:
+            continue
+        yield PitchPair(K, A, B, hubs[A][0], hubs[B][0], d, ka, kb)

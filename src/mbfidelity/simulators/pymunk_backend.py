@@ -59,16 +59,15 @@ from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, Poin
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE, UNSUPPORTED,
                    Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
                    Samples, Scheme, Setting, Stopwatch)
-from .reactions import (actuator_force, balance_forces, body_wrenches, joint_reactions,
-                        pair_element_names, subtree_force)
+from .reactions import actuator_force, balance_forces, body_wrenches, motion_reactions
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
-                   NotEliminable, body_states, cos_sin, coordinate_reader, coupled,
+                   NotEliminable, angle_coupling, body_states, coordinate_reader, cos_sin, coupled,
                    description_reason, element_kind, element_loads, force_bodies,
-                   joint_coordinates, motions, num, point_mass, point_state, rigid_body, rot,
-                   sample_columns, traced, wrench)
+                   joint_coordinates, motions, num, pitch_pairs, point_mass, point_state,
+                   rigid_body, rot, sample_columns, traced, wrench)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -219,19 +218,12 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     cannot be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
     circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
     contact replaces."""
-    k: dict[str, float] = {}
-    k0 = num(c.constant)
-    for name, coef in c.coefficients:
-        j = mech.joints[mech.coordinates.index(name)]
-        if element_kind(j) == PRISMATIC:
-            raise _Refused(f"coupling {c.name}: coordinate {name} is prismatic; Chipmunk couples "
-                           "only angles (GearJoint)")
-        s = -1.0 if j.clockwise else 1.0
-        coef = num(coef)
-        k[j.child] = k.get(j.child, 0.0) + coef * s
-        if not j.absolute:
-            k[j.parent] = k.get(j.parent, 0.0) - coef * s
-        k0 += coef * s * num(j.angle_offset)
+    slides = [name for name, _ in c.coefficients
+              if element_kind(mech.joints[mech.coordinates.index(name)]) == PRISMATIC]
+    if slides:
+        raise _Refused(f"coupling {c.name}: coordinate {slides[0]} is prismatic; Chipmunk "
+                       "couples only angles (GearJoint)")
+    k, k0 = angle_coupling(mech, c)
     scale = max((abs(v) for v in k.values()), default=0.0)
     bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
     if not bodies:
@@ -242,44 +234,20 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             return "gear", (a, WORLD, -k0 / k[a], 1.0)
         a, b = bodies
         return "gear", (a, b, -k0 / k[a], -k[b] / k[a])
-    for K in bodies:
-        others = [b for b in bodies if b != K]
-        hubs: dict[str, tuple[tuple, tuple]] = {}  # body -> (its hub point, K's hub point)
-        for j in mech.joints:
-            if element_kind(j) == REVOLUTE and K in (j.parent, j.child):
-                if j.parent == K:
-                    hubs[j.child] = (tuple(_vec(j.child_anchor)), tuple(_vec(j.parent_anchor)))
-                else:
-                    hubs[j.parent] = (tuple(_vec(j.parent_anchor)), tuple(_vec(j.child_anchor)))
-        if not set(others) <= set(hubs):
+    for pair in pitch_pairs(mech, k, bodies, scale):
+        if not (engine_ok(pair.a) and engine_ok(pair.b)):
             continue
-        if len(others) == 2:
-            A, B = others
-            if abs(sum(k[b] for b in bodies)) > 1e-12 * scale:
-                continue
-            ka, kb = k[A], k[B]
-        elif len(others) == 1 and WORLD in hubs:
-            A, B = others[0], WORLD
-            ka = k[A]
-            kb = -(k[K] + ka)
-        else:
-            continue
-        if not (engine_ok(A) and engine_ok(B)):
-            continue
-        d = float(np.linalg.norm(np.subtract(hubs[B][1], hubs[A][1])))
-        if d == 0.0 or abs(ka + kb) <= 1e-12 * scale:
-            continue
-        lam = ka / (ka + kb)
+        A, B, K, d, lam = pair.a, pair.b, pair.carrier, pair.d, pair.lam
         wrap = 2 * math.pi * abs(k[K]) if K in massless else 0.0
         circles = None
         if contact:
             if K not in massless:  # the carrier's hinges would keep the distance: see _build
                 raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
                                "massless carrier arm, which the contact replaces")
-            circles = (A, hubs[A][0], abs(lam) * d, B, hubs[B][0], abs(lam - 1) * d,
+            circles = (A, pair.hub_a, abs(lam) * d, B, pair.hub_b, abs(lam - 1) * d,
                        not 0.0 < lam < 1.0)
-        return "pitch", _Pitch(c.name, A, B, hubs[A][0], hubs[B][0], d, lam, ka + kb, wrap, K,
-                               circles)
+        return "pitch", _Pitch(c.name, A, B, pair.hub_a, pair.hub_b, d, lam,
+                               pair.k_a + pair.k_b, wrap, K, circles)
     raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
                    "couples the absolute angles of two bodies, and a coupling of three is "
                    "expressible here only as two bodies hinged on a common carrier (gear pair, "
@@ -646,10 +614,6 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
     if g.pin == WORLD or g.pin in layout.infinite or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf:
         return True
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
-
-
-def _pt(v) -> tuple[float, float]:
-    return (num(v[0]), num(v[1]))
 
 
 def _after_first(values: np.ndarray) -> np.ndarray:
@@ -1383,32 +1347,20 @@ class PymunkBackend(Backend):
     @staticmethod
     def _tree_reactions(mech: Mechanism, comp: _Compiled, joints: Sequence[str], S: np.ndarray,
                         H: float, shift: int, h: float, t: np.ndarray) -> dict[str, np.ndarray]:
-        """Force the parent exerts on the child (`reactions.joint_reaction`): Newton on the
-        child's subtree over the step n -> n+1, sum m (v(n+1) - v(n))/h - m g, minus the
-        element forces from outside as applied in that step (evaluated at the
-        position-updated state x + H v and t + shift h). Chipmunk computes that impulse at
-        the position-updated configuration x(n+1), so it is given to sample n+1 (measured
-        on the pendulums: 3.5-40x closer to the model's reaction at that sample than at
-        sample n); sample 0 has no step before it and is NaN. A start with angular
-        velocity shows an O(1) transient at sample 1: the first step also builds the
-        steady O(h^2) joint gap of the position update, and its impulse contains that
-        correction."""
+        """Force the parent exerts on the child over the step n -> n+1
+        (`reactions.motion_reactions`), the element forces from outside as applied in
+        that step (at the position-updated state x + H v and t + shift h). Chipmunk
+        computes that impulse at the position-updated configuration x(n+1), so it is given
+        to sample n+1 (measured on the pendulums: 3.5-40x closer to the model's reaction
+        at that sample than at sample n); sample 0 has no step before it and is NaN. A
+        start with angular velocity shows an O(1) transient at sample 1: the first step
+        also builds the steady O(h^2) joint gap of the position update, and its impulse
+        contains that correction."""
         if not joints:
             return {}
-        frames, ahead = comp.frames(S), comp.frames(S[:-1], H)
-        accelerations = {name: np.column_stack([np.diff(frames[name][3]) / h,
-                                                np.diff(frames[name][4]) / h])
-                         for name in comp.layout.dynamic}
-        t_applied = t[:-1] + shift * h
-        # a pair element's force on its first body as applied (`plan.element_loads`: the
-        # second load of a PointToPoint is the one on body_a)
-        paired = pair_element_names(mech)
-        pairs = {f.name: sample_columns(loads(ahead, t_applied)[1][1], len(t_applied))
-                 for f, loads in zip(mech.forces, comp.elements) if f.name in paired}
-        q, qd = (sample_columns(cols, len(t_applied)) for cols in joint_coordinates(mech, ahead))
-        transmitted = {j: subtree_force(mech, j, t[1:], accelerations) for j in joints}
-        return {name: _after_first(force) for name, force in joint_reactions(
-            mech, joints, transmitted, t_applied, q, qd, pair_forces=pairs).items()}
+        return {name: _after_first(force) for name, force in motion_reactions(
+            mech, joints, comp.frames(S), comp.frames(S[:-1], H), comp.elements,
+            t[:-1] + shift * h, h).items()}
 
     def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, H: float, shift: int,
                 h: float, t: np.ndarray):

@@ -55,8 +55,8 @@ from ..systems.model import (
     Prismatic,
     Revolute,
 )
-from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin, num,
-                   point_state, sample_columns, wrench)
+from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
+                   joint_coordinates, num, point_state, sample_columns, wrench)
 
 
 def _point(v) -> tuple[float, float]:
@@ -318,3 +318,26 @@ def balance_forces(mech: Mechanism, frames: Mapping, needed: np.ndarray
                     if kind == "joint"}
     constraint_forces = {c.name: assemble(grouped["closure", c.name]) for c in mech.constraints}
     return joint_forces, constraint_forces, residual
+
+
+def motion_reactions(mech: Mechanism, joints: Sequence[str], frames: Mapping,
+                     ahead: Mapping, element_loads: Sequence, t_applied: np.ndarray,
+                     h: float) -> dict[str, np.ndarray]:
+    """The contract's reaction (N, 2) at each of `joints` over each step n -> n+1 of h
+    (`frames` over the samples 0..N), for an engine that reports no joint force: Newton
+    on the child's subtree, sum m (v(n+1) - v(n))/h - m g (`subtree_force`), minus the
+    forces from outside as applied in the step (`joint_reaction`): the force elements'
+    (`element_loads`: each one's loads as a function of the frames and t, in
+    `mech.forces` order) evaluated at the frames `ahead` and the times `t_applied`."""
+    n = len(t_applied)
+    accelerations = {b.name: np.column_stack([np.diff(frames[b.name][3]) / h,
+                                              np.diff(frames[b.name][4]) / h])
+                     for b in mech.bodies if not b.massless}
+    # a pair element's force on its first body as applied (`plan.element_loads`: the
+    # second load of a PointToPoint is the one on body_a)
+    paired = pair_element_names(mech)
+    pairs = {f.name: sample_columns(loads(ahead, t_applied)[1][1], n)
+             for f, loads in zip(mech.forces, element_loads) if f.name in paired}
+    q, qd = (sample_columns(cols, n) for cols in joint_coordinates(mech, ahead))
+    transmitted = {j: subtree_force(mech, j, t_applied, accelerations) for j in joints}
+    return joint_reactions(mech, joints, transmitted, t_applied, q, qd, pair_forces=pairs)
