@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import math
 from types import SimpleNamespace
-from dataclasses import dataclass, field
+from dataclasses import astuple, dataclass, field
 from functools import cached_property
 from typing import Callable, Mapping, Sequence
 
@@ -60,7 +60,7 @@ from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTI
                    Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
                    Samples, Scheme, Setting, Stopwatch)
 from .reactions import actuator_force, balance_forces, body_wrenches, motion_reactions
-from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+from .plan import (PitchPair, BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
@@ -112,31 +112,21 @@ class _Carrier:
 
 
 @dataclass(frozen=True)
-class _Pitch:
-    """A LinearCoupling k_a th_a + k_b th_b + k_k th_k = const (sum k = 0) with a, b
-    hinged on the carrier k at hub points: a PivotJoint between a and b at the pitch point
-    (see the module docstring)."""
+class _Pitch(PitchPair):
+    """The pitch pair of the LinearCoupling `name`: a PivotJoint between a and b at the
+    pitch point (see the module docstring), or with `contact` (ring body, ring centre,
+    ring radius, disc body, centre, radius, internal) colliding pitch circles."""
 
     name: str
-    a: str
-    b: str
-    hub_a: tuple[float, float]  # local point of a (its hinge on the carrier)
-    hub_b: tuple[float, float]
-    d: float  # hub distance on the carrier
-    lam: float  # k_a / (k_a + k_b)
-    ksum: float  # k_a + k_b
     wrap: float  # Phi jumps by this when a massless carrier's angle wraps (0: none)
-    carrier: str
-    contact: tuple | None  # (ring body, ring centre, ring radius, disc body, centre, radius, internal)
+    contact: tuple | None
 
 
 @dataclass(frozen=True)
 class _Drive:
     """A prescribed coordinate (its `Prescribed` element `name`) on `joint`, whose parent
-    is the world or a body with mass and whose child has mass: imposed by a Chipmunk
-    constraint whose target (a prismatic joint's parent anchor, a hinge's gear phase) is
-    moved before every step, or, on the world, a kinematic child whose velocity is set
-    every step (see `PymunkBackend._schedule`)."""
+    is the world or a body with mass and whose child has mass (how it is imposed: the
+    PRESCRIBED expression, `PymunkBackend._schedule`)."""
 
     name: str
     joint: Revolute | Prismatic
@@ -156,7 +146,7 @@ class _Layout:
     cog: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: engine (mass, moment) of every engine body
     engine_mass: dict[str, tuple[float, float]] = field(default_factory=dict)
-    #: PinJoints (a, b, anchor a, anchor b, length, massless link)
+    #: PinJoints (a, b, anchor a, anchor b, massless link)
     pins: list[tuple] = field(default_factory=list)
     #: GearJoints of couplings and glued carriers (a, b, phase, ratio)
     gears: list[tuple[str, str, float, float]] = field(default_factory=list)
@@ -237,17 +227,15 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     for pair in pitch_pairs(mech, k, bodies, scale):
         if not (engine_ok(pair.a) and engine_ok(pair.b)):
             continue
-        A, B, K, d, lam = pair.a, pair.b, pair.carrier, pair.d, pair.lam
-        wrap = 2 * math.pi * abs(k[K]) if K in massless else 0.0
         circles = None
         if contact:
-            if K not in massless:  # the carrier's hinges would keep the distance: see _build
+            if pair.carrier not in massless:  # its hinges would keep the distance: _build
                 raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
                                "massless carrier arm, which the contact replaces")
-            circles = (A, pair.hub_a, abs(lam) * d, B, pair.hub_b, abs(lam - 1) * d,
-                       not 0.0 < lam < 1.0)
-        return "pitch", _Pitch(c.name, A, B, pair.hub_a, pair.hub_b, d, lam,
-                               pair.k_a + pair.k_b, wrap, K, circles)
+            circles = (pair.a, pair.hub_a, abs(pair.lam) * pair.d, pair.b, pair.hub_b,
+                       abs(pair.lam - 1) * pair.d, not 0.0 < pair.lam < 1.0)
+        wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
+        return "pitch", _Pitch(*astuple(pair), c.name, wrap, circles)
     raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
                    "couples the absolute angles of two bodies, and a coupling of three is "
                    "expressible here only as two bodies hinged on a common carrier (gear pair, "
@@ -314,8 +302,7 @@ def _eliminated(ctx, body) -> None:
             layout.pivots.append((ra, other, pa, point))
         for other, point in link.at_beta[1:]:
             layout.pivots.append((rb, other, pb, point))
-        length = float(np.linalg.norm(np.subtract(link.beta, link.alpha)))
-        layout.pins.append((ra, rb, pa, pb, length, link.link))
+        layout.pins.append((ra, rb, pa, pb, link.link))
 
 
 def _folded_groove(fold: Fold) -> _Groove:
@@ -962,7 +949,7 @@ class PymunkBackend(Backend):
         # distance would be enforced twice and Gauss-Seidel may leave the contact's normal
         # impulse, hence its friction, at zero)
         replaced = {p.carrier for p in layout.pitches if p.contact is not None}
-        for a, b, pa, pb, _, link in layout.pins:
+        for a, b, pa, pb, link in layout.pins:
             if link not in replaced:
                 constraints.append(pymunk.PinJoint(bodies[a], bodies[b], pa, pb))
         for g in layout.grooves:
@@ -1082,7 +1069,7 @@ class PymunkBackend(Backend):
         a, b = bodies[pitch.a], bodies[pitch.b]
         engine = [bodies[n] for n in comp.layout.engine]
         cogs = [comp.layout.cog.get(n) for n in comp.layout.engine]
-        scale = pitch.d / pitch.ksum
+        scale = pitch.d / (pitch.k_a + pitch.k_b)
         last: list[float | None] = [None]
 
         def anchors():
@@ -1311,25 +1298,41 @@ class PymunkBackend(Backend):
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                        n_steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
+        """The samples and the forces. Chipmunk reports only an impulse's magnitude, so
+        the forces over each step n -> n+1 come from Newton-Euler over the step, minus the
+        element loads as applied in it (at the position-updated state x + H v and
+        t + shift h): in a tree, on the joint child's subtree (`reactions.motion_reactions`,
+        `reactions.actuator_force`); with closure constraints, the balance of every body
+        (`_forces`). Chipmunk computes that impulse at the position-updated configuration
+        x(n+1), so it is given to sample n+1 (measured on the pendulums: 3.5-40x closer to
+        the model's reaction at that sample than at sample n); sample 0 has no step before
+        it and is NaN. A start with angular velocity shows an O(1) transient at sample 1
+        of a tree's reactions: the first step also builds the steady O(h^2) joint gap of
+        the position update, and its impulse contains that correction."""
         h = float(dt)
         run = self._run(mechanism, q0, qd0, n_steps, h, cfg, record=True)
-        mechanism, comp, clock, rows, H, shift = (run.mechanism, run.comp, run.clock,
-                                                  run.rows, run.H, run.shift)
-        S = np.array(rows)
+        mechanism, comp = run.mechanism, run.comp
+        S = np.array(run.rows)
         t = np.arange(n_steps + 1) * h
         q, qd = self._coordinates(mechanism, comp, S, q0, t)
+        frames, ahead = comp.frames(S), comp.frames(S[:-1], run.H)
+        t_applied = t[:-1] + run.shift * h
+        loads = (comp.body_loads(ahead, t_applied)
+                 if mechanism.constraints or comp.layout.drives else [])
+        reactions: dict[str, np.ndarray] = {}
         constraint_forces: dict[str, np.ndarray] = {}
         if mechanism.constraints:
-            joint_forces, constraint_forces = self._forces(mechanism, comp, S, H, shift, h, t)
+            joint_forces, constraint_forces = self._forces(mechanism, comp, S, ahead, loads, h)
             reactions = {j: joint_forces[j] for j in reaction_joints}
-        else:
-            reactions = self._tree_reactions(mechanism, comp, reaction_joints, S, H, shift, h, t)
-        frames, ahead = comp.frames(S), comp.frames(S[:-1], H)
-        loads = comp.body_loads(ahead, t[:-1] + shift * h) if comp.layout.drives else []
-        actuator_forces = {d.name: _after_first(actuator_force(mechanism, d.joint, frames, ahead,
-                                                               loads, h))
+        elif reaction_joints:
+            reactions = motion_reactions(mechanism, reaction_joints, frames, ahead,
+                                         comp.elements, t_applied, h)
+        actuator_forces = {d.name: actuator_force(mechanism, d.joint, frames, ahead, loads, h)
                            for d in comp.layout.drives}
-        return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
+        reactions, constraint_forces, actuator_forces = (
+            {name: _after_first(f) for name, f in forces.items()}
+            for forces in (reactions, constraint_forces, actuator_forces))
+        return Samples(q, qd, run.clock, reactions, constraint_forces, actuator_forces)
 
     @staticmethod
     def _coordinates(mechanism: Mechanism, comp: _Compiled, S: np.ndarray, q0: np.ndarray,
@@ -1344,43 +1347,25 @@ class PymunkBackend(Backend):
                 q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
         return q, qd
 
-    @staticmethod
-    def _tree_reactions(mech: Mechanism, comp: _Compiled, joints: Sequence[str], S: np.ndarray,
-                        H: float, shift: int, h: float, t: np.ndarray) -> dict[str, np.ndarray]:
-        """Force the parent exerts on the child over the step n -> n+1
-        (`reactions.motion_reactions`), the element forces from outside as applied in
-        that step (at the position-updated state x + H v and t + shift h). Chipmunk
-        computes that impulse at the position-updated configuration x(n+1), so it is given
-        to sample n+1 (measured on the pendulums: 3.5-40x closer to the model's reaction
-        at that sample than at sample n); sample 0 has no step before it and is NaN. A
-        start with angular velocity shows an O(1) transient at sample 1: the first step
-        also builds the steady O(h^2) joint gap of the position update, and its impulse
-        contains that correction."""
-        if not joints:
-            return {}
-        return {name: _after_first(force) for name, force in motion_reactions(
-            mech, joints, comp.frames(S), comp.frames(S[:-1], H), comp.elements,
-            t[:-1] + shift * h, h).items()}
-
-    def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, H: float, shift: int,
-                h: float, t: np.ndarray):
-        """Joint reactions and closure-constraint forces of a constrained mechanism.
+    def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, ahead: EliminatedFrames,
+                loads: list[Load], h: float) -> tuple[dict, dict]:
+        """Joint reactions and closure-constraint forces of a constrained mechanism over
+        each step (state rows `S`; the element `loads` as applied in it, at `ahead`).
 
         Chipmunk's `impulse` is a magnitude, and a closure may be a substitute (slider,
         pitch pivot, contact), so the forces are taken from momentum balance
         (`reactions.balance_forces`, which also says why not `joint_reaction`): for every
         description body, over the step n -> n+1, the engine parts that make it up give
         sum m (a - g) and sum (I alpha + r x m (a - g)) about its centre of mass; minus the
-        element loads as applied in that step, that is the wrench of the unknown joint
-        reactions and closure multipliers at the configuration x(n+1) where Chipmunk
-        computed its impulses (sample n+1, as the reactions; sample 0 NaN). A start with
-        velocity shows a transient at sample 1:
-        Chipmunk's velocity is staggered (v_n ~ v(t_n + h/2), whose constraint component
-        is -h times the curvature term), the exact initial velocity is not, and the first
-        impulse makes up the difference: 1.5 times the centripetal part (eccentric cam
-        spinning at 40 rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2)."""
+        element loads, that is the wrench of the unknown joint reactions and closure
+        multipliers at the configuration x(n+1) where Chipmunk computed its impulses. A
+        start with velocity shows a transient at sample 1: Chipmunk's velocity is
+        staggered (v_n ~ v(t_n + h/2), whose constraint component is -h times the
+        curvature term), the exact initial velocity is not, and the first impulse makes up
+        the difference: 1.5 times the centripetal part (eccentric cam spinning at 40
+        rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2)."""
         layout = comp.layout
-        m_steps = len(t) - 1
+        m_steps = len(S) - 1
         bodies = [b.name for b in mech.bodies]
         frames = comp.frames(S[1:])
         rhs = np.zeros((m_steps, 3 * len(bodies)))
@@ -1400,12 +1385,10 @@ class PymunkBackend(Backend):
             rhs[:, 3 * i] += fx
             rhs[:, 3 * i + 1] += fy
             rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
-        ahead = comp.frames(S[:-1], H)
-        rhs -= body_wrenches(bodies, comp.body_loads(ahead, t[:-1] + shift * h), ahead, m_steps)
+        rhs -= body_wrenches(bodies, loads, ahead, m_steps)
         joint_forces, constraint_forces, residual = balance_forces(mech, frames, rhs)
         self.diagnostics = {"balance_residual": residual, "notes": list(layout.notes)}
-        return ({name: _after_first(f) for name, f in joint_forces.items()},
-                {name: _after_first(f) for name, f in constraint_forces.items()})
+        return joint_forces, constraint_forces
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
