@@ -1236,3 +1236,51 @@ def pitch_pairs(mech: Mechanism, k: Mapping[str, float], bodies: Sequence[str],
         if d == 0.0 or abs(ka + kb) <= 1e-12 * scale:
             continue
         yield PitchPair(K, A, B, hubs[A][0], hubs[B][0], d, ka, kb)
+
+
+# --- small facts of the description an engine's translation asks for ---------------------
+
+
+def line_through_origin(base: np.ndarray, direction: np.ndarray) -> bool:
+    """Whether the line base + u direction (in a body's frame) passes through the frame's
+    origin, the body's centre of mass."""
+    scale = float(np.linalg.norm(direction)) * max(float(np.linalg.norm(base)), 1.0)
+    return abs(float(base[0] * direction[1] - base[1] * direction[0])) <= 1e-12 * scale
+
+
+def rotation_fixed(mech: Mechanism, body: str) -> bool:
+    """Whether the body's angle is constant: every joint from the world to it is
+    prismatic (its moment of inertia then enters no equation of motion)."""
+    while body != WORLD:
+        j = mech.joint_of_child(body)
+        if not isinstance(j, Prismatic):
+            return False
+        body = j.parent
+    return True
+
+
+def effective_mass(m: float, inertia: float, d: float) -> float:
+    """Mass of a rigid body felt at a point at distance d from its centre of mass, across
+    the radius: m I / (I + m d^2)."""
+    return m * inertia / (inertia + m * d * d)
+
+
+def continued_angles(mech: Mechanism, q: np.ndarray, q0: np.ndarray) -> np.ndarray:
+    """The samples q (rows) with every hinge angle unwrapped and continued from q0 (an
+    angle read by atan2 jumps by 2 pi); q is changed in place and returned."""
+    for i, j in enumerate(mech.joints):
+        if isinstance(j, Revolute):
+            col = np.unwrap(q[:, i])
+            q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
+    return q
+
+
+def coupling_residual(mech: Mechanism, coupling: LinearCoupling
+                      ) -> Callable[[Mapping], object]:
+    """The residual sum c_i q_i - C of a coupling as a function of the bodies' frame
+    states (numbers, arrays of samples or symbols), the coordinates read by
+    `coordinate_reader`."""
+    terms = [(num(coef), coordinate_reader(mech.joints[i]), mech.joints[i])
+             for name, coef in coupling.coefficients for i in [mech.coordinates.index(name)]]
+    return lambda frames: (sum(coef * read(frames[j.parent], frames[j.child])[0]
+                               for coef, read, j in terms) - num(coupling.constant))

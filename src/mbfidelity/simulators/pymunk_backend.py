@@ -60,14 +60,15 @@ from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTI
                    Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
                    Samples, Scheme, Setting, Stopwatch)
 from .reactions import actuator_force, balance_forces, body_wrenches, motion_reactions
-from .plan import (PitchPair, BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
-                   NotEliminable, angle_coupling, body_states, coordinate_reader, cos_sin, coupled,
-                   description_reason, element_kind, element_loads, force_bodies,
-                   joint_coordinates, motions, num, pitch_pairs, point_mass, point_state,
-                   rigid_body, rot, sample_columns, traced, wrench)
+                   NotEliminable, PitchPair, angle_coupling, body_states, continued_angles,
+                   cos_sin, coupled, coupling_residual, description_reason, effective_mass,
+                   element_kind, element_loads, force_bodies, joint_coordinates,
+                   line_through_origin, motions, num, pitch_pairs, point_mass, point_state,
+                   rigid_body, rot, rotation_fixed, sample_columns, traced, wrench)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -168,12 +169,6 @@ def _vec(v) -> np.ndarray:
     return np.array([num(v[0]), num(v[1])])
 
 
-def _through_origin(base: np.ndarray, direction: np.ndarray) -> bool:
-    """Whether the line base + u direction passes through the body's centre of mass."""
-    scale = float(np.linalg.norm(direction)) * max(float(np.linalg.norm(base)), 1.0)
-    return abs(float(base[0] * direction[1] - base[1] * direction[0])) <= 1e-12 * scale
-
-
 _GROOVE_LIMIT = (
     "Chipmunk's GrooveJoint computes the impulse that would stop the whole relative "
     "velocity of pin and slot (2x2 mass matrix) and keeps only its component normal to "
@@ -183,23 +178,6 @@ _GROOVE_LIMIT = (
     "pin body's centre of mass (or on the world). Otherwise the sliding velocity leaks "
     "into the normal direction (measured: velocity jump at the first step, O(h) joint "
     "drift, divergence for large offsets)")
-
-
-def _rotation_fixed(mech: Mechanism, body: str) -> bool:
-    """Whether the body's angle is constant: every joint from the world to it is
-    prismatic (its moment of inertia then enters no equation of motion)."""
-    while body != WORLD:
-        j = mech.joint_of_child(body)
-        if element_kind(j) != PRISMATIC:
-            return False
-        body = j.parent
-    return True
-
-
-def _effective_mass(m: float, inertia: float, d: float) -> float:
-    """Mass of a rigid body felt at a point at distance d from its centre of mass, across
-    the radius: m I / (I + m d^2)."""
-    return m * inertia / (inertia + m * d * d)
 
 
 def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
@@ -278,7 +256,7 @@ def _engine_body(ctx, body) -> None:
                        "needs a mass > 0 (or both 0 for a massless link that can be "
                        "eliminated)")
     ctx.layout.dynamic.append(body.name)
-    if _rotation_fixed(ctx.mech, body.name):
+    if rotation_fixed(ctx.mech, body.name):
         ctx.layout.infinite.add(body.name)
 
 
@@ -315,7 +293,7 @@ def _folded_groove(fold: Fold) -> _Groove:
         base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
         direction = -back @ _vec(pri.axis)
         anchor = _vec(rev.parent_anchor)
-        slot_ok = _through_origin(base, direction)
+        slot_ok = line_through_origin(base, direction)
         pin_ok = rev.parent == WORLD or not anchor.any()
     else:
         # the link turns with its parent: the pin (a point of the child) slides on a
@@ -324,7 +302,7 @@ def _folded_groove(fold: Fold) -> _Groove:
             _vec(rev.parent_anchor) - _vec(pri.child_anchor))
         direction = _vec(pri.axis)
         anchor = _vec(rev.child_anchor)
-        slot_ok = pri.parent == WORLD or _through_origin(base, direction)
+        slot_ok = pri.parent == WORLD or line_through_origin(base, direction)
         pin_ok = not anchor.any()
     if not (slot_ok and pin_ok):
         where = ("slot line off the slot body's centre of mass" if not slot_ok
@@ -357,7 +335,7 @@ def _slide(ctx, j: Prismatic) -> None:
     # with the rotation locked the pin can be the child's centre of mass
     base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
     axis = _vec(j.axis)
-    if j.parent != WORLD and not _through_origin(base, axis):
+    if j.parent != WORLD and not line_through_origin(base, axis):
         raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                        f"parent's centre of mass. {_GROOVE_LIMIT}")
     ctx.layout.grooves.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *_limits(j),
@@ -441,7 +419,7 @@ def _slot(ctx, c: PointOnLine) -> None:
         """A carrier of `host` at its point `at`: a glued slot carrier (kind "slot") or
         a point-mass pin slider (kind "pin"), pinned there."""
         m, inertia = num(ctx.mech.body(host).mass), num(ctx.mech.body(host).inertia)
-        mass = ctx.fraction * _effective_mass(m, inertia, float(np.linalg.norm(at)))
+        mass = ctx.fraction * effective_mass(m, inertia, float(np.linalg.norm(at)))
         name = f"_{kind}_{'carrier' if kind == 'slot' else 'slider'}_{c.name}"
         layout.carriers.append(_Carrier(name, host, kind, tuple(at), mass,
                                         mass * inertia / m if kind == "slot" else math.inf,
@@ -450,15 +428,15 @@ def _slot(ctx, c: PointOnLine) -> None:
         return name
 
     slot, pin, anchor = c.line_body, c.body, point
-    if slot != WORLD and not _through_origin(base, direction):
-        if _rotation_fixed(ctx.mech, slot):
+    if slot != WORLD and not line_through_origin(base, direction):
+        if rotation_fixed(ctx.mech, slot):
             layout.infinite.add(slot)
         else:  # slot carrier glued to the slot body, its centre on the line
             foot = base - float(base @ direction) * direction
             slot, base = substitute("slot", slot, foot), base - foot
             layout.gears.append((c.line_body, slot, 0.0, 1.0))
     if pin != WORLD and point.any():
-        if _rotation_fixed(ctx.mech, pin):
+        if rotation_fixed(ctx.mech, pin):
             layout.infinite.add(pin)
         else:  # pin slider: a point mass pinned to the pin point
             pin, anchor = substitute("pin", pin, point), np.zeros(2)
@@ -593,7 +571,7 @@ def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
 def _slot_exact(layout: _Layout, g: _Groove) -> bool:
     if g.slot == WORLD or g.slot in layout.infinite:
         return True
-    return _through_origin(np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))),
+    return line_through_origin(np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))),
                            np.array(g.direction))
 
 
@@ -678,15 +656,12 @@ class _Compiled:
         function of the engine bodies' positions (x, y, theta each)."""
         if pitch.name in self.phis:
             return self.phis[pitch.name]
-        c = next(c for c in self.mech.constraints if c.name == pitch.name)
-        terms = [(num(coef), coordinate_reader(self.mech.joints[i]), self.mech.joints[i])
-                 for name, coef in c.coefficients
-                 for i in [self.mech.coordinates.index(name)]]
+        residual = coupling_residual(self.mech, next(c for c in self.mech.constraints
+                                                     if c.name == pitch.name))
 
         def phi(*pos: float) -> list:
-            frames = self.at([pos[k:k + 3] for k in range(0, len(pos), 3)], [_ZERO] * self.n)
-            return [sum(coef * read(frames[j.parent], frames[j.child])[0]
-                        for coef, read, j in terms) - num(c.constant)]
+            return [residual(self.at([pos[k:k + 3] for k in range(0, len(pos), 3)],
+                                     [_ZERO] * self.n))]
 
         compiled = traced(phi, 3 * self.n)
         self.phis[pitch.name] = lambda *pos: compiled(*pos)[0]
@@ -1341,11 +1316,7 @@ class PymunkBackend(Backend):
         the angles of eliminated links, which come from atan2, continued from q0."""
         q, qd = (sample_columns(cols, len(t))
                  for cols in joint_coordinates(mechanism, comp.frames(S)))
-        for i, j in enumerate(mechanism.joints):
-            if element_kind(j) == REVOLUTE:
-                col = np.unwrap(q[:, i])
-                q[:, i] = col + 2 * math.pi * round((q0[i] - col[0]) / (2 * math.pi))
-        return q, qd
+        return continued_angles(mechanism, q, q0), qd
 
     def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, ahead: EliminatedFrames,
                 loads: list[Load], h: float) -> tuple[dict, dict]:
