@@ -1,7 +1,7 @@
 """The shared numeric kinematics of simulators/plan.py, checked against its forward
-kinematics (`body_states`, `point_state`) on every planar catalog mechanism, and Pymunk's
-elimination of massless links (its description frames and the virtual power of its
-loads) against the same."""
+kinematics (`body_states`, `point_state`) on every planar catalog mechanism, and the
+elimination of massless links (`plan.EliminatedFrames`; in Pymunk, its description frames
+and the virtual power of its loads) against the same."""
 from __future__ import annotations
 
 import functools
@@ -164,6 +164,44 @@ ELIMINATED = ("elastic_pendulum", "pendulum_sliding_block", "belt_pulleys", "fiv
               "slotted_link_spring_damper")
 
 
+@functools.lru_cache(maxsize=None)
+def _moving_state(sid: str) -> tuple:
+    """(numeric mechanism, q, qd): a consistent state in motion, the reference's after
+    0.2 s."""
+    from mbfidelity.analytic.reference import reference
+    from mbfidelity.comparisons.runner import DEFAULT_DT, _engine_mechanism
+    from mbfidelity.systems import all_systems
+
+    system = all_systems()[sid]
+    sc = system.scenarios[0]
+    values = system.parameter_values(None, scenario=sc)
+    ref = reference(system, sc, values, DEFAULT_DT, 0.2)
+    return _engine_mechanism(system, values, None), ref.q[-1], ref.qd[-1]
+
+
+@pytest.mark.parametrize("sid", ELIMINATED)
+def test_eliminated_frames_follow_the_forward_kinematics(sid):
+    """plan.EliminatedFrames, given the frames of the bodies with mass (body_states at a
+    consistent state in motion), gives every eliminated massless link's frame as
+    body_states does: no engine involved."""
+    from mbfidelity.simulators.plan import EliminatedFrames, Elimination, coupled, cos_sin
+
+    mech, q, qd = _moving_state(sid)
+    mech = coupled(mech)
+    want = body_states(mech, q, qd)
+    elimination = Elimination(mech)
+    assert elimination.kind
+
+    def massive(body: str) -> tuple:
+        x, y, th, vx, vy, w = want[body]
+        return (x, y, th, *cos_sin(th), vx, vy, w)
+
+    frames = EliminatedFrames(elimination, massive)
+    for name in elimination.kind:
+        scale = max(1.0, float(np.max(np.abs(want[name]))))
+        assert np.allclose(frames[name], want[name], rtol=0, atol=TOL * scale), (sid, name)
+
+
 @pytest.mark.parametrize("sid", ELIMINATED)
 def test_pymunk_frames_and_load_power_follow_the_description(sid):
     """From the engine state Pymunk builds at a consistent state, its description frames
@@ -171,18 +209,10 @@ def test_pymunk_frames_and_load_power_follow_the_description(sid):
     deliver the description's element power (the virtual-power Jacobian of an eliminated
     link, f . v + tau omega over the engine bodies at their centres of gravity)."""
     pytest.importorskip("pymunk")
-    from mbfidelity.analytic.reference import reference
-    from mbfidelity.comparisons.runner import DEFAULT_DT, _engine_mechanism
+    from mbfidelity.comparisons.runner import DEFAULT_DT
     from mbfidelity.simulators.pymunk_backend import BACKEND
-    from mbfidelity.systems import all_systems
 
-    system = all_systems()[sid]
-    sc = system.scenarios[0]
-    values = system.parameter_values(None, scenario=sc)
-    mech = _engine_mechanism(system, values, None)
-    # a consistent state in motion: the reference's after 0.2 s
-    ref = reference(system, sc, values, DEFAULT_DT, 0.2)
-    q0, qd0 = ref.q[-1], ref.qd[-1]
+    mech, q0, qd0 = _moving_state(sid)
     assert np.any(qd0 != 0)
     cfg = BACKEND.resolve_settings(None)
     layout, comp, space, bodies, balanced, _ = BACKEND._prepare(mech, q0, qd0, cfg, DEFAULT_DT)

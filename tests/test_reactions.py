@@ -251,3 +251,40 @@ def test_a_racks_guide_pushes_across_itself(backend):
     assert np.all(np.isfinite(got))
     assert np.max(np.abs(got[:, 0])) <= ALONG_RACK * weight
     assert np.allclose(got[:, 1], weight, rtol=ALONG_RACK)
+
+
+# --- forces from the bodies' motion (reactions.balance_forces, actuator_force) ----------
+
+L_ARM, M_BOB, I_BOB = 0.8, 1.5, 0.05
+
+
+def _pendulum(th: float) -> tuple[Mechanism, dict]:
+    """A bob hinged to the world at (0, 0) through its point (0, L) above its centre of
+    mass, held at rest at angle th (0: hanging), and its frames over three samples."""
+    mech = Mechanism(bodies=(Body("bob", M_BOB, I_BOB),),
+                     joints=(Revolute("hinge", "world", "bob", "th", child_anchor=(0, L_ARM)),),
+                     gravity=G)
+    states = body_states(mech, [th], [0.0])
+    return mech, {b: tuple(np.full(3, v) for v in st) for b, st in states.items()}
+
+
+def test_balance_forces_of_a_hanging_bob_carry_its_weight():
+    """At rest, hanging: the hinge holds the weight, R = (0, m g) on the bob; the balance
+    is solved exactly (residual 0)."""
+    mech, frames = _pendulum(0.0)
+    after = {b: tuple(v[1:] for v in st) for b, st in frames.items()}
+    needed = np.tile([0.0, M_BOB * G, 0.0], (2, 1))  # m (a - g), no moment about the centre
+    joint_forces, closures, residual = reactions.balance_forces(mech, after, needed)
+    assert closures == {}
+    assert np.allclose(joint_forces["hinge"], [[0.0, M_BOB * G]] * 2, rtol=0, atol=1e-12)
+    assert residual < 1e-12
+
+
+@pytest.mark.parametrize("th", [0.0, 0.4, -1.1])
+def test_actuator_force_holding_a_bob_at_rest_is_the_gravity_moment(th):
+    """A hinge's actuator holding the bob at rest at angle th balances the weight's
+    moment about the hinge: Q = m g L sin(th) (statics)."""
+    mech, frames = _pendulum(th)
+    ahead = {b: tuple(v[:-1] for v in st) for b, st in frames.items()}
+    force = reactions.actuator_force(mech, mech.joints[0], frames, ahead, [], 1e-3)
+    assert np.allclose(force, M_BOB * G * L_ARM * math.sin(th), rtol=1e-12, atol=1e-12)

@@ -27,7 +27,10 @@ them and lives here:
   compiles into the straight-line code of a step;
 - for an engine without massless bodies, the massless links eliminated by their shape
   (`Elimination`: folded, arms, free groups) and every body's frame from the bodies with
-  mass (`EliminatedFrames`).
+  mass (`EliminatedFrames`);
+- a coupling of hinge coordinates on the absolute body angles (`angle_coupling`) and as
+  rolling of pitch circles on a carrier (`pitch_pairs`), and small facts a translation
+  asks for (`line_through_origin`, `rotation_fixed`, `effective_mass`).
 """
 from __future__ import annotations
 

@@ -572,11 +572,12 @@ def _slot_exact(layout: _Layout, g: _Groove) -> bool:
     if g.slot == WORLD or g.slot in layout.infinite:
         return True
     return line_through_origin(np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))),
-                           np.array(g.direction))
+                               np.array(g.direction))
 
 
 def _pin_exact(layout: _Layout, g: _Groove) -> bool:
-    if g.pin == WORLD or g.pin in layout.infinite or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf:
+    if (g.pin == WORLD or g.pin in layout.infinite
+            or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf):
         return True
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
