@@ -595,12 +595,11 @@ _ZERO = (0.0, 0.0, 0.0)
 _UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
-def _rows(S: np.ndarray, H: float = 0.0) -> tuple[list, list]:
-    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from
-    state rows (columns of samples)."""
-    S = np.asarray(S, dtype=float).T
-    P = [tuple(S[k + i] + H * S[k + 3 + i] for i in range(3)) for k in range(0, len(S), 6)]
-    V = [tuple(S[k + 3 + i] for i in range(3)) for k in range(0, len(S), 6)]
+def _split(row: Sequence, H=0.0) -> tuple[list, list]:
+    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from a
+    state row (numbers, symbols or columns of samples; 6 entries per engine body)."""
+    P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
+    V = [tuple(row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
     return P, V
 
 
@@ -646,7 +645,7 @@ class _Compiled:
 
     def frames(self, S: np.ndarray, H: float = 0.0) -> EliminatedFrames:
         """The frames over state rows S (one sample per row) at x + H v."""
-        return self.at(*_rows(S, H))
+        return self.at(*_split(np.asarray(S, dtype=float).T, H))
 
     def body_loads(self, frames: EliminatedFrames, t) -> list[Load]:
         """The element loads on the description bodies."""
@@ -682,9 +681,7 @@ class _Compiled:
         engine bodies at the position-updated state x + H v of one state row. A load on
         an eliminated massless body reaches the engine bodies it follows by virtual
         power, J^T f, J's columns its velocities for a unit rate of each engine state."""
-        P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3))
-             for k in range(0, len(row), 6)]
-        V = [tuple(row[k + 3:k + 6]) for k in range(0, len(row), 6)]
+        P, V = _split(row, H)
         frames = self.at(P, V)
         out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
         for load in self.body_loads(frames, t):
