@@ -1068,7 +1068,7 @@ def moving_point(state: tuple, local) -> tuple:
     return x + rx, y + ry, vx - w * ry, vy + w * rx
 
 
-def _hung(pin: tuple, th, w, local) -> tuple:
+def hung_frame(pin: tuple, th, w, local) -> tuple:
     """The `EliminatedFrames.state` of a body at angle th turning at w, whose point
     `local` is at the moving point `pin` (x, y, vx, vy)."""
     c, s = cos_sin(th)
@@ -1102,7 +1102,7 @@ class EliminatedFrames:
         elif kind[0] == "fold":  # turns with `turner`, its point `local` on the pin
             _, turner, off, pin, pin_local, local = kind
             turning = self.state(turner)
-            state = _hung(moving_point(self.state(pin), pin_local), turning[2] + off,
+            state = hung_frame(moving_point(self.state(pin), pin_local), turning[2] + off,
                           turning[7], local)
         elif kind[0] == "link":  # its alpha on the point a, its beta towards b
             _, ra, pa, rb, pb, ell, alpha = kind
@@ -1110,7 +1110,7 @@ class EliminatedFrames:
             wx, wy = b[0] - a[0], b[1] - a[1]
             th = atan2(ell[0] * wy - ell[1] * wx, ell[0] * wx + ell[1] * wy)
             w = (wx * (b[3] - a[3]) - wy * (b[2] - a[2])) / (wx * wx + wy * wy)
-            state = _hung(a, th, w, alpha)
+            state = hung_frame(a, th, w, alpha)
         else:
             self._group(kind[1])
             return self.cache[body]

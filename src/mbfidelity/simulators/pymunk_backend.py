@@ -66,7 +66,7 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
                    NotEliminable, PitchPair, angle_coupling, body_states, continued_angles,
                    cos_sin, coupled, coupling_residual, description_reason, effective_mass,
-                   element_kind, element_loads, force_bodies, joint_coordinates,
+                   element_kind, element_loads, force_bodies, hung_frame, joint_coordinates,
                    line_through_origin, motions, num, pitch_pairs, point_mass, point_state,
                    rigid_body, rot, rotation_fixed, sample_columns, traced, wrench)
 
@@ -635,11 +635,9 @@ class _Compiled:
         def massive(body: str) -> tuple:
             k, cog = self.index[body], self.cogs.get(body)
             (x, y, th), (vx, vy, w) = P[k], V[k]
-            c, s = cos_sin(th)
-            if cog:  # the frame origin from the centre of gravity
-                rx, ry = c * cog[0] - s * cog[1], s * cog[0] + c * cog[1]
-                x, y, vx, vy = x - rx, y - ry, vx + w * ry, vy - w * rx
-            return (x, y, th, c, s, vx, vy, w)
+            if cog:  # the frame whose point cog is the centre of gravity
+                return hung_frame((x, y, vx, vy), th, w, cog)
+            return (x, y, th, *cos_sin(th), vx, vy, w)
 
         return EliminatedFrames(self.layout.elimination, massive)
 
