@@ -58,10 +58,6 @@ from ..systems.model import (
 from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
                    joint_coordinates, num, point_state, sample_columns, wrench)
 
-
-def _point(v) -> tuple[float, float]:
-    return (num(v[0]), num(v[1]))
-
 #: the elements whose force is a pair of opposite forces on two bodies
 PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
 
@@ -175,6 +171,10 @@ def pair_element_names(mech: Mechanism) -> set[str]:
 # (plan.EliminatedFrames; a body with mass has its frame origin at its centre of mass),
 # as arrays over the samples; `loads`: the element loads (`plan.Load`) as applied in each
 # step, at the frames `ahead` where the engine evaluated them.
+
+
+def _point(v) -> tuple[float, float]:
+    return (num(v[0]), num(v[1]))
 
 
 def _world_axis(states: Mapping, body: str, v) -> tuple:
