@@ -126,7 +126,6 @@ from .base import (
     Stopwatch,
     Setting,
 )
-from .reactions import joint_reactions
 from .plan import (
     HINGE_CLOSURE,
     CoordinateLaws,
@@ -1394,9 +1393,8 @@ class PyBulletBackend(Backend):
                     apply(k, jv, jvd)
                     step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
-            cmap = world.model.map
-            return BareLoop(clock.cpu, cmap.coordinates(np.array([[s[0] for s in js]]))[0],
-                            cmap.rates(np.array([[s[1] for s in js]]))[0])
+            return BareLoop.mapped(clock.cpu, world.model.map, [s[0] for s in js],
+                                   [s[1] for s in js])
         finally:
             p.disconnect(physicsClientId=world.cid)
 
@@ -1513,32 +1511,28 @@ class PyBulletBackend(Backend):
             forces = self._constraint_forces(model, CF[: steps + 1], JV[: steps + 1])
             q = model.map.coordinates(JV[: steps + 1, :n])
             qd = model.map.rates(JVD[: steps + 1, :n])
-            reactions: dict[str, np.ndarray] = {}
-            if reaction_joints:
-                # a gear is a joint force: both routes see it
-                gears = {c.element.name: forces[c.element.name] for c in closures
-                         if not c.pair}
-                if use_sensor:
-                    transmitted = {name: sensor[: steps + 1, r].copy()
-                                   for r, name in enumerate(reaction_joints)}
-                    pairs: dict[str, np.ndarray] = {}
-                else:
-                    jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
-                    transmitted = self._inverse_dynamics_forces(
-                        p, cid, model, cfg, joint_ids, list(reaction_joints),
-                        JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
-                    # inverse dynamics applies no element: the point-to-point and the
-                    # closure forces across the cut are in its force (on body_a: minus
-                    # the force recorded on point b). Rolling by contact: the contact
-                    # carries what the description's arm and coupling carried, so it
-                    # counts as transmitted through the joints (contract point 6)
-                    pairs = {pf.name: -f_point[: steps + 1, e]
-                             for e, pf in enumerate(model.point_forces)}
-                    pairs.update({c.element.name: forces[c.element.name] for c in closures
-                                  if c.pair})
-                reactions = joint_reactions(mechanism, reaction_joints, transmitted,
-                                            dt * np.arange(steps + 1), q, qd,
-                                            pair_forces=pairs, coupling_forces=gears)
+            # a gear is a joint force: both routes see it
+            gears = {c.element.name: forces[c.element.name] for c in closures if not c.pair}
+            pairs: dict[str, np.ndarray] = {}
+            if use_sensor:
+                transmitted = {name: sensor[: steps + 1, r].copy()
+                               for r, name in enumerate(reaction_joints)}
+            elif reaction_joints:
+                jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
+                transmitted = self._inverse_dynamics_forces(
+                    p, cid, model, cfg, joint_ids, list(reaction_joints),
+                    JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
+                # inverse dynamics applies no element: the point-to-point and the closure
+                # forces across the cut are in its force (on body_a: minus the force
+                # recorded on point b). Rolling by contact: the contact carries what the
+                # description's arm and coupling carried, so it counts as transmitted
+                # through the joints (contract point 6)
+                pairs = {pf.name: -f_point[: steps + 1, e]
+                         for e, pf in enumerate(model.point_forces)}
+                pairs.update({c.element.name: forces[c.element.name] for c in closures
+                              if c.pair})
+            else:
+                transmitted = {}
             violation = self._violations(p, cid, body, eidx, model, JV[: steps + 1])
         finally:
             p.disconnect(physicsClientId=cid)
@@ -1554,7 +1548,9 @@ class PyBulletBackend(Backend):
         extras = {"constraint_violation": violation}
         if contact_report is not None:
             extras["contact"] = contact_report
-        return Samples(q, qd, clock, reactions, forces, actuators, extras=extras)
+        return Samples(q, qd, clock, constraint_forces=forces, actuator_forces=actuators,
+                       extras=extras, transmitted=transmitted, pair_forces=pairs,
+                       coupling_forces=gears)
 
     def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
