@@ -55,6 +55,7 @@ from .plan import (
     coordinate_map,
     element_kind,
     elements,
+    gravity_vector,
     num,
     point_mass,
     rigid_body,
@@ -708,11 +709,7 @@ def mjcf(build: Build) -> str:
             lines += indent(1, slider)
         return indent(depth, lines + ["</body>"])
 
-    g = num(mech.gravity)
-    gravity = (0, -g, 0)
-    if mech.spatial:
-        up = np.array([num(u) for u in mech.up], dtype=float)
-        gravity = -g * up / np.linalg.norm(up)
+    gravity = gravity_vector(mech)
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',

@@ -77,6 +77,22 @@ def rot(theta: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
+def turned(theta: np.ndarray, x, y) -> np.ndarray:
+    """The vectors (x, y) turned by the angles theta, one row per sample (N, 2)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([c * x - s * y, s * x + c * y], axis=1)
+
+
+def gravity_vector(mech: Mechanism) -> tuple[float, float, float]:
+    """The acceleration of gravity in world axes: along -y, or in a spatial mechanism
+    (model convention 10) against its `up`."""
+    g = num(mech.gravity)
+    if not mech.spatial:
+        return 0.0, -g, 0.0
+    up = np.array([num(u) for u in mech.up] + [0.0] * (3 - len(mech.up)), dtype=float)
+    return tuple(float(v) for v in -g * up / np.linalg.norm(up))
+
+
 def linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
     """(a, b, c) with law = a + b x + c xd (numbers, no TIME), or None when the law is not
     of that form."""

@@ -98,63 +98,19 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (
-    WORLD,
-    CoordinateForce,
-    LinearCoupling,
-    Mechanism,
-    PointToPoint,
-    Prescribed,
-    RollingContact,
-    inertia_matrix,
-)
 from ..analytic.linear import quadratic_eigenvalues
-from .base import (
-    ElementBuilders,
-    SEMI_IMPLICIT_EULER_STABILITY,
-    Scheme,
-    EXACT,
-    SUBSTITUTE,
-    UNSUPPORTED,
-    NO_BEAM_ELEMENT,
-    Backend,
-    BeamElement,
-    Expression,
-    Linearization,
-    BareLoop,
-    Samples,
-    Stopwatch,
-    Setting,
-)
-from .plan import (
-    HINGE_CLOSURE,
-    CoordinateLaws,
-    Motion,
-    spatial_tree_reason,
-    BODY,
-    PRESCRIBED,
-    COORDINATE_FORCE_CUSTOM,
-    COORDINATE_FORCE_LINEAR,
-    LINEAR_COUPLING,
-    MASSLESS_BODY,
-    POINT_ON_LINE,
-    POINT_ON_POINT,
-    POINT_TO_POINT_CUSTOM,
-    POINT_TO_POINT_LINEAR,
-    PRISMATIC,
-    REVOLUTE,
-    ROLLING_CONTACT,
-    TIME_LOAD,
-    ForceLaw,
-    constrained_bodies,
-    coordinate_map,
-    coupling_row,
-    element_kind,
-    element_loads,
-    elements,
-    num,
-    point_state,
-)
+from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
+                             Prescribed, RollingContact, inertia_matrix)
+from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
+                   UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
+                   Linearization, Samples, Scheme, Setting, Stopwatch)
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+                   LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
+                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
+                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
+                   constrained_bodies, coordinate_map, coupling_row, element_kind,
+                   element_loads, elements, gravity_vector, num, point_state,
+                   spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -201,12 +157,6 @@ def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
 def _point(ls, link: int, point) -> tuple[float, float, float, float]:
     """World position and velocity of a body point (centre-of-mass frame)."""
     return point_state(_pose(ls, link), point)
-
-
-def _turned(th: np.ndarray, x, y) -> np.ndarray:
-    """The vectors (x, y) turned by the angles th, one row per sample (N, 2)."""
-    c, s = np.cos(th), np.sin(th)
-    return np.stack([c * x - s * y, s * x + c * y], axis=1)
 
 
 @dataclass
@@ -418,10 +368,7 @@ class _Rotor(_Slot):
             th = model.map.angle(model.links[self.line_link].body, q)
         else:
             th = np.zeros(len(rows))
-        nx, ny = _slider_row_normal(self.direction)
-        cs, sn = np.cos(th), np.sin(th)
-        f = rows[:, 1]
-        return np.stack([f * (cs * nx - sn * ny), f * (sn * nx + cs * ny)], axis=1)
+        return rows[:, 1:2] * turned(th, *_slider_row_normal(self.direction))
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
@@ -523,10 +470,7 @@ class _Translation:
         self.mech, self.cfg = mech, cfg
         self.n = len(mech.joints)
         self.map = coordinate_map(mech)
-        gravity = num(mech.gravity)
-        up = np.array([num(u) for u in mech.up], dtype=float)
-        self.gravity_vector = ((0.0, -gravity, 0.0) if not mech.spatial
-                               else tuple(-gravity * up / np.linalg.norm(up)))
+        self.gravity_vector = gravity_vector(mech)
         masses = [num(b.mass) for b in mech.bodies]
         inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
@@ -878,7 +822,7 @@ def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray
     disc) is what the coupling's -lambda stands for."""
     ct = model.contact
     cvec, const = coupling_row(model.mech, coupling)
-    u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
+    u = turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
     ux, uy = u[:, 0], u[:, 1]
     normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
     friction = FC[:, 0] * -uy + FC[:, 1] * ux
@@ -1577,7 +1521,7 @@ class PyBulletBackend(Backend):
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
         q = model.map.coordinates(JV[:, :model.n])
-        return {name: _turned(model.map.angle(model.mech.joints[i].parent, q),
+        return {name: turned(model.map.angle(model.mech.joints[i].parent, q),
                               out[:, r, 0], out[:, r, 1])
                 for r, (i, name) in enumerate(zip(joint_ids, names))}
 

@@ -49,7 +49,7 @@ from ..systems.model import (
     PointToPoint,
     Prismatic,
 )
-from .plan import CoordinateMap, ForceLaw, coordinate_map, num
+from .plan import CoordinateMap, ForceLaw, coordinate_map, num, turned
 
 #: the elements whose force is a pair of opposite forces on two bodies
 PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
@@ -62,9 +62,7 @@ def slide_direction(mech: Mechanism, joint: Prismatic, q: np.ndarray,
     cmap = cmap or coordinate_map(mech)
     axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
     axis = axis / float(axis @ axis)
-    th = cmap.angle(joint.parent, q)
-    c, s = np.cos(th), np.sin(th)
-    return np.stack([c * axis[0] - s * axis[1], s * axis[0] + c * axis[1]], axis=1)
+    return turned(cmap.angle(joint.parent, q), axis[0], axis[1])
 
 
 def subtree_force(mech: Mechanism, joint_name: str, t: np.ndarray,
