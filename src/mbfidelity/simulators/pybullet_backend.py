@@ -93,8 +93,9 @@ step: refused.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -1173,22 +1174,10 @@ class PyBulletBackend(Backend):
         return out
 
     @staticmethod
-    def _constraint_forces(model: _Translation, CF: np.ndarray, JV: np.ndarray
-                           ) -> dict[str, np.ndarray]:
-        """getConstraintState rows -> the contract's physical terms (each closure's
-        `force`, signs measured)."""
-        q = model.map.coordinates(JV[:, :model.n]) if model.closures else None
-        return {c.element.name: c.force(CF[:, r], q, model)
-                for r, c in enumerate(model.closures)}
-
-    @staticmethod
     def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
-                    JV: np.ndarray) -> dict[str, np.ndarray]:
-        """Each closure's violation at every sample (`violations`, or `violation` from the
-        engine's own forward kinematics)."""
-        if not model.closures:
-            return {}
-        q = model.map.coordinates(JV[:, :model.n])
+                    JV: np.ndarray, q: np.ndarray) -> dict[str, np.ndarray]:
+        """Each closure's violation at the samples (engine joint values JV, coordinates
+        q): `violations`, or `violation` from the engine's own forward kinematics."""
         out = {c.element.name: c.violations(q) for c in model.closures}
         geo = [c for c in model.closures if c.pair]
         n_all = len(eidx)
@@ -1201,11 +1190,12 @@ class PyBulletBackend(Backend):
         return out
 
     # --- contract points 6 and 9 ---------------------------------------------------------
+    @contextmanager
     def _open(self, p, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, dt: float,
-              cfg: dict, sensor_joints: Sequence[int] = ()) -> _World:
+              cfg: dict, sensor_joints: Sequence[int] = ()) -> Iterator[_World]:
         """Connect a DIRECT client, build the mechanism and set the state (q0, qd0);
         enable the joint force/torque sensor on the joints `sensor_joints` (description
-        joint indices). The caller disconnects the client."""
+        joint indices). The client is disconnected on leaving."""
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
@@ -1232,10 +1222,9 @@ class PyBulletBackend(Backend):
                 _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
                 p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
-        except BaseException:
+            yield _World(cid, body, eidx, model, cids)
+        finally:
             p.disconnect(physicsClientId=cid)
-            raise
-        return _World(cid, body, eidx, model, cids)
 
     @staticmethod
     def _inputs(p, world: _World, dt: float, cfg: dict
@@ -1320,8 +1309,7 @@ class PyBulletBackend(Backend):
         """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
         import pybullet as p
 
-        world = self._open(p, mechanism, q0, qd0, dt, cfg)
-        try:
+        with self._open(p, mechanism, q0, qd0, dt, cfg) as world:
             apply, reads = self._inputs(p, world, dt, cfg)
             step, cid = p.stepSimulation, world.cid
             get_states, body, links = p.getJointStates, world.body, world.eidx[:world.model.n]
@@ -1339,8 +1327,6 @@ class PyBulletBackend(Backend):
             js = get_states(body, links, physicsClientId=cid)
             return BareLoop.mapped(clock.cpu, world.model.map, [s[0] for s in js],
                                    [s[1] for s in js])
-        finally:
-            p.disconnect(physicsClientId=world.cid)
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
@@ -1360,8 +1346,7 @@ class PyBulletBackend(Backend):
         name, (q0, qd0) = next(iter(initial_states.items()))
         cfg = self.resolve_settings(settings)
         recorder = Recorder(pybullet)
-        world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
-        try:
+        with self._open(recorder, mechanism, q0, qd0, dt, cfg) as world:
             outside = []
             if mechanism.forces or any(c.follows_pin for c in world.model.closures):
                 laws = [e.name for e in mechanism.forces]
@@ -1383,8 +1368,6 @@ class PyBulletBackend(Backend):
                       f"{list(world.eidx[:n])}, physicsClientId=cid)]"),
                 coordinates=coordinates, T=world.model.map.T, c=world.model.map.c, dt=dt,
                 not_in_script=outside)
-        finally:
-            pybullet.disconnect(physicsClientId=world.cid)
         return text, outside
 
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
@@ -1394,15 +1377,15 @@ class PyBulletBackend(Backend):
 
         joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
-        world = self._open(p, mechanism, q0, qd0, dt, cfg,
-                           sensor_joints=joint_ids if use_sensor else ())
-        cid, body, eidx, model, cids = world.cid, world.body, world.eidx, world.model, world.cids
-        contact, closures, n = model.contact, model.closures, model.n
-        # one extra step gives the reaction/acceleration (and the constraint forces) of
-        # the last sample
-        total = steps + 1 if (reaction_joints or closures or contact
-                              or mechanism.prescribed) else steps
-        try:
+        with self._open(p, mechanism, q0, qd0, dt, cfg,
+                        sensor_joints=joint_ids if use_sensor else ()) as world:
+            cid, body, eidx, model, cids = (world.cid, world.body, world.eidx, world.model,
+                                            world.cids)
+            contact, closures, n = model.contact, model.closures, model.n
+            # one extra step gives the reaction/acceleration (and the constraint forces)
+            # of the last sample
+            total = steps + 1 if (reaction_joints or closures or contact
+                                  or mechanism.prescribed) else steps
             JV, JVD = np.empty((total + 1, len(eidx))), np.empty((total + 1, len(eidx)))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
             # force on point b of each point-to-point element (on a: opposite)
@@ -1451,10 +1434,12 @@ class PyBulletBackend(Backend):
                             sensor[k, r] = rf[0], rf[1]
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
+            jv, jvd = JV[: steps + 1], JVD[: steps + 1]  # the samples
 
-            forces = self._constraint_forces(model, CF[: steps + 1], JV[: steps + 1])
-            q = model.map.coordinates(JV[: steps + 1, :n])
-            qd = model.map.rates(JVD[: steps + 1, :n])
+            q, qd = model.map.coordinates(jv[:, :n]), model.map.rates(jvd[:, :n])
+            # getConstraintState rows -> the contract's physical terms (signs measured)
+            forces = {c.element.name: c.force(CF[: steps + 1, r], q, model)
+                      for r, c in enumerate(closures)}
             # a gear is a joint force: both routes see it
             gears = {c.element.name: forces[c.element.name] for c in closures if not c.pair}
             pairs: dict[str, np.ndarray] = {}
@@ -1464,8 +1449,8 @@ class PyBulletBackend(Backend):
             elif reaction_joints:
                 jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
                 transmitted = self._inverse_dynamics_forces(
-                    p, cid, model, cfg, joint_ids, list(reaction_joints),
-                    JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
+                    p, cid, model, cfg, joint_ids, list(reaction_joints), jv, jvd,
+                    jvdd[: steps + 1], q)
                 # inverse dynamics applies no element: the point-to-point and the closure
                 # forces across the cut are in its force (on body_a: minus the force
                 # recorded on point b). Rolling by contact: the contact carries what the
@@ -1477,14 +1462,11 @@ class PyBulletBackend(Backend):
                               if c.pair})
             else:
                 transmitted = {}
-            violation = self._violations(p, cid, body, eidx, model, JV[: steps + 1])
-        finally:
-            p.disconnect(physicsClientId=cid)
+            violation = self._violations(p, cid, body, eidx, model, jv, q)
 
         contact_report = None
         if contact is not None:
-            contact_report = _contact_report(model, model.coupling, q, qd,
-                                                  JV[: steps + 1], FC[: steps + 1])
+            contact_report = _contact_report(model, model.coupling, q, qd, jv, FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
         actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
@@ -1498,7 +1480,8 @@ class PyBulletBackend(Backend):
 
     def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
-                                 JVD: np.ndarray, JVDD: np.ndarray) -> dict[str, np.ndarray]:
+                                 JVD: np.ndarray, JVDD: np.ndarray, q: np.ndarray
+                                 ) -> dict[str, np.ndarray]:
         """The force from parent to child at each joint (world axes): the inverse-dynamics
         force on two massless prismatic joints (x, y of the parent frame) inserted in front
         of the joint. It applies no force element and no closure, so it holds every force
@@ -1520,7 +1503,6 @@ class PyBulletBackend(Backend):
                           physicsClientId=cid)
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
-        q = model.map.coordinates(JV[:, :model.n])
         return {name: turned(model.map.angle(model.mech.joints[i].parent, q),
                               out[:, r, 0], out[:, r, 1])
                 for r, (i, name) in enumerate(zip(joint_ids, names))}
@@ -1531,19 +1513,14 @@ class PyBulletBackend(Backend):
         orientation (a spatial link's frame is aligned with its body's)."""
         import pybullet as p
 
-        cfg = self.resolve_settings(settings)
-        model = _Translation(mechanism, cfg)
-        cid = self._connect(p, cfg, 1e-3, model.gravity_vector)
-        try:
-            body, eidx, _ = self._build(p, cid, model, cfg)
+        rest, cfg = np.zeros(len(mechanism.joints)), self.resolve_settings(settings)
+        with self._open(p, mechanism, rest, rest, 1e-3, cfg) as world:
             out = {}
-            for i, lk in enumerate(model.links[:model.n]):
-                info = p.getDynamicsInfo(body, eidx[i], physicsClientId=cid)
-                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=cid))
+            for i, lk in enumerate(world.model.links[:world.model.n]):
+                info = p.getDynamicsInfo(world.body, world.eidx[i], physicsClientId=world.cid)
+                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=world.cid))
                 out[lk.body] = (np.array(info[2], dtype=float), R.reshape(3, 3))
             return out
-        finally:
-            p.disconnect(physicsClientId=cid)
 
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
@@ -1558,13 +1535,12 @@ class PyBulletBackend(Backend):
             # calculateMassMatrix / calculateInverseDynamics describe the open tree only;
             # PyBullet has no constrained linearization (the free-vibration fit remains)
             return None
-        model = _Translation(mechanism, cfg)
-        n = model.n
         h_rel = float(cfg["linearize_step"])
-        cid = self._connect(p, cfg, dt, model.gravity_vector)
-        try:
-            body, eidx, _ = self._build(p, cid, model, cfg)
-            jv_eq = model.map.engine_values(np.asarray(q_eq, dtype=float))
+        q_eq = np.asarray(q_eq, dtype=float)
+        with self._open(p, mechanism, q_eq, np.zeros(len(q_eq)), dt, cfg) as world:
+            cid, body, eidx, model = world.cid, world.body, world.eidx, world.model
+            n = model.n
+            jv_eq = model.map.engine_values(q_eq)
             zeros = [0.0] * n
             perm = np.asarray(eidx[:n])  # engine (depth-first) index of each joint
 
@@ -1619,8 +1595,6 @@ class PyBulletBackend(Backend):
                 K[:, i] = (residual(jv_eq + h * e, v0) - residual(jv_eq - h * e, v0)) / (2 * h)
                 C[:, i] = (residual(jv_eq, v0 + h_rel * e)
                            - residual(jv_eq, v0 - h_rel * e)) / (2 * h_rel)
-        finally:
-            p.disconnect(physicsClientId=cid)
         eig = quadratic_eigenvalues(M, C, K)
         return Linearization(
             eigenvalues=eig,
