@@ -89,10 +89,10 @@ conventions 1-8) into one engine and runs it. The contract:
 11. Shared steps: what every backend needs before its engine enters is computed once, in
     `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
     map between description coordinates and engine joint values, forward kinematics),
-    the reactions' bookkeeping once, in `reactions` (from the force an engine books as
-    transmitted, or its centre-of-mass accelerations, the forces entering the child's
-    subtree from outside taken out), and settings are validated here; a backend
-    translates the plan into its engine, steps it and reads out.
+    the reactions' bookkeeping once, in `reactions`, run by `simulate` (from the force an
+    engine books as transmitted, or its centre-of-mass accelerations, the forces entering
+    the child's subtree from outside taken out), and settings are validated here; a
+    backend translates the plan into its engine, steps it and reads out.
 12. Flexible elements (optional): a backend declares in `BEAM_ELEMENTS`, per kind of the
     engine's own flexible (beam) element, a `BeamElement`: its `Expression` (exact: the
     element discretizes the Euler-Bernoulli beam itself; soft: it converges to a
