@@ -317,6 +317,13 @@ class _Slot(_Pin):
         return (_point(ls, self.pin_link, self.pin_point),
                 _point(ls, self.line_link, self.line_point), u)
 
+    def _along(self, ls) -> tuple[float, float]:
+        """Where the pin is along the slot, s = (P - L) . u, and its rate (v_P - v_L) . u
+        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
+        the rotation of u adds nothing), from link states."""
+        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
+        return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
+
     def violation(self, ls) -> float:
         """Signed distance n . (P - L) of the pin from the slot line (m)."""
         (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(ls)
@@ -330,13 +337,8 @@ class _Slider(_Slot):
     (child); its force on the pin (parent) is minus the rows."""
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
-        """The slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
-        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
-        the rotation of u adds nothing)."""
-        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
-        s = (px - lx) * ux + (py - ly) * uy
-        sd = (pvx - lvx) * ux + (pvy - lvy) * uy
-        p.resetJointState(body, eidx[self.aux], s, sd, physicsClientId=cid)
+        """The slider sits under the pin and moves with it along the slot (`_along`)."""
+        p.resetJointState(body, eidx[self.aux], *self._along(ls), physicsClientId=cid)
 
 
 @dataclass
@@ -377,9 +379,7 @@ class _Rotor(_Slot):
         Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
         (fixed) the slot body would feel the force at L instead of at the pin (measured: a
         bar slotted along its own axis through its pivot then swings freely)."""
-        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(
-            {lk: ls[m] for lk, m in slot_of.items()})
-        s = (px - lx) * ux + (py - ly) * uy
+        s, _ = self._along({lk: ls[m] for lk, m in slot_of.items()})
         ux, uy = self.direction
         return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
 
