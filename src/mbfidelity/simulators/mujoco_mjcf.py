@@ -59,6 +59,7 @@ from .plan import (
     num,
     point_mass,
     rigid_body,
+    ring_of_boxes,
     rot,
     spatial_tree_reason,
 )
@@ -584,12 +585,9 @@ def _rolling_contact(build: Build, c: RollingContact) -> None:
         f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
         f'conaffinity="0"{params}/>')
     nseg = int(s["ring_segments"])
-    R, (cx, cy) = geo["R"], geo["centre"]
-    t = 0.1 * R  # radial thickness of the ring's boxes; the inner faces lie at R
-    half = R * math.tan(math.pi / nseg)  # faces meet: a polygon circumscribing R
-    for k in range(nseg):
-        a = 2 * math.pi * k / nseg
-        x, y = cx + (R + t / 2) * math.cos(a), cy + (R + t / 2) * math.sin(a)
+    # the inner faces lie at R and meet: a polygon circumscribing R
+    boxes, t, half = ring_of_boxes(geo["centre"], geo["R"], nseg)
+    for x, y, a in boxes:
         build.geoms.setdefault(build.carrier[geo["track"]], []).append(
             f'<geom type="box" size="{fmt(t / 2, half, 2 * geo["r"])}" '
             f'pos="{fmt(x, y, 0)}" quat="{fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '

@@ -83,6 +83,19 @@ def turned(theta: np.ndarray, x, y) -> np.ndarray:
     return np.stack([c * x - s * y, s * x + c * y], axis=1)
 
 
+def ring_of_boxes(centre, R: float, count: int
+                  ) -> tuple[list[tuple[float, float, float]], float, float]:
+    """The track of a rolling contact as `count` boxes whose inner faces are tangent to the
+    circle of radius R about `centre` (a regular polygon with the circle as its incircle):
+    each box's centre (x, y) and angle, the boxes' radial thickness (0.1 R) and the half
+    length R tan(pi / count) at which neighbouring faces meet."""
+    thick = 0.1 * R
+    rho = R + thick / 2.0
+    boxes = [(centre[0] + rho * math.cos(a), centre[1] + rho * math.sin(a), a)
+             for a in (2.0 * math.pi * i / count for i in range(count))]
+    return boxes, thick, R * math.tan(math.pi / count)
+
+
 def gravity_vector(mech: Mechanism) -> tuple[float, float, float]:
     """The acceleration of gravity in world axes: along -y, or in a spatial mechanism
     (model convention 10) against its `up`."""

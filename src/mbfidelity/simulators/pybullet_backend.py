@@ -111,7 +111,7 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
                    constrained_bodies, coordinate_map, coupling_row, element_kind,
                    element_loads, elements, gravity_vector, num, point_state,
-                   spatial_tree_reason, turned)
+                   ring_of_boxes, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -742,17 +742,11 @@ def _contact_shapes(p, cid: int, model: _Translation, cfg: dict
         raise ValueError("contact_ring_boxes must be at least 8")
     lo, li = model.link_of[ct.outer], model.link_of[ct.inner]
     off = model.links[lo].inertial_position  # body frame -> link frame: + this
-    cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
-    thick = 0.1 * ct.R
-    half_len = ct.R * math.tan(math.pi / n_box) * 1.001
-    depth = 2.0 * ct.r
-    pos, orn, half = [], [], []
-    for i in range(n_box):
-        a = 2.0 * math.pi * i / n_box
-        rho = ct.R + thick / 2.0
-        pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
-        orn.append(_quat_z(a))
-        half.append([thick / 2.0, half_len, depth])
+    boxes, thick, half_len = ring_of_boxes((ct.centre[0] + off[0], ct.centre[1] + off[1]),
+                                           ct.R, n_box)
+    pos = [[x, y, 0.0] for x, y, _ in boxes]
+    orn = [_quat_z(a) for _, _, a in boxes]
+    half = [[thick / 2.0, half_len * 1.001, 2.0 * ct.r] for _ in boxes]
     # createCollisionShapeArray keeps only the first 16 children (measured with
     # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
     # its own massless fixed link on the track
