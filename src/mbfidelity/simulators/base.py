@@ -324,8 +324,8 @@ class Samples:
 
     The reactions are either given as such (`reactions`) or, as most engines measure them,
     as what the engine books as passing from parent to child at each requested joint
-    (`transmitted`, or its subtree's Newton force), together with the forces of that
-    bookkeeping's outside elements it holds: the pair elements' (`pair_forces`) and the
+    (`transmitted`, or its subtree's Newton force), together with the forces from outside
+    the child's subtree that this force holds: the pair elements' (`pair_forces`) and the
     couplings' (`coupling_forces`); the base then takes them out once
     (`reactions.joint_reactions`, contract point 11)."""
 
