@@ -45,7 +45,9 @@ conventions 1-8) into one engine and runs it. The contract:
      conventions (engines with relative or maximal coordinates map back);
    - ``reactions``: for each requested joint, shape (N+1, 2): the force the parent
      exerts on the child through the joint, world axes, belonging to the state at the
-     same sample (NaN where the engine cannot give it for that sample);
+     same sample (NaN where the engine cannot give it for that sample); a backend
+     hands in what its engine books as transmitted and the outside forces that holds,
+     and the base takes them out (`Samples`, point 11);
    - ``constraint_forces``: for each closure constraint of the mechanism, shape (N+1, k),
      in physical terms at the same samples: PointOnPoint, the force on body_a from
      body_b (world x, y); PointOnLine, the force of the slot on the pin (world x, y);
@@ -87,10 +89,10 @@ conventions 1-8) into one engine and runs it. The contract:
 11. Shared steps: what every backend needs before its engine enters is computed once, in
     `plan` (numbers, rotations, element kinds, force laws classified and compiled, the
     map between description coordinates and engine joint values, forward kinematics),
-    the reactions' bookkeeping once, in `reactions` (from the force an engine books as
-    transmitted, or its centre-of-mass accelerations, the forces entering the child's
-    subtree from outside taken out), and settings are validated here; a backend
-    translates the plan into its engine, steps it and reads out.
+    the reactions' bookkeeping once, in `reactions`, run by `simulate` (from the force an
+    engine books as transmitted, or its centre-of-mass accelerations, the forces entering
+    the child's subtree from outside taken out), and settings are validated here; a
+    backend translates the plan into its engine, steps it and reads out.
 12. Flexible elements (optional): a backend declares in `BEAM_ELEMENTS`, per kind of the
     engine's own flexible (beam) element, a `BeamElement`: its `Expression` (exact: the
     element discretizes the Euler-Bernoulli beam itself; soft: it converges to a
@@ -123,7 +125,9 @@ import numpy as np
 from ..systems import Expectation
 from ..systems._continua import Beam
 from ..systems.model import Mechanism
-from .plan import ELEMENT_KINDS, description_reason, element_kind, elements
+from .plan import (ELEMENT_KINDS, CoordinateMap, description_reason, element_kind,
+                   elements)
+from .reactions import joint_reactions
 
 EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
 LEVELS = (EXACT, SOFT, SUBSTITUTE, UNSUPPORTED)
@@ -316,7 +320,14 @@ class Samples:
     """What a backend's `_simulate_impl` reads out (contract point 6): the samples in the
     description's coordinates, the forces, the stepping's `clock`, and `extras`, attributes
     beyond the contract set on the `RunResult` (a substitute's own constraint violation,
-    a contact's report), read by the reports when present."""
+    a contact's report), read by the reports when present.
+
+    The reactions are either given as such (`reactions`) or, as most engines measure them,
+    as what the engine books as passing from parent to child at each requested joint
+    (`transmitted`, or its subtree's Newton force), together with the forces from outside
+    the child's subtree that this force holds: the pair elements' (`pair_forces`) and the
+    couplings' (`coupling_forces`); the base then takes them out once
+    (`reactions.joint_reactions`, contract point 11)."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -326,6 +337,11 @@ class Samples:
     actuator_forces: dict[str, np.ndarray] = field(default_factory=dict)
     error_control: ErrorControl | None = None
     extras: dict[str, object] = field(default_factory=dict)
+    #: per requested joint, the force the engine books as transmitted (None: `reactions`
+    #: holds the contract's reactions already)
+    transmitted: Mapping[str, np.ndarray] | None = None
+    pair_forces: Mapping[str, np.ndarray] = field(default_factory=dict)
+    coupling_forces: Mapping[str, np.ndarray] = field(default_factory=dict)
 
 
 @dataclass
@@ -336,6 +352,13 @@ class BareLoop:
     cpu_time: float
     q: np.ndarray
     qd: np.ndarray
+
+    @classmethod
+    def mapped(cls, cpu_time: float, cmap: CoordinateMap, values, rates) -> "BareLoop":
+        """The bare loop's end state from the engine's joint values and rates (one row,
+        mapped as `simulate` maps its samples)."""
+        return cls(cpu_time, cmap.coordinates(np.array([values]))[0],
+                   cmap.rates(np.array([rates]))[0])
 
 
 @dataclass(frozen=True)
@@ -480,7 +503,12 @@ class Backend(ABC):
         if out.q.shape != (steps + 1, n) or out.qd.shape != (steps + 1, n):
             raise RuntimeError(f"{self.id} returned samples of shape {out.q.shape}, "
                                f"{out.qd.shape}; expected {(steps + 1, n)}")
-        run = RunResult(t=t, q=out.q, qd=out.qd, reactions=out.reactions,
+        reactions = out.reactions
+        if out.transmitted is not None:
+            reactions = joint_reactions(mechanism, reaction_joints, out.transmitted, t, out.q,
+                                        out.qd, pair_forces=out.pair_forces,
+                                        coupling_forces=out.coupling_forces)
+        run = RunResult(t=t, q=out.q, qd=out.qd, reactions=reactions,
                         wall_time=out.clock.wall, integrator_order=order, settings=cfg,
                         steps=steps, constraint_forces=out.constraint_forces,
                         cpu_time=out.clock.cpu, actuator_forces=out.actuator_forces,

@@ -96,7 +96,6 @@ from .base import (
     Scheme,
     Setting,
 )
-from .reactions import joint_reactions
 from .plan import (
     CoordinateLaws,
     driven_start,
@@ -849,7 +848,6 @@ class DrakeBackend(Backend):
             read(steps + 1)
         state, actuators = state[:steps + 1], actuators[:steps + 1]
         forces = {name: f[:steps + 1] for name, f in forces.items()}
-        t = np.arange(steps + 1) * dt
         q = built.cmap.coordinates(state[:, :n])
         qd = built.cmap.rates(state[:, n:])
         actuator_forces = {name: actuators[:, k] for k, name in enumerate(driven)}
@@ -863,10 +861,9 @@ class DrakeBackend(Backend):
         # through it; the ball constraints and point-to-point forces act on the bodies
         couplings = {c.name: closures[c.name] for c in mechanism.constraints
                      if element_kind(c) == LINEAR_COUPLING}
-        reactions = joint_reactions(mechanism, reaction_joints, forces, t, q, qd,
-                                    coupling_forces=couplings)
-        return Samples(q, qd, clock, reactions, constraint_forces=closures,
-                       actuator_forces=actuator_forces, error_control=control)
+        return Samples(q, qd, clock, constraint_forces=closures,
+                       actuator_forces=actuator_forces, error_control=control,
+                       transmitted=forces, coupling_forces=couplings)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
@@ -879,8 +876,7 @@ class DrakeBackend(Backend):
                 simulator.AdvanceTo(k * dt)
         x = built.plant.GetPositionsAndVelocities(plant_context)[self._state_index(built)]
         n = len(mechanism.joints)
-        return BareLoop(clock.cpu, built.cmap.coordinates(x[None, :n])[0],
-                        built.cmap.rates(x[None, n:])[0])
+        return BareLoop.mapped(clock.cpu, built.cmap, x[:n], x[n:])
 
     @staticmethod
     def _state_index(built: _Built) -> np.ndarray:

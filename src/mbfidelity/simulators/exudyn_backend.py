@@ -81,8 +81,9 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, LINEA
                    POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
                    HINGE_CLOSURE, TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
                    constrained_bodies, coordinate_map, driven_start,
-                   massive_below, num, rot, spatial_tree_reason)
-from .reactions import joint_reactions, subtree_force
+                   gravity_vector, massive_below, num, rot,
+                   spatial_tree_reason, turned)
+from .reactions import subtree_force
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -283,11 +284,7 @@ def _tree_links(mech: Mechanism, geo: _Geometry, exu) -> dict:
     mechanism, against its `up`."""
     bodies = [mech.body(j.child) for j in mech.joints]
     masses, tensors = zip(*(_builder(b)(b, mech) for b in bodies))
-    gravity = [0.0, -num(mech.gravity), 0.0]
-    if mech.spatial:
-        up = np.array([num(c) for c in mech.up] + [0.0] * (3 - len(mech.up)))
-        gravity = (-num(mech.gravity) * up / np.linalg.norm(up)).tolist()
-    return dict(gravity=gravity, baseOffset=[0.0, 0.0, 0.0],
+    return dict(gravity=list(gravity_vector(mech)), baseOffset=[0.0, 0.0, 0.0],
                 jointTypes=[getattr(exu.JointType, t) for t in geo.types],
                 linkParents=geo.parents,
                 jointTransformations=exu.Matrix3DList([_rot3(a) for a in geo.rotations]),
@@ -468,10 +465,7 @@ def _prismatic_2d(c: PointOnLine, system: _System) -> None:
     def slot_force(data: np.ndarray, u: np.ndarray) -> np.ndarray:
         """ForceLocal: the slot's force on the pin in the pin marker's frame, turned to
         world axes."""
-        angle = geo.frame_angle(c.body, u)
-        cos, sin = np.cos(angle), np.sin(angle)
-        fx, fy = data[:, 1], data[:, 2]
-        return np.stack([cos * fx - sin * fy, sin * fx + cos * fy], axis=1)
+        return turned(geo.frame_angle(c.body, u), data[:, 1], data[:, 2])
 
     system.closures.append(_ClosureItem(c.name, obj, "ForceLocal", slot_force))
 
@@ -906,20 +900,18 @@ class ExudynBackend(Backend):
             # Exudyn adds C_u^T lam = lam e_p to the engine equations: the constraint
             # pushes engine coordinate p with -lam, -lam / scale on q (virtual work)
             actuator_forces[d.name] = -lam / d.scale
-        reactions: dict[str, np.ndarray] = {}
-        if reaction_joints:
-            acc = {b: system.stored(s)[:, 1:3] for b, s in s_acc.items()}
-            for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
-                acc[b][0] = a0
-            # Newton on each subtree: every element force from outside is taken out;
-            # Exudyn's connector force is the force on marker 0 (body_a)
-            newton = {name: subtree_force(mechanism, name, t, acc) for name in reaction_joints}
-            pairs = {**{name: system.stored(s)[:, 1:3] for name, s in s_conn.items()},
-                     **{c.name: constraint_forces[c.name] for c in closures if c.pair}}
-            couplings = {c.name: constraint_forces[c.name] for c in closures if not c.pair}
-            reactions = joint_reactions(mechanism, reaction_joints, newton, t, q, qd,
-                                        pair_forces=pairs, coupling_forces=couplings)
-        return Samples(q, qd, clock, reactions, constraint_forces, actuator_forces)
+        acc = {b: system.stored(s)[:, 1:3] for b, s in s_acc.items()}
+        for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
+            acc[b][0] = a0
+        # Newton on each subtree: every element force from outside is taken out;
+        # Exudyn's connector force is the force on marker 0 (body_a)
+        newton = {name: subtree_force(mechanism, name, t, acc) for name in reaction_joints}
+        pairs = {**{name: system.stored(s)[:, 1:3] for name, s in s_conn.items()},
+                 **{c.name: constraint_forces[c.name] for c in closures if c.pair}}
+        couplings = {c.name: constraint_forces[c.name] for c in closures if not c.pair}
+        return Samples(q, qd, clock, constraint_forces=constraint_forces,
+                       actuator_forces=actuator_forces, transmitted=newton, pair_forces=pairs,
+                       coupling_forces=couplings)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:

@@ -80,7 +80,6 @@ from .mujoco_mjcf import (
     translate,
 )
 from .plan import ForceLaw, coupled, motions, num
-from .reactions import joint_reactions
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -854,11 +853,10 @@ class MujocoBackend(Backend):
         # transmitted
         couplings = {cl.element.name: forces[cl.element.name] for cl in comp.build.closures
                      if cl.kind == "tendon"}
-        reactions = joint_reactions(mechanism, reaction_joints, transmitted, t, q, qd,
-                                    pair_forces=pairs, coupling_forces=couplings)
         # the substitute's own error: each closure's violation at every sample
-        return Samples(q, qd, clock, reactions, forces, actuators,
-                       extras={"constraint_violation": violation})
+        return Samples(q, qd, clock, constraint_forces=forces, actuator_forces=actuators,
+                       extras={"constraint_violation": violation}, transmitted=transmitted,
+                       pair_forces=pairs, coupling_forces=couplings)
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
@@ -871,8 +869,8 @@ class MujocoBackend(Backend):
             with Stopwatch() as clock:
                 if steps:
                     mujoco.mj_step(comp.model, comp.data, nstep=steps)
-        q, qd = self._coordinates(comp, comp.data.qpos[None, :], comp.data.qvel[None, :])
-        return BareLoop(clock.cpu, q[0], qd[0])
+        return BareLoop.mapped(clock.cpu, comp.build.cmap, comp.data.qpos[comp.qadr],
+                               comp.data.qvel[comp.vadr])
 
     def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
                   qd0: np.ndarray) -> _Compiled:

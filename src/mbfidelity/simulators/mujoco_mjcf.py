@@ -55,9 +55,11 @@ from .plan import (
     coordinate_map,
     element_kind,
     elements,
+    gravity_vector,
     num,
     point_mass,
     rigid_body,
+    ring_of_boxes,
     rot,
     spatial_tree_reason,
 )
@@ -583,12 +585,9 @@ def _rolling_contact(build: Build, c: RollingContact) -> None:
         f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
         f'conaffinity="0"{params}/>')
     nseg = int(s["ring_segments"])
-    R, (cx, cy) = geo["R"], geo["centre"]
-    t = 0.1 * R  # radial thickness of the ring's boxes; the inner faces lie at R
-    half = R * math.tan(math.pi / nseg)  # faces meet: a polygon circumscribing R
-    for k in range(nseg):
-        a = 2 * math.pi * k / nseg
-        x, y = cx + (R + t / 2) * math.cos(a), cy + (R + t / 2) * math.sin(a)
+    # the inner faces lie at R and meet: a polygon circumscribing R
+    boxes, t, half = ring_of_boxes(geo["centre"], geo["R"], nseg)
+    for x, y, a in boxes:
         build.geoms.setdefault(build.carrier[geo["track"]], []).append(
             f'<geom type="box" size="{fmt(t / 2, half, 2 * geo["r"])}" '
             f'pos="{fmt(x, y, 0)}" quat="{fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '
@@ -708,11 +707,7 @@ def mjcf(build: Build) -> str:
             lines += indent(1, slider)
         return indent(depth, lines + ["</body>"])
 
-    g = num(mech.gravity)
-    gravity = (0, -g, 0)
-    if mech.spatial:
-        up = np.array([num(u) for u in mech.up], dtype=float)
-        gravity = -g * up / np.linalg.norm(up)
+    gravity = gravity_vector(mech)
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',

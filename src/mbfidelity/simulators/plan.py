@@ -84,6 +84,35 @@ def rot(theta: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
+def turned(theta: np.ndarray, x, y) -> np.ndarray:
+    """The vectors (x, y) turned by the angles theta, one row per sample (N, 2)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([c * x - s * y, s * x + c * y], axis=1)
+
+
+def ring_of_boxes(centre, R: float, count: int
+                  ) -> tuple[list[tuple[float, float, float]], float, float]:
+    """The track of a rolling contact as `count` boxes whose inner faces are tangent to the
+    circle of radius R about `centre` (a regular polygon with the circle as its incircle):
+    each box's centre (x, y) and angle, the boxes' radial thickness (0.1 R) and the half
+    length R tan(pi / count) at which neighbouring faces meet."""
+    thick = 0.1 * R
+    rho = R + thick / 2.0
+    boxes = [(centre[0] + rho * math.cos(a), centre[1] + rho * math.sin(a), a)
+             for a in (2.0 * math.pi * i / count for i in range(count))]
+    return boxes, thick, R * math.tan(math.pi / count)
+
+
+def gravity_vector(mech: Mechanism) -> tuple[float, float, float]:
+    """The acceleration of gravity in world axes: along -y, or in a spatial mechanism
+    (model convention 10) against its `up`."""
+    g = num(mech.gravity)
+    if not mech.spatial:
+        return 0.0, -g, 0.0
+    up = np.array([num(u) for u in mech.up] + [0.0] * (3 - len(mech.up)), dtype=float)
+    return tuple(float(v) for v in -g * up / np.linalg.norm(up))
+
+
 def linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
     """(a, b, c) with law = a + b x + c xd (numbers, no TIME), or None when the law is not
     of that form."""

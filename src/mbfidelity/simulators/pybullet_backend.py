@@ -93,69 +93,25 @@ step: refused.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from ..systems.model import (
-    WORLD,
-    CoordinateForce,
-    LinearCoupling,
-    Mechanism,
-    PointToPoint,
-    Prescribed,
-    RollingContact,
-    inertia_matrix,
-)
 from ..analytic.linear import quadratic_eigenvalues
-from .base import (
-    ElementBuilders,
-    SEMI_IMPLICIT_EULER_STABILITY,
-    Scheme,
-    EXACT,
-    SUBSTITUTE,
-    UNSUPPORTED,
-    NO_BEAM_ELEMENT,
-    Backend,
-    BeamElement,
-    Expression,
-    Linearization,
-    BareLoop,
-    Samples,
-    Stopwatch,
-    Setting,
-)
-from .reactions import joint_reactions
-from .plan import (
-    HINGE_CLOSURE,
-    CoordinateLaws,
-    Motion,
-    spatial_tree_reason,
-    BODY,
-    PRESCRIBED,
-    COORDINATE_FORCE_CUSTOM,
-    COORDINATE_FORCE_LINEAR,
-    LINEAR_COUPLING,
-    MASSLESS_BODY,
-    POINT_ON_LINE,
-    POINT_ON_POINT,
-    POINT_TO_POINT_CUSTOM,
-    POINT_TO_POINT_LINEAR,
-    PRISMATIC,
-    REVOLUTE,
-    ROLLING_CONTACT,
-    TIME_LOAD,
-    ForceLaw,
-    constrained_bodies,
-    coordinate_map,
-    coupling_row,
-    element_kind,
-    element_loads,
-    elements,
-    num,
-    point_state,
-)
+from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
+                             Prescribed, RollingContact, inertia_matrix)
+from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
+                   UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
+                   Linearization, Samples, Scheme, Setting, Stopwatch)
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+                   LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
+                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
+                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
+                   constrained_bodies, coordinate_map, coupling_row, element_kind,
+                   element_loads, elements, gravity_vector, num, point_state,
+                   ring_of_boxes, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -202,12 +158,6 @@ def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
 def _point(ls, link: int, point) -> tuple[float, float, float, float]:
     """World position and velocity of a body point (centre-of-mass frame)."""
     return point_state(_pose(ls, link), point)
-
-
-def _turned(th: np.ndarray, x, y) -> np.ndarray:
-    """The vectors (x, y) turned by the angles th, one row per sample (N, 2)."""
-    c, s = np.cos(th), np.sin(th)
-    return np.stack([c * x - s * y, s * x + c * y], axis=1)
 
 
 @dataclass
@@ -367,6 +317,13 @@ class _Slot(_Pin):
         return (_point(ls, self.pin_link, self.pin_point),
                 _point(ls, self.line_link, self.line_point), u)
 
+    def _along(self, ls) -> tuple[float, float]:
+        """Where the pin is along the slot, s = (P - L) . u, and its rate (v_P - v_L) . u
+        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
+        the rotation of u adds nothing), from link states."""
+        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
+        return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
+
     def violation(self, ls) -> float:
         """Signed distance n . (P - L) of the pin from the slot line (m)."""
         (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(ls)
@@ -380,13 +337,8 @@ class _Slider(_Slot):
     (child); its force on the pin (parent) is minus the rows."""
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
-        """The slider sits under the pin, s = (P - L) . u, and moves at (v_P - v_L) . u
-        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
-        the rotation of u adds nothing)."""
-        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
-        s = (px - lx) * ux + (py - ly) * uy
-        sd = (pvx - lvx) * ux + (pvy - lvy) * uy
-        p.resetJointState(body, eidx[self.aux], s, sd, physicsClientId=cid)
+        """The slider sits under the pin and moves with it along the slot (`_along`)."""
+        p.resetJointState(body, eidx[self.aux], *self._along(ls), physicsClientId=cid)
 
 
 @dataclass
@@ -419,10 +371,7 @@ class _Rotor(_Slot):
             th = model.map.angle(model.links[self.line_link].body, q)
         else:
             th = np.zeros(len(rows))
-        nx, ny = _slider_row_normal(self.direction)
-        cs, sn = np.cos(th), np.sin(th)
-        f = rows[:, 1]
-        return np.stack([f * (cs * nx - sn * ny), f * (sn * nx + cs * ny)], axis=1)
+        return rows[:, 1:2] * turned(th, *_slider_row_normal(self.direction))
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
@@ -430,9 +379,7 @@ class _Rotor(_Slot):
         Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
         (fixed) the slot body would feel the force at L instead of at the pin (measured: a
         bar slotted along its own axis through its pivot then swings freely)."""
-        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(
-            {lk: ls[m] for lk, m in slot_of.items()})
-        s = (px - lx) * ux + (py - ly) * uy
+        s, _ = self._along({lk: ls[m] for lk, m in slot_of.items()})
         ux, uy = self.direction
         return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
 
@@ -524,10 +471,7 @@ class _Translation:
         self.mech, self.cfg = mech, cfg
         self.n = len(mech.joints)
         self.map = coordinate_map(mech)
-        gravity = num(mech.gravity)
-        up = np.array([num(u) for u in mech.up], dtype=float)
-        self.gravity_vector = ((0.0, -gravity, 0.0) if not mech.spatial
-                               else tuple(-gravity * up / np.linalg.norm(up)))
+        self.gravity_vector = gravity_vector(mech)
         masses = [num(b.mass) for b in mech.bodies]
         inertias = [num(b.inertia) for b in mech.bodies]
         self.m_min = min((m for m in masses if m > 0), default=1.0)
@@ -798,17 +742,11 @@ def _contact_shapes(p, cid: int, model: _Translation, cfg: dict
         raise ValueError("contact_ring_boxes must be at least 8")
     lo, li = model.link_of[ct.outer], model.link_of[ct.inner]
     off = model.links[lo].inertial_position  # body frame -> link frame: + this
-    cx, cy = ct.centre[0] + off[0], ct.centre[1] + off[1]
-    thick = 0.1 * ct.R
-    half_len = ct.R * math.tan(math.pi / n_box) * 1.001
-    depth = 2.0 * ct.r
-    pos, orn, half = [], [], []
-    for i in range(n_box):
-        a = 2.0 * math.pi * i / n_box
-        rho = ct.R + thick / 2.0
-        pos.append([cx + rho * math.cos(a), cy + rho * math.sin(a), 0.0])
-        orn.append(_quat_z(a))
-        half.append([thick / 2.0, half_len, depth])
+    boxes, thick, half_len = ring_of_boxes((ct.centre[0] + off[0], ct.centre[1] + off[1]),
+                                           ct.R, n_box)
+    pos = [[x, y, 0.0] for x, y, _ in boxes]
+    orn = [_quat_z(a) for _, _, a in boxes]
+    half = [[thick / 2.0, half_len * 1.001, 2.0 * ct.r] for _ in boxes]
     # createCollisionShapeArray keeps only the first 16 children (measured with
     # getCollisionShapeData): the ring is split into compounds of 16 boxes, each on
     # its own massless fixed link on the track
@@ -879,7 +817,7 @@ def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray
     disc) is what the coupling's -lambda stands for."""
     ct = model.contact
     cvec, const = coupling_row(model.mech, coupling)
-    u = _turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
+    u = turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
     ux, uy = u[:, 0], u[:, 1]
     normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
     friction = FC[:, 0] * -uy + FC[:, 1] * ux
@@ -1230,22 +1168,10 @@ class PyBulletBackend(Backend):
         return out
 
     @staticmethod
-    def _constraint_forces(model: _Translation, CF: np.ndarray, JV: np.ndarray
-                           ) -> dict[str, np.ndarray]:
-        """getConstraintState rows -> the contract's physical terms (each closure's
-        `force`, signs measured)."""
-        q = model.map.coordinates(JV[:, :model.n]) if model.closures else None
-        return {c.element.name: c.force(CF[:, r], q, model)
-                for r, c in enumerate(model.closures)}
-
-    @staticmethod
     def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
-                    JV: np.ndarray) -> dict[str, np.ndarray]:
-        """Each closure's violation at every sample (`violations`, or `violation` from the
-        engine's own forward kinematics)."""
-        if not model.closures:
-            return {}
-        q = model.map.coordinates(JV[:, :model.n])
+                    JV: np.ndarray, q: np.ndarray) -> dict[str, np.ndarray]:
+        """Each closure's violation at the samples (engine joint values JV, coordinates
+        q): `violations`, or `violation` from the engine's own forward kinematics."""
         out = {c.element.name: c.violations(q) for c in model.closures}
         geo = [c for c in model.closures if c.pair]
         n_all = len(eidx)
@@ -1258,11 +1184,12 @@ class PyBulletBackend(Backend):
         return out
 
     # --- contract points 6 and 9 ---------------------------------------------------------
+    @contextmanager
     def _open(self, p, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, dt: float,
-              cfg: dict, sensor_joints: Sequence[int] = ()) -> _World:
+              cfg: dict, sensor_joints: Sequence[int] = ()) -> Iterator[_World]:
         """Connect a DIRECT client, build the mechanism and set the state (q0, qd0);
         enable the joint force/torque sensor on the joints `sensor_joints` (description
-        joint indices). The caller disconnects the client."""
+        joint indices). The client is disconnected on leaving."""
         ok = self.support(mechanism)
         if not ok.ok:
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
@@ -1289,10 +1216,9 @@ class PyBulletBackend(Backend):
                 _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
                 p.enableJointForceTorqueSensor(body, eidx[i], True, physicsClientId=cid)
-        except BaseException:
+            yield _World(cid, body, eidx, model, cids)
+        finally:
             p.disconnect(physicsClientId=cid)
-            raise
-        return _World(cid, body, eidx, model, cids)
 
     @staticmethod
     def _inputs(p, world: _World, dt: float, cfg: dict
@@ -1377,8 +1303,7 @@ class PyBulletBackend(Backend):
         """The world of `simulate` stepped with only the per-step inputs (`_inputs`)."""
         import pybullet as p
 
-        world = self._open(p, mechanism, q0, qd0, dt, cfg)
-        try:
+        with self._open(p, mechanism, q0, qd0, dt, cfg) as world:
             apply, reads = self._inputs(p, world, dt, cfg)
             step, cid = p.stepSimulation, world.cid
             get_states, body, links = p.getJointStates, world.body, world.eidx[:world.model.n]
@@ -1394,11 +1319,8 @@ class PyBulletBackend(Backend):
                     apply(k, jv, jvd)
                     step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
-            cmap = world.model.map
-            return BareLoop(clock.cpu, cmap.coordinates(np.array([[s[0] for s in js]]))[0],
-                            cmap.rates(np.array([[s[1] for s in js]]))[0])
-        finally:
-            p.disconnect(physicsClientId=world.cid)
+            return BareLoop.mapped(clock.cpu, world.model.map, [s[0] for s in js],
+                                   [s[1] for s in js])
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
@@ -1418,8 +1340,7 @@ class PyBulletBackend(Backend):
         name, (q0, qd0) = next(iter(initial_states.items()))
         cfg = self.resolve_settings(settings)
         recorder = Recorder(pybullet)
-        world = self._open(recorder, mechanism, q0, qd0, dt, cfg)
-        try:
+        with self._open(recorder, mechanism, q0, qd0, dt, cfg) as world:
             outside = []
             if mechanism.forces or any(c.follows_pin for c in world.model.closures):
                 laws = [e.name for e in mechanism.forces]
@@ -1441,8 +1362,6 @@ class PyBulletBackend(Backend):
                       f"{list(world.eidx[:n])}, physicsClientId=cid)]"),
                 coordinates=coordinates, T=world.model.map.T, c=world.model.map.c, dt=dt,
                 not_in_script=outside)
-        finally:
-            pybullet.disconnect(physicsClientId=world.cid)
         return text, outside
 
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
@@ -1452,15 +1371,15 @@ class PyBulletBackend(Backend):
 
         joint_ids = [mechanism.joints.index(mechanism.joint(name)) for name in reaction_joints]
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
-        world = self._open(p, mechanism, q0, qd0, dt, cfg,
-                           sensor_joints=joint_ids if use_sensor else ())
-        cid, body, eidx, model, cids = world.cid, world.body, world.eidx, world.model, world.cids
-        contact, closures, n = model.contact, model.closures, model.n
-        # one extra step gives the reaction/acceleration (and the constraint forces) of
-        # the last sample
-        total = steps + 1 if (reaction_joints or closures or contact
-                              or mechanism.prescribed) else steps
-        try:
+        with self._open(p, mechanism, q0, qd0, dt, cfg,
+                        sensor_joints=joint_ids if use_sensor else ()) as world:
+            cid, body, eidx, model, cids = (world.cid, world.body, world.eidx, world.model,
+                                            world.cids)
+            contact, closures, n = model.contact, model.closures, model.n
+            # one extra step gives the reaction/acceleration (and the constraint forces)
+            # of the last sample
+            total = steps + 1 if (reaction_joints or closures or contact
+                                  or mechanism.prescribed) else steps
             JV, JVD = np.empty((total + 1, len(eidx))), np.empty((total + 1, len(eidx)))
             sensor = np.full((total + 1, len(joint_ids), 2), np.nan)
             # force on point b of each point-to-point element (on a: opposite)
@@ -1509,44 +1428,39 @@ class PyBulletBackend(Backend):
                             sensor[k, r] = rf[0], rf[1]
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
+            jv, jvd = JV[: steps + 1], JVD[: steps + 1]  # the samples
 
-            forces = self._constraint_forces(model, CF[: steps + 1], JV[: steps + 1])
-            q = model.map.coordinates(JV[: steps + 1, :n])
-            qd = model.map.rates(JVD[: steps + 1, :n])
-            reactions: dict[str, np.ndarray] = {}
-            if reaction_joints:
-                # a gear is a joint force: both routes see it
-                gears = {c.element.name: forces[c.element.name] for c in closures
-                         if not c.pair}
-                if use_sensor:
-                    transmitted = {name: sensor[: steps + 1, r].copy()
-                                   for r, name in enumerate(reaction_joints)}
-                    pairs: dict[str, np.ndarray] = {}
-                else:
-                    jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
-                    transmitted = self._inverse_dynamics_forces(
-                        p, cid, model, cfg, joint_ids, list(reaction_joints),
-                        JV[: steps + 1], JVD[: steps + 1], jvdd[: steps + 1])
-                    # inverse dynamics applies no element: the point-to-point and the
-                    # closure forces across the cut are in its force (on body_a: minus
-                    # the force recorded on point b). Rolling by contact: the contact
-                    # carries what the description's arm and coupling carried, so it
-                    # counts as transmitted through the joints (contract point 6)
-                    pairs = {pf.name: -f_point[: steps + 1, e]
-                             for e, pf in enumerate(model.point_forces)}
-                    pairs.update({c.element.name: forces[c.element.name] for c in closures
-                                  if c.pair})
-                reactions = joint_reactions(mechanism, reaction_joints, transmitted,
-                                            dt * np.arange(steps + 1), q, qd,
-                                            pair_forces=pairs, coupling_forces=gears)
-            violation = self._violations(p, cid, body, eidx, model, JV[: steps + 1])
-        finally:
-            p.disconnect(physicsClientId=cid)
+            q, qd = model.map.coordinates(jv[:, :n]), model.map.rates(jvd[:, :n])
+            # getConstraintState rows -> the contract's physical terms (signs measured)
+            forces = {c.element.name: c.force(CF[: steps + 1, r], q, model)
+                      for r, c in enumerate(closures)}
+            # a gear is a joint force: both routes see it
+            gears = {c.element.name: forces[c.element.name] for c in closures if not c.pair}
+            pairs: dict[str, np.ndarray] = {}
+            if use_sensor:
+                transmitted = {name: sensor[: steps + 1, r].copy()
+                               for r, name in enumerate(reaction_joints)}
+            elif reaction_joints:
+                jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
+                transmitted = self._inverse_dynamics_forces(
+                    p, cid, model, cfg, joint_ids, list(reaction_joints), jv, jvd,
+                    jvdd[: steps + 1], q)
+                # inverse dynamics applies no element: the point-to-point and the closure
+                # forces across the cut are in its force (on body_a: minus the force
+                # recorded on point b). Rolling by contact: the contact carries what the
+                # description's arm and coupling carried, so it counts as transmitted
+                # through the joints (contract point 6)
+                pairs = {pf.name: -f_point[: steps + 1, e]
+                         for e, pf in enumerate(model.point_forces)}
+                pairs.update({c.element.name: forces[c.element.name] for c in closures
+                              if c.pair})
+            else:
+                transmitted = {}
+            violation = self._violations(p, cid, body, eidx, model, jv, q)
 
         contact_report = None
         if contact is not None:
-            contact_report = _contact_report(model, model.coupling, q, qd,
-                                                  JV[: steps + 1], FC[: steps + 1])
+            contact_report = _contact_report(model, model.coupling, q, qd, jv, FC[: steps + 1])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
         actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
@@ -1554,11 +1468,14 @@ class PyBulletBackend(Backend):
         extras = {"constraint_violation": violation}
         if contact_report is not None:
             extras["contact"] = contact_report
-        return Samples(q, qd, clock, reactions, forces, actuators, extras=extras)
+        return Samples(q, qd, clock, constraint_forces=forces, actuator_forces=actuators,
+                       extras=extras, transmitted=transmitted, pair_forces=pairs,
+                       coupling_forces=gears)
 
     def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
-                                 JVD: np.ndarray, JVDD: np.ndarray) -> dict[str, np.ndarray]:
+                                 JVD: np.ndarray, JVDD: np.ndarray, q: np.ndarray
+                                 ) -> dict[str, np.ndarray]:
         """The force from parent to child at each joint (world axes): the inverse-dynamics
         force on two massless prismatic joints (x, y of the parent frame) inserted in front
         of the joint. It applies no force element and no closure, so it holds every force
@@ -1580,8 +1497,7 @@ class PyBulletBackend(Backend):
                           physicsClientId=cid)
             for r, (vx, vy) in enumerate(vslots):
                 out[k, r] = tau[vx], tau[vy]
-        q = model.map.coordinates(JV[:, :model.n])
-        return {name: _turned(model.map.angle(model.mech.joints[i].parent, q),
+        return {name: turned(model.map.angle(model.mech.joints[i].parent, q),
                               out[:, r, 0], out[:, r, 1])
                 for r, (i, name) in enumerate(zip(joint_ids, names))}
 
@@ -1591,19 +1507,14 @@ class PyBulletBackend(Backend):
         orientation (a spatial link's frame is aligned with its body's)."""
         import pybullet as p
 
-        cfg = self.resolve_settings(settings)
-        model = _Translation(mechanism, cfg)
-        cid = self._connect(p, cfg, 1e-3, model.gravity_vector)
-        try:
-            body, eidx, _ = self._build(p, cid, model, cfg)
+        rest, cfg = np.zeros(len(mechanism.joints)), self.resolve_settings(settings)
+        with self._open(p, mechanism, rest, rest, 1e-3, cfg) as world:
             out = {}
-            for i, lk in enumerate(model.links[:model.n]):
-                info = p.getDynamicsInfo(body, eidx[i], physicsClientId=cid)
-                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=cid))
+            for i, lk in enumerate(world.model.links[:world.model.n]):
+                info = p.getDynamicsInfo(world.body, world.eidx[i], physicsClientId=world.cid)
+                R = np.array(p.getMatrixFromQuaternion(info[4], physicsClientId=world.cid))
                 out[lk.body] = (np.array(info[2], dtype=float), R.reshape(3, 3))
             return out
-        finally:
-            p.disconnect(physicsClientId=cid)
 
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
@@ -1618,13 +1529,12 @@ class PyBulletBackend(Backend):
             # calculateMassMatrix / calculateInverseDynamics describe the open tree only;
             # PyBullet has no constrained linearization (the free-vibration fit remains)
             return None
-        model = _Translation(mechanism, cfg)
-        n = model.n
         h_rel = float(cfg["linearize_step"])
-        cid = self._connect(p, cfg, dt, model.gravity_vector)
-        try:
-            body, eidx, _ = self._build(p, cid, model, cfg)
-            jv_eq = model.map.engine_values(np.asarray(q_eq, dtype=float))
+        q_eq = np.asarray(q_eq, dtype=float)
+        with self._open(p, mechanism, q_eq, np.zeros(len(q_eq)), dt, cfg) as world:
+            cid, body, eidx, model = world.cid, world.body, world.eidx, world.model
+            n = model.n
+            jv_eq = model.map.engine_values(q_eq)
             zeros = [0.0] * n
             perm = np.asarray(eidx[:n])  # engine (depth-first) index of each joint
 
@@ -1679,8 +1589,6 @@ class PyBulletBackend(Backend):
                 K[:, i] = (residual(jv_eq + h * e, v0) - residual(jv_eq - h * e, v0)) / (2 * h)
                 C[:, i] = (residual(jv_eq, v0 + h_rel * e)
                            - residual(jv_eq, v0 - h_rel * e)) / (2 * h_rel)
-        finally:
-            p.disconnect(physicsClientId=cid)
         eig = quadratic_eigenvalues(M, C, K)
         return Linearization(
             eigenvalues=eig,

@@ -56,7 +56,7 @@ from ..systems.model import (
     Revolute,
 )
 from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
-                   joint_coordinates, num, point_state, sample_columns, wrench)
+                   joint_coordinates, num, point_state, sample_columns, turned, wrench)
 
 #: the elements whose force is a pair of opposite forces on two bodies
 PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
@@ -69,9 +69,7 @@ def slide_direction(mech: Mechanism, joint: Prismatic, q: np.ndarray,
     cmap = cmap or coordinate_map(mech)
     axis = np.array([num(joint.axis[0]), num(joint.axis[1])])
     axis = axis / float(axis @ axis)
-    th = cmap.angle(joint.parent, q)
-    c, s = np.cos(th), np.sin(th)
-    return np.stack([c * axis[0] - s * axis[1], s * axis[0] + c * axis[1]], axis=1)
+    return turned(cmap.angle(joint.parent, q), axis[0], axis[1])
 
 
 def subtree_force(mech: Mechanism, joint_name: str, t: np.ndarray,
