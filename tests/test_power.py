@@ -243,3 +243,38 @@ def test_an_error_the_motion_does_not_depend_on_is_below_the_gates():
     assert {"trajectory", "frequency"} <= set(changes)
     assert all(v["change"] == 0.0 for v in changes.values())
     assert found.verdict == power.BELOW_GATES and "do not depend on g" in found.why
+
+
+def _reading(neutralised: float, incidents: list, change: dict) -> power.DefaultPower:
+    return power.DefaultPower(
+        "a_default", 1.0, 0.0, rejected=False, moved=True, change=change,
+        effect={"s.trajectory_max": {"neutralised": neutralised, "switched_on": 0.5,
+                                     "tolerance": 1e-3, "unit": "relative",
+                                     "status": "xfail"}},
+        incidents=incidents)
+
+
+def test_a_default_on_a_run_the_engine_fails_without_it_is_told_apart_from_a_blind_gate():
+    """The verdict rule of a default (`classify_default`): a crash the neutralised run has
+    too does not make the default act; a motion the engine does not produce without it
+    (its trajectory metric not finite there) is "on a failed run", not a blind gate; the
+    same change of a finite motion away from the reference is "not rejected"."""
+    from mbfidelity.comparisons.runner import Comparison
+
+    crash = {"scenario": "s", "stage": "engine run", "outcome": "crashed", "message": "x"}
+    baseline = Comparison("sys", "engine", "", {}, {}, 1e-3)
+    baseline.incidents.append(dict(crash))
+    within = {"quantity": "s.motion", "change": 1e-6, "gate": 1e-3, "ratio": 1e-3}
+    shared = _reading(0.1, [dict(crash)], within)
+    power.classify_default(shared, baseline)
+    assert not shared.acts and shared.verdict == power.BELOW_GATES
+    new = _reading(0.1, [dict(crash, scenario="t")], within)
+    power.classify_default(new, baseline)
+    assert new.acts  # a crash of its own
+    beyond = {"quantity": "s.motion", "change": math.inf, "gate": 1e-3, "ratio": math.inf}
+    failed = _reading(math.inf, [], beyond)
+    power.classify_default(failed, baseline)
+    assert failed.verdict == power.ON_FAILED_RUN
+    finite = _reading(0.1, [], beyond)
+    power.classify_default(finite, baseline)
+    assert finite.verdict == power.NOT_REJECTED

@@ -113,6 +113,9 @@ REJECTED, NO_EFFECT, BELOW_GATES, NOT_REJECTED = (
 #: a default that moves the motion beyond the gate toward the reference: the metric
 #: judging what it moves has a smaller error with it (nothing for a gate to reject)
 CLOSER = "closer to the reference"
+#: a default that moves a motion the engine does not produce without it (its run stops or
+#: diverges there, a declared failure): no value of the neutralised run to compare with
+ON_FAILED_RUN = "on a failed run"
 
 
 @dataclass
@@ -158,7 +161,8 @@ class DefaultPower:
     moved: bool = True
     #: the judged quantity it changes most against its gate: quantity, change, gate, ratio
     change: dict = field(default_factory=dict)
-    #: REJECTED, NO_EFFECT, BELOW_GATES or NOT_REJECTED, and why (`classify_default`)
+    #: REJECTED, NO_EFFECT, BELOW_GATES, CLOSER, ON_FAILED_RUN or NOT_REJECTED, and why
+    #: (`classify_default`)
     verdict: str = ""
     why: str = ""
     #: per metric of the out-of-the-box reading: neutralised value, switched-on value,
@@ -258,11 +262,15 @@ def classify_default(d: DefaultPower, baseline: Comparison) -> None:
     """`d.acts`, `d.verdict` and `d.why` from its reading (in place): rejected; no effect
     (no metric moved); below the gates (its largest change against a gate is within it);
     closer to the reference (the quantity it moves most beyond its gate is judged with a
-    smaller error with it); not rejected (a judged quantity moved beyond its gate, away
-    from the reference or unjudged, and no gate caught it: the metric that judges it,
-    named, and its status in the baseline)."""
+    smaller error with it); on a failed run (the metric judging it has no finite value
+    without it: the engine's run stops or diverges there); not rejected (a judged quantity
+    moved beyond its gate, away from the reference or unjudged, and no gate caught it: the
+    metric that judges it, named, and its status in the baseline). An incident of the run
+    acts only where the baseline does not have it too."""
     c = d.change
-    d.acts = bool(c and c["ratio"] > 1.0) or bool(d.incidents)
+    shared = {(i["scenario"], i["stage"]) for i in baseline.incidents}
+    d.acts = bool(c and c["ratio"] > 1.0) or any(
+        (i["scenario"], i["stage"]) not in shared for i in d.incidents)
     if d.rejected:
         d.verdict = REJECTED
         d.why = (f"rejected by {', '.join(d.rejected_by[:4])}"
@@ -278,7 +286,12 @@ def classify_default(d: DefaultPower, baseline: Comparison) -> None:
                 if c["quantity"].endswith(".motion") else c["quantity"])
         judged = d.effect.get(name)
         moved = f"{c['quantity']} changes by {c['change']:.3g} against a gate of {c['gate']:.3g}"
-        if judged is not None and judged["switched_on"] < judged["neutralised"]:
+        if judged is not None and judged["neutralised"] is not None \
+                and not math.isfinite(judged["neutralised"]):
+            d.verdict = ON_FAILED_RUN
+            d.why = (f"{moved}: {name} is {judged['neutralised']:.3g} without it (the "
+                     f"engine's run is not finite there), nothing to compare with")
+        elif judged is not None and judged["switched_on"] < judged["neutralised"]:
             d.verdict = CLOSER
             d.why = (f"{moved}, toward the reference: {name} {judged['neutralised']:.3g} "
                      f"without it, {judged['switched_on']:.3g} with it")
@@ -580,6 +593,8 @@ def summary_of(entries: list[dict]) -> dict:
                                             if d.get("verdict") == NOT_REJECTED],
                            "closer_to_reference": [f"{s}:{d['setting']}" for s, d in acting
                                                    if d.get("verdict") == CLOSER],
+                           "on_failed_run": [f"{s}:{d['setting']}" for s, d in acting
+                                             if d.get("verdict") == ON_FAILED_RUN],
                            "below_gates": [f"{s}:{d['setting']}" for s, d in alone
                                            if d.get("verdict") == BELOW_GATES]}
         out[sim] = row
