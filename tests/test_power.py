@@ -278,3 +278,24 @@ def test_a_default_on_a_run_the_engine_fails_without_it_is_told_apart_from_a_bli
     finite = _reading(0.1, [], beyond)
     power.classify_default(finite, baseline)
     assert finite.verdict == power.NOT_REJECTED
+
+
+def test_a_reading_is_kept_by_its_content_and_made_again_for_another_engine_version(
+        tmp_path, monkeypatch):
+    """`cached_entry`: the second call takes the reading from the persistent cache, equal
+    to the one made but for the mark; another engine version is another key, so an
+    upgraded engine's readings are made again."""
+    from mbfidelity.comparisons import out_of_the_box
+
+    _installed("pymunk")
+    monkeypatch.setenv("MBFIDELITY_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv("MBFIDELITY_NO_CACHE", raising=False)
+    args = ("compound_pendulum", "pymunk", 1e-3, (), ("mass",))
+    made = out_of_the_box.cached_entry(*args)
+    assert not made.from_cache and made.errors[0].trials
+    kept = out_of_the_box.cached_entry(*args)
+    assert kept.from_cache
+    assert {**kept.as_dict(), "from_cache": False} == made.as_dict()
+    key = out_of_the_box._entry_key(*args)
+    monkeypatch.setattr(get_backend("pymunk"), "version", lambda: "another version")
+    assert out_of_the_box._entry_key(*args) != key

@@ -29,19 +29,31 @@ made again engine by engine, each in a worker of its own. The near-equilibrium c
 `mbfidelity run` are not run. With `kinds` (`mbfidelity power`), each model error's runs
 (the first scenario) are judged against the same neutralised run, forked from the same
 process.
+
+Each system x engine's reading is kept in the persistent cache under the content it
+depends on (`cached_entry`): a report made again with the same code, engines and
+libraries takes the readings from there, and an engine's upgrade makes its readings alone
+again.
 """
 from __future__ import annotations
 
+import hashlib
 import os
+import pickle
 import resource
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
 from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
+from ..analytic import cache
+from ..analytic.derivation import cache_key
 from ..simulators import get_backend
 from ..systems import get_system
 from .budget import become_worker
@@ -218,11 +230,74 @@ def _cpu_seconds() -> float:
     return time.process_time() + children.ru_utime + children.ru_stime
 
 
+#: the cache folder of the readings (`cached_entry`)
+CACHE_FOLDER = "power"
+#: bump when the layout or the meaning of a cached reading changes
+CACHE_FORMAT = "1"
+
+
+@lru_cache(maxsize=1)
+def _package_digest() -> str:
+    """Digest of every module of the package: the description, the derivation, the
+    comparisons and the backends all decide a reading."""
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def _entry_key(system_id: str, simulator: str, dt: float, only, kinds) -> str | None:
+    """Content key of one system x engine's reading: the package's code and the system's
+    module, the engine's version (an upgraded engine's readings are made again, the
+    others' kept), the numerical libraries' and Python's versions, and the study's
+    arguments. None where the engine is not installed."""
+    import scipy
+    import sympy
+
+    backend = get_backend(simulator)
+    if not backend.available()[0]:
+        return None
+    h = hashlib.sha256()
+    # the system's own module too: a user's mechanism lives outside the package
+    for part in (CACHE_FORMAT, _package_digest(), cache_key(get_system(system_id)),
+                 system_id, simulator, backend.version(),
+                 float(dt).hex(), repr(None if only is None else sorted(only)),
+                 repr(tuple(kinds)), np.__version__, scipy.__version__, sympy.__version__,
+                 repr(sys.version_info[:3])):
+        h.update(f"{part}|".encode())
+    return h.hexdigest()[:32]
+
+
+def cached_entry(system_id: str, simulator: str, dt: float, only, kinds=()) -> PowerEntry:
+    """`defaults_entry`, kept in the persistent cache (analytic/cache.py: its folder, its
+    switch, its checksums) under the content it depends on (`_entry_key`): a reading is
+    deterministic but for its timings, so one taken from the cache is the one the run
+    made (`from_cache`, with that run's timings)."""
+    key = _entry_key(system_id, simulator, dt, only, kinds)
+    if key is not None:
+        payload = cache.load(CACHE_FOLDER, key)
+        if payload is not None:
+            try:
+                entry = pickle.loads(payload)
+            except Exception:  # a reading of an older layout: made again
+                entry = None
+            if isinstance(entry, PowerEntry):
+                entry.from_cache = True
+                return entry
+    entry = defaults_entry(system_id, simulator, dt, only, kinds)
+    if key is not None:
+        cache.store(CACHE_FOLDER, key, pickle.dumps(entry))
+    return entry
+
+
 def _system_job(system_id: str, sims: list[str], dt: float, only, kinds=()
                 ) -> tuple[list[PowerEntry], float]:
-    """Every engine's reading of one system, and the job's CPU seconds."""
+    """Every engine's reading of one system (`cached_entry`), and the job's CPU
+    seconds."""
     start = _cpu_seconds()
-    entries = [defaults_entry(system_id, sim, dt, only, kinds) for sim in sims]
+    entries = [cached_entry(system_id, sim, dt, only, kinds) for sim in sims]
     return entries, _cpu_seconds() - start
 
 

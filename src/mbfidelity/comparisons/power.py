@@ -199,6 +199,9 @@ class PowerEntry:
     comparisons: int = 0
     wall_time_s: float = 0.0
     engine_time_s: float = 0.0
+    #: taken from the persistent cache (comparisons/out_of_the_box.py, `cached_entry`):
+    #: its timings are those of the run that made it
+    from_cache: bool = False
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
