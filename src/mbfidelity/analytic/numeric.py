@@ -98,6 +98,21 @@ def _residual_at_rest_terms(d: Derivation) -> sp.Matrix:
     return -d.Q_autonomous
 
 
+def _vanishes(expr) -> bool:
+    """Whether `expr` is identically zero. A value clearly off zero at a sample point
+    proves it is not, at no cost; only an expression that vanishes there is simplified
+    (simplify of a long unsimplified expression, `Mechanism.simplify` false, does not
+    return in useful time)."""
+    expr = sp.sympify(expr)
+    if expr == 0:
+        return True
+    sample = {x: 0.3 + 0.1 * i for i, x in enumerate(sorted(expr.free_symbols, key=str))}
+    value = complex(expr.xreplace(sample).evalf())
+    if abs(value) > 1e-9:
+        return False
+    return sp.simplify(expr) == 0
+
+
 class CompiledSystem:
     """Every numeric function of one system's derivation, compiled once, with the
     parameter values as leading arguments (`NumericModel` binds them): a new parameter
@@ -311,8 +326,8 @@ class NumericModel:
         d = self.derivation
         dissipation = d.D.xreplace(self.subs)
         q_aut_t = any(TIME in sp.sympify(e).free_symbols for e in d.Q.xreplace(self.subs))
-        return bool(d.energy_route and sp.simplify(dissipation) == 0 and not q_aut_t
-                    and not self.driven)
+        return bool(d.energy_route and not q_aut_t and not self.driven
+                    and _vanishes(dissipation))
 
     # --- constraint manifold -------------------------------------------------------------
     def constraint_values(self, q) -> np.ndarray:
@@ -486,6 +501,24 @@ class NumericModel:
             return np.concatenate([y[k:], self._explicit[2](*y, t)])
         q, qd = self.state_from_independent(y[:k], y[k:])
         return np.concatenate([y[k:], self.dynamics(q, qd, t)[0][self.independent]])
+
+    def ode_jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """d(ode_rhs)/dy of an unconstrained, undriven model, exact: with R = M q'' + h - Q
+        zero along the motion, dq''/dq = -M^-1 dR/dq and dq''/dq' = -M^-1 dR/dq' at the
+        state's q'' (an implicit integrator's Newton matrix; a finite-difference one
+        fails on a coordinate the equations do not contain, such as a free shaft's
+        angle, whose column is zero)."""
+        if self.constrained or self.driven:
+            raise ValueError("the exact Jacobian is written for unconstrained, undriven "
+                             "models")
+        k = len(self.independent)
+        q, qd = y[:k], y[k:]
+        M, R_qd, R_q = self.residual_jacobians(q, qd, self.acceleration(q, qd, t), t)
+        J = np.zeros((2 * k, 2 * k))
+        J[:k, k:] = np.eye(k)
+        J[k:, :k] = -np.linalg.solve(M, R_q)
+        J[k:, k:] = -np.linalg.solve(M, R_qd)
+        return J
 
     def residual(self, q, qd, qdd, t: float) -> np.ndarray:
         return np.array(self._residual(*q, *qd, *qdd, t), dtype=float).reshape(-1)

@@ -1,9 +1,9 @@
 """Published values (a benchmark's solution, `System.published`) against the reference.
 
 A state value is the published expression of the coordinates and velocities at its
-instant, integrated there as the reference is (DOP853 at the reference's tolerance, its
-error estimated by the change at a 10x looser one, which bounds positions and velocities
-alike);
+instant, integrated there as the reference is (DOP853, or Radau for a stiff system, at
+the reference's tolerance, its error estimated by the change at a 10x looser one, which
+bounds positions and velocities alike);
 an energy is the total T + V of that state;
 a period is measured on the reference as the mean spacing of the coordinate's upward
 crossings of its centre value (the mean of its extremes), located on the cubic Hermite
@@ -21,10 +21,9 @@ import sympy as sp
 from scipy.interpolate import CubicHermiteSpline
 
 from ..systems import Published, System, coordinate_symbols, get_system
-from scipy.integrate import solve_ivp
 
 from .numeric import numeric_model
-from .reference import LOOSE, TIGHT, consistent_initial_state, reference
+from .reference import LOOSE, TIGHT, consistent_initial_state, integrate, reference
 
 #: samples of the reference per scenario duration for a period measurement
 SAMPLES = 10000
@@ -44,8 +43,9 @@ def _applies(system: System, item: Published, values: Mapping[str, float],
 
 
 def _state_at(system: System, scenario, values, time: float, tol: float):
-    """(q, qd) at `time` from the scenario's consistent initial state: DOP853 at `tol`
-    straight to the instant (no sampling), dependent coordinates completed there."""
+    """(q, qd) at `time` from the scenario's consistent initial state: the reference's
+    integrator (DOP853, or Radau for a stiff system) at `tol` straight to the instant (no
+    sampling), dependent coordinates completed there."""
     model = numeric_model(system.id, values)
     if model.driven:
         raise ValueError(f"{system.id}: published states of driven mechanisms are not "
@@ -53,12 +53,9 @@ def _state_at(system: System, scenario, values, time: float, tol: float):
     q0, qd0 = consistent_initial_state(system, scenario, values)
     ind = model.independent
     model._warm, model._tangent = np.array(q0, dtype=float), None
-    sol = solve_ivp(model.ode_rhs, (0.0, time), np.concatenate([q0[ind], qd0[ind]]),
-                    method="DOP853", rtol=tol, atol=tol)
-    if not sol.success:
-        raise RuntimeError(f"reference solve failed: {sol.message}")
+    y = integrate(model, np.concatenate([q0[ind], qd0[ind]]), np.array([0.0, time]), tol,
+                  system.stiff)[-1]
     k = len(ind)
-    y = sol.y[:, -1]
     if not model.constrained:
         return y[:k], y[k:]
     return model.state_from_independent(y[:k], y[k:])

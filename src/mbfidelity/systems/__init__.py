@@ -372,6 +372,11 @@ class System:
     #: A stiff chain sets a few periods of its first mode: over the default its fast
     #: modes alone cost a minute of reference
     near_equilibrium_t_end: float | None = None
+    #: a stiff motion (damping or stiffness rates far above the motion's own, e.g. a
+    #: stiff spring-damper coupler): the reference is integrated by an implicit method
+    #: (Radau IIA with the model's exact Jacobian, analytic/reference.py) instead of
+    #: DOP853, whose stability bound would force steps far below what the accuracy needs
+    stiff: bool = False
     #: values the sources publish for the motion (a benchmark's solution), a function of
     #: the parameter symbols like `printed`: `analyze` compares each with the reference
     published: Callable[[SimpleNamespace], tuple[Published, ...]] = lambda P: ()

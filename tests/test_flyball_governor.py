@@ -1,0 +1,72 @@
+"""The stiff flyball governor (IFToMM A05, systems/benchmarks/iftomm_a05_flyball_governor.py):
+a spatial tree (free shaft, slide, two hinged rods) with stiff spatial spring-damper
+couplers, whose reference is integrated by Radau IIA. Expected values come from the hand
+derivation (tests/hand/iftomm_a05_flyball_governor.py): the angular momentum about the
+shaft, which no torque changes, and the slow swing's far turning point on Watt's rigid
+linkage with that momentum and the energy the stiff couplers barely dissipate."""
+import numpy as np
+import pytest
+
+from hand import iftomm_a05_flyball_governor as hand
+from mbfidelity.analytic.numeric import numeric_model
+from mbfidelity.analytic.reference import consistent_initial_state, integrate
+from mbfidelity.systems import get_system
+
+A05 = "iftomm_a05_flyball_governor"
+
+
+def _solve(values, t, tol=1e-10):
+    s = get_system(A05)
+    model = numeric_model(A05, values)
+    q0, qd0 = consistent_initial_state(s, s.scenarios[0], values)
+    return model, integrate(model, np.concatenate([q0, qd0]), t, tol, stiff=True)
+
+
+@pytest.mark.parametrize("params", [{}, {"m": 3.0, "omega0": 8.0, "alpha0": 0.4, "d": 0.08}])
+def test_the_published_momentum_is_the_hand_closed_form(params):
+    """The module's published H_0 = I_axis(phi_0) omega_0 equals the hand's (written
+    apart, body by body), at the defaults and elsewhere."""
+    s = get_system(A05)
+    v = s.parameter_values(params)
+    (item,) = s.published(s.symbols)
+    assert item.value(v) == pytest.approx(hand.initial_angular_momentum(v), rel=1e-13)
+
+
+def test_the_reference_keeps_the_angular_momentum():
+    """H = I_axis(phi1, phi2) psi' (hand) stays at H_0 along the Radau solution: the
+    integration at 1e-10 over 2 s (two swings) keeps it to about the tolerance times H's
+    scale (H_0 ~ 54 kg m^2/s: within 1e-7); the swing changes I_axis and psi' by some
+    20 %, so a wrong moment or a lost torque-free balance would show at that scale."""
+    s = get_system(A05)
+    v = s.parameter_values()
+    t = np.linspace(0.0, 2.0, 41)
+    _, y = _solve(v, t)
+    H = np.array([hand.axial_moment(v, row[2], -row[3]) * row[4] for row in y])
+    assert np.ptp(y[:, 4]) > 0.1 * v["omega0"]  # the shaft's speed did change
+    np.testing.assert_allclose(H, hand.initial_angular_momentum(v), rtol=0, atol=1e-7)
+
+
+def test_the_swing_turns_where_the_rigid_linkage_does():
+    """The slider's far turning point against the hand's rigid linkage (couplers at l0,
+    H and the energy kept): the couplers stretch under the swing's loads by F/k (forces
+    of a few hundred newtons: a few 1e-4 m each) and their dampers take a little of the
+    energy, so the two agree to 1e-3 m, while the swing itself spans 0.24 m."""
+    v = get_system(A05).parameter_values()
+    t = np.linspace(0.0, 1.0, 2001)  # the first swing, up and back
+    _, y = _solve(v, t)
+    s0, far = hand.turning_points(v)
+    assert y[0, 1] == pytest.approx(s0, abs=1e-12)
+    assert far - s0 > 0.2
+    assert np.max(y[:, 1]) == pytest.approx(far, abs=1e-3)
+
+
+@pytest.mark.slow
+def test_the_implicit_reference_agrees_with_dop853():
+    """Radau IIA with the exact Jacobian against the explicit DOP853 (whose steps the
+    couplers' decay rates keep near 1e-4 s) at the same tolerance, over the benchmark's
+    10 s: the two methods share nothing but the equations, and agree on s to 1e-8 m."""
+    v = get_system(A05).parameter_values()
+    t = np.linspace(0.0, 10.0, 101)
+    model, implicit = _solve(v, t, tol=1e-11)
+    explicit = integrate(model, implicit[0], t, 1e-11, stiff=False)
+    np.testing.assert_allclose(implicit[:, 1], explicit[:, 1], rtol=0, atol=1e-8)
