@@ -7,6 +7,7 @@ from functools import lru_cache
 
 import pytest
 
+from hand import facts
 from mbfidelity.comparisons.runner import compare
 from mbfidelity.simulators import SIMULATOR_IDS, all_backends
 from mbfidelity.systems import all_systems
@@ -23,7 +24,9 @@ CHECKS = {
 
 
 def _applicable(system):
-    checks = ["trajectory", "frequency"]
+    checks = ["trajectory"]
+    if not getattr(HAND.get(system.id), "NO_FREE_VIBRATION", None):
+        checks.append("frequency")
     if any("reaction" in sc.checks for sc in system.scenarios) and system.reaction_joints:
         checks.append("reaction")
     if system.mechanism.constraints and any("constraint_force" in sc.checks
@@ -34,6 +37,7 @@ def _applicable(system):
     return checks
 
 
+HAND = facts()
 CASES = [(s.id, sim, check) for s in all_systems().values() for sim in SIMULATOR_IDS
          for check in _applicable(s)]
 
@@ -55,10 +59,14 @@ def _marks(system_id: str, simulator: str) -> list:
     """Its system's worker group. In `make test-slow`: Drake's driven rows (the actuator's
     inverse dynamics runs in Python at every integrator stage) and its rows on the discrete
     plant (closures, couplings, slots: the SAP solver's step and the Python force system
-    at every step; tests/test_drake.py gates its closed loops on two mechanisms)."""
+    at every step; tests/test_drake.py gates its closed loops on two mechanisms), and
+    every engine on a stiff row (its own small step over the whole run)."""
     marks = [pytest.mark.xdist_group(system_id)]
-    mechanism = all_systems()[system_id].mechanism
+    system = all_systems()[system_id]
+    mechanism = system.mechanism
     if simulator == "drake" and (mechanism.prescribed or mechanism.constraints):
+        marks.append(pytest.mark.slow)
+    if system.stiff:  # its own small step over the whole run, and a stiff reference
         marks.append(pytest.mark.slow)
     return marks
 

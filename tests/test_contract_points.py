@@ -99,6 +99,21 @@ def _angle_aware_gap(mech, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return gap
 
 
+def _unstable_at(system_id: str, backend, mech, dt: float) -> bool:
+    """Whether the comparison refuses the row at this step: the engine's scheme cannot be
+    stable on its fastest mode (a stiff row, whose states then overflow to NaN)."""
+    from mbfidelity.comparisons.runner import _refuse_unstable_step
+    from mbfidelity.systems import get_system
+
+    system = get_system(system_id)
+    try:
+        _refuse_unstable_step(system, backend, mech, backend.resolve_settings({}),
+                              system.parameter_values(None, scenario=system.scenarios[0]), dt)
+    except ValueError:
+        return True
+    return False
+
+
 @pytest.mark.parametrize("backend", INSTALLED, ids=lambda b: b.id)
 def test_bare_loop_ends_in_the_state_of_simulate(backend):
     """On every catalog row the engine expresses: after the same steps from the same state,
@@ -108,7 +123,7 @@ def test_bare_loop_ends_in_the_state_of_simulate(backend):
     differ), bounded by 64 unit round-offs of the state's size."""
     checked = 0
     for sid, mech, q0, qd0, dt in _catalog_starts():
-        if not backend.support(mech).ok:
+        if not backend.support(mech).ok or _unstable_at(sid, backend, mech, dt):
             continue
         run = backend.simulate(mech, q0, qd0, BARE_STEPS * dt, dt)
         bare = backend.bare_loop_run(mech, q0, qd0, BARE_STEPS * dt, dt)

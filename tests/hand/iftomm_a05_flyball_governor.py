@@ -51,6 +51,9 @@ EQUILIBRIA = (None, 0)
 MISPRINTS = set()
 #: the hanging rest state is not stable in the linear sense (the free shaft drifts)
 OPERATING_POINT_STABLE = False
+#: why no free-vibration check applies: there is no stable equilibrium to release near
+NO_FREE_VIBRATION = ("every equilibrium drifts with the free shaft (a rigid, undamped "
+                     "rotation about its axis): none is stable to vibrate about")
 
 
 def rod_mass(v):

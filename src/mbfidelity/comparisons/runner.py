@@ -267,7 +267,7 @@ def _coordinate_scales(system: System, q_eq: np.ndarray) -> np.ndarray:
 
 
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None,
-            dt: float = DEFAULT_DT, t_end: float | None = None,
+            dt: float | None = None, t_end: float | None = None,
             settings: Mapping | None = None, scenarios: Iterable[str] | None = None,
             keep_series: bool = False, variant: str | None = None,
             engine_scale: Mapping[str, float] | None = None,
@@ -280,8 +280,11 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     values). `held_gates` (name -> a baseline comparison's metric, `Metric.as_dict`):
     the metrics unresolved a priori are judged by the baseline's refinement gates instead
     of the engine's own refinement, and where the baseline judged the engine's limit, on
-    one run at the baseline's finest step (`_judge_held`)."""
+    one run at the baseline's finest step (`_judge_held`). `dt` None: the system's own
+    step (`System.step`), else DEFAULT_DT."""
     system = get_system(system_id)
+    default_dt = system.step or DEFAULT_DT
+    dt = default_dt if dt is None else dt
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
     with _declarations_judged_at(base_values), _engine_scaled(engine_scale or {}), \
@@ -308,7 +311,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
                 raise ValueError(f"{system.id} has no scenario {name!r}; scenarios: "
                                  f"{', '.join(sc.name for sc in system.scenarios)}")
         # declarations describe the scenarios as declared, at the default step
-        strict = t_end is None and dt == DEFAULT_DT
+        strict = t_end is None and dt == default_dt
         # from here on every stage's failure is an incident of this comparison
         with contained(result, "*", "description") as stage:
             mech = _engine_mechanism(system, base_values, variant)

@@ -87,8 +87,8 @@ def fmt(*xs: float) -> str:
 
 
 def _xyz(point) -> str:
-    """A planar point of the description as an MJCF position."""
-    return fmt(num(point[0]), num(point[1]), 0)
+    """A point of the description (planar: z = 0) as an MJCF position."""
+    return fmt(num(point[0]), num(point[1]), num(point[2]) if len(point) > 2 else 0)
 
 
 def _site(name: str, point) -> str:
@@ -674,8 +674,9 @@ _SHAPE_GEOMS = {
 
 def spatial_reason(mech: Mechanism) -> str:
     """Why the spatial build cannot hold a spatial mechanism (empty: it can): closures
-    become equalities, slides slide joints."""
-    return spatial_tree_reason(mech, closures=True, slides=True)
+    become equalities, slides slide joints, point-to-point elements spatial tendons
+    between sites."""
+    return spatial_tree_reason(mech, closures=True, slides=True, point_forces=True)
 
 
 def mjcf(build: Build) -> str:

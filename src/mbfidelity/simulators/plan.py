@@ -602,12 +602,13 @@ def point_state(st: tuple, local) -> tuple:
     return x + rx, y + ry, vx - w * ry, vy + w * rx
 
 
-def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str:
+def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool,
+                        point_forces: bool = False) -> str:
     """Why an engine's spatial build (model convention 10) cannot hold a spatial
     mechanism, empty when it can: every such build takes relative, counter-clockwise
-    hinges without an angle offset, folds no massless body and has no point-to-point
-    element; `closures` and `slides` say whether it takes closure constraints (a
-    spatial mechanism's are hinge closures) and prismatic joints."""
+    hinges without an angle offset and folds no massless body; `closures`, `slides` and
+    `point_forces` say whether it takes closure constraints (a spatial mechanism's are
+    hinge closures), prismatic joints and point-to-point elements."""
     if mech.constraints and not closures:
         return "closure constraints in a spatial mechanism"
     for j in mech.joints:
@@ -619,7 +620,7 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool) -> str
             return f"joint {j.name}: the spatial build takes no angle offset"
     if any(b.massless for b in mech.bodies):
         return "a massless body in a spatial mechanism (the spatial build folds none)"
-    if any(isinstance(f, PointToPoint) for f in mech.forces):
+    if not point_forces and any(isinstance(f, PointToPoint) for f in mech.forces):
         return "a point-to-point element in a spatial mechanism (the spatial build has none)"
     return ""
 

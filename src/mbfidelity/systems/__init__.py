@@ -377,6 +377,10 @@ class System:
     #: (Radau IIA with the model's exact Jacobian, analytic/reference.py) instead of
     #: DOP853, whose stability bound would force steps far below what the accuracy needs
     stiff: bool = False
+    #: the step (s) a comparison runs this row at when it is given none (None: the
+    #: project's default): a stiff row's, where the default step would put an explicit
+    #: scheme's w h on the fastest mode beyond its stability limit (the module says why)
+    step: float | None = None
     #: values the sources publish for the motion (a benchmark's solution), a function of
     #: the parameter symbols like `printed`: `analyze` compares each with the reference
     published: Callable[[SimpleNamespace], tuple[Published, ...]] = lambda P: ()
