@@ -70,3 +70,69 @@ def test_the_implicit_reference_agrees_with_dop853():
     model, implicit = _solve(v, t, tol=1e-11)
     explicit = integrate(model, implicit[0], t, 1e-11, stiff=False)
     np.testing.assert_allclose(implicit[:, 1], explicit[:, 1], rtol=0, atol=1e-8)
+
+
+# --- engines ---------------------------------------------------------------------------
+
+def test_mujoco_builds_the_couplers_as_spatial_tendons():
+    """MuJoCo's build (hinges, a slide joint, a spatial tendon with its own stiffness,
+    free length and damping per coupler) follows the Radau solution over the first half
+    swing at the row's step: RK4's error on the swing is of order (w h)^4 w T with
+    w ~ 7 rad/s, h = 1e-4 s (about 1e-13 m), the couplers' fast modes are barely excited
+    from unstretched couplers, and the reference's own error is near its tolerance, so
+    the two agree to 1e-8 m in s (a wrong attachment point or law would move s by the
+    order of its own error: millimetres)."""
+    pytest.importorskip("mujoco")
+    from mbfidelity.simulators.mujoco_backend import BACKEND
+    from mbfidelity.systems.benchmarks.iftomm_a05_flyball_governor import STEP
+
+    s = get_system(A05)
+    v = s.parameter_values()
+    mech = s.numeric_mechanism(v)
+    assert BACKEND.support(mech).ok
+    q0, qd0 = consistent_initial_state(s, s.scenarios[0], v)
+    run = BACKEND.simulate(mech, q0, qd0, 0.5, STEP)
+    _, y = _solve(v, run.t[::500])
+    assert np.ptp(y[:, 1]) > 0.1  # the slider moved
+    np.testing.assert_allclose(run.q[::500, 1], y[:, 1], rtol=0, atol=1e-8)
+
+
+def test_the_project_step_is_refused_on_the_couplers():
+    """At the project's default step (1e-3 s) RK4 cannot be stable on the couplers'
+    fastest decay (w h far beyond its limit): the comparison refuses it before any run,
+    and the row's own step (`System.step`) is what a comparison given no step uses."""
+    pytest.importorskip("mujoco")
+    from mbfidelity.comparisons.runner import compare
+
+    with pytest.raises(ValueError, match="cannot be stable with mujoco's RK4"):
+        compare(A05, "mujoco", dt=1e-3)
+    assert get_system(A05).step is not None and get_system(A05).step < 1e-3
+
+
+@pytest.mark.slow
+def test_mujoco_passes_and_a_heavier_ball_is_rejected():
+    """MuJoCo passes every gate at the row's step; with both balls 1 % heavier in its
+    build only (the reference keeps the true mass) the swing's balance of centrifugal pull,
+    weight and the slider's weight shifts, and s(t) moves far beyond the trajectory gate."""
+    pytest.importorskip("mujoco")
+    from mbfidelity.comparisons import power
+    from mbfidelity.comparisons.runner import compare
+
+    baseline = compare(A05, "mujoco")
+    assert baseline.supported and baseline.passed, baseline.metrics
+    mutated = compare(A05, "mujoco", engine_scale={"m": 1.01})
+    rejecting = power.rejecting_metrics(baseline, mutated)
+    assert not mutated.passed
+    assert any(name.startswith("published.trajectory") for name in rejecting), rejecting
+
+
+@pytest.mark.slow
+def test_the_benchmark_error_table_runs_the_governor_at_its_step():
+    """`api.benchmark_errors`: MuJoCo completes the benchmark's 10 s at the row's step,
+    its error in s well below a millimetre."""
+    pytest.importorskip("mujoco")
+    from mbfidelity import api
+
+    row, = api.benchmark_errors([A05], ["mujoco"])["rows"]
+    assert row["status"] == "completed" and row["dt"] == get_system(A05).step
+    assert set(row["errors"]) == {"s"} and row["error"] < 1e-6

@@ -560,9 +560,10 @@ def convergence(systems: Iterable[str] | None = None, sims: Iterable[str] | None
 
 
 def benchmark_errors(systems: Iterable[str] | None = None,
-                     sims: Iterable[str] | None = None, dt: float = DEFAULT_DT) -> dict:
+                     sims: Iterable[str] | None = None, dt: float | None = None) -> dict:
     """Each engine's error as the benchmark defines it (`System.benchmark_error`) and its
-    CPU seconds of stepping, at its default settings and the step `dt`, over each
+    CPU seconds of stepping, at its default settings and the step `dt` (None: each row's
+    own step, `System.step`, else DEFAULT_DT; every row states the step it ran), over each
     benchmark row's whole scenario (default: every row that declares a measure, every
     installed engine); a run that does not complete is reported with its status and the
     system's declared reason. `rows` lists them in system x engine order."""
@@ -580,7 +581,7 @@ def benchmark_errors(systems: Iterable[str] | None = None,
             raise ValueError(f"{s} declares no benchmark error measure")
     sim_ids = (checked_simulators(sims) if sims else
                [e for e, b in all_backends().items() if b.available()[0]])
-    if not (np.isfinite(dt) and dt > 0):
+    if dt is not None and not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"the step must be positive; got {dt}")
     rows = [default_step_error(s, e, dt) for s in sys_ids for e in sim_ids]
     return {"provenance": provenance(), "dt": dt, "rows": rows}

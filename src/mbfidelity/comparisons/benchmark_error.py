@@ -94,8 +94,9 @@ def declared_failure(system: System, simulator: str, scenario: str) -> str:
     return exp.reason if exp is not None and exp.kind == "xfail" else ""
 
 
-def default_step_error(system_id: str, simulator: str, dt: float = DEFAULT_DT) -> dict:
-    """One engine on one benchmark row at its default settings and the step `dt`, over
+def default_step_error(system_id: str, simulator: str, dt: float | None = None) -> dict:
+    """One engine on one benchmark row at its default settings and the step `dt` (None:
+    the row's own step, `System.step`, else DEFAULT_DT), over
     the benchmark's whole scenario: the benchmark's error (each quantity's and the
     largest), the CPU and wall seconds of the stepping, and the run's status ("completed",
     "diverged": non-finite states, "crashed": the engine raised, "unsupported"), with the
@@ -103,6 +104,7 @@ def default_step_error(system_id: str, simulator: str, dt: float = DEFAULT_DT) -
     completed run whose trajectory it declares an expected failure or unresolved at this
     step."""
     system = get_system(system_id)
+    dt = (system.step or DEFAULT_DT) if dt is None else dt
     measure = system.benchmark_error
     if measure is None:
         raise ValueError(f"{system.id} declares no benchmark error measure")
