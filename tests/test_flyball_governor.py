@@ -74,17 +74,23 @@ def test_the_implicit_reference_agrees_with_dop853():
 
 # --- engines ---------------------------------------------------------------------------
 
-def test_mujoco_builds_the_couplers_as_spatial_tendons():
+@pytest.mark.parametrize("simulator", ["mujoco", "exudyn"])
+def test_the_engines_build_the_couplers_in_space(simulator):
     """MuJoCo's build (hinges, a slide joint, a spatial tendon with its own stiffness,
-    free length and damping per coupler) follows the Radau solution over the first half
-    swing at the row's step: RK4's error on the swing is of order (w h)^4 w T with
+    free length and damping per coupler) and Exudyn's (a kinematic tree of RevoluteY/Z
+    and PrismaticY links, an ObjectConnectorSpringDamper per coupler between tree
+    markers) follow the Radau solution over the first half swing at the row's step, both
+    with their RK4: the error on the swing is of order (w h)^4 w T with
     w ~ 7 rad/s, h = 1e-4 s (about 1e-13 m), the couplers' fast modes are barely excited
     from unstretched couplers, and the reference's own error is near its tolerance, so
     the two agree to 1e-8 m in s (a wrong attachment point or law would move s by the
     order of its own error: millimetres)."""
-    pytest.importorskip("mujoco")
-    from mbfidelity.simulators.mujoco_backend import BACKEND
+    from mbfidelity.simulators import all_backends
     from mbfidelity.systems.benchmarks.iftomm_a05_flyball_governor import STEP
+
+    BACKEND = all_backends()[simulator]
+    if not BACKEND.available()[0]:
+        pytest.skip(f"{simulator} not installed")
 
     s = get_system(A05)
     v = s.parameter_values()

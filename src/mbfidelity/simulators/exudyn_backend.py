@@ -169,7 +169,8 @@ class _Geometry:
 
     def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
         """A description body-frame point expressed in the body's link frame."""
-        return self.com[body] + _rot3(-self.beta[body]) @ np.array([*point, 0.0])
+        padded = [*point, 0.0, 0.0][:3]  # a planar point lies at z = 0
+        return self.com[body] + _rot3(-self.beta[body]) @ np.array(padded)
 
     def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
         """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
@@ -185,21 +186,31 @@ _AXIS_JOINTS = {(1.0, 0.0, 0.0): "RevoluteX", (0.0, 1.0, 0.0): "RevoluteY",
                 (0.0, 0.0, 1.0): "RevoluteZ"}
 
 
-def _hinge_axis(j: Revolute) -> tuple[float, ...]:
-    axis = np.array([num(v) for v in (j.axis if j.axis is not None else (0, 0, 1))])
+def _hinge_axis(j: Revolute | Prismatic) -> tuple[float, ...]:
+    """A hinge's unit axis, or a slide's (three components)."""
+    given = j.axis if j.axis is not None else (0, 0, 1)
+    axis = np.array([num(v) for v in given] + [0.0] * (3 - len(given)))
     return tuple(float(v) for v in axis / np.linalg.norm(axis))
+
+
+_SLIDE_JOINTS = {(1.0, 0.0, 0.0): "PrismaticX", (0.0, 1.0, 0.0): "PrismaticY",
+                 (0.0, 0.0, 1.0): "PrismaticZ"}
 
 
 def _spatial_reason(mech: Mechanism) -> str:
     """Why the spatial tree cannot hold a spatial mechanism (empty: it can): besides the
-    common conditions, its hinges turn about a link axis."""
-    common = spatial_tree_reason(mech, closures=False, slides=False)
+    common conditions, its hinges turn about and its slides run along a link axis (its
+    point-to-point elements are spring-dampers between tree markers)."""
+    common = spatial_tree_reason(mech, closures=False, slides=True, point_forces=True)
     if common:
         return common
     for j in mech.joints:
-        if _hinge_axis(j) not in _AXIS_JOINTS:
+        if isinstance(j, Revolute) and _hinge_axis(j) not in _AXIS_JOINTS:
             return (f"joint {j.name}: the tree's hinges turn about a link axis (RevoluteX, "
                     f"Y or Z), not about {_hinge_axis(j)}")
+        if isinstance(j, Prismatic) and _hinge_axis(j) not in _SLIDE_JOINTS:
+            return (f"joint {j.name}: the tree's slides run along a link axis (PrismaticX, "
+                    f"Y or Z), not along {_hinge_axis(j)}")
     return ""
 
 
@@ -241,9 +252,13 @@ def _hinge(joint: Revolute, mech: Mechanism) -> tuple[str, float, float]:
             num(joint.angle_offset), 0.0)
 
 
-@_builds(PRISMATIC, Expression(EXACT, "PrismaticX link, the joint frame turned to the axis"))
+@_builds(PRISMATIC, Expression(EXACT, "PrismaticX link, the joint frame turned to the axis "
+                                      "(spatial: PrismaticX, Y or Z)"))
 def _slide(joint: Prismatic, mech: Mechanism) -> tuple[str, float, float]:
-    """As `_hinge`: the joint frame's x axis along the slide."""
+    """As `_hinge`: the joint frame's x axis along the slide (spatial: the link axis of
+    the slide, frames aligned with the parent's)."""
+    if mech.spatial:
+        return _SLIDE_JOINTS[_hinge_axis(joint)], num(joint.angle_offset), 0.0
     axis = np.array([num(v) for v in joint.axis])
     alpha = math.atan2(axis[1], axis[0])
     return "PrismaticX", alpha, alpha - num(joint.angle_offset)

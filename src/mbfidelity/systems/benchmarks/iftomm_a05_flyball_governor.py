@@ -49,10 +49,12 @@ analytic/reference.py); an explicit engine needs steps well below 2 m/c, and the
 comparisons run this row at its own step (`STEP`, `System.step`) instead of the
 project's default.
 
-Engines. MuJoCo builds it natively: hinges, a slide joint and a spatial tendon with its
-own stiffness, free length and damping for each coupler. The planar engine (Pymunk) has
-no spatial expression; the spatial builds of the others take hinges only (no slide) or
-no spatial point-to-point element, and their backends say so.
+Engines. MuJoCo builds it natively (hinges, a slide joint, and a spatial tendon with its
+own stiffness, free length and damping for each coupler), and so does Exudyn (a
+kinematic tree of RevoluteY, PrismaticY and RevoluteZ links, and an
+ObjectConnectorSpringDamper between tree markers for each coupler). The planar engine
+(Pymunk) has no spatial expression; PyBullet's spatial build takes hinges only (no
+slide) and Drake's translation is planar, and their backends say so.
 
 What the sources publish. The benchmark gives s(t) as a reference solution file whose
 numbers the papers show only as a figure (the OpenSim port plots its s over it); no
