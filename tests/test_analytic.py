@@ -17,6 +17,12 @@ from hand import facts
 
 SYSTEMS = list(all_systems())
 HAND = facts()
+#: stiff rows (Radau IIA over their couplers' decay, several seconds per solve of a whole
+#: scenario): their sensitivity study (two such solves) and their second equilibrium
+#: search (at drawn parameters, every start of a four-coordinate grid) run with the slow
+#: suite
+STIFF_SLOW = [pytest.param(s, marks=pytest.mark.slow) if all_systems()[s].stiff else s
+              for s in SYSTEMS]
 
 
 def test_every_system_has_hand_facts():
@@ -114,7 +120,7 @@ def test_sliding_block_inverted_equilibrium_position():
     assert inverted[0].q[1] == pytest.approx(v["rho0"] - 2 * v["m"] * v["g"] / v["k"], rel=1e-12)
 
 
-@pytest.mark.parametrize("system_id", SYSTEMS)
+@pytest.mark.parametrize("system_id", STIFF_SLOW)
 def test_two_routes_to_the_linearization_agree(system_id):
     """Jacobians of the equations of motion (eq. 104-106) against Hessians of T, V and D
     (eq. 107-109; Italian notes §5.3.3-5.3.4), at every equilibrium."""
@@ -371,7 +377,7 @@ def _floquet_unstable_start(system, scenario) -> bool:
     return result.verdict == "unstable"
 
 
-@pytest.mark.parametrize("system_id", SYSTEMS)
+@pytest.mark.parametrize("system_id", STIFF_SLOW)
 def test_scenarios_are_not_chaotic(system_id):
     """Trajectory gates assume errors grow linearly (tolerances.py); a scenario whose
     small perturbations grow by orders of magnitude cannot be gated."""
