@@ -56,6 +56,12 @@ ObjectConnectorSpringDamper between tree markers for each coupler). The planar e
 (Pymunk) has no spatial expression; PyBullet's spatial build takes hinges only (no
 slide) and Drake's translation is planar, and their backends say so.
 
+Equilibria. At rest the rods hang (or stand) with the couplers along the shaft, and the
+springs admit bent configurations too; the shaft's angle is free at every one of them
+(no stiffness, no damping: a rigid, undamped drift, a double zero eigenvalue), so none is
+stable in the linear sense and no free-vibration check applies. The operating point is
+the hanging one; its modes are the rods' swings and the slider's two overdamped roots.
+
 What the sources publish. The benchmark gives s(t) as a reference solution file whose
 numbers the papers show only as a figure (the OpenSim port plots its s over it); no
 number of it is restated here. What has a closed form is compared instead: no torque
