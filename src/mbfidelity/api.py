@@ -638,7 +638,7 @@ def beams(sims: Iterable[str] | None = None, elements: Iterable[int] = (2, 4, 8,
 
 
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None, *,
-            dt: float = DEFAULT_DT, t_end: float | None = None,
+            dt: float | None = None, t_end: float | None = None,
             settings: Mapping | None = None, variant: str | None = None,
             timeout: float | None = 900.0) -> Comparison:
     """One system on one engine: every scenario's metrics against their gates. The engine
@@ -693,7 +693,7 @@ def _validated_settings(settings: Mapping[str, Mapping] | None) -> dict[str, dic
 
 
 def run(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
-        out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+        out: str | Path | None = None, *, dt: float | None = None,
         settings: Mapping[str, Mapping] | None = None, variants: bool = False,
         resume: bool = False, report: bool = True,
         scheduler: str | None = None, progress=None) -> list[Comparison]:
@@ -755,7 +755,7 @@ class CheckResult:
 
 def check(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
           out: str | Path = "mbfidelity-check", *, baseline: str | Path | None = None,
-          dt: float = DEFAULT_DT, settings: Mapping[str, Mapping] | None = None,
+          dt: float | None = None, settings: Mapping[str, Mapping] | None = None,
           report: bool = False) -> CheckResult:
     """The gates against the installed engines (default: every installed one): a verdict
     per system x engine and the results in `out`. Passed when every gate passes or is
@@ -783,7 +783,7 @@ def diff(old: str | Path, new: str | Path) -> ResultsDiff:
 
 
 def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float] | None = None,
-           *, settings: Mapping | None = None, dt: float = DEFAULT_DT) -> tuple[str, list[str]]:
+           *, settings: Mapping | None = None, dt: float | None = None) -> tuple[str, list[str]]:
     """(the engine's model file as text, what the file alone does not reproduce): MuJoCo's
     MJCF with a keyframe per scenario and the coordinate map."""
     from .comparisons.export import export_model
@@ -791,8 +791,7 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
     system = _system(system_id)
     _backend(simulator)
     _checked_parameters(system, params)
-    if not dt > 0:
-        raise ValueError("dt must be positive")
+    checked_duration("dt", dt)
     return export_model(system.id, simulator, params, settings, dt)
 
 
@@ -800,7 +799,7 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
 
 
 def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
-          out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+          out: str | Path | None = None, *, dt: float | None = None,
           workers: int | None = None, progress=None):
     """The power study (comparisons/power.py) of systems x engines (default: all systems,
     every installed engine): per injected model error the smallest relative error the
@@ -841,7 +840,7 @@ def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
 
 
 def out_of_the_box(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
-                   out: str | Path | None = None, *, dt: float = DEFAULT_DT,
+                   out: str | Path | None = None, *, dt: float | None = None,
                    workers: int | None = None, defaults: Iterable[str] | None = None,
                    progress=None):
     """The out-of-the-box study (comparisons/out_of_the_box.py) of systems x engines

@@ -14,6 +14,9 @@ from typing import List, Optional
 import numpy as np
 import typer
 
+#: the --dt option of the commands that run engines
+STEP_HELP = "time step, s (default: the row's own step, else 0.001)"
+
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Cross-validate multibody simulators against exact models.")
 
@@ -264,7 +267,7 @@ def _settings(items: Optional[List[str]]) -> dict:
 def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                 sim: str = typer.Option(..., "--sim", help="mujoco | pybullet | exudyn | pymunk"),
                 param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
-                dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+                dt: Optional[float] = typer.Option(None, "--dt", help=STEP_HELP),
                 t_end: Optional[float] = typer.Option(None, "--t-end", help="simulated time, s"),
                 setting: Optional[List[str]] = typer.Option(
                     None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
@@ -315,7 +318,7 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
 def run(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
         sims: Optional[List[str]] = typer.Option(None, "--sims", help="simulator ids"),
         out: Path = typer.Option(Path("results"), "--out", callback=_out_folder, help="output folder"),
-        dt: float = typer.Option(1e-3, "--dt"),
+        dt: Optional[float] = typer.Option(None, "--dt", help=STEP_HELP),
         variants: bool = typer.Option(False, "--variants/--no-variants",
                                       help="also run each system's variants (e.g. rolling by "
                                            "friction contact) on the engines that build them"),
@@ -685,7 +688,7 @@ def check_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
                                            "with: a gate that got worse fails the check"),
               out: Path = typer.Option(Path("mbfidelity-check"), "--out", callback=_out_folder,
                                        help="where the results are written"),
-              dt: float = typer.Option(1e-3, "--dt"),
+              dt: Optional[float] = typer.Option(None, "--dt", help=STEP_HELP),
               setting: Optional[List[str]] = typer.Option(
                   None, "--setting", help="ENGINE.KEY=VALUE: an engine setting (JSON value)"),
               report: bool = typer.Option(False, "--report/--no-report",
@@ -787,7 +790,7 @@ def export_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
                param: Optional[List[str]] = typer.Option(None, "--param", help="NAME=VALUE"),
                setting: Optional[List[str]] = typer.Option(
                    None, "--setting", help="engine setting KEY=VALUE (JSON value)"),
-               dt: float = typer.Option(1e-3, "--dt", help="time step written in the model"),
+               dt: Optional[float] = typer.Option(None, "--dt", help="time step written in the model, s (default: the row's own step, else 0.001)"),
                ) -> None:
     """The mechanism as the harness builds it, saved: MuJoCo's MJCF with a keyframe per
     scenario and the map from the description's coordinates (custom numerics)."""
@@ -840,7 +843,7 @@ def global_options_first(argv: list[str]) -> list[str]:
 def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", help="system ids"),
               sims: Optional[List[str]] = typer.Option(
                   None, "--sims", help="simulator ids (default: every installed one)"),
-              dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+              dt: Optional[float] = typer.Option(None, "--dt", help=STEP_HELP),
               out: Optional[Path] = typer.Option(
                   None, "--out", callback=_out_folder,
                   help="also write power.json, out_of_the_box.json and their pages there "
@@ -887,7 +890,7 @@ def out_of_the_box_cmd(systems: Optional[List[str]] = typer.Option(None, "--syst
                                                                 help="system ids"),
                        sims: Optional[List[str]] = typer.Option(
                            None, "--sims", help="simulator ids (default: every installed one)"),
-                       dt: float = typer.Option(1e-3, "--dt", help="time step, s"),
+                       dt: Optional[float] = typer.Option(None, "--dt", help=STEP_HELP),
                        out: Optional[Path] = typer.Option(
                            None, "--out", callback=_out_folder,
                            help="also write out_of_the_box.json and out_of_the_box.html there "

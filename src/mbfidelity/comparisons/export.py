@@ -11,16 +11,17 @@ from typing import Mapping
 from ..analytic.reference import consistent_initial_state
 from ..simulators import get_backend
 from ..systems import get_system
-from .runner import DEFAULT_DT
+from .runner import own_step
 
 
 def export_model(system_id: str, simulator: str, params: Mapping[str, float] | None = None,
                  settings: Mapping | None = None,
-                 dt: float = DEFAULT_DT) -> tuple[str, list[str]]:
+                 dt: float | None = None) -> tuple[str, list[str]]:
     """(the engine's model file, what the file alone does not reproduce of the harness's
     build). Keyframes for the scenarios that run at these parameters (a scenario that
     overrides a parameter builds another model). ValueError for what cannot be exported."""
     system = get_system(system_id)
+    dt = own_step(system_id, dt)
     backend = get_backend(simulator)
     if not hasattr(backend, "export"):
         raise ValueError(f"no export for {simulator}: its build is not recorded as a file or "

@@ -18,7 +18,7 @@ from ..systems import get_system
 from . import results_folder
 from .budget import become_worker
 from ..analytic.derivation import cache_key
-from .runner import (DEFAULT_DT, Comparison, compare, failed_comparison, isolated_compare,
+from .runner import (Comparison, compare, failed_comparison, isolated_compare, own_step,
                      provenance, record_incident)
 
 #: wall-clock budget of one comparison when a job is re-run engine by engine after its
@@ -39,6 +39,7 @@ def _one_system(args, run=compare) -> tuple[list[Comparison], float]:
     parallel on the derivation and models this process already built. Returns the
     comparisons and the job's CPU seconds."""
     system, sims, dt, variants, out, settings = args
+    dt = own_step(system, dt)
     start = time.process_time()
 
     def attempt(sim, **kwargs) -> Comparison:
@@ -110,7 +111,8 @@ def _run_on_cluster(scheduler: str, order: list[int], systems: list[str], common
 
 def _failed_job(system: str, sims: list[str], dt: float, exc: BaseException
                 ) -> list[Comparison]:
-    return [failed_comparison(system, sim, None, dt, "", "job", exc) for sim in sims]
+    return [failed_comparison(system, sim, None, own_step(system, dt), "", "job", exc)
+            for sim in sims]
 
 
 def _isolated_job(args) -> tuple[list[Comparison], float]:
@@ -169,7 +171,7 @@ def _load_job(out: Path, request: tuple) -> tuple[list[Comparison], float] | Non
 
 
 def reusable_jobs(out: Path, systems: Iterable[str], simulators: Iterable[str],
-                  dt: float = DEFAULT_DT, variants: bool = False,
+                  dt: float | None = None, variants: bool = False,
                   settings: Mapping[str, dict] | None = None) -> list[str]:
     """The systems whose finished job `out` holds for this request (`run --resume`)."""
     sims = list(simulators)
@@ -202,7 +204,7 @@ def schedule(systems: Iterable[str], measured: Mapping[str, float] | None = None
     return sorted(systems, key=cost.__getitem__, reverse=True)
 
 
-def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float = DEFAULT_DT,
+def run_matrix(systems: Iterable[str], simulators: Iterable[str], dt: float | None = None,
                workers: int | None = None,
                progress: Callable[[Comparison], None] | None = None,
                variants: bool = False, out: Path | None = None,

@@ -62,7 +62,7 @@ from .power import (RUN_TIMEOUT_FACTOR, RUN_TIMEOUT_FLOOR, DefaultPower, PowerEn
                     classify_default, effect_against, engine_defaults, error_powers,
                     free_coordinates, largest_change, metric_named, out_of_the_box_document,
                     power_document, rejecting_metrics, same_metrics, worst_scenario)
-from .runner import DEFAULT_DT, Comparison, compare, failed_comparison, isolated_compare
+from .runner import Comparison, compare, failed_comparison, isolated_compare, own_step
 
 #: wall-clock budget of one default's run: this many times the neutralised run's wall
 #: time, at least RUN_BUDGET_FLOOR s. A default can make a run much longer than the
@@ -140,13 +140,14 @@ def _reading(key: str, value: object, harness: object, note: str, neutral: Compa
     return d
 
 
-def defaults_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
+def defaults_entry(system_id: str, simulator: str, dt: float | None = None,
                    only: Iterable[str] | None = None, kinds: Iterable[str] = ()
                    ) -> PowerEntry:
     """The out-of-the-box reading of one system on one engine (see the module doc); with
     `only`, just those of the engine's neutralised defaults, each alone (no "all"); with
     `kinds`, the power study's model errors of those kinds too."""
     kinds = tuple(kinds)
+    dt = own_step(system_id, dt)
     started = time.perf_counter()
     system = get_system(system_id)
     backend = get_backend(simulator)
@@ -292,10 +293,11 @@ def cached_entry(system_id: str, simulator: str, dt: float, only, kinds=()) -> P
     return entry
 
 
-def _system_job(system_id: str, sims: list[str], dt: float, only, kinds=()
+def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=()
                 ) -> tuple[list[PowerEntry], float]:
-    """Every engine's reading of one system (`cached_entry`), and the job's CPU
-    seconds."""
+    """Every engine's reading of one system (`cached_entry`; `dt` None: the system's own
+    step), and the job's CPU seconds."""
+    dt = own_step(system_id, dt)
     start = _cpu_seconds()
     entries = [cached_entry(system_id, sim, dt, only, kinds) for sim in sims]
     return entries, _cpu_seconds() - start
@@ -350,7 +352,7 @@ class OutOfTheBoxStudy:
 
 
 def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
-                         dt: float = DEFAULT_DT, workers: int | None = None,
+                         dt: float | None = None, workers: int | None = None,
                          order: Iterable[str] | None = None,
                          progress: Callable[[PowerEntry], None] | None = None,
                          only: Iterable[str] | None = None, kinds: Iterable[str] = ()
@@ -393,12 +395,12 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                     crashed.append(futures[fut])
                 except Exception as exc:  # the job could not come back: its entries say so
                     collect(futures[fut], ([PowerEntry(
-                        futures[fut], sim, supported=False, dt=dt,
+                        futures[fut], sim, supported=False, dt=own_step(futures[fut], dt),
                         reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
                         for sim in sims], 0.0))
     for s in crashed:
         start = _cpu_seconds()
-        entries = [_isolated_entry(s, sim, dt, only, kinds) for sim in sims]
+        entries = [_isolated_entry(s, sim, own_step(s, dt), only, kinds) for sim in sims]
         collect(s, (entries, _cpu_seconds() - start))
     entries = [e for s in systems for e in found[s]]
     return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers,

@@ -473,7 +473,7 @@ def same_metrics(a: Comparison, b: Comparison) -> bool:
         va[k] == vb[k] or (math.isnan(va[k]) and math.isnan(vb[k])) for k in va)
 
 
-def power_entry(system_id: str, simulator: str, dt: float = DEFAULT_DT,
+def power_entry(system_id: str, simulator: str, dt: float | None = None,
                 kinds: Iterable[str] = tuple(ERROR_KINDS), defaults: bool = True
                 ) -> PowerEntry:
     """The power study of one system on one engine (see the module doc): the model

@@ -266,6 +266,12 @@ def _coordinate_scales(system: System, q_eq: np.ndarray) -> np.ndarray:
                      for c, q in zip(system.coordinates, q_eq)])
 
 
+def own_step(system_id: str, dt: float | None = None) -> float:
+    """`dt`, or where None the system's own comparison step (`System.step`: a stiff row's),
+    else DEFAULT_DT."""
+    return dt if dt is not None else (get_system(system_id).step or DEFAULT_DT)
+
+
 def compare(system_id: str, simulator: str, params: Mapping[str, float] | None = None,
             dt: float | None = None, t_end: float | None = None,
             settings: Mapping | None = None, scenarios: Iterable[str] | None = None,
@@ -283,7 +289,7 @@ def compare(system_id: str, simulator: str, params: Mapping[str, float] | None =
     one run at the baseline's finest step (`_judge_held`). `dt` None: the system's own
     step (`System.step`), else DEFAULT_DT."""
     system = get_system(system_id)
-    default_dt = system.step or DEFAULT_DT
+    default_dt = own_step(system_id)
     dt = default_dt if dt is None else dt
     chosen_variant = system.variant(variant) if variant else None
     base_values = system.parameter_values(params)
