@@ -1357,3 +1357,25 @@ def rolling_geometry(mech: Mechanism, c: RollingContact) -> RollingGeometry:
     return RollingGeometry(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
                            centre, tuple(num(v) for v in hub.child_anchor),
                            mech.joints.index(hub), (float(u[0]), float(u[1])))
+
+
+def rolling_contact_report(mech: Mechanism, coupling: LinearCoupling,
+                           geometry: RollingGeometry, cmap: CoordinateMap, q: np.ndarray,
+                           qd: np.ndarray, penetration: np.ndarray, force: np.ndarray,
+                           points: np.ndarray) -> dict[str, np.ndarray]:
+    """Measured errors of a RollingContact's friction stand-in, from the force of the
+    track on the disc (`force`, world x, y per sample): slip (the coupling's Phi, m), slip
+    rate (m/s), the `penetration` of the disc into the track (m), normal and friction
+    force (N), the friction ratio |f| / N and the number of contact `points`; `friction`
+    (the tangential component f, track on disc, along t = k x u with u from the track
+    centre to the disc) is what the coupling's -lambda stands for."""
+    cvec, const = coupling_row(mech, coupling)
+    u = turned(cmap.angle(mech.joints[geometry.hub].parent, q), *geometry.radial)
+    ux, uy = u[:, 0], u[:, 1]
+    normal = -(force[:, 0] * ux + force[:, 1] * uy)
+    friction = force[:, 0] * -uy + force[:, 1] * ux
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(friction) / normal
+    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec, "penetration": penetration,
+            "normal_force": normal, "friction": friction, "friction_ratio": ratio,
+            "contact_points": points}

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..analytic.linear import quadratic_eigenvalues
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
-                             Prescribed, RollingContact, inertia_matrix)
+                             Prescribed, inertia_matrix)
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
                    Linearization, Samples, Scheme, Setting, Stopwatch)
@@ -45,8 +45,8 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
                    RollingGeometry, constrained_bodies, coordinate_map, coupling_row,
                    element_kind, element_loads, elements, gravity_vector, num, point_state,
-                   principal_inertia, ring_of_boxes, rolling_geometry, spatial_tree_reason,
-                   turned)
+                   principal_inertia, ring_of_boxes, rolling_contact_report,
+                   rolling_geometry, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -278,14 +278,12 @@ class _Slider(_Slot):
 
 @dataclass
 class _Rotor(_Slot):
-    """PointOnLine (default): a rotor link (revolute, no mass, small inertia) on the pin
-    body at the pin, and a JOINT_PRISMATIC constraint (rotor = parent, axis along the slot
-    in its frame; slot body = child, pivot moved under the pin before each step): one
-    in-plane row normal to the slot plus a row locking the rotor's angle to the slot
-    body's; the rotor's inertia is the only substitute. Row 1 is the in-plane normal of
-    the slot (`_slider_row_normal`, turned with the slot body) and holds the force on the
-    PARENT (checked with either body as parent on the scotch yoke); the parent is the
-    rotor, i.e. the pin: the contract's force is + row 1 times that normal."""
+    """PointOnLine (default; built as its registered expression says): JOINT_PRISMATIC,
+    rotor = parent (axis along the slot), slot body = child, has one in-plane row normal to
+    the slot plus a row locking the rotor's angle to the slot body's. Row 1 is the
+    in-plane normal of the slot (`_slider_row_normal`, turned with the slot body) and holds
+    the force on the PARENT (checked with either body as parent on the scotch yoke); the
+    parent is the rotor, i.e. the pin: the contract's force is + row 1 times that normal."""
 
     follows_pin = True
 
@@ -310,10 +308,7 @@ class _Rotor(_Slot):
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
-        slot body's frame: L + ((P - L) . u) u. PyBullet's JOINT_PRISMATIC evaluates its
-        Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
-        (fixed) the slot body would feel the force at L instead of at the pin (measured: a
-        bar slotted along its own axis through its pivot then swings freely)."""
+        slot body's frame: L + ((P - L) . u) u (why: the setting point_on_line's note)."""
         s, _ = self._along({lk: ls[m] for lk, m in slot_of.items()})
         ux, uy = self.direction
         return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
@@ -700,26 +695,6 @@ def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, flo
         count += 1
     return fx, fy, float(count)
 
-def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray,
-                    qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
-    """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
-    (m/s), penetration of the disc into the track (radial slider value, m), normal
-    and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
-    component f, track on disc, along t = k x u with u from the track centre to the
-    disc) is what the coupling's -lambda stands for."""
-    ct = model.contact
-    cvec, const = coupling_row(model.mech, coupling)
-    u = turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
-    ux, uy = u[:, 0], u[:, 1]
-    normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
-    friction = FC[:, 0] * -uy + FC[:, 1] * ux
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.abs(friction) / normal
-    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
-            "penetration": JV[:, model.radial_link], "normal_force": normal,
-            "friction": friction, "friction_ratio": ratio,
-            "contact_points": FC[:, 2]}
-
 
 @_builds(PRESCRIBED,
          Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
@@ -790,7 +765,6 @@ class PyBulletBackend(Backend):
             "True: the description's mass and central inertia are set on every link with "
             "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
             "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
-            "No collision shapes are created, so there are no contacts between links. "
             "Engine default (False): PyBullet Quickstart Guide, loadURDF flags: without "
             "URDF_USE_INERTIA_FROM_FILE 'Bullet recomputed the inertia tensor based on "
             "mass and volume of the collision shape'; createMultiBody does the same.",
@@ -802,9 +776,9 @@ class PyBulletBackend(Backend):
             "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
         "massless_link_mass": Setting(
             0.0, float,
-            "Mass given to the description's massless link bodies; 0 (default) is exact: "
-            "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
-            "child. A positive value is a substitute whose effect shows in the error."),
+            "Mass given to the description's massless link bodies; 0 (default) is exact "
+            "(MASSLESS_BODY's expression); a positive value is a substitute whose effect "
+            "shows in the error."),
         "reaction_method": Setting(
             "inverse_dynamics", _REACTION_METHODS,
             "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
@@ -858,18 +832,18 @@ class PyBulletBackend(Backend):
             engine_default=1e-7),
         "point_on_line": Setting(
             "prismatic", _POINT_ON_LINE,
-            "'prismatic' (default): a rotor link (revolute, no mass, inertia "
-            "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
-            "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
-            "under the pin before every step (changeConstraint(jointChildPivot)): the "
-            "engine evaluates the Jacobian at a fixed body point, and with the pivot at "
-            "the slot's line point a slot turning about that point receives no torque "
-            "(measured on the slotted bar). One normal row: well conditioned. 'slider': a "
-            "slider link (prismatic along the slot, mass slider_mass_ratio x the smallest "
-            "body mass) and a POINT2POINT pin -> slider; its two world-axis rows have "
-            "effective masses 1/m_slider along the slot and O(1) across it, which "
-            "Gauss-Seidel cannot separate when the slot is oblique (the slotted bar "
-            "diverges); fine for slots along x or y."),
+            "'prismatic' (default; the build of POINT_ON_LINE's expression): the "
+            "JOINT_PRISMATIC's child pivot is moved under the pin before every step "
+            "(changeConstraint(jointChildPivot)): the engine evaluates the Jacobian at its "
+            "pivots, fixed body points, and with the pivot fixed at the slot's line point "
+            "the slot body feels the force there instead of at the pin (measured: a bar "
+            "slotted along its own axis through its pivot then swings freely, receiving no "
+            "torque). One normal row: well conditioned. 'slider': a slider link (prismatic "
+            "along the slot, mass slider_mass_ratio x the smallest body mass) and a "
+            "POINT2POINT pin -> slider; its two world-axis rows have effective masses "
+            "1/m_slider along the slot and O(1) across it, which Gauss-Seidel cannot "
+            "separate when the slot is oblique (the slotted bar diverges); fine for slots "
+            "along x or y."),
         "rotor_inertia_ratio": Setting(
             1e-6, float,
             "Inertia of the rotor links of point_on_line='prismatic', relative to the "
@@ -1124,15 +1098,13 @@ class PyBulletBackend(Backend):
     @staticmethod
     def _inputs(p, world: _World, dt: float, cfg: dict
                 ) -> tuple[Callable[[int, list, list], list | None] | None, bool]:
-        """What the engine must be given before step k: the joint forces of the
-        CoordinateForce laws (from the joint values and rates at the start of the step,
-        `jv` and `jvd` over at least the n coordinate links) and the point-to-point forces
-        (from the engine's link states), both at t = k dt; the PRISMATIC pivots moved under
-        the pins (`_Rotor.pivot`); the velocity motors of the prescribed coordinates
-        (setting prescribed_motion), each driven joint's target velocity set to
-        (v(t_k+1) - v)/h. Returns that function, which gives back the (x, y) force on point
-        b of each point-to-point element (None where there are none), and whether it reads
-        `jv` and `jvd`; (None, False) when nothing is given."""
+        """The function that gives the engine what it needs before step k (t = k dt, `jv`
+        and `jvd` the joint values and rates at the start of the step over at least the n
+        coordinate links): the force elements (their builders' expressions), the PRISMATIC
+        pivots (`_Rotor.pivot`), the prescribed motors (setting prescribed_motion); it
+        returns the (x, y) force on point b of each point-to-point element (None where
+        there are none). With it, whether it reads `jv` and `jvd`; (None, False) when
+        nothing is given."""
         model, cid, body, eidx = world.model, world.cid, world.body, world.eidx
         n = model.n
         has_cf = bool(model.coordinate_laws)
@@ -1362,7 +1334,9 @@ class PyBulletBackend(Backend):
 
         contact_report = None
         if contact is not None:
-            contact_report = _contact_report(model, model.coupling, q, qd, jv, FC[: steps + 1])
+            contact_report = rolling_contact_report(
+                mechanism, model.coupling, contact, model.map, q, qd,
+                jv[:, model.radial_link], FC[: steps + 1, :2], FC[: steps + 1, 2])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
         # the motor acts on its own joint only: Q = A^T tau is A[i, i] tau
