@@ -1003,45 +1003,13 @@ class PyBulletBackend(Backend):
                     or abs(info[2][2] - diagonal[2]) > 1e-12 * max(1.0, diagonal[2])):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
-            moving = sorted(set(range(nl)) - set(getattr(model, "fixed_links", ())
-                                                 if fixed_shapes is not None else ()))
+            moving = sorted(set(range(nl)) - {created[k] for k in fixed})
             p.setJointMotorControlArray(body, moving, p.VELOCITY_CONTROL,
                                         targetVelocities=[0.0] * len(moving),
                                         forces=[0.0] * len(moving), physicsClientId=cid)
         return body, engine_index, virtual
 
-    def _connect(self, p, settings: dict, dt: float, gravity: Sequence[float],
-                 constrained: bool = False) -> int:
-        cid = p.connect(p.DIRECT)
-        if cid < 0:
-            raise RuntimeError("pybullet connect(DIRECT) failed")
-        p.setGravity(*gravity, physicsClientId=cid)
-        p.setTimeStep(dt, physicsClientId=cid)
-        p.setPhysicsEngineParameter(
-            fixedTimeStep=dt, numSubSteps=0,
-            jointFeedbackMode=p.JOINT_FEEDBACK_IN_WORLD_SPACE, physicsClientId=cid)
-        if constrained:
-            p.setPhysicsEngineParameter(
-                erp=float(settings["constraint_erp"]),
-                numSolverIterations=int(settings["solver_iterations"]),
-                solverResidualThreshold=float(settings["solver_residual_threshold"]),
-                physicsClientId=cid)
-        return cid
-
     # --- closure constraints -------------------------------------------------------------
-    @staticmethod
-    def _add_constraints(p, cid: int, body: int, eidx: list[int], model: _Translation,
-                         cfg: dict) -> list[int]:
-        """One PyBullet constraint per closure (frames relative to the centre-of-mass
-        frames, which are the description's body frames)."""
-        out = []
-        for c in model.closures:
-            uid = c.create(p, cid, body, eidx, cfg)
-            if uid < 0:
-                raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
-            out.append(uid)
-        return out
-
     @staticmethod
     def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
                     JV: np.ndarray, q: np.ndarray) -> dict[str, np.ndarray]:
@@ -1070,9 +1038,21 @@ class PyBulletBackend(Backend):
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
         model = _Translation(mechanism, cfg)
         n = model.n
-        cid = self._connect(p, cfg, dt, model.gravity_vector,
-                            constrained=bool(model.closures) or model.contact is not None)
+        cid = p.connect(p.DIRECT)
+        if cid < 0:
+            raise RuntimeError("pybullet connect(DIRECT) failed")
         try:
+            p.setGravity(*model.gravity_vector, physicsClientId=cid)
+            p.setTimeStep(dt, physicsClientId=cid)
+            p.setPhysicsEngineParameter(
+                fixedTimeStep=dt, numSubSteps=0,
+                jointFeedbackMode=p.JOINT_FEEDBACK_IN_WORLD_SPACE, physicsClientId=cid)
+            if model.closures or model.contact is not None:
+                p.setPhysicsEngineParameter(
+                    erp=float(cfg["constraint_erp"]),
+                    numSolverIterations=int(cfg["solver_iterations"]),
+                    solverResidualThreshold=float(cfg["solver_residual_threshold"]),
+                    physicsClientId=cid)
             shapes, ring = (_contact_shapes(p, cid, model, cfg)
                             if model.contact is not None else (None, None))
             body, eidx, _ = self._build(p, cid, model, cfg, collision=shapes, fixed_shapes=ring)
@@ -1086,7 +1066,11 @@ class PyBulletBackend(Backend):
                                      computeForwardKinematics=1, physicsClientId=cid)
                 for c in model.closures:
                     c.place(p, cid, body, eidx, ls)
-            cids = self._add_constraints(p, cid, body, eidx, model, cfg)
+            cids = []  # one per closure, its frames relative to the body frames
+            for c in model.closures:
+                cids.append(c.create(p, cid, body, eidx, cfg))
+                if cids[-1] < 0:
+                    raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
             if model.contact is not None:
                 _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
@@ -1282,11 +1266,10 @@ class PyBulletBackend(Backend):
                         f_point[k] = forces
                     step(physicsClientId=cid)
                     js = get_states(body, eidx, physicsClientId=cid)
-                    # the motor's force read after a step belongs to the state before it
+                    # what is read after a step (the motors', constraints', contacts' and
+                    # sensors' forces) belongs to the state before it
                     for r, slot in enumerate(driven_slots):
                         motor[k, r] = js[slot][3]
-                    # constraint and contact forces read after a step belong to the state
-                    # before it
                     for r, uid in enumerate(cids):
                         st = get_cstate(uid, physicsClientId=cid)
                         CF[k, r, : len(st)] = st
@@ -1295,7 +1278,6 @@ class PyBulletBackend(Backend):
                             get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
                             ring_links, disc_link)
                     if use_sensor:
-                        # the feedback read after a step belongs to the state before it
                         for r, slot in enumerate(sensor_slots):
                             rf = js[slot][2]
                             sensor[k, r] = rf[0], rf[1]
