@@ -1318,7 +1318,8 @@ class PyBulletBackend(Backend):
         if contact is not None:
             contact_report = rolling_contact_report(
                 mechanism, model.coupling, contact, model.map, q, qd,
-                jv[:, model.radial_link], FC[: steps + 1, :2], FC[: steps + 1, 2])
+                jv[:, model.radial_link],  # the penetration: the radial slider's value
+                FC[: steps + 1, :2], FC[: steps + 1, 2])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
         # the motor acts on its own joint only: Q = A^T tau is A[i, i] tau
