@@ -1317,3 +1317,66 @@ def coupling_residual(mech: Mechanism, coupling: LinearCoupling
              for name, coef in coupling.coefficients for i in [mech.coordinates.index(name)]]
     return lambda frames: (sum(coef * read(frames[j.parent], frames[j.child])[0]
                                for coef, read, j in terms) - num(coupling.constant))
+
+
+def principal_inertia(tensor: np.ndarray) -> tuple[list[float], list[float]]:
+    """(principal moments, quaternion x y z w of the principal axes) of a symmetric
+    3 x 3 central tensor: the eigenvectors, made a right-handed frame."""
+    values, vectors = np.linalg.eigh(tensor)
+    if np.linalg.det(vectors) < 0:
+        vectors[:, 2] = -vectors[:, 2]
+    from scipy.spatial.transform import Rotation
+
+    return [float(v) for v in values], [float(v) for v in Rotation.from_matrix(vectors).as_quat()]
+
+
+@dataclass
+class RollingGeometry:
+    """Where a RollingContact's friction stand-in sits: a disc (inner circle of radius r)
+    on a radius arm about the centre of a circular track (outer circle, radius R)."""
+
+    coupling: str
+    outer: str
+    inner: str
+    R: float
+    r: float
+    centre: tuple[float, float]       # outer circle centre, outer body frame
+    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
+    hub: int                          # joint index of the inner body (its parent: the arm)
+    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
+
+
+def rolling_geometry(mech: Mechanism, c: RollingContact) -> RollingGeometry:
+    """The geometry of a RollingContact: the ring is centred at the arm's hinge on the
+    track, the disc's circle at its hub, and the radial direction runs along the arm from
+    that hinge to the hub."""
+    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
+    centre = tuple(num(v) for v in hinge.parent_anchor)
+    arm = (np.array([num(v) for v in hub.parent_anchor])
+           - np.array([num(v) for v in hinge.child_anchor]))
+    u = arm / np.linalg.norm(arm)
+    return RollingGeometry(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
+                           centre, tuple(num(v) for v in hub.child_anchor),
+                           mech.joints.index(hub), (float(u[0]), float(u[1])))
+
+
+def rolling_contact_report(mech: Mechanism, coupling: LinearCoupling,
+                           geometry: RollingGeometry, cmap: CoordinateMap, q: np.ndarray,
+                           qd: np.ndarray, penetration: np.ndarray, force: np.ndarray,
+                           points: np.ndarray) -> dict[str, np.ndarray]:
+    """Measured errors of a RollingContact's friction stand-in, from the force of the
+    track on the disc (`force`, world x, y per sample): slip (the coupling's Phi, m), slip
+    rate (m/s), the `penetration` of the disc into the track (m), normal and friction
+    force (N), the friction ratio |f| / N and the number of contact `points`; `friction`
+    (the tangential component f, track on disc, along t = k x u with u from the track
+    centre to the disc) is what the coupling's -lambda stands for."""
+    cvec, const = coupling_row(mech, coupling)
+    u = turned(cmap.angle(mech.joints[geometry.hub].parent, q), *geometry.radial)
+    ux, uy = u[:, 0], u[:, 1]
+    normal = -(force[:, 0] * ux + force[:, 1] * uy)
+    friction = force[:, 0] * -uy + force[:, 1] * ux
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(friction) / normal
+    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec, "penetration": penetration,
+            "normal_force": normal, "friction": friction, "friction_ratio": ratio,
+            "contact_points": points}

@@ -1,94 +1,28 @@
 """PyBullet backend: a reduced-coordinate Featherstone multibody (``createMultiBody``) with
-a fixed base at the world origin, one link per joint, no collision shapes and explicit
-inertias.
+a fixed base at the world origin, one link per joint (its engine joint value ``v = A q +
+b``, `plan.CoordinateMap`), no collision shapes and explicit inertias.
 
 Translation (generic over the description, conventions 1-8 of `systems.model`): each
 element kind of the description (`plan.ELEMENT_KINDS`) has one builder, registered together
 with the expressions it builds (`_builds`; `EXPRESSIONS` is that registry's declarations),
-which puts the element into `_Translation`, the mechanism in PyBullet's terms (links,
-closures, point forces, coordinate laws, drives) from the shared plan's numbers and
-coordinate map; each closure is one class per PyBullet construct (`_Pin`, `_Slider`,
-`_Rotor`, `_Gear`) that creates its constraint, places its extra link, and turns the
-engine's constraint rows into the contract's force and violation.
+which puts the element into `_Translation`, the mechanism in PyBullet's terms; each closure
+is one class per PyBullet construct (`_Pin`, `_Slider`, `_Rotor`, `_Gear`) that creates its
+constraint, places its extra link, and turns the engine's constraint rows into the
+contract's force (signs measured, in each class) and violation.
 
-- Each body becomes one link whose URDF link frame sits at the anchor of the joint that
-  places it (the body's ``child_anchor``) with the body's orientation; the inertial frame
-  is offset by ``-child_anchor`` so that it is the body frame (origin at the centre of
-  mass). PyBullet's ``linkPositions`` are relative to the parent's link frame.
-- ``Revolute``: axis z; ``angle_offset`` is the joint frame's orientation. Absolute
-  angles (``absolute=True``), clockwise coordinates and non-unit prismatic axes make the
-  engine's joint values an affine map of the description coordinates, ``jv = A q + b``;
-  states map back with ``A^-1`` and generalized forces map as ``tau = A^-T Q``.
-- A spatial mechanism (model convention 10; open trees of massive bodies on relative
-  counter-clockwise hinges without offset): link frames at the 3-D anchors aligned with
-  the parent, hinge axes from the description, the full central tensor as its principal
-  moments (``localInertiaDiagonal``) and principal axes (the inertial frame's
-  orientation), read back by `stored_inertia`; gravity along -up.
-- ``Prismatic``: axis in the x-y plane of the joint frame (the parent axis rotated by
-  ``-angle_offset``), normalised (its length goes into ``A``).
-- Massless bodies are links of mass 0 and inertia 0: Featherstone's articulated-body
-  algorithm only inverts the articulated inertia of each joint, which the child carries.
-- Closure constraints (``createConstraint``, solved with the velocity-level projected
-  Gauss-Seidel of the multibody solver: J(q_k) v_{k+1} = -erp Phi(q_k)/dt, then
-  q_{k+1} = q_k + dt v_{k+1}; exact for linear constraints, first order otherwise):
-  ``PointOnPoint`` -> ``JOINT_POINT2POINT``; ``PointOnLine`` -> a rotor link on the pin
-  (revolute, no mass, tiny inertia) and ``JOINT_PRISMATIC`` rotor -> slot body, whose
-  child pivot is moved under the pin before each step (the engine evaluates the
-  constraint Jacobian at its pivot, a fixed body point); ``LinearCoupling`` -> written on
-  the engine joint values (``w = A^-T c``) and, when it involves exactly two of them,
-  ``JOINT_GEAR`` (jv_a + ratio jv_b = target). Couplings of one or of three or more joint
-  values are refused by `support`. Massless bodies that carry nothing but are held by a
-  constraint get a small substitute mass. Constraint frames are centre-of-mass frames
-  (= body frames). The violation of each closure is measured at every sample
-  (``RunResult.constraint_violation``). The setting "point_on_line" = "slider" selects
-  the alternative substitute (see `setting_notes`). ``RollingContact`` (a variant's
-  stand-in for a rolling coupling): the hub rides on a massless radial slider, a sphere
-  of the disc's radius touches a ring of boxes on massless fixed links of the track
-  (`_contact_shapes`); the coupling's Phi is then the measured slip.
-- createMultiBody stores links in depth-first order of the tree; the backend maps its
-  creation order to the engine's indices through the joint names ("joint<k+1>").
-- ``CoordinateForce``: joint forces through ``setJointMotorControlArray(TORQUE_CONTROL)``
-  every step. ``PointToPoint``: ``applyExternalForce`` (world frame) at both points every
-  step, from the engine's own link states. Both are evaluated at the state and time at
-  the start of the step, which is the single stage of PyBullet's semi-implicit Euler.
+Closure constraints (``createConstraint``) are solved with the velocity-level projected
+Gauss-Seidel of the multibody solver (setting constraint_erp), then q_{k+1} = q_k + dt
+v_{k+1}: exact for linear constraints, first order otherwise. Their forces are read with
+``getConstraintState`` after a step (impulse / dt of that step, so they belong to the
+state before it). Because the projection is velocity level, a constraint's curvature term
+(centripetal J'v) enters the force one step late, through the position error: a run that
+starts fast on a curved constraint reports at the first sample a force lacking J'v (and
+half of it too much at the second); afterwards the forces are first-order accurate.
 
-Reactions: PyBullet's joint force/torque sensor (``enableJointForceTorqueSensor``) adds a
-second "constraint pass" of the articulated-body algorithm, run with the already updated
-velocities and with the Coriolis accelerations of the links but without the matching
-``m w x v`` terms; on a chain it is wrong as soon as the joints move (1.7 N on the double
-pendulum after 0.15 s), while on a single link the spurious part vanishes. The default
-route therefore reads the reaction from the engine's own inverse dynamics
-(``calculateInverseDynamics``) on a copy of the model in which two massless prismatic
-joints (parent-frame x and y) are inserted in front of each requested joint, at the
-engine's state and its acceleration of the same step (``(v_{k+1} - v_k)/dt``, exact for
-semi-implicit Euler). The sensor stays available (setting ``reaction_method``).
-Closure-constraint forces that reach the child's subtree from outside are taken out
-like the point-to-point forces (checked by Newton's law on the scotch yoke's disc and
-the slotted bar: 3e-14 N).
-
-Constraint forces: ``getConstraintState`` after a step (impulse / dt of that step, so it
-belongs to the state before it, like the reactions). Measured sign conventions:
-POINT2POINT rows hold the force on the CHILD (world x, y, z); PRISMATIC rows (row 1 = the
-in-plane normal of the slot) hold the force on the PARENT; GEAR's one row f gives joint
-forces f (1, ratio). Because the projection is velocity level, a constraint's curvature
-term (centripetal J'v) enters the force one step late, through the position error: a run
-that starts fast on a curved constraint reports at the first sample a force lacking J'v
-(and half of it too much at the second); afterwards the forces are first-order accurate.
-
-Prescribed motion (convention 9; setting ``prescribed_motion``): before every step the
-driven joint's VELOCITY_CONTROL motor gets targetVelocity = (v(t+h) - v)/h, v = A q + b
-its engine joint value, with a force that never saturates; the free joints keep their
-velocity motors disabled. The motor is a velocity constraint of the same solve as the
-joints, so the free bodies feel the imposed acceleration within the step, and semi-implicit
-Euler then moves the coordinate onto v(t+h) (its error is the solver's residual). The
-free coordinates keep the scheme's first order. Overwriting the joint state each step
-(resetJointState) would move the driven body without accelerating the others; the
-default motor gains only follow the target loosely. The actuator force is the motor's
-applied force ``getJointState()[3]`` (impulse / dt of the step, so it belongs to the
-state before it) times A[i, i]: the motor acts on its own joint only, and generalized
-forces map as Q = A^T tau. A coordinate that is a sum of engine joint values (an
-absolute angle on a turning parent) would need the parent's angle at t+h before the
-step: refused.
+Reactions (setting reaction_method): by default the engine's own inverse dynamics on a
+copy of the model (`_inverse_dynamics_forces`), which applies no element and no closure,
+so that `reactions.joint_reaction` takes out the forces that reach the child's subtree
+from outside.
 """
 from __future__ import annotations
 
@@ -101,7 +35,7 @@ import numpy as np
 
 from ..analytic.linear import quadratic_eigenvalues
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
-                             Prescribed, RollingContact, inertia_matrix)
+                             Prescribed, inertia_matrix)
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
                    Linearization, Samples, Scheme, Setting, Stopwatch)
@@ -109,9 +43,10 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
-                   constrained_bodies, coordinate_map, coupling_row, element_kind,
-                   element_loads, elements, gravity_vector, num, point_state,
-                   ring_of_boxes, spatial_tree_reason, turned)
+                   RollingGeometry, constrained_bodies, coordinate_map, coupling_row,
+                   element_kind, element_loads, elements, gravity_vector, num, point_state,
+                   principal_inertia, ring_of_boxes, rolling_contact_report,
+                   rolling_geometry, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -343,14 +278,12 @@ class _Slider(_Slot):
 
 @dataclass
 class _Rotor(_Slot):
-    """PointOnLine (default): a rotor link (revolute, no mass, small inertia) on the pin
-    body at the pin, and a JOINT_PRISMATIC constraint (rotor = parent, axis along the slot
-    in its frame; slot body = child, pivot moved under the pin before each step): one
-    in-plane row normal to the slot plus a row locking the rotor's angle to the slot
-    body's; the rotor's inertia is the only substitute. Row 1 is the in-plane normal of
-    the slot (`_slider_row_normal`, turned with the slot body) and holds the force on the
-    PARENT (checked with either body as parent on the scotch yoke); the parent is the
-    rotor, i.e. the pin: the contract's force is + row 1 times that normal."""
+    """PointOnLine (default; built as its registered expression says): JOINT_PRISMATIC,
+    rotor = parent (axis along the slot), slot body = child, has one in-plane row normal to
+    the slot plus a row locking the rotor's angle to the slot body's. Row 1 is the
+    in-plane normal of the slot (`_slider_row_normal`, turned with the slot body) and holds
+    the force on the PARENT (checked with either body as parent on the scotch yoke); the
+    parent is the rotor, i.e. the pin: the contract's force is + row 1 times that normal."""
 
     follows_pin = True
 
@@ -375,10 +308,7 @@ class _Rotor(_Slot):
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
-        slot body's frame: L + ((P - L) . u) u. PyBullet's JOINT_PRISMATIC evaluates its
-        Jacobian at its pivots, fixed points of the bodies; with the child pivot at L
-        (fixed) the slot body would feel the force at L instead of at the pin (measured: a
-        bar slotted along its own axis through its pivot then swings freely)."""
+        slot body's frame: L + ((P - L) . u) u (why: the setting point_on_line's note)."""
         s, _ = self._along({lk: ls[m] for lk, m in slot_of.items()})
         ux, uy = self.direction
         return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
@@ -421,22 +351,6 @@ class _Gear:
     def violations(self, q: np.ndarray) -> np.ndarray:
         """Phi = c . q - constant."""
         return q @ self.weights - self.constant
-
-
-def _spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial build cannot hold a spatial mechanism (empty: it can)."""
-    return spatial_tree_reason(mech, closures=False, slides=False)
-
-
-def principal_inertia(tensor: np.ndarray) -> tuple[list[float], list[float]]:
-    """(principal moments, quaternion x y z w of the principal axes) of a symmetric
-    3 x 3 central tensor: the eigenvectors, made a right-handed frame."""
-    values, vectors = np.linalg.eigh(tensor)
-    if np.linalg.det(vectors) < 0:
-        vectors[:, 2] = -vectors[:, 2]
-    from scipy.spatial.transform import Rotation
-
-    return [float(v) for v in values], [float(v) for v in Rotation.from_matrix(vectors).as_quat()]
 
 
 def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
@@ -483,7 +397,7 @@ class _Translation:
         self.closures: list[_Pin | _Gear] = []
         self.point_forces: list[_PointForce] = []
         self.coordinate_forces: list[CoordinateForce] = []
-        self.contact: _Contact | None = None
+        self.contact: RollingGeometry | None = None
         self.coupling: LinearCoupling | None = None  # the rolling coupling a contact stands for
         self.radial_link = -1
         self.fixed_links: list[int] = []  # engine links of the contact ring (`_build`)
@@ -560,9 +474,10 @@ def _massless_body(model: _Translation, body) -> None:
 
 def _joint_link(model: _Translation, j, revolute: bool, axis: list[float]) -> None:
     """The link of description joint j: its URDF frame at the joint's anchor on the
-    parent, turned by the angle offset; its inertial frame at -child_anchor."""
+    parent, turned by the angle offset; its inertial frame at -child_anchor, so that it is
+    the body frame (origin at the centre of mass)."""
     i = model.mech.joints.index(j)
-    if model.mech.spatial:  # model convention 10; `_spatial_reason` bounds the cases
+    if model.mech.spatial:  # model convention 10; `translation_reason` bounds the cases
         model.links.append(_spatial_link(model.mech, i, model.link_of[j.parent],
                                          model.anchor_of[j.parent]))
         model.anchor_of[j.child] = tuple(-v for v in model.links[-1].inertial_position)
@@ -588,6 +503,8 @@ def _hinge(model: _Translation, j) -> None:
 @_builds(PRISMATIC, Expression(EXACT, "prismatic link along the unit axis (its length in "
                                       "v = A q + b)"))
 def _slide(model: _Translation, j) -> None:
+    """The axis in the x-y plane of the joint frame: the parent-frame axis turned by
+    -angle_offset, normalised (its length goes into A)."""
     i = model.mech.joints.index(j)
     axis = np.array([num(j.axis[0]), num(j.axis[1])]) / model.map.A[i, i]
     c, s = math.cos(-num(j.angle_offset)), math.sin(-num(j.angle_offset))
@@ -681,36 +598,6 @@ def _linear_coupling(model: _Translation, c) -> None:
 # --- rolling by friction contact (a variant's stand-in for a rolling coupling) ---------
 
 
-@dataclass
-class _Contact:
-    """Friction-contact variant of a rolling coupling: a disc (inner Circle of radius r)
-    on a radius arm about the centre of a circular track (outer Circle, radius R)."""
-
-    coupling: str
-    outer: str
-    inner: str
-    R: float
-    r: float
-    centre: tuple[float, float]       # outer circle centre, outer body frame
-    inner_centre: tuple[float, float]  # inner circle centre, inner body frame
-    hub: int                          # joint index of the inner body (its parent: the arm)
-    radial: tuple[float, float]        # unit direction track centre -> hub, arm frame
-
-
-def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
-    """The engine geometry of a RollingContact: the ring is centred at the arm's hinge on
-    the track, the disc's circle at its hub, and the radial slider runs along the arm
-    from that hinge to the hub."""
-    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
-    centre = tuple(num(v) for v in hinge.parent_anchor)
-    arm = (np.array([num(v) for v in hub.parent_anchor])
-           - np.array([num(v) for v in hinge.child_anchor]))
-    u = arm / np.linalg.norm(arm)
-    return _Contact(c.name, c.track, c.disc, num(c.track_radius), num(c.disc_radius),
-                    centre, tuple(num(v) for v in hub.child_anchor), mech.joints.index(hub),
-                    (float(u[0]), float(u[1])))
-
-
 @_builds(ROLLING_CONTACT, Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
                                                  "of contact_ring_boxes boxes (velocity-level "
                                                  "contact with erp; the hub on a massless "
@@ -719,7 +606,7 @@ def _contact_of(mech: Mechanism, c: RollingContact) -> _Contact:
 def _rolling_contact(model: _Translation, c) -> None:
     """The disc's hub rides on a massless radial slider on the arm, so that the contact,
     not the arm, carries the normal force (shapes and friction: `_contact_shapes`)."""
-    model.contact, model.coupling = _contact_of(model.mech, c), c.coupling
+    model.contact, model.coupling = rolling_geometry(model.mech, c), c.coupling
     hub = model.links[model.contact.hub]
     k = len(model.links)
     u = model.contact.radial
@@ -808,26 +695,6 @@ def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, flo
         count += 1
     return fx, fy, float(count)
 
-def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray,
-                    qd: np.ndarray, JV: np.ndarray, FC: np.ndarray) -> dict:
-    """Measured errors of the contact variant: slip (the coupling's Phi, m), slip rate
-    (m/s), penetration of the disc into the track (radial slider value, m), normal
-    and friction force (N) and the friction ratio |f| / N; `friction` (the tangential
-    component f, track on disc, along t = k x u with u from the track centre to the
-    disc) is what the coupling's -lambda stands for."""
-    ct = model.contact
-    cvec, const = coupling_row(model.mech, coupling)
-    u = turned(model.map.angle(model.mech.joints[ct.hub].parent, q), *ct.radial)
-    ux, uy = u[:, 0], u[:, 1]
-    normal = -(FC[:, 0] * ux + FC[:, 1] * uy)
-    friction = FC[:, 0] * -uy + FC[:, 1] * ux
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.abs(friction) / normal
-    return {"slip": q @ cvec - const, "slip_rate": qd @ cvec,
-            "penetration": JV[:, model.radial_link], "normal_force": normal,
-            "friction": friction, "friction_ratio": ratio,
-            "contact_points": FC[:, 2]}
-
 
 @_builds(PRESCRIBED,
          Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
@@ -836,7 +703,8 @@ def _contact_report(model: _Translation, coupling: LinearCoupling, q: np.ndarray
                     when="the coordinate is one engine joint value", applies=_one_joint_value),
          Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an absolute "
                                  "angle on a turning parent): one joint motor cannot impose "
-                                 "it", when="otherwise"))
+                                 "it without the parent's angle at t+h before the step",
+                    when="otherwise"))
 def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
     model.driven.append(Motion(prescribed, model.mech.coordinates.index(prescribed.coordinate)))
 
@@ -897,7 +765,6 @@ class PyBulletBackend(Backend):
             "True: the description's mass and central inertia are set on every link with "
             "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
             "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
-            "No collision shapes are created, so there are no contacts between links. "
             "Engine default (False): PyBullet Quickstart Guide, loadURDF flags: without "
             "URDF_USE_INERTIA_FROM_FILE 'Bullet recomputed the inertia tensor based on "
             "mass and volume of the collision shape'; createMultiBody does the same.",
@@ -909,16 +776,20 @@ class PyBulletBackend(Backend):
             "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
         "massless_link_mass": Setting(
             0.0, float,
-            "Mass given to the description's massless link bodies; 0 (default) is exact: "
-            "PyBullet accepts a zero-mass, zero-inertia link that carries a massive "
-            "child. A positive value is a substitute whose effect shows in the error."),
+            "Mass given to the description's massless link bodies; 0 (default) is exact "
+            "(MASSLESS_BODY's expression); a positive value is a substitute whose effect "
+            "shows in the error."),
         "reaction_method": Setting(
             "inverse_dynamics", _REACTION_METHODS,
             "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
             "massless prismatic joints in front of each reaction joint, at the engine's "
-            "state and acceleration of the same step. 'joint_sensor': "
-            "enableJointForceTorqueSensor (world-space feedback); exact on a single link, "
-            "wrong on chains in motion (its constraint pass re-adds Coriolis terms)."),
+            "state and acceleration of the same step ((v_k+1 - v_k)/dt, exact for "
+            "semi-implicit Euler). 'joint_sensor': enableJointForceTorqueSensor "
+            "(world-space feedback); its second constraint pass of the articulated-body "
+            "algorithm runs with the already updated velocities and the links' Coriolis "
+            "accelerations but without the matching m w x v terms: exact on a single link "
+            "(the spurious part vanishes), wrong on chains in motion (1.7 N on the double "
+            "pendulum after 0.15 s)."),
         "linearize_step": Setting(
             1e-6, float,
             "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
@@ -961,18 +832,18 @@ class PyBulletBackend(Backend):
             engine_default=1e-7),
         "point_on_line": Setting(
             "prismatic", _POINT_ON_LINE,
-            "'prismatic' (default): a rotor link (revolute, no mass, inertia "
-            "rotor_inertia_ratio x the smallest body inertia) at the pin and a "
-            "JOINT_PRISMATIC constraint rotor -> slot body, whose child pivot is moved "
-            "under the pin before every step (changeConstraint(jointChildPivot)): the "
-            "engine evaluates the Jacobian at a fixed body point, and with the pivot at "
-            "the slot's line point a slot turning about that point receives no torque "
-            "(measured on the slotted bar). One normal row: well conditioned. 'slider': a "
-            "slider link (prismatic along the slot, mass slider_mass_ratio x the smallest "
-            "body mass) and a POINT2POINT pin -> slider; its two world-axis rows have "
-            "effective masses 1/m_slider along the slot and O(1) across it, which "
-            "Gauss-Seidel cannot separate when the slot is oblique (the slotted bar "
-            "diverges); fine for slots along x or y."),
+            "'prismatic' (default; the build of POINT_ON_LINE's expression): the "
+            "JOINT_PRISMATIC's child pivot is moved under the pin before every step "
+            "(changeConstraint(jointChildPivot)): the engine evaluates the Jacobian at its "
+            "pivots, fixed body points, and with the pivot fixed at the slot's line point "
+            "the slot body feels the force there instead of at the pin (measured: a bar "
+            "slotted along its own axis through its pivot then swings freely, receiving no "
+            "torque). One normal row: well conditioned. 'slider': a slider link (prismatic "
+            "along the slot, mass slider_mass_ratio x the smallest body mass) and a "
+            "POINT2POINT pin -> slider; its two world-axis rows have effective masses "
+            "1/m_slider along the slot and O(1) across it, which Gauss-Seidel cannot "
+            "separate when the slot is oblique (the slotted bar diverges); fine for slots "
+            "along x or y."),
         "rotor_inertia_ratio": Setting(
             1e-6, float,
             "Inertia of the rotor links of point_on_line='prismatic', relative to the "
@@ -1004,14 +875,17 @@ class PyBulletBackend(Backend):
         "prescribed_motion": Setting(
             "velocity_motor", ("velocity_motor",),
             "A prescribed coordinate (convention 9) is driven by the joint's VELOCITY_CONTROL "
-            "motor with targetVelocity = (q(t+h) - q)/h and force prescribed_motor_force, set "
-            "before every step: the velocity-level solve then lands the coordinate on q(t+h) "
-            "(semi-implicit Euler moves positions with the new velocities), so the imposed "
-            "motion is exact to the solver's tolerance and the free coordinates keep the "
-            "scheme's first order; the actuator force is the motor's applied force "
-            "(getJointState()[3]) of the step that starts at the sample. Replaces "
-            "resetJointState each step (the free bodies would never feel the acceleration: "
-            "0.40 rad on a driven pendulum) and the default motor gains (1.2e-2)."),
+            "motor with targetVelocity = (v(t+h) - v)/h on its engine joint value v = A q + b "
+            "and force prescribed_motor_force, set before every step (the free joints' "
+            "motors stay off): the motor is a velocity constraint of the same solve as the "
+            "joints, so the free bodies feel the imposed acceleration within the step, and "
+            "semi-implicit Euler (positions move with the new velocities) lands the "
+            "coordinate on q(t+h): the imposed motion is exact to the solver's tolerance and "
+            "the free coordinates keep the scheme's first order; the actuator force is the "
+            "motor's applied force (getJointState()[3]) of the step that starts at the "
+            "sample. Replaces resetJointState each step (the free bodies would never feel "
+            "the acceleration: 0.40 rad on a driven pendulum) and the default motor gains "
+            "(1.2e-2)."),
         "prescribed_motor_force": Setting(
             1.0e9, float,
             "Maximum force/torque of a prescribed coordinate's velocity motor: large enough "
@@ -1039,7 +913,8 @@ class PyBulletBackend(Backend):
     SPATIAL_REASON = ""
 
     def translation_reason(self, mechanism: Mechanism) -> str:
-        return _spatial_reason(mechanism) if mechanism.spatial else ""
+        return (spatial_tree_reason(mechanism, closures=False, slides=False)
+                if mechanism.spatial else "")
 
     # --- model building ----------------------------------------------------------------
     def _build(self, p, cid: int, model: _Translation, settings: dict,
@@ -1128,45 +1003,13 @@ class PyBulletBackend(Backend):
                     or abs(info[2][2] - diagonal[2]) > 1e-12 * max(1.0, diagonal[2])):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
-            moving = sorted(set(range(nl)) - set(getattr(model, "fixed_links", ())
-                                                 if fixed_shapes is not None else ()))
+            moving = sorted(set(range(nl)) - {created[k] for k in fixed})
             p.setJointMotorControlArray(body, moving, p.VELOCITY_CONTROL,
                                         targetVelocities=[0.0] * len(moving),
                                         forces=[0.0] * len(moving), physicsClientId=cid)
         return body, engine_index, virtual
 
-    def _connect(self, p, settings: dict, dt: float, gravity: Sequence[float],
-                 constrained: bool = False) -> int:
-        cid = p.connect(p.DIRECT)
-        if cid < 0:
-            raise RuntimeError("pybullet connect(DIRECT) failed")
-        p.setGravity(*gravity, physicsClientId=cid)
-        p.setTimeStep(dt, physicsClientId=cid)
-        p.setPhysicsEngineParameter(
-            fixedTimeStep=dt, numSubSteps=0,
-            jointFeedbackMode=p.JOINT_FEEDBACK_IN_WORLD_SPACE, physicsClientId=cid)
-        if constrained:
-            p.setPhysicsEngineParameter(
-                erp=float(settings["constraint_erp"]),
-                numSolverIterations=int(settings["solver_iterations"]),
-                solverResidualThreshold=float(settings["solver_residual_threshold"]),
-                physicsClientId=cid)
-        return cid
-
     # --- closure constraints -------------------------------------------------------------
-    @staticmethod
-    def _add_constraints(p, cid: int, body: int, eidx: list[int], model: _Translation,
-                         cfg: dict) -> list[int]:
-        """One PyBullet constraint per closure (frames relative to the centre-of-mass
-        frames, which are the description's body frames)."""
-        out = []
-        for c in model.closures:
-            uid = c.create(p, cid, body, eidx, cfg)
-            if uid < 0:
-                raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
-            out.append(uid)
-        return out
-
     @staticmethod
     def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
                     JV: np.ndarray, q: np.ndarray) -> dict[str, np.ndarray]:
@@ -1195,9 +1038,21 @@ class PyBulletBackend(Backend):
             raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
         model = _Translation(mechanism, cfg)
         n = model.n
-        cid = self._connect(p, cfg, dt, model.gravity_vector,
-                            constrained=bool(model.closures) or model.contact is not None)
+        cid = p.connect(p.DIRECT)
+        if cid < 0:
+            raise RuntimeError("pybullet connect(DIRECT) failed")
         try:
+            p.setGravity(*model.gravity_vector, physicsClientId=cid)
+            p.setTimeStep(dt, physicsClientId=cid)
+            p.setPhysicsEngineParameter(
+                fixedTimeStep=dt, numSubSteps=0,
+                jointFeedbackMode=p.JOINT_FEEDBACK_IN_WORLD_SPACE, physicsClientId=cid)
+            if model.closures or model.contact is not None:
+                p.setPhysicsEngineParameter(
+                    erp=float(cfg["constraint_erp"]),
+                    numSolverIterations=int(cfg["solver_iterations"]),
+                    solverResidualThreshold=float(cfg["solver_residual_threshold"]),
+                    physicsClientId=cid)
             shapes, ring = (_contact_shapes(p, cid, model, cfg)
                             if model.contact is not None else (None, None))
             body, eidx, _ = self._build(p, cid, model, cfg, collision=shapes, fixed_shapes=ring)
@@ -1211,7 +1066,11 @@ class PyBulletBackend(Backend):
                                      computeForwardKinematics=1, physicsClientId=cid)
                 for c in model.closures:
                     c.place(p, cid, body, eidx, ls)
-            cids = self._add_constraints(p, cid, body, eidx, model, cfg)
+            cids = []  # one per closure, its frames relative to the body frames
+            for c in model.closures:
+                cids.append(c.create(p, cid, body, eidx, cfg))
+                if cids[-1] < 0:
+                    raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
             if model.contact is not None:
                 _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
@@ -1223,15 +1082,13 @@ class PyBulletBackend(Backend):
     @staticmethod
     def _inputs(p, world: _World, dt: float, cfg: dict
                 ) -> tuple[Callable[[int, list, list], list | None] | None, bool]:
-        """What the engine must be given before step k: the joint forces of the
-        CoordinateForce laws (from the joint values and rates at the start of the step,
-        `jv` and `jvd` over at least the n coordinate links) and the point-to-point forces
-        (from the engine's link states), both at t = k dt; the PRISMATIC pivots moved under
-        the pins (`_Rotor.pivot`); the velocity motors of the prescribed coordinates
-        (setting prescribed_motion), each driven joint's target velocity set to
-        (v(t_k+1) - v)/h. Returns that function, which gives back the (x, y) force on point
-        b of each point-to-point element (None where there are none), and whether it reads
-        `jv` and `jvd`; (None, False) when nothing is given."""
+        """The function that gives the engine what it needs before step k (t = k dt, `jv`
+        and `jvd` the joint values and rates at the start of the step over at least the n
+        coordinate links): the force elements (their builders' expressions), the PRISMATIC
+        pivots (`_Rotor.pivot`), the prescribed motors (setting prescribed_motion); it
+        returns the (x, y) force on point b of each point-to-point element (None where
+        there are none). With it, whether it reads `jv` and `jvd`; (None, False) when
+        nothing is given."""
         model, cid, body, eidx = world.model, world.cid, world.body, world.eidx
         n = model.n
         has_cf = bool(model.coordinate_laws)
@@ -1409,11 +1266,10 @@ class PyBulletBackend(Backend):
                         f_point[k] = forces
                     step(physicsClientId=cid)
                     js = get_states(body, eidx, physicsClientId=cid)
-                    # the motor's force read after a step belongs to the state before it
+                    # what is read after a step (the motors', constraints', contacts' and
+                    # sensors' forces) belongs to the state before it
                     for r, slot in enumerate(driven_slots):
                         motor[k, r] = js[slot][3]
-                    # constraint and contact forces read after a step belong to the state
-                    # before it
                     for r, uid in enumerate(cids):
                         st = get_cstate(uid, physicsClientId=cid)
                         CF[k, r, : len(st)] = st
@@ -1422,7 +1278,6 @@ class PyBulletBackend(Backend):
                             get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
                             ring_links, disc_link)
                     if use_sensor:
-                        # the feedback read after a step belongs to the state before it
                         for r, slot in enumerate(sensor_slots):
                             rf = js[slot][2]
                             sensor[k, r] = rf[0], rf[1]
@@ -1449,7 +1304,8 @@ class PyBulletBackend(Backend):
                 # forces across the cut are in its force (on body_a: minus the force
                 # recorded on point b). Rolling by contact: the contact carries what the
                 # description's arm and coupling carried, so it counts as transmitted
-                # through the joints (contract point 6)
+                # through the joints (contract point 6). Checked by Newton's law on the
+                # scotch yoke's disc and the slotted bar (3e-14 N)
                 pairs = {pf.name: -f_point[: steps + 1, e]
                          for e, pf in enumerate(model.point_forces)}
                 pairs.update({c.element.name: forces[c.element.name] for c in closures
@@ -1460,9 +1316,13 @@ class PyBulletBackend(Backend):
 
         contact_report = None
         if contact is not None:
-            contact_report = _contact_report(model, model.coupling, q, qd, jv, FC[: steps + 1])
+            contact_report = rolling_contact_report(
+                mechanism, model.coupling, contact, model.map, q, qd,
+                jv[:, model.radial_link],  # the penetration: the radial slider's value
+                FC[: steps + 1, :2], FC[: steps + 1, 2])
             forces[contact.coupling] = contact_report.pop("friction")[:, None]
             violation[contact.coupling] = contact_report.pop("slip")
+        # the motor acts on its own joint only: Q = A^T tau is A[i, i] tau
         actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
         # the substitutes' own error: each closure's violation at every sample
         extras = {"constraint_violation": violation}
