@@ -1,48 +1,10 @@
-"""MuJoCo backend: the description is translated to MJCF text and integrated with RK4.
+"""MuJoCo backend: the description is translated to MJCF text (`mujoco_mjcf`, one builder
+per element kind with its declared expression) and integrated with RK4.
 
-Translation (`to_mjcf`, module `mujoco_mjcf`): each element kind of the description has
-one builder, registered together with the `Expression` it declares (contract point 5);
-the builders add MJCF fragments to a `Build`, which is assembled into the MJCF text.
-
-- Every body with mass becomes an MJCF body whose frame is the description's
-  centre-of-mass frame, with an explicit ``<inertial>`` (without one MuJoCo derives mass
-  from geom density); the planar inertia goes on z, and on x and y so that it is valid.
-  A massless body with a single child joint is folded into that child: its MJCF body
-  carries the chain of joints, which MuJoCo applies in order, each with its anchor and axis
-  in the body frame at the reference configuration (v = 0, body frames from
-  `plan.body_states`). A spatial mechanism (model convention 10) is written body by body:
-  frames at parent_anchor - child_anchor, joints about the description's axes at
-  child_anchor, the full central tensor as ``fullinertia`` (read back by
-  `stored_inertia`) and gravity along -up.
-- Engine joint values v relate to the description coordinates q by the affine map of
-  `plan.CoordinateMap`: absolute angles become ``q - theta_parent``, clockwise coordinates
-  change sign.
-- Laws that MuJoCo cannot hold natively, time loads among them, are applied by the passive
-  callback (``mujoco.set_mjcb_passive``), which MuJoCo calls at every RK4 stage with
-  ``d.time`` set to the stage time.
-- Closure constraints become MuJoCo equalities, which are SOFT (solref/solimp; MuJoCo
-  clamps the impedance at 0.9999, so each row transmits at most 99.99 % of the needed
-  force at once and a small violation makes up the rest). Each closure's force (contract
-  point 6) and violation are read after ``mj_forward`` at every sample; the violation is
-  returned as ``RunResult.constraint_violation``. A spatial loop's hinge closure is two
-  ``connect`` equalities on the hinge axis (the point and the axis's direction); its
-  force is reported as NaN (a loop with redundant closure equations is statically
-  indeterminate: the force is not determined by the motion).
-- ``Prescribed`` coordinates (setting ``prescribed_motion``): a control callback
-  (``mujoco.set_mjcb_control``, installed with the passive callback and restored after,
-  both being process-global) imposes the acceleration (`_Compiled._make_control`). Joint
-  equalities with a moving reference and mocap welds are soft, so they are not used.
-- Prismatic ``limits`` are admissible intervals of the description, not stops; they are
-  not turned into MuJoCo joint limits (a limit is a soft constraint that would only act
-  outside the interval).
-
-Reactions: ``mj_forward`` + ``mj_rnePostConstraint`` at each sampled state (after the
-stepping, outside the timed loop); ``cfrc_int[body, 3:6]`` is the force the parent exerts
-on the body (world axes). Forces MuJoCo books as joint-space passive forces (joint
-springs/dampers, the callback, tendon equalities) are inside that number, so those acting
-on the child's subtree from outside are taken out (`reactions.joint_reaction`) to give the
-description's joint reaction; native tendon forces are already outside it (MuJoCo puts
-them in ``cfrc_ext``).
+Laws MuJoCo cannot hold natively run in the passive callback (`_Compiled._make_callback`),
+prescribed motions in the control callback (`_Compiled._make_control`); closures are soft
+equalities whose force and violation are read at every sample (`_ClosureSamples`), and
+joint reactions start from the force MuJoCo books as transmitted (`_Transmitted`).
 """
 from __future__ import annotations
 
@@ -187,6 +149,9 @@ class _Compiled:
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
+        """The passive callback (``mujoco.set_mjcb_passive``) of the laws MuJoCo cannot hold
+        natively, time loads among them, or None: MuJoCo calls it at every RK4 stage with
+        ``d.time`` set to the stage time."""
         build, model = self.build, self.model
         half = dt / 2
         coord_terms = []
@@ -471,10 +436,13 @@ class _ClosureSamples:
 
 
 class _Transmitted:
-    """Per joint the force MuJoCo books as passing from parent to child (``cfrc_int`` of
-    the child's MJCF body), and per point-to-point element that the callback applies
-    (joint-space forces, which ``cfrc_int`` counts as transmitted) its force on body_a;
-    native tendon forces are already external (MuJoCo puts them in ``cfrc_ext``).
+    """Per joint the force MuJoCo books as passing from parent to child (``cfrc_int[body,
+    3:6]`` of the child's MJCF body, world axes, after mj_rnePostConstraint). Forces MuJoCo
+    books as joint-space passive forces (joint springs and dampers, the callback, tendon
+    equalities) are inside that number, so the base takes out those acting on the child's
+    subtree from outside (`reactions.joint_reaction`): per point-to-point element that the
+    callback applies, its force on body_a is recorded here; native tendon forces are
+    already external (MuJoCo puts them in ``cfrc_ext``).
     `record(k)` after mj_forward and mj_rnePostConstraint at sample k; `result(t)`."""
 
     def __init__(self, comp: _Compiled, n_samples: int, joints: Sequence[str]) -> None:

@@ -3,9 +3,8 @@
 Each element kind of the description (`plan.ELEMENT_KINDS`) has one builder, registered
 with `_builds` together with the `Expression`(s) it declares (contract point 5), so that
 the declaration and the code that builds the element are one thing; `translate` runs the
-builders over the description's elements in order, each adding MJCF fragments (per MJCF
-body: its <body> attributes, joints, <inertial>, sites, contact geoms, slider bodies;
-tendons and equalities) to a `Build`, and `mjcf` assembles them. Body frames and joint
+builders over the description's elements in order, each adding MJCF fragments to a
+`Build`, and `mjcf` assembles them. Body frames and joint
 anchors come from `plan.body_states` at the reference configuration (every engine joint
 value 0); engine joint values relate to the description coordinates by
 `plan.CoordinateMap`.
@@ -168,13 +167,14 @@ POINT_MASS_INERTIA_FLOOR = 1e-14
 class Build:
     """The MJCF build of a numeric mechanism: the fragments each element's builder adds
     (per MJCF body: the <body> attributes, joints, <inertial>, sites, contact geoms, slider
-    bodies; the tendons and equalities) and what the callbacks and the read-outs need. Its
-    numbers come from the shared plan (`plan.CoordinateMap`, `plan.body_states`)."""
+    bodies; the tendons and equalities) and what the callbacks and the read-outs need."""
 
     mech: Mechanism
     cmap: CoordinateMap  # description coordinates q <-> engine joint values v
     carrier: dict[str, str]  # description body -> MJCF body carrying it
-    chains: dict[str, list[int]]  # MJCF body -> description joint indices, in order
+    #: MJCF body -> description joint indices, in order (MuJoCo applies a body's joints
+    #: in order)
+    chains: dict[str, list[int]]
     mj_parent: dict[str, str]
     settings: dict  # the resolved settings
     #: the step the file is written for (MJCF's default 0.002 s when written without one)
@@ -209,6 +209,7 @@ class Build:
 
     def add_inertial(self, body: str, mass: float, com: Sequence[float],
                      inertia: float) -> None:
+        # explicit: without an <inertial> MuJoCo derives the mass from the geoms' density
         self.inertial[body] = (f'<inertial pos="{fmt(com[0], com[1], 0)}" mass="{fmt(mass)}" '
                                f'diaginertia="{fmt(inertia, inertia, inertia)}"/>')
 
@@ -292,7 +293,7 @@ def _foldable(mech: Mechanism) -> set[str]:
 def _body(build: Build, body) -> None:
     build.add_frame(body.name)
     mass, inertia = num(body.mass), num(body.inertia)
-    if build.mech.spatial:
+    if build.mech.spatial:  # the full central tensor (read back by `stored_inertia`)
         I = np.array(inertia_matrix(body).tolist(), dtype=float)
         build.inertial[body.name] = (
             f'<inertial pos="0 0 0" mass="{fmt(mass)}" fullinertia="'
@@ -349,6 +350,8 @@ def _revolute(build: Build, joint) -> None:
                                       "intervals, not stops)"))
 def _prismatic(build: Build, joint) -> None:
     i, body = build.mech.joints.index(joint), build.carrier[joint.child]
+    # no MuJoCo joint limits: a limit is a soft constraint that would only act outside the
+    # description's admissible interval
     axis = [num(v) for v in joint.axis] + [0.0] * (3 - len(joint.axis))
     if not build.mech.spatial:  # the axis turns with the parent
         world = rot(build.frames[joint.parent][2]) @ np.array(axis[:2])
