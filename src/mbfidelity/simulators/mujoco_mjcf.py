@@ -90,8 +90,20 @@ def _xyz(point) -> str:
     return fmt(num(point[0]), num(point[1]), num(point[2]) if len(point) > 2 else 0)
 
 
-def _site(name: str, point) -> str:
-    return f'<site name="{name}" pos="{_xyz(point)}"/>'
+def _vec3(vector) -> list[float]:
+    """A description vector, planar or spatial, as three numbers (planar: z = 0)."""
+    return [num(v) for v in vector] + [0.0] * (3 - len(vector))
+
+
+def _z_quat(angle: float) -> str:
+    """An MJCF quat: a turn by `angle` about z."""
+    return fmt(math.cos(angle / 2), 0, 0, math.sin(angle / 2))
+
+
+def _inertial(mass: float, inertia: float, com: Sequence[float] = (0.0, 0.0)) -> str:
+    """An explicit <inertial>: without one MuJoCo derives the mass from the geoms' density."""
+    return (f'<inertial pos="{fmt(com[0], com[1], 0)}" mass="{fmt(mass)}" '
+            f'diaginertia="{fmt(inertia, inertia, inertia)}"/>')
 
 
 @dataclass
@@ -207,19 +219,15 @@ class Build:
     def m_min(self) -> float:
         return min(num(b.mass) for b in self.mech.bodies if not b.massless)
 
-    def add_inertial(self, body: str, mass: float, com: Sequence[float],
-                     inertia: float) -> None:
-        # explicit: without an <inertial> MuJoCo derives the mass from the geoms' density
-        self.inertial[body] = (f'<inertial pos="{fmt(com[0], com[1], 0)}" mass="{fmt(mass)}" '
-                               f'diaginertia="{fmt(inertia, inertia, inertia)}"/>')
+    def add_site(self, body: str, name: str, pos: str) -> None:
+        self.sites.setdefault(body, []).append(f'<site name="{name}" pos="{pos}"/>')
 
     def add_frame(self, body: str, gravcomp: bool = False) -> None:
         """The <body> attributes: its frame relative to its MJCF parent at the reference
         configuration (spatial: parent_anchor - child_anchor, model convention 10)."""
         if self.mech.spatial:
             j = self.mech.joints[self.chains[body][0]]
-            pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
-                      for a in (j.parent_anchor, j.child_anchor))
+            pa, ca = (np.array(_vec3(a)) for a in (j.parent_anchor, j.child_anchor))
             self.heads[body] = f'name="{body}" pos="{fmt(*(pa - ca))}"'
             return
         x, y, th = self.frames[body][:3]
@@ -227,7 +235,7 @@ class Build:
         rel = rot(thp).T @ np.array([x - xp, y - yp])
         ang = th - thp
         self.heads[body] = (f'name="{body}" pos="{fmt(rel[0], rel[1], 0)}" '
-                            f'quat="{fmt(math.cos(ang / 2), 0, 0, math.sin(ang / 2))}"'
+                            f'quat="{_z_quat(ang)}"'
                             + (' gravcomp="1"' if gravcomp and self.gravcomp else ""))
 
     @property
@@ -302,7 +310,7 @@ def _body(build: Build, body) -> None:
     if inertia == 0:  # a point mass: above MuJoCo's mjMINVAL (1e-15) whatever the mass
         radius = float(build.settings["point_mass_gyration"])
         inertia = max(mass * radius**2, POINT_MASS_INERTIA_FLOOR)
-    build.add_inertial(body.name, mass, (0.0, 0.0), inertia)
+    build.inertial[body.name] = _inertial(mass, inertia)
 
 
 @_builds(
@@ -329,7 +337,7 @@ def _massless_body(build: Build, body) -> None:
     mass = float(build.settings[key]) * build.m_min
     build.substitutes[body.name] = (mass, mass * GYRATION**2)
     build.add_frame(body.name, gravcomp=True)
-    build.add_inertial(body.name, mass, (0.0, 0.0), mass * GYRATION**2)
+    build.inertial[body.name] = _inertial(mass, mass * GYRATION**2)
 
 
 @_builds(REVOLUTE, Expression(EXACT, "hinge about z on the relative angle (absolute and "
@@ -338,7 +346,7 @@ def _revolute(build: Build, joint) -> None:
     i, body = build.mech.joints.index(joint), build.carrier[joint.child]
     if build.mech.spatial:  # about the description's axis at child_anchor
         axis = [num(v) for v in (joint.axis if joint.axis is not None else (0, 0, 1))]
-        pos = [num(v) for v in joint.child_anchor] + [0.0] * (3 - len(joint.child_anchor))
+        pos = _vec3(joint.child_anchor)
     else:
         axis = (0, 0, 1)
         loc = build.local(body, build.anchor(joint) - np.array(build.frames[body][:2]))
@@ -352,7 +360,7 @@ def _prismatic(build: Build, joint) -> None:
     i, body = build.mech.joints.index(joint), build.carrier[joint.child]
     # no MuJoCo joint limits: a limit is a soft constraint that would only act outside the
     # description's admissible interval
-    axis = [num(v) for v in joint.axis] + [0.0] * (3 - len(joint.axis))
+    axis = _vec3(joint.axis)
     if not build.mech.spatial:  # the axis turns with the parent
         world = rot(build.frames[joint.parent][2]) @ np.array(axis[:2])
         ax = build.local(body, world)
@@ -375,7 +383,7 @@ def _point_to_point(build: Build, f: PointToPoint) -> None:
             spec = (0.0, 0.0, c)
     build.p2p.append(_P2P(f, f.name, spec, law.law))
     for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
-        build.sites.setdefault(body, []).append(_site(f"{f.name}:{tag}", point))
+        build.add_site(body, f"{f.name}:{tag}", _xyz(point))
 
 
 def _coordinate_force(build: Build, f: CoordinateForce) -> None:
@@ -427,7 +435,7 @@ def _point_on_point(build: Build, c: PointOnPoint) -> None:
     build.closures.append(Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
     for site, body, point in ((f"{c.name}:a", c.body_a, c.point_a),
                               (f"{c.name}:b", c.body_b, c.point_b)):
-        build.sites.setdefault(body, []).append(_site(site, point))
+        build.add_site(body, site, _xyz(point))
 
 
 #: the second connect of a hinge closure sits this many times the mechanism's length
@@ -471,9 +479,8 @@ def _hinge_closure(build: Build, c: HingeClosure) -> None:
     for tag, body, point, axis in (("a", c.body_a, c.point_a, c.axis_a),
                                    ("b", c.body_b, c.point_b, c.axis_b)):
         p, n = (np.array([num(v) for v in x], dtype=float) for x in (point, axis))
-        build.sites.setdefault(body, []).extend([
-            f'<site name="{c.name}:{tag}" pos="{fmt(*p)}"/>',
-            f'<site name="{c.name}:axis:{tag}" pos="{fmt(*(p + span * n / np.linalg.norm(n)))}"/>'])
+        build.add_site(body, f"{c.name}:{tag}", fmt(*p))
+        build.add_site(body, f"{c.name}:axis:{tag}", fmt(*(p + span * n / np.linalg.norm(n))))
 
 
 def _slider_masses(build: Build, pin_body: str) -> None:
@@ -511,7 +518,7 @@ def _slider_masses(build: Build, pin_body: str) -> None:
     com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
     inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
                - rest * float(com @ com))
-    build.add_inertial(pin_body, rest, (float(com[0]), float(com[1])), inertia)
+    build.inertial[pin_body] = _inertial(rest, inertia, com)
 
 
 @_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
@@ -528,7 +535,7 @@ def _point_on_line(build: Build, c: PointOnLine) -> None:
     inertia = mass * SLIDER_GYRATION**2
     cl = Closure(c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider")
     build.closures.append(cl)
-    build.sites.setdefault(c.body, []).append(_site(cl.site1, c.point))
+    build.add_site(c.body, cl.site1, _xyz(c.point))
     gravcomp = (c.body == WORLD or c.body in build.substitutes) and build.gravcomp
     dr = [num(v) for v in c.direction]
     # the slot body's MJCF frame is its description frame (slot bodies are never folded):
@@ -539,8 +546,7 @@ def _point_on_line(build: Build, c: PointOnLine) -> None:
         f'<body name="{cl.slider}" pos="{_xyz(c.line_point)}"'
         + (' gravcomp="1">' if gravcomp else ">"),
         f'  <joint name="{cl.slider}" type="slide" axis="{fmt(dr[0], dr[1], 0)}"/>',
-        f'  <inertial pos="0 0 0" mass="{fmt(mass)}" '
-        f'diaginertia="{fmt(inertia, inertia, inertia)}"/>',
+        "  " + _inertial(mass, inertia),
         f'  <site name="{cl.site2}"/>',
         "</body>"])
 
@@ -593,7 +599,7 @@ def _rolling_contact(build: Build, c: RollingContact) -> None:
     for x, y, a in boxes:
         build.geoms.setdefault(build.carrier[geo["track"]], []).append(
             f'<geom type="box" size="{fmt(t / 2, half, 2 * geo["r"])}" '
-            f'pos="{fmt(x, y, 0)}" quat="{fmt(math.cos(a / 2), 0, 0, math.sin(a / 2))}" '
+            f'pos="{fmt(x, y, 0)}" quat="{_z_quat(a)}" '
             f'contype="0" conaffinity="2"{params}/>')
     # the arm's length is freed: the contact's normal force replaces it (a slide right
     # after the arm's hinge, along the arm)
@@ -655,7 +661,7 @@ def _shape_geom(shape) -> str:
 
 def _segment_geom(shape: Segment) -> str:
     # a spatial segment has three-component ends; a planar one lies at z = 0
-    a, b = ([num(v) for v in end] + [0.0] * (3 - len(end)) for end in (shape.a, shape.b))
+    a, b = (_vec3(end) for end in (shape.a, shape.b))
     r = num(shape.width) / 2
     if a == b:
         return f'<geom type="sphere" size="{fmt(r)}" pos="{fmt(*a)}"/>'
