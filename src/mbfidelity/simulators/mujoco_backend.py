@@ -48,12 +48,14 @@ _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
 class _Compiled:
-    """A compiled MuJoCo model of a build plus the index maps and the passive callback."""
+    """A compiled MuJoCo model of a build, stepped at the step its MJCF is written for
+    (`Build.dt`: the closures' and contacts' solref follow it), plus the index maps and
+    the callbacks."""
 
-    def __init__(self, build: Build, integrator: str, dt: float, autoreset: bool = False) -> None:
+    def __init__(self, build: Build, integrator: str, autoreset: bool = False) -> None:
         import mujoco
 
-        self.mujoco, self.build, s = mujoco, build, build.settings
+        self.mujoco, self.build, s, dt = mujoco, build, build.settings, build.dt
         self.model = m = mujoco.MjModel.from_xml_string(build.xml)
         m.opt.timestep = dt
         m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
@@ -63,10 +65,6 @@ class _Compiled:
                 ("enableflags", mujoco.mjtEnableBit.mjENBL_DIAGEXACT, s["diagexact"])):
             flags = getattr(m.opt, field_name)
             setattr(m.opt, field_name, flags | int(bit) if on else flags & ~int(bit))
-        if build.closures:
-            m.eq_solref[:] = (float(s["constraint_timeconst_steps"]) * dt,
-                              float(s["constraint_dampratio"]))
-            m.eq_solimp[:] = s["constraint_solimp"]
         self.data = mujoco.MjData(m)
         names = [j.name for j in build.mech.joints]
         self.qadr = np.array([m.joint(nm).qposadr[0] for nm in names])
@@ -88,10 +86,6 @@ class _Compiled:
         m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{s['contact_cone'].upper()}")
         m.opt.impratio = float(s["impratio"])
         m.opt.noslip_iterations = int(s["noslip_iterations"])
-        if contacts:  # the contacts' time constant follows the step like the equalities'
-            solref = (float(s["contact_timeconst_steps"]) * dt, float(s["contact_dampratio"]))
-            m.geom_solref[self.disc_geom] = solref
-            m.geom_solref[np.flatnonzero(m.geom_conaffinity == 2)] = solref
         self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
         self.actuator = np.zeros(len(build.mech.prescribed))
@@ -744,7 +738,7 @@ class MujocoBackend(Backend):
         moves as the harness's build)."""
         s = self.resolve_settings(settings)
         build = self._build(mechanism, s, dt=dt)
-        comp = _Compiled(build, s["integrator"], dt, bool(s["autoreset"]))
+        comp = _Compiled(build, s["integrator"], bool(s["autoreset"]))
         keys = []
         for name, (q, qd) in initial_states.items():
             comp.set_state(np.asarray(q, dtype=float), np.asarray(qd, dtype=float))
@@ -816,7 +810,8 @@ class MujocoBackend(Backend):
             t = dt * np.arange(steps + 1)
             actuators, forces, violation, transmitted, pairs = self._read_out(
                 comp, qpos, qvel, t, reaction_joints)
-        q, qd = self._coordinates(comp, qpos, qvel)
+        cmap = comp.build.cmap
+        q, qd = cmap.coordinates(qpos[:, comp.qadr]), cmap.rates(qvel[:, comp.vadr])
         # a coupling's tendon equality acts in joint space: cfrc_int counts it as
         # transmitted
         couplings = {cl.element.name: forces[cl.element.name] for cl in comp.build.closures
@@ -842,17 +837,10 @@ class MujocoBackend(Backend):
 
     def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
                   qd0: np.ndarray) -> _Compiled:
-        comp = _Compiled(self._build(mechanism, cfg, dt=dt), cfg["integrator"], dt,
+        comp = _Compiled(self._build(mechanism, cfg, dt=dt), cfg["integrator"],
                          bool(cfg["autoreset"]))
         comp.set_state(q0, qd0)
         return comp
-
-    @staticmethod
-    def _coordinates(comp: _Compiled, qpos: np.ndarray,
-                     qvel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Engine joint values (rows) -> the description's coordinates and rates."""
-        build = comp.build
-        return build.cmap.coordinates(qpos[:, comp.qadr]), build.cmap.rates(qvel[:, comp.vadr])
 
     @staticmethod
     def _read_out(comp: _Compiled, qpos: np.ndarray, qvel: np.ndarray, t: np.ndarray,
@@ -963,7 +951,7 @@ class MujocoBackend(Backend):
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the
         # continuous-time inverse dynamics do not depend on the integrator)
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
-        comp = _Compiled(build, integrator, dt)
+        comp = _Compiled(build, integrator)
         m, d = comp.model, comp.data
         with _CallbacksInstalled(comp.callback, comp.control):
             if s["linearization"] == "inverseFD" and build.closures:
