@@ -66,13 +66,16 @@ class _Compiled:
             flags = getattr(m.opt, field_name)
             setattr(m.opt, field_name, flags | int(bit) if on else flags & ~int(bit))
         self.data = mujoco.MjData(m)
-        names = [j.name for j in build.mech.joints]
-        self.qadr = np.array([m.joint(nm).qposadr[0] for nm in names])
-        self.vadr = np.array([m.joint(nm).dofadr[0] for nm in names])
+
+        def addresses(names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+            """The joints' qpos and dof addresses."""
+            return (np.array([m.joint(nm).qposadr[0] for nm in names], dtype=int),
+                    np.array([m.joint(nm).dofadr[0] for nm in names], dtype=int))
+
+        self.qadr, self.vadr = addresses([j.name for j in build.mech.joints])
         sliders = [cl for cl in build.closures if cl.kind == "slider"]
         self.slider_jnt = np.array([m.joint(cl.slider).id for cl in sliders], dtype=int)
-        self.slider_qadr = np.array([m.jnt_qposadr[j] for j in self.slider_jnt], dtype=int)
-        self.slider_vadr = np.array([m.jnt_dofadr[j] for j in self.slider_jnt], dtype=int)
+        self.slider_qadr, self.slider_vadr = addresses([cl.slider for cl in sliders])
         self.slider_body = np.array([m.body(cl.slider).id for cl in sliders], dtype=int)
         self.slider_sites = [(m.site(cl.site1).id, m.site(cl.site2).id) for cl in sliders]
         #: each closure's equalities (a hinge closure has two connects)
@@ -80,8 +83,7 @@ class _Compiled:
                       + ([m.equality(f"{cl.element.name}:axis").id] if cl.kind == "hinge" else [])
                       if cl.kind != "contact" else [] for cl in build.closures]
         contacts = [cl for cl in build.closures if cl.kind == "contact"]
-        self.radial_qadr = np.array([m.joint(cl.slider).qposadr[0] for cl in contacts], dtype=int)
-        self.radial_vadr = np.array([m.joint(cl.slider).dofadr[0] for cl in contacts], dtype=int)
+        self.radial_qadr, self.radial_vadr = addresses([cl.slider for cl in contacts])
         self.disc_geom = [m.geom(f"{cl.element.name}:disc").id for cl in contacts]
         m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{s['contact_cone'].upper()}")
         m.opt.impratio = float(s["impratio"])

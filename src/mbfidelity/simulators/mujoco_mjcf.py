@@ -704,18 +704,19 @@ def mjcf(build: Build) -> str:
     def indent(depth: int, lines) -> list[str]:
         return [f"{'  ' * depth}{x}" for x in lines]
 
-    def body_xml(name: str, depth: int) -> list[str]:
-        lines = [f"<body {build.heads[name]}>"]
-        lines += indent(1, [jt.xml(law(jt.law)) for jt in build.joints[name]])
-        lines += indent(1, [build.inertial[name]]
-                        + [g for g in map(_shape_geom, mech.body(name).shapes) if g]
-                        + build.geoms.get(name, []) + build.sites.get(name, []))
+    def inside(name: str) -> list[str]:
+        """What an MJCF body (or the world) holds after its own elements: its sites, its
+        child bodies, its sliders."""
+        lines = list(build.sites.get(name, []))
         for child in build.chains:
             if build.mj_parent[child] == name:
-                lines += indent(1, body_xml(child, 0))
-        for slider in build.sliders.get(name, []):
-            lines += indent(1, slider)
-        return indent(depth, lines + ["</body>"])
+                lines += [f"<body {build.heads[child]}>"]
+                lines += indent(1, [jt.xml(law(jt.law)) for jt in build.joints[child]]
+                                + [build.inertial[child]]
+                                + [g for g in map(_shape_geom, mech.body(child).shapes) if g]
+                                + build.geoms.get(child, []) + inside(child))
+                lines += ["</body>"]
+        return lines + [x for slider in build.sliders.get(name, []) for x in slider]
 
     gravity = gravity_vector(mech)
     out = [
@@ -728,12 +729,7 @@ def mjcf(build: Build) -> str:
         '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
         "  <worldbody>",
     ]
-    out += indent(2, build.sites.get(WORLD, []))
-    for name in build.chains:
-        if build.mj_parent[name] == WORLD:
-            out += body_xml(name, 2)
-    for slider in build.sliders.get(WORLD, []):
-        out += indent(2, slider)
+    out += indent(2, inside(WORLD))
     out.append("  </worldbody>")
     couplings = [cl for cl in build.closures if cl.kind in ("tendon", "contact")]
     if build.p2p or couplings:
