@@ -141,7 +141,7 @@ class _Compiled:
         qfrc = self._contact_qfrc(self.disc_geom[k_contact])
         Q = self.build.cmap.A.T @ qfrc[self.vadr]
         j = cl.contact["j"]
-        q = self.build.cmap.T @ (d.qpos[self.qadr] - self.build.cmap.b)
+        q = self.build.cmap.coordinates(d.qpos[self.qadr])
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):

@@ -52,6 +52,7 @@ from .plan import (
     ForceLaw,
     body_states,
     coordinate_map,
+    coupling_row,
     element_kind,
     elements,
     gravity_vector,
@@ -253,10 +254,8 @@ class Build:
 
     def coupling(self, c, kind: str, **extra) -> Closure:
         """A linear relation c . q = C as a fixed tendon over the engine joint values."""
-        coef = np.zeros(self.n)
-        for name, value in c.coefficients:
-            coef[self.mech.coordinates.index(name)] += num(value)
-        w, offset = self.cmap.on_engine_values(coef, num(c.constant))
+        coef, constant = coupling_row(self.mech, c)
+        w, offset = self.cmap.on_engine_values(coef, constant)
         weights = {self.mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
         return Closure(c, kind, weights=weights, offset=offset, coef=coef, **extra)
 
