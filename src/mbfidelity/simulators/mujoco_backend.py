@@ -145,9 +145,8 @@ class _Compiled:
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
-        """The passive callback (``mujoco.set_mjcb_passive``) of the laws MuJoCo cannot hold
-        natively, time loads among them, or None: MuJoCo calls it at every RK4 stage with
-        ``d.time`` set to the stage time."""
+        """The passive callback of the laws MuJoCo cannot hold natively (time loads among
+        them), or None."""
         build, model = self.build, self.model
         half = dt / 2
         coord_terms = []
@@ -337,7 +336,7 @@ class _Compiled:
 class _ClosureSamples:
     """Each closure's force in the contract's physical terms and its violation
     (PointOnPoint: distance of the two points, m; HingeClosure: the larger distance of its
-    two connects' points, m, its force NaN; PointOnLine: signed distance of the pin from
+    two connects' points, m, its force NaN (not determined by the motion); PointOnLine: signed distance of the pin from
     the slot line, m; LinearCoupling: Phi) over the sampled states. `record(k)`,
     after mj_forward at sample k, copies what the closures need (their equality rows'
     force and position, the sliders' acceleration and axis, the contacts' state);
@@ -406,9 +405,8 @@ class _ClosureSamples:
                 forces[name] = f[:, :1]
                 violation[name] = pos[:, 0]
             elif cl.kind == "hinge":
-                # the force is not determined by the motion (mujoco_mjcf's
-                # HINGE_FORCE_INDETERMINATE); the violation is the larger distance of the
-                # two connects' points (the hinge point's and the axis point's)
+                # mujoco_mjcf's HINGE_FORCE_INDETERMINATE; the connects of the hinge point
+                # and of the axis point
                 forces[name] = np.full((self.n, 3), np.nan)
                 violation[name] = np.maximum(np.linalg.norm(pos[:, :3], axis=1),
                                              np.linalg.norm(pos[:, 3:6], axis=1))
@@ -850,8 +848,7 @@ class MujocoBackend(Backend):
         """One pass over the sampled states, outside the timed loop: mj_forward at each
         sample's time (and mj_rnePostConstraint where reactions or sliders need the
         bodies' accelerations), reading each prescribed coordinate's actuator force (what
-        the control callback applies there), the closures' forces and violations
-        (`_ClosureSamples`) and the joints' transmitted forces (`_Transmitted`)."""
+        the control callback applies there) and the `_ClosureSamples` and `_Transmitted`."""
         import mujoco
 
         m, d = comp.model, comp.data
