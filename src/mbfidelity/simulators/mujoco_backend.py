@@ -8,9 +8,10 @@ joint reactions start from the force MuJoCo books as transmitted (`_Transmitted`
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -336,11 +337,11 @@ class _Compiled:
 class _ClosureSamples:
     """Each closure's force in the contract's physical terms and its violation
     (PointOnPoint: distance of the two points, m; HingeClosure: the larger distance of its
-    two connects' points, m, its force NaN (not determined by the motion); PointOnLine: signed distance of the pin from
-    the slot line, m; LinearCoupling: Phi) over the sampled states. `record(k)`,
-    after mj_forward at sample k, copies what the closures need (their equality rows'
-    force and position, the sliders' acceleration and axis, the contacts' state);
-    `result()` forms the physical terms over all samples at once."""
+    two connects' points, m, its force NaN (not determined by the motion); PointOnLine:
+    signed distance of the pin from the slot line, m; LinearCoupling: Phi) over the
+    sampled states. `record(k)`, after mj_forward at sample k, copies what the closures
+    need (their equality rows' force and position, the sliders' acceleration and axis, the
+    contacts' state); `result()` forms the physical terms over all samples at once."""
 
     def __init__(self, comp: _Compiled, n_samples: int) -> None:
         self.comp, self.n = comp, n_samples
@@ -488,29 +489,25 @@ class _Transmitted:
         return transmitted, pairs
 
 
-class _CallbacksInstalled:
+@contextlib.contextmanager
+def _callbacks_installed(comp: _Compiled) -> Iterator[None]:
     """Installs the passive callback (and the control callback of prescribed motions,
-    when given) for a block and restores the previous ones after: MuJoCo's callbacks
-    are process-global."""
+    when there is one) for a block and restores the previous ones after: MuJoCo's
+    callbacks are process-global."""
+    import mujoco
 
-    def __init__(self, passive, control=None) -> None:
-        import mujoco
-
-        self.mujoco = mujoco
-        self.callbacks = [(mujoco.get_mjcb_passive, mujoco.set_mjcb_passive, passive),
-                          (mujoco.get_mjcb_control, mujoco.set_mjcb_control, control)]
-        self.previous: list = []
-
-    def __enter__(self) -> None:
-        self.previous = []
-        for get, put, callback in self.callbacks:
+    previous = []
+    try:
+        for get, put, callback in (
+                (mujoco.get_mjcb_passive, mujoco.set_mjcb_passive, comp.callback),
+                (mujoco.get_mjcb_control, mujoco.set_mjcb_control, comp.control)):
             if callback is not None:
-                self.previous.append((put, get()))
+                previous.append((put, get()))
                 put(callback)
-
-    def __exit__(self, *exc) -> None:
-        for put, previous in reversed(self.previous):
-            put(previous)
+        yield
+    finally:
+        for put, callback in reversed(previous):
+            put(callback)
 
 
 #: the engine's own flexible element (contract point 12)
@@ -801,7 +798,7 @@ class MujocoBackend(Backend):
         states = np.empty((steps + 1, mujoco.mj_stateSize(m, spec)))
         step, get_state = mujoco.mj_step, mujoco.mj_getState
         get_state(m, d, states[0], spec)
-        with _CallbacksInstalled(comp.callback, comp.control):
+        with _callbacks_installed(comp):
             with Stopwatch() as clock:
                 for row in states[1:]:
                     step(m, d)
@@ -828,7 +825,7 @@ class MujocoBackend(Backend):
         import mujoco
 
         comp = self._compiled(mechanism, cfg, dt, q0, qd0)
-        with _CallbacksInstalled(comp.callback, comp.control):
+        with _callbacks_installed(comp):
             with Stopwatch() as clock:
                 if steps:
                     mujoco.mj_step(comp.model, comp.data, nstep=steps)
@@ -952,7 +949,7 @@ class MujocoBackend(Backend):
         integrator = s["integrator"] if s["integrator"] != "RK4" else "Euler"
         comp = _Compiled(build, integrator)
         m, d = comp.model, comp.data
-        with _CallbacksInstalled(comp.callback, comp.control):
+        with _callbacks_installed(comp):
             if s["linearization"] == "inverseFD" and build.closures:
                 eig, extra = self._constrained_modes(comp, q_eq, eps)
                 method = ("mujoco mjd_inverseFD with the equalities off (M, C, K of the tree, "

@@ -82,6 +82,11 @@ SOFT_EQUALITY_METRICS = ("*.trajectory_*", "*.energy_drift", "*.constraint_*", "
                          "convergence.order")
 
 
+def _soft_equality(level: str, how: str) -> Expression:
+    """The expression of a closure held by MuJoCo's soft equalities (`SOFT_EQUALITY`)."""
+    return Expression(level, how, expected_failures=SOFT_EQUALITY_METRICS, reason=SOFT_EQUALITY)
+
+
 def fmt(*xs: float) -> str:
     return " ".join(format(float(x), ".17g") for x in xs)
 
@@ -427,9 +432,7 @@ def _time_load(build: Build, f) -> None:
         _FORCES[type(f)](build, f)
 
 
-@_builds(POINT_ON_POINT, Expression(SOFT, "connect equality between two sites",
-                                    expected_failures=SOFT_EQUALITY_METRICS,
-                                    reason=SOFT_EQUALITY))
+@_builds(POINT_ON_POINT, _soft_equality(SOFT, "connect equality between two sites"))
 def _point_on_point(build: Build, c: PointOnPoint) -> None:
     build.closures.append(Closure(c, "connect", f"{c.name}:a", f"{c.name}:b"))
     for site, body, point in ((f"{c.name}:a", c.body_a, c.point_a),
@@ -461,17 +464,13 @@ def _hinge_span(mech: Mechanism) -> float:
     return max((math.sqrt(sum(num(v) ** 2 for v in p)) for p in points), default=1.0) or 1.0
 
 
-@_builds(HINGE_CLOSURE, Expression(SOFT, "two connect equalities, one at the hinge point and "
-                                         "one at a point on the hinge axis (axis_a on body_a "
-                                         "and axis_b on body_b, taken pointing the same way): "
-                                         "together they hold the point and the axis's "
-                                         "direction (six rows, one of them, the axial "
-                                         "distance, implied by the others; a loop's redundant "
-                                         "equations more), which soft equalities tolerate "
-                                         "(their regularisation splits the force among "
-                                         "dependent rows). " + HINGE_FORCE_INDETERMINATE,
-                                   expected_failures=SOFT_EQUALITY_METRICS,
-                                   reason=SOFT_EQUALITY))
+@_builds(HINGE_CLOSURE, _soft_equality(
+    SOFT, "two connect equalities, one at the hinge point and one at a point on the hinge "
+          "axis (axis_a on body_a and axis_b on body_b, taken pointing the same way): "
+          "together they hold the point and the axis's direction (six rows, one of them, "
+          "the axial distance, implied by the others; a loop's redundant equations more), "
+          "which soft equalities tolerate (their regularisation splits the force among "
+          "dependent rows). " + HINGE_FORCE_INDETERMINATE))
 def _hinge_closure(build: Build, c: HingeClosure) -> None:
     span = HINGE_SPAN_FACTOR * _hinge_span(build.mech)
     build.closures.append(Closure(c, "hinge", f"{c.name}:a", f"{c.name}:b"))
@@ -520,13 +519,10 @@ def _slider_masses(build: Build, pin_body: str) -> None:
     build.inertial[pin_body] = _inertial(rest, inertia, com)
 
 
-@_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "no point-on-line equality: a slider body on "
-                                               "the slot body (slide joint along the slot) "
-                                               "connected to the pin, its mass taken out of "
-                                               "the pin body (exact while the constraint "
-                                               "holds); the connect is soft",
-                                   expected_failures=SOFT_EQUALITY_METRICS,
-                                   reason=SOFT_EQUALITY))
+@_builds(POINT_ON_LINE, _soft_equality(
+    SUBSTITUTE, "no point-on-line equality: a slider body on the slot body (slide joint "
+                "along the slot) connected to the pin, its mass taken out of the pin body "
+                "(exact while the constraint holds); the connect is soft"))
 def _point_on_line(build: Build, c: PointOnLine) -> None:
     if c.name not in build.slider_mass:
         _slider_masses(build, c.body)
@@ -550,11 +546,9 @@ def _point_on_line(build: Build, c: PointOnLine) -> None:
         "</body>"])
 
 
-@_builds(LINEAR_COUPLING, Expression(SOFT, "fixed tendon sum(w_j v_j) over the engine joint "
-                                           "values held by a tendon equality (an exact linear "
-                                           "relation; soft like every equality)",
-                                     expected_failures=SOFT_EQUALITY_METRICS,
-                                     reason=SOFT_EQUALITY))
+@_builds(LINEAR_COUPLING, _soft_equality(
+    SOFT, "fixed tendon sum(w_j v_j) over the engine joint values held by a tendon "
+          "equality (an exact linear relation; soft like every equality)"))
 def _linear_coupling(build: Build, c) -> None:
     build.closures.append(build.coupling(c, "tendon"))
 
