@@ -56,6 +56,7 @@ from .plan import (
     element_kind,
     elements,
     gravity_vector,
+    length_scale,
     num,
     point_mass,
     rigid_body,
@@ -63,7 +64,7 @@ from .plan import (
     rot,
     spatial_tree_reason,
 )
-from .reactions import PAIR_ELEMENTS
+from .reactions import pair_element_bodies
 
 #: what MuJoCo's soft equalities cost (docs/engines.md; the numbers per mechanism are
 #: measured in the results)
@@ -272,18 +273,12 @@ _BUILDERS = ElementBuilders()
 _builds = _BUILDERS.builds
 
 
-def _point_loaded_bodies(mech: Mechanism) -> set[str]:
-    """Bodies that a loop or slot constraint or a point-to-point element acts on."""
-    return ({b for c in mech.constraints if isinstance(c, PAIR_ELEMENTS) for b in c.bodies}
-            | {b for f in mech.forces if isinstance(f, PointToPoint) for b in (f.body_a, f.body_b)})
-
-
 def _foldable(mech: Mechanism) -> set[str]:
     """Massless bodies whose joints are folded into their single child (exact). A massless
     body with another number of child joints, or that a constraint or a point-to-point
     element refers to, has no such child frame: it becomes a substitute body of small mass
     (setting ``massless_mass_ratio``)."""
-    used = _point_loaded_bodies(mech)
+    used = pair_element_bodies(mech)
     return {b.name for b in mech.bodies if b.massless and b.name not in used
             and sum(1 for j in mech.joints if j.parent == b.name) == 1}
 
@@ -336,7 +331,7 @@ def _massless_body(build: Build, body) -> None:
     # carries no load of its own and can be very light; a massless body that a
     # constraint or a point force loads must be heavier, because MuJoCo's soft
     # constraints scale their stiffness with the mass they move
-    loaded = body.name in _point_loaded_bodies(build.mech)
+    loaded = body.name in pair_element_bodies(build.mech)
     key = "massless_mass_ratio" if loaded else "link_mass_ratio"
     mass = float(build.settings[key]) * build.m_min
     build.substitutes[body.name] = (mass, mass * GYRATION**2)
@@ -441,7 +436,7 @@ def _point_on_point(build: Build, c: PointOnPoint) -> None:
 
 
 #: the second connect of a hinge closure sits this many times the mechanism's length
-#: scale (`_hinge_span`) along the hinge axis: the couple that keeps the axes parallel is
+#: scale (`plan.length_scale`) along the hinge axis: the couple that keeps the axes parallel is
 #: the two connects' forces times their distance, so a span much shorter than the bodies
 #: softens the axis's rows (a given violation of the points is a larger tilt); a span of
 #: the bodies' own size conditions them like the point's
@@ -455,15 +450,6 @@ HINGE_FORCE_INDETERMINATE = (
     "equalities a split of their own, neither of them the mechanism's")
 
 
-def _hinge_span(mech: Mechanism) -> float:
-    """A length of the mechanism's own size: the largest distance of a joint anchor or a
-    hinge closure's point from the frame it is given in."""
-    points = [a for j in mech.joints for a in (j.parent_anchor, j.child_anchor)]
-    points += [p for c in mech.constraints if isinstance(c, HingeClosure)
-               for p in (c.point_a, c.point_b)]
-    return max((math.sqrt(sum(num(v) ** 2 for v in p)) for p in points), default=1.0) or 1.0
-
-
 @_builds(HINGE_CLOSURE, _soft_equality(
     SOFT, "two connect equalities, one at the hinge point and one at a point on the hinge "
           "axis (axis_a on body_a and axis_b on body_b, taken pointing the same way): "
@@ -472,7 +458,7 @@ def _hinge_span(mech: Mechanism) -> float:
           "which soft equalities tolerate (their regularisation splits the force among "
           "dependent rows). " + HINGE_FORCE_INDETERMINATE))
 def _hinge_closure(build: Build, c: HingeClosure) -> None:
-    span = HINGE_SPAN_FACTOR * _hinge_span(build.mech)
+    span = HINGE_SPAN_FACTOR * length_scale(build.mech)
     build.closures.append(Closure(c, "hinge", f"{c.name}:a", f"{c.name}:b"))
     for tag, body, point, axis in (("a", c.body_a, c.point_a, c.axis_a),
                                    ("b", c.body_b, c.point_b, c.axis_b)):

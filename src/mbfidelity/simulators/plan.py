@@ -1380,3 +1380,12 @@ def rolling_contact_report(mech: Mechanism, coupling: LinearCoupling,
     return {"slip": q @ cvec - const, "slip_rate": qd @ cvec, "penetration": penetration,
             "normal_force": normal, "friction": friction, "friction_ratio": ratio,
             "contact_points": points}
+
+
+def length_scale(mech: Mechanism) -> float:
+    """A length of the mechanism's own size: the largest distance of a joint anchor or a
+    hinge closure's point from the frame it is given in."""
+    points = [a for j in mech.joints for a in (j.parent_anchor, j.child_anchor)]
+    points += [p for c in mech.constraints if isinstance(c, HingeClosure)
+               for p in (c.point_a, c.point_b)]
+    return max((math.sqrt(sum(num(v) ** 2 for v in p)) for p in points), default=1.0) or 1.0

@@ -163,6 +163,12 @@ def pair_element_names(mech: Mechanism) -> set[str]:
     return {e.name for e in (*mech.forces, *mech.constraints) if isinstance(e, PAIR_ELEMENTS)}
 
 
+def pair_element_bodies(mech: Mechanism) -> set[str]:
+    """The bodies a pair element (`PAIR_ELEMENTS`) acts on."""
+    return ({b for c in mech.constraints if isinstance(c, PAIR_ELEMENTS) for b in c.bodies}
+            | {b for f in mech.forces if isinstance(f, PointToPoint) for b in (f.body_a, f.body_b)})
+
+
 # --- forces from Newton-Euler over each step, for an engine that reports none ----------
 #
 # `frames`: the description bodies' frame states (x, y, theta, vx, vy, omega) by body
