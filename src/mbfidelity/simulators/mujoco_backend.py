@@ -94,18 +94,6 @@ class _Compiled:
         self.actuator = np.zeros(len(build.mech.prescribed))
         self.control = self._make_control(integrator, dt)
 
-    def _contact_qfrc(self, geom: int) -> np.ndarray:
-        """Joint-space force of the contacts of one geom (after mj_forward)."""
-        mujoco, m, d = self.mujoco, self.model, self.data
-        kinds = {int(mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS),
-                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_PYRAMIDAL),
-                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_ELLIPTIC)}
-        rows = [r for r in range(d.nefc) if int(d.efc_type[r]) in kinds
-                and geom in d.contact.geom[d.efc_id[r]]]
-        if not rows:
-            return np.zeros(m.nv)
-        return self.efc_jacobian()[rows].T @ d.efc_force[rows]
-
     def efc_jacobian(self) -> np.ndarray:
         """The constraint Jacobian efc_J (nefc, nv), dense (after mj_forward)."""
         mujoco, m, d = self.mujoco, self.model, self.data
@@ -138,8 +126,14 @@ class _Compiled:
         closure): the generalized force of the disc's contacts on the description
         coordinates (A^T qfrc), as the coupling's value -lam, i.e. that on the disc's
         coordinate over its coefficient; and the accumulated slip Phi = c.q - const."""
-        d = self.data
-        qfrc = self._contact_qfrc(self.disc_geom[k_contact])
+        mujoco, m, d = self.mujoco, self.model, self.data
+        kinds = {int(mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS),
+                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_PYRAMIDAL),
+                 int(mujoco.mjtConstraint.mjCNSTR_CONTACT_ELLIPTIC)}
+        rows = [r for r in range(d.nefc) if int(d.efc_type[r]) in kinds
+                and self.disc_geom[k_contact] in d.contact.geom[d.efc_id[r]]]
+        # the joint-space force of the disc's contacts
+        qfrc = self.efc_jacobian()[rows].T @ d.efc_force[rows] if rows else np.zeros(m.nv)
         Q = self.build.cmap.A.T @ qfrc[self.vadr]
         j = cl.contact["j"]
         q = self.build.cmap.coordinates(d.qpos[self.qadr])
@@ -709,13 +703,10 @@ class MujocoBackend(Backend):
         xml = self._build(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
-        flags = []
-        if not s["autoreset"]:
-            flags.append('autoreset="disable"')
-        if not s["refsafe"]:
-            flags.append('refsafe="disable"')
-        if s["diagexact"] and "<equality>" in xml:
-            flags.append('diagexact="enable"')
+        flags = [flag for flag, on in (('autoreset="disable"', not s["autoreset"]),
+                                       ('refsafe="disable"', not s["refsafe"]),
+                                       ('diagexact="enable"', s["diagexact"] and "<equality>" in xml))
+                 if on]
         if flags:
             head, tail = xml.split("<flag ", 1)
             attrs, rest = tail.split("/>", 1)
