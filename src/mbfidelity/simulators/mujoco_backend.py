@@ -222,11 +222,10 @@ class _Compiled:
         actuator = self.actuator
         discrete = integrator != "RK4"
         h = float(dt)
-        damping = np.diag(model.dof_damping) if integrator != "RK4" else None
-        euler_damp = integrator == "Euler" and not (
-            model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP))
-        if integrator == "Euler" and not euler_damp:
-            damping = None
+        # Euler damps implicitly unless eulerdamp is disabled
+        eulerdamp = not model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+        damping = (np.diag(model.dof_damping) if discrete and (integrator != "Euler" or eulerdamp)
+                   else None)
         tendons = ([int(i) for i in np.flatnonzero(model.tendon_damping)]
                    if integrator in ("implicit", "implicitfast") else [])
         coriolis = integrator == "implicit"
