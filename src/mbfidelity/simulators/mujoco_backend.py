@@ -702,10 +702,9 @@ class MujocoBackend(Backend):
         xml = self._build(mechanism, s, dt=dt).xml
         opt = f'integrator="{s["integrator"]}"' + (f' timestep="{fmt(dt)}"' if dt else "")
         xml = xml.replace("<option ", f"<option {opt} ", 1)
-        flags = [flag for flag, on in (('autoreset="disable"', not s["autoreset"]),
-                                       ('refsafe="disable"', not s["refsafe"]),
-                                       ('diagexact="enable"', s["diagexact"] and "<equality>" in xml))
-                 if on]
+        flags = [flag for flag, on in (
+            ('autoreset="disable"', not s["autoreset"]), ('refsafe="disable"', not s["refsafe"]),
+            ('diagexact="enable"', s["diagexact"] and "<equality>" in xml)) if on]
         if flags:
             head, tail = xml.split("<flag ", 1)
             attrs, rest = tail.split("/>", 1)
