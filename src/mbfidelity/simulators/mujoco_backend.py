@@ -992,17 +992,17 @@ class MujocoBackend(Backend):
         """N flex edges along x (vertices i l / N, the end vertices pinned; gravity and
         contacts off), the point mass added to the vertex at x = a (in the MjSpec, then
         recompiled: raising ``body_mass`` of the compiled model left MuJoCo's mass matrix
-        unchanged, measured). MuJoCo spreads a
-        flexcomp's mass equally over all N + 1 vertices, pinned ones included, so the
-        flexcomp gets rho l (N + 1) / N and each moving vertex carries rho l / N.
+        unchanged, measured). MuJoCo spreads a flexcomp's mass equally over all N + 1
+        vertices, pinned ones included, so the flexcomp gets rho l (N + 1) / N and each
+        moving vertex carries rho l / N.
 
         Frequencies by free-vibration fits: each mode is released alone, from the mode shape
         of the engine's own elastic forces (central differences of ``qfrc_passive`` in the
         vertices' y coordinates with MuJoCo's mass matrix: the engine's linearization,
-        kept as a cross-check), at an amplitude of 1e-6 l (geometric nonlinearity ~1e-12),
-        and integrated with MuJoCo's Euler (semi-implicit: v += h a, then q += h v; its
-        implicit integrators do not run flex) for `_FLEX_PERIODS` periods at a step with
-        omega_max h = `_FLEX_OMEGA_DT` (stable below 2). The record is the modal coordinate
+        kept as a cross-check), at the amplitude `_FLEX_AMPLITUDE` l, and integrated with
+        MuJoCo's Euler (semi-implicit: v += h a, then q += h v; its implicit integrators do
+        not run flex) for `_FLEX_PERIODS` periods at a step with omega_max h =
+        `_FLEX_OMEGA_DT`. The record is the modal coordinate
         (mass-weighted projection on the shape); for one undamped mode it obeys
         s[n+1] + s[n-1] = 2 cos(theta) s[n] exactly, so cos(theta) is fitted by least
         squares on all samples (linear prediction), and omega = 2 sin(theta / 2) / h
@@ -1011,9 +1011,9 @@ class MujocoBackend(Backend):
         (`resolution`) is taken as its distance to the linearization, which bounds it:
         measured 1e-12..5e-8 (the linear prediction's residual is ~1e-14 of the record, so
         most of that distance is the linearization's round-off), far below the element's
-        error (>= 8e-4 at N = 32). No setting applies: the route fixes its integrator and
-        step."""
-        self.check_beam_request(beam, kind, elements, settings, "the flex route (its integrator and step are fixed)")
+        error (>= 8e-4 at N = 32)."""
+        self.check_beam_request(beam, kind, elements, settings,
+                                "the flex route (its integrator and step are fixed)")
         import mujoco
         import scipy.linalg
 
