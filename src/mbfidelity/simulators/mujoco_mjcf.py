@@ -327,10 +327,7 @@ def _body(build: Build, body) -> None:
 def _massless_body(build: Build, body) -> None:
     if body.name in build.foldable:
         return
-    # a pure kinematic link (several children, no constraint or point force on it)
-    # carries no load of its own and can be very light; a massless body that a
-    # constraint or a point force loads must be heavier, because MuJoCo's soft
-    # constraints scale their stiffness with the mass they move
+    # a loaded one is heavier: the notes of the two settings say why
     loaded = body.name in pair_element_bodies(build.mech)
     key = "massless_mass_ratio" if loaded else "link_mass_ratio"
     mass = float(build.settings[key]) * build.m_min
