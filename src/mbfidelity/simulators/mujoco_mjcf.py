@@ -92,14 +92,14 @@ def fmt(*xs: float) -> str:
     return " ".join(format(float(x), ".17g") for x in xs)
 
 
-def _xyz(point) -> str:
-    """A point of the description (planar: z = 0) as an MJCF position."""
-    return fmt(num(point[0]), num(point[1]), num(point[2]) if len(point) > 2 else 0)
-
-
 def _vec3(vector) -> list[float]:
     """A description vector, planar or spatial, as three numbers (planar: z = 0)."""
     return [num(v) for v in vector] + [0.0] * (3 - len(vector))
+
+
+def _xyz(point) -> str:
+    """A point of the description as an MJCF position."""
+    return fmt(*_vec3(point))
 
 
 def _z_quat(angle: float) -> str:
