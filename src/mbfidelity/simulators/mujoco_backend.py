@@ -135,7 +135,7 @@ class _Compiled:
         # the joint-space force of the disc's contacts
         qfrc = self.efc_jacobian()[rows].T @ d.efc_force[rows] if rows else np.zeros(m.nv)
         Q = self.build.cmap.A.T @ qfrc[self.vadr]
-        j = cl.contact["j"]
+        j = cl.contact.hub
         q = self.build.cmap.coordinates(d.qpos[self.qadr])
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
@@ -445,7 +445,7 @@ class _Transmitted:
         # rolling by contact: the contact carries what the description's arm and coupling
         # carried, so it counts as transmitted through the joints (contract point 6)
         self.discs = [cl.contact for cl in build.closures if cl.kind == "contact"]
-        self.disc_bid = np.array([m.body(build.carrier[g["disc"]]).id for g in self.discs],
+        self.disc_bid = np.array([m.body(build.carrier[g.inner]).id for g in self.discs],
                                  dtype=int)
         N = n_samples
         self.cf = np.empty((N, len(self.bodies), 2))
@@ -471,7 +471,7 @@ class _Transmitted:
             inside = set(build.mech.subtree(joint.child))
             r = self.cf[:, self.bodies.index(build.carrier[joint.child])].copy()
             for i, g in enumerate(self.discs):
-                if g["disc"] in inside and g["track"] not in inside:
+                if g.inner in inside and g.outer not in inside:
                     r += self.ext[:, i]
             transmitted[name] = r
         pairs: dict[str, np.ndarray] = {}

@@ -50,6 +50,7 @@ from .plan import (
     TIME_LOAD,
     CoordinateMap,
     ForceLaw,
+    RollingGeometry,
     body_states,
     coordinate_map,
     coupling_row,
@@ -61,6 +62,7 @@ from .plan import (
     point_mass,
     rigid_body,
     ring_of_boxes,
+    rolling_geometry,
     rot,
     spatial_tree_reason,
 )
@@ -151,7 +153,7 @@ class Closure:
     weights: dict[str, float] = field(default_factory=dict)
     offset: float = 0.0
     coef: np.ndarray | None = None  # LinearCoupling: coefficients over the coordinates
-    contact: dict = field(default_factory=dict)  # RollingContact: see _contact_geometry
+    contact: RollingGeometry | None = None  # RollingContact: where its disc and ring sit
 
 
 @dataclass
@@ -536,19 +538,6 @@ def _linear_coupling(build: Build, c) -> None:
     build.closures.append(build.coupling(c, "tendon"))
 
 
-def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict:
-    """Where a RollingContact sits in the MJCF: the disc's hub joint, the arm's hinge on
-    the track (the ring's centre, track frame) and the radii. The arm must fold into the
-    disc's MJCF body, which then also carries the radial slide that frees its length."""
-    if c.arm not in foldable:
-        raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
-                         "link that carries the disc only")
-    hub, hinge = mech.joint_of_child(c.disc), mech.joint_of_child(c.arm)
-    return {"disc": c.disc, "arm_joint": hinge.name, "disc_joint": hub.name,
-            "track": c.track, "centre": [num(v) for v in hinge.parent_anchor],
-            "R": num(c.track_radius), "r": num(c.disc_radius), "j": mech.joints.index(hub)}
-
-
 @_builds(ROLLING_CONTACT, Expression(SUBSTITUTE, "friction contact of a sphere disc on a ring "
                                                  "of ring_segments boxes (soft, regularised "
                                                  "friction; the arm's length freed by a "
@@ -558,31 +547,35 @@ def _contact_geometry(mech: Mechanism, c: RollingContact, foldable: set) -> dict
                                                  "slip; linearize uses the coupling"))
 def _rolling_contact(build: Build, c: RollingContact) -> None:
     mech, s = build.mech, build.settings
-    geo = _contact_geometry(mech, c, build.foldable)
+    # the arm's hinge and the slide that frees its length go to the disc's MJCF body
+    if c.arm not in build.foldable:
+        raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
+                         "link that carries the disc only")
+    geo = rolling_geometry(mech, c)
     cl = build.coupling(c, "contact", slider=f"{c.name}:radial", contact=geo)
     build.closures.append(cl)
     params = (f' condim="3" friction="{fmt(s["contact_friction"], 0, 0)}" solref="'
               f'{fmt(float(s["contact_timeconst_steps"]) * build.dt, s["contact_dampratio"])}"'
               f' solimp="{fmt(*s["contact_solimp"])}"')
-    disc = build.carrier[geo["disc"]]
+    disc = build.carrier[geo.inner]
     build.geoms.setdefault(disc, []).append(
-        f'<geom name="{c.name}:disc" type="sphere" size="{fmt(geo["r"])}" '
-        f'pos="{_xyz(mech.joint(geo["disc_joint"]).child_anchor)}" contype="2" '
-        f'conaffinity="0"{params}/>')
+        f'<geom name="{c.name}:disc" type="sphere" size="{fmt(geo.r)}" '
+        f'pos="{_xyz(geo.inner_centre)}" contype="2" conaffinity="0"{params}/>')
     nseg = int(s["ring_segments"])
     # the inner faces lie at R and meet: a polygon circumscribing R
-    boxes, t, half = ring_of_boxes(geo["centre"], geo["R"], nseg)
+    boxes, t, half = ring_of_boxes(geo.centre, geo.R, nseg)
     for x, y, a in boxes:
-        build.geoms.setdefault(build.carrier[geo["track"]], []).append(
-            f'<geom type="box" size="{fmt(t / 2, half, 2 * geo["r"])}" '
+        build.geoms.setdefault(build.carrier[geo.outer], []).append(
+            f'<geom type="box" size="{fmt(t / 2, half, 2 * geo.r)}" '
             f'pos="{fmt(x, y, 0)}" quat="{_z_quat(a)}" '
             f'contype="0" conaffinity="2"{params}/>')
     # the arm's length is freed: the contact's normal force replaces it (a slide right
     # after the arm's hinge, along the arm)
-    anchor, hub = (build.anchor(mech.joint(geo[k])) for k in ("arm_joint", "disc_joint"))
+    hinge = mech.joint_of_child(c.arm)
+    anchor, hub = build.anchor(hinge), build.anchor(mech.joints[geo.hub])
     u = build.local(disc, (hub - anchor) / np.linalg.norm(hub - anchor))
     joints = build.joints[disc]
-    at = next(k for k, jt in enumerate(joints) if jt.name == geo["arm_joint"])
+    at = next(k for k, jt in enumerate(joints) if jt.name == hinge.name)
     joints.insert(at + 1, _Joint(cl.slider, "slide", (u[0], u[1], 0)))
 
 
