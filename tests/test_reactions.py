@@ -162,7 +162,7 @@ def _slide_rows() -> tuple:
         slides = tuple(j.name for j in mech.joints
                        if isinstance(j, Prismatic) and j.coordinate not in driven)
         if slides:
-            dt = getattr(sc, "dt", None) or DEFAULT_DT
+            dt = getattr(sc, "dt", None) or system.step or DEFAULT_DT  # a stiff row's own
             t_end = min(sc.t_end, 60 * dt)
             ref = reference(system, sc, values, dt, t_end)
             out.append((sid, mech, ref.q[0], ref.qd[0], dt, t_end, slides))
