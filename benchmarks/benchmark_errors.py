@@ -1,6 +1,6 @@
 """The benchmark rows' table as the benchmarks ask for it: per problem and engine, the
 error as the benchmark defines it (`System.benchmark_error`) and the CPU seconds of the
-stepping, at the engine's default settings and the default step, over the problem's
+stepping, at the engine's default settings and the row's own step, over the problem's
 whole run (`mbfidelity.api.benchmark_errors`); and, with --figure DIR, the convergence
 study of the benchmark rows over their whole runs (its page draws the benchmark's error
 against the CPU seconds: `mbfidelity convergence --systems ... --t-end ... --out DIR`).
@@ -23,16 +23,18 @@ def _cell(x, fmt: str) -> str:
 
 
 def markdown(doc: dict) -> str:
-    lines = [f"Default step {doc['dt']:g} s, each engine at its default settings, over each "
-             f"problem's whole run ({doc['provenance'].get('git_describe', '')}).", "",
-             "| problem | engine | scheme | benchmark error | unit | CPU s | status |",
-             "|---|---|---|---|---|---|---|"]
+    step = ("each row's own step" if doc["dt"] is None else f"step {doc['dt']:g} s")
+    lines = [f"At {step}, each engine at its default settings, over each problem's whole "
+             f"run ({doc['provenance'].get('git_describe', '')}).", "",
+             "| problem | engine | step (s) | scheme | benchmark error | unit | CPU s | status |",
+             "|---|---|---|---|---|---|---|---|"]
     for r in doc["rows"]:
         status = r["status"] + (f": {r['message']}" if r["message"] else "")
         if r["declared"]:
             status += (" (declared)" if r["status"] != "completed" else
                        f" (trajectory declared {r['declared'].split(':')[0]})")
-        lines.append(f"| {r['system']} | {r['simulator']} | {r.get('scheme', '-')} | "
+        lines.append(f"| {r['system']} | {r['simulator']} | {_cell(r['dt'], 'g')} | "
+                     f"{r.get('scheme', '-')} | "
                      f"{_cell(r['error'], '.3g')} | {r['unit']} | "
                      f"{_cell(r['cpu_time'], '.3g')} | {status} |")
     return "\n".join(lines) + "\n"
