@@ -297,7 +297,7 @@ def compare_cmd(system_id: str = typer.Argument(..., metavar="SYSTEM"),
         _json(doc)
     else:
         shown = f"{result.system}[{result.variant}]" if result.variant else result.system
-        typer.echo(f"{shown} on {result.simulator} {result.engine_version}, dt={dt:g}")
+        typer.echo(f"{shown} on {result.simulator} {result.engine_version}, dt={result.dt:g}")
         said = set()
         for m in result.metrics:
             extra = f"  ({m.reason})" if m.reason and m.reason not in said else ""

@@ -3,7 +3,7 @@
 A state value is the published expression of the coordinates and velocities at its
 instant, integrated there as the reference is (DOP853, or Radau for a stiff system, at
 the reference's tolerance, its error estimated by the change at a 10x looser one, which
-bounds positions and velocities alike);
+bounds positions and velocities alike, and at least the tolerance relative to the value);
 an energy is the total T + V of that state;
 a period is measured on the reference as the mean spacing of the coordinate's upward
 crossings of its centre value (the mean of its extremes), located on the cubic Hermite
@@ -64,15 +64,18 @@ def _state_at(system: System, scenario, values, time: float, tol: float):
 def _at_instant(system: System, item: Published, values, scenario, solved: dict,
                 read) -> tuple[float, float]:
     """`read(q, qd)` of the state at the item's instant, and its error estimate: its change
-    from the reference's tolerance to a 10x looser one (as the reference's own estimate).
-    `solved` keeps the states already integrated (one solve per instant and tolerance)."""
+    from the reference's tolerance to a 10x looser one (as the reference's own estimate),
+    and at least that tolerance relative to the value (the solve is not asked to be
+    closer; where both solves already meet it, their change is round-off and says
+    nothing smaller). `solved` keeps the states already integrated (one solve per instant
+    and tolerance)."""
     out = []
     for tol in (TIGHT, LOOSE):
         key = (scenario.name, item.time, tol)
         if key not in solved:
             solved[key] = _state_at(system, scenario, values, item.time, tol)
         out.append(float(read(*solved[key])))
-    return out[0], abs(out[1] - out[0])
+    return out[0], max(abs(out[1] - out[0]), TIGHT * abs(out[0]))
 
 
 def _state(system: System, item: Published, values, scenario,
