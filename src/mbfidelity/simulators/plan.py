@@ -597,9 +597,7 @@ def point_state(st: tuple, local) -> tuple:
     state (x, y, theta, vx, vy, omega), whose entries are numbers, arrays of samples or
     SymPy expressions (`cos_sin`)."""
     x, y, th, vx, vy, w = st
-    c, s = cos_sin(th)
-    rx, ry = c * local[0] - s * local[1], s * local[0] + c * local[1]
-    return x + rx, y + ry, vx - w * ry, vy + w * rx
+    return moving_point((x, y, th, *cos_sin(th), vx, vy, w), local)
 
 
 def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool,
