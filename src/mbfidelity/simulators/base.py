@@ -34,7 +34,9 @@ conventions 1-8) into one engine and runs it. The contract:
    (`translation_reason`) or when one of its elements is unsupported; reported as data,
    not raised.
 6. `simulate(mechanism, q0, qd0, t_end, dt, settings, reaction_joints)` builds a fresh
-   model, integrates from the state (q0, qd0) (description coordinates) with fixed step
+   model, integrates from the state (q0, qd0) (description coordinates; the base puts
+   each prescribed coordinate on its motion at t = 0, `plan.driven_start`, so that the
+   motion the engine is given decides where it starts) with fixed step
    dt for round(t_end/dt) steps, and returns a `RunResult` sampled at every step,
    including t = 0. The base owns it (in the manner of SciPy's `OdeSolver.step`): it
    resolves the settings, refuses an unsupported mechanism or an unknown reaction joint,
@@ -125,8 +127,8 @@ import numpy as np
 from ..systems import Expectation
 from ..systems._continua import Beam
 from ..systems.model import Mechanism
-from .plan import (ELEMENT_KINDS, CoordinateMap, description_reason, element_kind,
-                   elements)
+from .plan import (ELEMENT_KINDS, CoordinateMap, description_reason, driven_start,
+                   element_kind, elements)
 from .reactions import joint_reactions
 
 EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
@@ -495,9 +497,8 @@ class Backend(ABC):
         for name in reaction_joints:
             mechanism.joint(name)  # KeyError for an unknown joint
         order = self.scheme(mechanism, cfg).order
-        out = self._simulate_impl(mechanism, np.asarray(q0, dtype=float),
-                                  np.asarray(qd0, dtype=float), steps, dt, cfg,
-                                  tuple(reaction_joints))
+        out = self._simulate_impl(mechanism, *driven_start(mechanism, q0, qd0), steps, dt,
+                                  cfg, tuple(reaction_joints))
         t = np.arange(steps + 1) * dt
         n = len(mechanism.joints)
         if out.q.shape != (steps + 1, n) or out.qd.shape != (steps + 1, n):
@@ -526,8 +527,8 @@ class Backend(ABC):
                       t_end: float, dt: float, settings: Mapping | None = None) -> BareLoop:
         """The bare loop's CPU seconds and the state it ended in (contract point 9)."""
         cfg, steps = self._run_frame(mechanism, t_end, dt, settings)
-        return self._bare_loop_impl(mechanism, np.asarray(q0, dtype=float),
-                                    np.asarray(qd0, dtype=float), steps, dt, cfg)
+        return self._bare_loop_impl(mechanism, *driven_start(mechanism, q0, qd0), steps,
+                                    dt, cfg)
 
     def _run_frame(self, mechanism: Mechanism, t_end: float, dt: float,
                    settings: Mapping | None) -> tuple[dict, int]:

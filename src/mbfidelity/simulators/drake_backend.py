@@ -98,7 +98,6 @@ from .base import (
 )
 from .plan import (
     CoordinateLaws,
-    driven_start,
     BODY,
     COORDINATE_FORCE_CUSTOM,
     COORDINATE_FORCE_LINEAR,
@@ -803,7 +802,6 @@ class DrakeBackend(Backend):
                        steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
         built = self._build(mechanism, cfg, dt)
-        q0, qd0 = driven_start(mechanism, q0, qd0)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
         n = len(mechanism.joints)
@@ -869,7 +867,6 @@ class DrakeBackend(Backend):
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The diagram of `simulate`, advanced to the same sample times, nothing read."""
         built = self._build(mechanism, cfg, dt)
-        q0, qd0 = driven_start(mechanism, q0, qd0)
         simulator, _, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         with Stopwatch() as clock:
             for k in range(1, steps + 1):

@@ -864,7 +864,7 @@ class ExudynBackend(Backend):
                        reaction_joints: tuple[str, ...]) -> Samples:
         solver = self._solver_for(mechanism, cfg)
         t_run = steps * dt
-        system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
+        system = _build(mechanism, q0, qd0, cfg)
         geo, closures, driven = system.geo, system.closures, system.driven
         ovt = system.exu.OutputVariableType
         s_u = system.sensor("SensorNode", nodeNumber=system.node,
@@ -932,7 +932,7 @@ class ExudynBackend(Backend):
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The system of `simulate` without its sensors, solved by the same solver."""
         solver = self._solver_for(mechanism, cfg)
-        system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
+        system = _build(mechanism, q0, qd0, cfg)
         system.mbs.Assemble()
         if system.driven:
             self._consistent_start(system)
