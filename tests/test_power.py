@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from mbfidelity.comparisons import power
 from mbfidelity.comparisons.runner import compare
@@ -316,3 +318,21 @@ def test_each_modes_change_is_set_against_the_gate_of_that_mode():
             assert gate["metric"].endswith("_mode" + quantity.split()[-1])
     assert "frequency mode 1" not in judged
     assert found.verdict != power.NOT_REJECTED, found.why
+
+
+@given(threshold=st.integers(0, len(power.EPSILONS)),
+       start=st.integers(0, len(power.EPSILONS) - 1))
+def test_search_from_the_predicted_decade_finds_the_first_rejected(threshold, start):
+    """Whatever decade the prediction names, the search returns the first rejected one of
+    a monotone rejection (len: none), in at most five runs (the plain bisection's bound on
+    six decades), and in at most two where the prediction is right or one decade low."""
+    calls = []
+
+    def rejects(i: int) -> bool:
+        calls.append(i)
+        return i >= threshold
+
+    assert power.first_rejected(rejects, start) == threshold
+    assert len(calls) == len(set(calls)) and len(calls) <= 5
+    if start in (threshold, threshold - 1):
+        assert len(calls) <= 2

@@ -26,17 +26,19 @@ judged on the run at h/K against the baseline's bound on the limit (an error tha
 the engine's limit off the reference is caught there, where the bound at h is too wide
 to catch it).
 
-For each error kind the smallest rejected eps on the decade grid `EPSILONS` is found
-assuming rejection is monotone in eps (a larger error is rejected whenever a smaller one
-is): the grid's ends first (the largest eps not rejected: none is; the smallest rejected:
-it is the answer), then bisection between them: one run where no gate catches the
-largest error, two where one catches the smallest, at most five. `ErrorPower.monotone`
-records whether the runs made agree with the assumption. Next to it,
-the change that a 1 % error (`PROBE`) makes in the exact model (reference with the mutated
-parameter against the true one: the first scenario's trajectory and actuator forces, and
-the modes' frequencies) is set against the gate of each of those quantities, so that an
-error too small to move a judged quantity beyond its gate ("below the gates") is told apart
-from a blind gate (`classify_error`).
+First, the change that a 1 % error (`PROBE`) makes in the exact model (reference with
+the mutated parameter against the true one: the first scenario's trajectory and actuator
+forces, and the modes' frequencies) is set against the gate of each of those quantities,
+so that an error too small to move a judged quantity beyond its gate ("below the gates")
+is told apart from a blind gate (`classify_error`). Then the smallest rejected eps on the
+decade grid `EPSILONS` is found assuming rejection is monotone in eps (a larger error is
+rejected whenever a smaller one is), by `first_rejected`: the search starts at the decade
+that change predicts (`predicted_start`: a small error acts linearly, so the gate's
+margin is first exceeded near PROBE times margin over change), tries its neighbour on the
+side the first answer points to, and bisects what is left: two runs where the prediction
+holds, at most five otherwise, as the plain bisection of the grid. The prediction only
+orders the runs; the answer is that of the runs. `ErrorPower.monotone` records whether
+the runs made agree with the assumption.
 
 Each neutralised default (`Setting.engine_default`) is switched back on alone, and all
 together (the engine as a user gets it), in comparisons/out_of_the_box.py. A default acts
@@ -137,7 +139,7 @@ class ErrorPower:
     #: smallest eps of the grid the gates reject (None: not even the largest)
     smallest_rejected: float | None = None
     trials: list[Trial] = field(default_factory=list)
-    #: whether the trials agree with rejection monotone in eps (the grid's top checked)
+    #: whether the trials made agree with rejection monotone in eps
     monotone: bool = True
     #: the exact model's change at eps = PROBE against the gates (see the module doc)
     motion_change: dict = field(default_factory=dict)
@@ -503,6 +505,47 @@ def error_powers(system, simulator: str, kinds: Iterable[str], baseline: Compari
     return [_error_power(system, kind, values, scenario, baseline, dt, run) for kind in kinds]
 
 
+def predicted_start(motion: Mapping, baseline: Comparison) -> int:
+    """The grid index where the search for the smallest rejected eps starts: the smallest
+    eps whose predicted change (linear in eps, from the exact model's change at PROBE)
+    exceeds the margin of the metric that holds in `baseline` (tolerance minus its value)
+    most nearly crossed; the grid's top where no such change was measured."""
+    scale = 0.0
+    for quantity in motion.get("against_gates", {}).values():
+        m = metric_named(baseline, quantity["metric"])
+        if m is None or m.status not in HOLDS or not quantity["change"] > 0:
+            continue
+        margin = m.tolerance - abs(m.value) if math.isfinite(m.value) else m.tolerance
+        scale = max(scale, quantity["change"] / max(margin, 1e-300))
+    if not scale > 0:
+        return len(EPSILONS) - 1
+    crossing = PROBE / scale
+    return next((i for i, eps in enumerate(EPSILONS) if eps >= crossing), len(EPSILONS) - 1)
+
+
+def first_rejected(rejects, start: int, size: int = len(EPSILONS)) -> int:
+    """The first index of range(size) where `rejects(i)` holds (size: none), assuming it
+    is monotone in i, found from `start`: `start`, its neighbour on the side its answer
+    points to, then bisection of what remains."""
+    lo, hi = 0, size  # the answer lies in [lo, hi]
+
+    def probe(i: int) -> None:
+        nonlocal lo, hi
+        if rejects(i):
+            hi = i
+        else:
+            lo = i + 1
+
+    probe(start)
+    neighbour = start - 1 if hi == start else start + 1
+    if lo <= neighbour < hi:
+        probe(neighbour)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        probe(mid)
+    return hi
+
+
 def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPower:
     parameter = mutated_parameter(system, kind, values)
     if parameter is None:
@@ -510,6 +553,10 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
                           f"no parameter of this kind enters the mechanism "
                           f"({', '.join(ERROR_KINDS[kind]) or GRAVITY_PARAMETER})")
     power = ErrorPower(kind, parameter, True)
+    try:
+        power.motion_change = motion_change(system, scenario, values, parameter, baseline, dt)
+    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+        power.motion_change = {"eps": PROBE, "error": str(exc)}
     tried: dict[int, bool] = {}
 
     def trial(i: int) -> bool:
@@ -522,29 +569,11 @@ def _error_power(system, kind, values, scenario, baseline, dt, run) -> ErrorPowe
         tried[i] = bool(by)
         return tried[i]
 
-    # the grid's ends first, then bisection between them: the first index rejected,
-    # assuming rejection monotone in eps
-    top = len(EPSILONS) - 1
-    if not trial(top):
-        hi = len(EPSILONS)
-    elif trial(0):
-        hi = 0
-    else:
-        lo, hi = 1, top
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if trial(mid):
-                hi = mid
-            else:
-                lo = mid + 1
+    hi = first_rejected(trial, predicted_start(power.motion_change, baseline))
     power.monotone = all(tried[j] for j in tried if j >= hi) and not any(
         tried[j] for j in tried if j < hi)
     power.smallest_rejected = EPSILONS[hi] if hi < len(EPSILONS) else None
     power.trials.sort(key=lambda t: t.eps)
-    try:
-        power.motion_change = motion_change(system, scenario, values, parameter, baseline, dt)
-    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
-        power.motion_change = {"eps": PROBE, "error": str(exc)}
     classify_error(power)
     return power
 
