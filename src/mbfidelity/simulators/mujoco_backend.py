@@ -695,12 +695,16 @@ class MujocoBackend(Backend):
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
                 dt: float | None = None) -> str:
-        """The MJCF text of the translated mechanism (with the integrator setting and,
-        when given, the time step), to save and load with ``MjModel.from_xml_path``.
-        Laws that need the passive callback are not in the file."""
+        """The MJCF text of the translated mechanism (with the integrator and contact
+        solver settings, the flags `_Compiled` sets and, when given, the time step), to
+        save and load with ``MjModel.from_xml_path``. Laws that need the passive callback
+        are not in the file."""
         s = self.resolve_settings(settings)
         xml = self._build(mechanism, s, dt=dt).xml
-        opt = f'integrator="{s["integrator"]}"' + (f' timestep="{fmt(dt)}"' if dt else "")
+        opt = (f'integrator="{s["integrator"]}" cone="{s["contact_cone"]}" '
+               f'impratio="{fmt(s["impratio"])}" '
+               f'noslip_iterations="{int(s["noslip_iterations"])}"'
+               + (f' timestep="{fmt(dt)}"' if dt else ""))
         xml = xml.replace("<option ", f"<option {opt} ", 1)
         flags = [flag for flag, on in (
             ('autoreset="disable"', not s["autoreset"]), ('refsafe="disable"', not s["refsafe"]),
@@ -748,8 +752,6 @@ class MujocoBackend(Backend):
         if comp.control is not None:
             outside.append("prescribed motions imposed by the harness's control callback "
                            f"(mjcb_control): {', '.join(p.name for p in mechanism.prescribed)}")
-        if any(c.kind == "contact" for c in build.closures):
-            outside.append("the contact ring's solref, set on the compiled model")
         return xml, outside
 
     def stored_inertia(self, mechanism: Mechanism, settings: Mapping | None = None
