@@ -73,15 +73,15 @@ from ..systems._continua import Beam
 from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mechanism,
                              PointOnLine, PointOnPoint, PointToPoint, Prescribed, Prismatic,
                              Revolute, inertia_matrix)
-from .base import (EXACT, ElementBuilders, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
-                   BeamElement, BeamModes, Expression, Linearization, Samples, Scheme, Setting,
-                   Stopwatch)
-from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, LINEAR_COUPLING,
-                   MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT, POINT_TO_POINT_CUSTOM,
-                   POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE, ROLLING_CONTACT,
-                   HINGE_CLOSURE, TIME_LOAD, CoordinateLaws, CoordinateMap, ForceLaw, Motion,
-                   constrained_bodies, coordinate_map, driven_start,
-                   gravity_vector, massive_below, num, rot,
+from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
+                   BeamElement, BeamModes, ElementBuilders, Expression, Linearization, Samples,
+                   Scheme, Setting, Stopwatch)
+from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
+                   LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
+                   POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
+                   ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, LinkFrames, Motion,
+                   axis_aligned, constrained_bodies, coordinate_map, driven_start,
+                   gravity_vector, link_axis, link_frames, massive_below, num, rot, rot_z,
                    spatial_tree_reason, turned)
 from .reactions import subtree_force
 
@@ -115,12 +115,6 @@ _AXIAL_FACTOR = 1e4
 _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
-def _rot3(angle: float) -> np.ndarray:
-    out = np.eye(3)
-    out[:2, :2] = rot(angle)
-    return out
-
-
 @dataclass
 class _ClosureItem:
     """One closure constraint as built in Exudyn: its object, the output its sensor reads
@@ -146,72 +140,6 @@ class _DrivenItem:
     motion: Motion
     scale: float
     shift: float
-
-
-@dataclass
-class _Geometry:
-    """The link frames of Exudyn's kinematic tree for a (numeric) mechanism: one link per
-    joint, its frame at the joint, turned to a prismatic joint's axis; the map between
-    the description's coordinates and the engine's joint values is the shared one."""
-
-    cmap: CoordinateMap
-    link_of: dict[str, int]          # body name -> link index
-    parents: list[int]
-    types: list[str]                 # Exudyn joint type names
-    offsets: list[np.ndarray]        # joint offsets (parent link frame), 3-vectors
-    rotations: list[float]           # joint frame rotation against the parent link frame
-    beta: dict[str, float]           # link frame orientation minus body angle
-    com: dict[str, np.ndarray]       # centre of mass in the link frame
-
-    @property
-    def n(self) -> int:
-        return len(self.parents)
-
-    def local_point(self, body: str, point: Sequence[float]) -> np.ndarray:
-        """A description body-frame point expressed in the body's link frame."""
-        padded = [*point, 0.0, 0.0][:3]  # a planar point lies at z = 0
-        return self.com[body] + _rot3(-self.beta[body]) @ np.array(padded)
-
-    def frame_angle(self, body: str, u: np.ndarray) -> np.ndarray:
-        """Orientation of the body's link frame (world: 0) for engine values u (rows)."""
-        return u @ self.cmap.angle_v[body] + self.cmap.angle_v0[body] + self.beta[body]
-
-    def coordinates(self, u: np.ndarray, ut: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Engine values and rates (rows) -> the description's coordinates and rates."""
-        T = self.cmap.T
-        return u @ T.T + self.cmap.c, ut @ T.T
-
-
-_AXIS_JOINTS = {(1.0, 0.0, 0.0): "RevoluteX", (0.0, 1.0, 0.0): "RevoluteY",
-                (0.0, 0.0, 1.0): "RevoluteZ"}
-
-
-def _hinge_axis(j: Revolute | Prismatic) -> tuple[float, ...]:
-    """A hinge's unit axis, or a slide's (three components)."""
-    given = j.axis if j.axis is not None else (0, 0, 1)
-    axis = np.array([num(v) for v in given] + [0.0] * (3 - len(given)))
-    return tuple(float(v) for v in axis / np.linalg.norm(axis))
-
-
-_SLIDE_JOINTS = {(1.0, 0.0, 0.0): "PrismaticX", (0.0, 1.0, 0.0): "PrismaticY",
-                 (0.0, 0.0, 1.0): "PrismaticZ"}
-
-
-def _spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial tree cannot hold a spatial mechanism (empty: it can): besides the
-    common conditions, its hinges turn about and its slides run along a link axis (its
-    point-to-point elements are spring-dampers between tree markers)."""
-    common = spatial_tree_reason(mech, closures=False, slides=True, point_forces=True)
-    if common:
-        return common
-    for j in mech.joints:
-        if isinstance(j, Revolute) and _hinge_axis(j) not in _AXIS_JOINTS:
-            return (f"joint {j.name}: the tree's hinges turn about a link axis (RevoluteX, "
-                    f"Y or Z), not about {_hinge_axis(j)}")
-        if isinstance(j, Prismatic) and _hinge_axis(j) not in _SLIDE_JOINTS:
-            return (f"joint {j.name}: the tree's slides run along a link axis (PrismaticX, "
-                    f"Y or Z), not along {_hinge_axis(j)}")
-    return ""
 
 
 # --- element builders, registered per element kind with their expressions ------------------
@@ -243,66 +171,41 @@ def _link_inertia(body: Body, mech: Mechanism) -> tuple[float, np.ndarray]:
     return num(body.mass), np.diag([0.0, 0.0, num(body.inertia)])
 
 
-@_builds(REVOLUTE, Expression(EXACT, "RevoluteZ link of the kinematic tree (spatial: "
-                                     "RevoluteX, Y or Z)"))
-def _hinge(joint: Revolute, mech: Mechanism) -> tuple[str, float, float]:
-    """(Exudyn joint type, the joint frame's angle in the parent body's frame, the link
-    frame's angle minus the child body's)."""
-    return (_AXIS_JOINTS[_hinge_axis(joint)] if mech.spatial else "RevoluteZ",
-            num(joint.angle_offset), 0.0)
+@_builds(REVOLUTE,
+         Expression(EXACT, "RevoluteZ link of the kinematic tree (spatial: RevoluteX, Y or Z)",
+                    when="a planar hinge, or a spatial one about a link axis",
+                    applies=axis_aligned),
+         Expression(UNSUPPORTED, "the spatial tree's hinges turn about a link axis "
+                                 "(RevoluteX, Y or Z), not about any other axis",
+                    when="a spatial hinge about another axis"))
+def _hinge(joint: Revolute, mech: Mechanism) -> str:
+    """The Exudyn joint type of the hinge's link (its frame: `plan.link_frames`)."""
+    return "Revolute" + link_axis(joint) if mech.spatial else "RevoluteZ"
 
 
-@_builds(PRISMATIC, Expression(EXACT, "PrismaticX link, the joint frame turned to the axis "
-                                      "(spatial: PrismaticX, Y or Z)"))
-def _slide(joint: Prismatic, mech: Mechanism) -> tuple[str, float, float]:
-    """As `_hinge`: the joint frame's x axis along the slide (spatial: the link axis of
-    the slide, frames aligned with the parent's)."""
-    if mech.spatial:
-        return _SLIDE_JOINTS[_hinge_axis(joint)], num(joint.angle_offset), 0.0
-    axis = np.array([num(v) for v in joint.axis])
-    alpha = math.atan2(axis[1], axis[0])
-    return "PrismaticX", alpha, alpha - num(joint.angle_offset)
+@_builds(PRISMATIC,
+         Expression(EXACT, "PrismaticX link, the joint frame turned to the axis (spatial: "
+                           "PrismaticX, Y or Z)",
+                    when="a planar slide, or a spatial one along a link axis",
+                    applies=axis_aligned),
+         Expression(UNSUPPORTED, "the spatial tree's slides run along a link axis "
+                                 "(PrismaticX, Y or Z), not along any other axis",
+                    when="a spatial slide along another axis"))
+def _slide(joint: Prismatic, mech: Mechanism) -> str:
+    """As `_hinge`: a planar slide's joint frame has its x axis along the slide."""
+    return "Prismatic" + link_axis(joint) if mech.spatial else "PrismaticX"
 
 
-def _geometry(mech: Mechanism) -> _Geometry:
-    link_of: dict[str, int] = {}
-    parents: list[int] = []
-    types: list[str] = []
-    offsets: list[np.ndarray] = []
-    rotations: list[float] = []
-    beta: dict[str, float] = {WORLD: 0.0}
-    com: dict[str, np.ndarray] = {WORLD: np.zeros(3)}
-
-    def column(v) -> np.ndarray:
-        """An anchor in 3-D: a planar one's in-plane components, a spatial one's all."""
-        values = [num(c) for c in v][:3 if mech.spatial else 2]
-        return np.array(values + [0.0] * (3 - len(values)))
-
-    for i, j in enumerate(mech.joints):
-        p = j.parent
-        parents.append(link_of[p] if p != WORLD else -1)
-        link_of[j.child] = i
-        # the joint point in the parent's link frame (a spatial tree's frames are aligned
-        # with their parents: beta = 0, model convention 10)
-        offsets.append(com[p] + _rot3(-beta[p]) @ column(j.parent_anchor))
-        joint_type, angle, beta[j.child] = _builder(j)(j, mech)
-        types.append(joint_type)
-        rotations.append(angle - beta[p])
-        com[j.child] = -_rot3(-beta[j.child]) @ column(j.child_anchor)
-    return _Geometry(coordinate_map(mech), link_of, parents, types, offsets, rotations,
-                     beta, com)
-
-
-def _tree_links(mech: Mechanism, geo: _Geometry, exu) -> dict:
+def _tree_links(mech: Mechanism, geo: LinkFrames, exu) -> dict:
     """The ``ObjectKinematicTree`` arguments that describe its links (the frames of `geo`,
-    each body's mass and tensor from its builder) and gravity, along -y or, in a spatial
-    mechanism, against its `up`."""
+    each joint's type and each body's mass and tensor from its builder) and gravity, along
+    -y or, in a spatial mechanism, against its `up`."""
     bodies = [mech.body(j.child) for j in mech.joints]
     masses, tensors = zip(*(_builder(b)(b, mech) for b in bodies))
     return dict(gravity=list(gravity_vector(mech)), baseOffset=[0.0, 0.0, 0.0],
-                jointTypes=[getattr(exu.JointType, t) for t in geo.types],
+                jointTypes=[getattr(exu.JointType, _builder(j)(j, mech)) for j in mech.joints],
                 linkParents=geo.parents,
-                jointTransformations=exu.Matrix3DList([_rot3(a) for a in geo.rotations]),
+                jointTransformations=exu.Matrix3DList([rot_z(a) for a in geo.rotations]),
                 jointOffsets=exu.Vector3DList([list(o) for o in geo.offsets]),
                 linkInertiasCOM=exu.Matrix3DList(list(tensors)),
                 linkCOMs=exu.Vector3DList([list(geo.com[b.name]) for b in bodies]),
@@ -322,7 +225,7 @@ class _System:
     SC: object
     mbs: object
     mech: Mechanism
-    geo: _Geometry
+    geo: LinkFrames
     cfg: dict
     node: int = -1
     tree: int = -1
@@ -553,7 +456,7 @@ def _tension_user_function(law: Callable[..., float]):
     return uf
 
 
-def _coordinate_user_function(geo: _Geometry, laws: CoordinateLaws):
+def _coordinate_user_function(geo: LinkFrames, laws: CoordinateLaws):
     """The laws' generalized force on the engine coordinates (T^T Q)."""
     T, c, n = geo.cmap.T, geo.cmap.c, geo.n
     if np.array_equal(T, np.eye(n)) and not np.any(c):
@@ -574,7 +477,7 @@ def _build(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict) -> _Syst
     import exudyn as exu
     import exudyn.itemInterface as items
 
-    geo = _geometry(mech)
+    geo = link_frames(mech)
     Tinv = np.linalg.inv(geo.cmap.T)
     u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.cmap.c)
     ud0 = Tinv @ np.asarray(qd0, dtype=float)
@@ -738,7 +641,12 @@ class ExudynBackend(Backend):
                 for j, tensor in zip(mechanism.joints, tensors.reshape(-1, 3, 3))}
 
     def translation_reason(self, mechanism: Mechanism) -> str:
-        return _spatial_reason(mechanism) if mechanism.spatial else ""
+        """A spatial mechanism: the common conditions of a spatial tree (its point-to-point
+        elements are spring-dampers between tree markers; each joint's axis is checked by
+        its builder's declared cases)."""
+        if not mechanism.spatial:
+            return ""
+        return spatial_tree_reason(mechanism, closures=False, slides=True, point_forces=True)
 
     # --- model building: the element builders above; the consistent start --------------------
     def _mass_and_rhs(self, system: _System, explicit: bool) -> tuple[np.ndarray, np.ndarray]:
