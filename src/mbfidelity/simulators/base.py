@@ -399,6 +399,44 @@ class Linearization:
     extra: dict = field(default_factory=dict)
 
 
+def constraint_manifold_eigenvalues(
+        M: np.ndarray, K: np.ndarray, D: np.ndarray,
+        forces_and_jacobian: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+        u_eq: np.ndarray, step: float) -> tuple[np.ndarray, dict]:
+    """(eigenvalues, what the route found) of a tree (M, K, D on its n coordinates u)
+    whose closure constraints hold it at the equilibrium u_eq, from the engine's forces f
+    and constraint Jacobian C (n x m) at u (`forces_and_jacobian`): the static multipliers
+    of C lam = f (least squares), the constraint stiffness H = d(C lam)/du by central
+    differences of C with `step`, and the projection of M, K + H, D on the null space of
+    C^T (SVD), then the first-order eigenproblem with damping. Eigenvalue parts within
+    1e-12 of the largest |s| are set to zero: a rigid mode (belt pulleys) has a
+    structurally zero eigenvalue, which the projection's round-off would turn into a tiny
+    frequency. The facts: the step, the multipliers, the equilibrium's residual
+    max |C lam - f| and the rank of C."""
+    from ..analytic.linear import quadratic_eigenvalues
+
+    n = len(u_eq)
+    f, C = forces_and_jacobian(u_eq)
+    lam = np.linalg.lstsq(C, f, rcond=None)[0]
+    residual = float(np.max(np.abs(C @ lam - f), initial=0.0))
+    H = np.zeros((n, n))
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = step
+        H[:, k] = (forces_and_jacobian(u_eq + e)[1] - forces_and_jacobian(u_eq - e)[1]) @ lam
+    H /= 2 * step
+    U, sv, _ = np.linalg.svd(C)
+    rank = int(np.sum(sv > 1e-12 * max(1.0, float(np.max(sv, initial=0.0)))))
+    N = U[:, rank:]
+    Mn, Kn, Dn = N.T @ M @ N, N.T @ (K + H) @ N, N.T @ D @ N
+    eig = quadratic_eigenvalues(Mn, Dn, Kn)
+    tiny = 1e-12 * max(float(np.max(np.abs(eig), initial=0.0)), 1e-300)
+    eig = np.where(np.abs(eig.real) <= tiny, 0.0, eig.real) + 1j * np.where(
+        np.abs(eig.imag) <= tiny, 0.0, eig.imag)
+    return eig, {"constraint_step": step, "multipliers": lam.tolist(),
+                 "equilibrium_residual": residual, "constraint_rank": rank}
+
+
 class Backend(ABC):
     id: str = ""
     #: every setting the backend uses (contract point 4), in the order they are reported

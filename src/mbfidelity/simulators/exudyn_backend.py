@@ -75,13 +75,13 @@ from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mecha
                              Revolute, inertia_matrix)
 from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
                    BeamElement, BeamModes, ElementBuilders, Expression, Linearization, Samples,
-                   Scheme, Setting, Stopwatch)
+                   Scheme, Setting, Stopwatch, constraint_manifold_eigenvalues)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, LinkFrames, Motion,
                    axis_aligned, constrained_bodies, coordinate_map, driven_start,
-                   gravity_vector, link_axis, link_frames, massive_below, num, rot, rot_z,
+                   gravity_vector, link_axis, link_frames, massive_below, num, prescribed_start, rot, rot_z,
                    spatial_tree_reason, turned)
 from .reactions import subtree_force
 
@@ -458,16 +458,11 @@ def _tension_user_function(law: Callable[..., float]):
 
 def _coordinate_user_function(geo: LinkFrames, laws: CoordinateLaws):
     """The laws' generalized force on the engine coordinates (T^T Q)."""
-    T, c, n = geo.cmap.T, geo.cmap.c, geo.n
-    if np.array_equal(T, np.eye(n)) and not np.any(c):
-        def uf(mbs, t, item, u, u_t):  # description coordinates are the engine's
-            return laws.generalized(u, u_t, t)
-        return uf
+    on_engine_values = laws.on_engine_values(geo.cmap.T, geo.cmap.c)
 
-    def uf_mapped(mbs, t, item, u, u_t):
-        Q = laws.generalized(T @ np.asarray(u) + c, T @ np.asarray(u_t), t)
-        return (T.T @ np.asarray(Q)).tolist()
-    return uf_mapped
+    def uf(mbs, t, item, u, u_t):
+        return on_engine_values(u, u_t, t)
+    return uf
 
 
 def _build(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict) -> _System:
@@ -677,16 +672,8 @@ class ExudynBackend(Backend):
         (computeInitialAccelerations off for driven runs). Returns lam (the solver records
         zero multipliers for the sample at t = 0)."""
         mass, rhs = self._mass_and_rhs(system, explicit=False)
-        n = len(mass)
-        acc = np.zeros(n)
-        held = [d.motion.index for d in system.driven]
-        for d in system.driven:
-            acc[d.motion.index] = d.motion.acceleration(0.0) / d.scale
-        free = [i for i in range(n) if i not in held]
-        if free:
-            acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
-                                        rhs[free] - mass[np.ix_(free, held)] @ acc[held])
-        lam = rhs[held] - (mass @ acc)[held]
+        acc, lam = prescribed_start(mass, rhs, {d.motion.index: d.motion.acceleration(0.0)
+                                                / d.scale for d in system.driven})
         initial = system.exu.ConfigurationType.Initial
         system.mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
         system.mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
@@ -956,8 +943,8 @@ class ExudynBackend(Backend):
     def _on_constraint_manifold(self, system: _System, q_eq: np.ndarray, M: np.ndarray,
                                 K: np.ndarray, D: np.ndarray, eps: float
                                 ) -> tuple[np.ndarray, str, dict]:
-        """(eigenvalues, method, extra): the linearization on the constraint manifold from the engine's own matrices: M, K,
-        D of the tree (``ComputeLinearizedSystem``, Richardson as above), the constraint
+        """(eigenvalues, method, extra): the linearization on the constraint manifold
+        (`constraint_manifold_eigenvalues`) from the engine's own matrices: M, K, D of the tree (``ComputeLinearizedSystem``, Richardson as above), the constraint
         Jacobian C (n x m, Exudyn's ``ComputeJacobianAE``), the static multipliers from
         the engine's forces (C lam = f at the equilibrium) and the constraint stiffness
         d(C lam)/du by central differences of Exudyn's C; then the null-space projection
@@ -986,26 +973,8 @@ class ExudynBackend(Backend):
             helper.FinalizeSolver(mbs, sim)
             return f, C
 
-        f, C = forces_and_jacobian(u_eq)
-        lam = np.linalg.lstsq(C, f, rcond=None)[0]
-        residual = float(np.max(np.abs(C @ lam - f), initial=0.0))
         step = float(cfg["linearization_constraint_step"])
-        H = np.zeros((n, n))
-        for k in range(n):
-            e = np.zeros(n)
-            e[k] = step
-            H[:, k] = (forces_and_jacobian(u_eq + e)[1] - forces_and_jacobian(u_eq - e)[1]) @ lam
-        H /= 2 * step
-        U, sv, _ = np.linalg.svd(C)
-        rank = int(np.sum(sv > 1e-12 * max(1.0, float(np.max(sv, initial=0.0)))))
-        N = U[:, rank:]
-        Mn, Kn, Dn = N.T @ M @ N, N.T @ (K + H) @ N, N.T @ D @ N
-        eig = quadratic_eigenvalues(Mn, Dn, Kn)
-        # a rigid mode (belt pulleys) has a structurally zero eigenvalue; the projection
-        # leaves ~1e-15 |s| of round-off in it, which would read as a tiny frequency
-        tiny = 1e-12 * max(float(np.max(np.abs(eig), initial=0.0)), 1e-300)
-        eig = np.where(np.abs(eig.real) <= tiny, 0.0, eig.real) + 1j * np.where(
-            np.abs(eig.imag) <= tiny, 0.0, eig.imag)
+        eig, found = constraint_manifold_eigenvalues(M, K, D, forces_and_jacobian, u_eq, step)
         how = ("Richardson-extrapolated forward differences"
                if cfg["linearization_richardson"] else "one forward difference")
         method = ("exudyn tree M, K, D (mbs.ComputeLinearizedSystem, K and D by " + how
@@ -1015,8 +984,7 @@ class ExudynBackend(Backend):
                   "ComputeODE2Eigenvalues, first-order eigenproblem")
         return eig, method, {"coordinates": "null space of the engine's constraint Jacobian "
                                             "(eigenvalues are invariant)",
-                             "relative_epsilon": eps, "constraint_step": step, "multipliers": lam.tolist(),
-                             "equilibrium_residual": residual, "constraint_rank": rank}
+                             "relative_epsilon": eps, **found}
 
     # --- flexible elements (contract point 12) ----------------------------------------------
     BEAM_ELEMENTS = {

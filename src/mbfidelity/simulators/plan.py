@@ -316,6 +316,21 @@ class CoordinateLaws:
         return Q
 
 
+    def on_engine_values(self, T: np.ndarray, c: np.ndarray
+                         ) -> Callable[[Sequence[float], Sequence[float], float], list]:
+        """The generalized force on engine joint values u (q = T u + c) as a function of
+        (u, u', t): T^T Q(T u + c, T u', t), or Q itself where the engine's values are the
+        description's coordinates (T = I, c = 0)."""
+        if np.array_equal(T, np.eye(self.n)) and not np.any(c):
+            return self.generalized
+
+        def mapped(u, u_t, t: float) -> list:
+            Q = self.generalized(T @ np.asarray(u) + c, T @ np.asarray(u_t), t)
+            return (T.T @ np.asarray(Q)).tolist()
+
+        return mapped
+
+
 _LAWS: dict[object, ForceLaw] = {}
 
 
@@ -371,6 +386,24 @@ def driven_start(mech: Mechanism, q0, qd0) -> tuple[np.ndarray, np.ndarray]:
     for motion in motions(mech):
         q0[motion.index], qd0[motion.index] = motion.position(0.0), motion.rate(0.0)
     return q0, qd0
+
+
+def prescribed_start(mass: np.ndarray, rhs: np.ndarray, prescribed: Mapping[int, float]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """(accelerations, multipliers) at the start of a driven run that meet the prescribed
+    accelerations u_p'' (`prescribed`: coordinate index -> u_p'') of a system M u'' +
+    C^T lam = f whose prescribed coordinates are held by constraints C = e_p^T: the free
+    ones from M_ff u_f'' = f_f - M_fp u_p'', and lam_p = f_p - (M u'')_p (M, f: the
+    engine's mass matrix and right-hand side at the initial state)."""
+    acc = np.zeros(len(mass))
+    held = list(prescribed)
+    for index, value in prescribed.items():
+        acc[index] = value
+    free = [i for i in range(len(mass)) if i not in held]
+    if free:
+        acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
+                                    rhs[free] - mass[np.ix_(free, held)] @ acc[held])
+    return acc, rhs[held] - (mass @ acc)[held]
 
 
 def coupled(mech: Mechanism) -> Mechanism:
