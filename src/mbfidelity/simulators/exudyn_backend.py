@@ -83,7 +83,7 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    axis_aligned, constrained_bodies, coordinate_map, driven_start,
                    gravity_vector, link_axis, link_frames, massive_below, num, prescribed_start, rot, rot_z,
                    spatial_tree_reason, turned)
-from .reactions import subtree_force
+from .reactions import subtree_bodies, subtree_newton
 
 #: order of accuracy of the fixed-step solvers offered through the "solver" setting
 #: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
@@ -118,15 +118,13 @@ _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 @dataclass
 class _ClosureItem:
     """One closure constraint as built in Exudyn: its object, the output its sensor reads
-    ("Force" or "ForceLocal"), how that output maps to the contract's physical terms
-    (sensor rows, engine values u -> force), and whether the force acts between two
-    points (a pair force of the reactions) or on the coordinates (a coupling's)."""
+    ("Force" or "ForceLocal") and how that output maps to the contract's physical terms
+    (sensor rows, engine values u -> force)."""
 
     name: str
     obj: int
     output: str
     force: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    pair: bool = True
 
 
 @dataclass
@@ -407,7 +405,7 @@ def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
     # its Force is the multiplier, entering as Phi_u^T lam as in the description (Phi
     # identical): the generalized force is -lam
     system.closures.append(_ClosureItem(c.name, obj, "Force",
-                                        lambda data, u: -data[:, 1:2].copy(), pair=False))
+                                        lambda data, u: -data[:, 1:2].copy()))
 
 
 @_builds(
@@ -767,13 +765,10 @@ class ExudynBackend(Backend):
         s_ut = system.sensor("SensorNode", nodeNumber=system.node,
                              outputVariableType=ovt.Coordinates_t)
         # centre-of-mass accelerations of every massive body below a requested joint
-        acc_bodies = {b for name in reaction_joints
-                      for b in mechanism.subtree(mechanism.joint(name).child)
-                      if num(mechanism.body(b).mass) != 0}
         s_acc = {b: system.sensor("SensorKinematicTree", objectNumber=system.tree,
                                   linkNumber=geo.link_of[b], localPosition=list(geo.com[b]),
                                   outputVariableType=ovt.Acceleration)
-                 for b in sorted(acc_bodies)}
+                 for b in subtree_bodies(mechanism, reaction_joints)}
 
         def force_sensor(obj: int, output: str = "Force") -> int:
             return system.sensor("SensorObject", objectNumber=obj,
@@ -815,13 +810,10 @@ class ExudynBackend(Backend):
             acc[b][0] = a0
         # Newton on each subtree: every element force from outside is taken out;
         # Exudyn's connector force is the force on marker 0 (body_a)
-        newton = {name: subtree_force(mechanism, name, t, acc) for name in reaction_joints}
-        pairs = {**{name: system.stored(s)[:, 1:3] for name, s in s_conn.items()},
-                 **{c.name: constraint_forces[c.name] for c in closures if c.pair}}
-        couplings = {c.name: constraint_forces[c.name] for c in closures if not c.pair}
+        connectors = {name: system.stored(s)[:, 1:3] for name, s in s_conn.items()}
         return Samples(q, qd, clock, constraint_forces=constraint_forces,
-                       actuator_forces=actuator_forces, transmitted=newton, pair_forces=pairs,
-                       coupling_forces=couplings)
+                       actuator_forces=actuator_forces, **subtree_newton(
+                           mechanism, reaction_joints, t, acc, connectors, constraint_forces))
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:

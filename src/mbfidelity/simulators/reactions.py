@@ -87,6 +87,32 @@ def subtree_force(mech: Mechanism, joint_name: str, t: np.ndarray,
     return total
 
 
+
+def subtree_bodies(mech: Mechanism, joints: Sequence[str]) -> list[str]:
+    """The bodies with mass in the child subtrees of `joints`, sorted: those whose
+    centre-of-mass accelerations `subtree_force` needs."""
+    return sorted({b for name in joints for b in mech.subtree(mech.joint(name).child)
+                   if num(mech.body(b).mass) != 0})
+
+
+def subtree_newton(mech: Mechanism, joints: Sequence[str], t: np.ndarray,
+                   accelerations: Mapping[str, np.ndarray],
+                   element_forces: Mapping[str, np.ndarray],
+                   constraint_forces: Mapping[str, np.ndarray]) -> dict[str, dict]:
+    """The reactions' part of `base.Samples` for an engine that measures its bodies'
+    centre-of-mass `accelerations`: per joint the Newton force of the child's subtree
+    (`subtree_force`) as `transmitted`, and the forces from outside that it holds, by the
+    module's sign convention: the point-to-point elements' (`element_forces`) and the
+    pair closures' among `constraint_forces` as `pair_forces`, the couplings' (the other
+    closures) as `coupling_forces`."""
+    pairs = pair_element_names(mech)
+    return {"transmitted": {name: subtree_force(mech, name, t, accelerations)
+                            for name in joints},
+            "pair_forces": {**element_forces, **{name: f for name, f in
+                                                 constraint_forces.items() if name in pairs}},
+            "coupling_forces": {name: f for name, f in constraint_forces.items()
+                                if name not in pairs}}
+
 def slide_generalized_force(mech: Mechanism, joint: Prismatic, t: np.ndarray,
                             q: np.ndarray, qd: np.ndarray,
                             coupling_forces: Mapping[str, np.ndarray]) -> np.ndarray:
