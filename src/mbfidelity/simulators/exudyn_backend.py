@@ -2,61 +2,45 @@
 
 Translation (generic over the description, conventions 1-8 of `systems.model`). Each
 element kind has one builder, registered with the expressions it declares (`_builds`;
-`EXPRESSIONS` is read from that registry):
+`EXPRESSIONS` is read from that registry; each declaration names the Exudyn item built):
 
-- every joint becomes one link of one kinematic tree, in joint order (parents come first);
-  `Revolute` -> ``RevoluteZ``, `Prismatic` -> ``PrismaticX`` with the joint frame turned so
-  that its x axis is the prismatic axis. Each link frame sits at the joint point of its
-  body with orientation ``theta_body + beta`` (beta = 0 for revolute children, the axis
-  angle minus the angle offset for prismatic children); the centre of mass is placed in
-  that frame, so the description's body frames are reproduced exactly;
+- every joint becomes one link of one kinematic tree, in joint order, its frames the
+  shared ones (`plan.LinkFrames`: at the joint, a slide's joint frame turned to its axis):
+  `Revolute` -> ``RevoluteZ``, `Prismatic` -> ``PrismaticX``; a spatial mechanism (model
+  convention 10) gets RevoluteX/Y/Z (PrismaticX/Y/Z) links with the full 3 x 3 central
+  tensor in ``linkInertiasCOM`` (stored as given: `stored_inertia`);
 - the engine's joint values ``u`` are relative; description coordinates are the shared
   affine map ``q = T u + c`` (`plan.CoordinateMap`), generalized forces map with ``T^T``;
-- massless link bodies are kept as zero-mass links (the tree accepts them while the
-  mass matrix stays regular, i.e. while a massive descendant carries the coordinates, or
-  while a closure constraint holds them: the augmented matrix [M C^T; C 0] is regular);
-- a spatial mechanism (model convention 10; open trees of massive bodies on relative
-  counter-clockwise hinges about a link axis, without offset) gets RevoluteX/Y/Z links
-  whose frames sit at the joints, aligned with their parents, with the full 3 x 3
-  central tensor in ``linkInertiasCOM`` (stored as given: `stored_inertia`);
-- gravity is the tree's own gravity vector; a `CoordinateForce` whose law is affine in
-  COORD/COORD_RATE and free of TIME uses the tree's PD terms (C++), any other law is a
-  Python ``forceUserFunction`` of the tree (called at every integrator stage with the
-  stage time); a `PointToPoint` element is an ``ObjectConnectorSpringDamper`` between
-  markers (native stiffness/damping/force when the law is affine in LENGTH/LENGTH_RATE,
-  a ``springForceUserFunction`` otherwise);
+- massless bodies are zero-mass links, gravity is the tree's own gravity vector, affine
+  laws use Exudyn's own terms (C++) and any other law a Python user function called at
+  every integrator stage with the stage time;
 - every step is sampled by in-memory sensors (write period dt/2, so each step is recorded
   exactly once), and Exudyn's C++ loop runs without Python stepping;
 - reactions: the tree has no joint-force output, so the force parent -> child is Newton's
-  law on the child's subtree (`reactions`), with the engine's centre-of-mass
-  accelerations (kinematic tree sensors, end-of-step accelerations), minus the element
-  and closure forces that enter the subtree from outside. The solvers record zero
-  accelerations at t = 0, so that sample uses the engine's mass matrix and right-hand
-  side at the initial state (constrained runs: the implicit solver's consistent ones);
+  law on the child's subtree (`reactions.subtree_newton`), with the engine's
+  centre-of-mass accelerations (kinematic tree sensors, end-of-step accelerations). The
+  solvers record zero accelerations at t = 0, so that sample uses the engine's mass
+  matrix and right-hand side at the initial state (constrained runs: the implicit
+  solver's consistent ones);
 - linearization: `mbs.ComputeLinearizedSystem` (exact M; K and D from Exudyn's
   forward-difference Jacobian, taken at two steps and Richardson-extrapolated), then the
   first-order eigenproblem with damping (all 2n eigenvalues); with closure constraints on
-  the constraint manifold: Exudyn's constraint Jacobian C, the static multipliers C lam =
-  f, the constraint stiffness d(C lam)/du by central differences of C, and the null-space
-  projection of ``ComputeODE2Eigenvalues`` (which alone omits d(C lam)/du).
+  the constraint manifold from Exudyn's constraint Jacobian
+  (`base.constraint_manifold_eigenvalues`; ``ComputeODE2Eigenvalues`` alone omits the
+  constraint stiffness d(C lam)/du).
 
-Closure constraints (`PointOnPoint` -> ``ObjectJointRevolute2D``, `PointOnLine` ->
-``ObjectJointPrismatic2D`` with the rotation free, `LinearCoupling` ->
-``ObjectConnectorCoordinateVector`` on the tree's coordinates) stay on the tree and are
-exact (index-3 algebraic equations, met to round-off); each builder says how its engine
-force maps to the contract's. Explicit solvers cannot run algebraic equations, so a
-constrained mechanism runs ``constrained_solver`` (GeneralizedAlpha, rho 0.9, or
-TrapezoidalIndex2; order 2).
+Closure constraints stay on the tree and are exact (index-3 algebraic equations, met to
+round-off); each builder says how its engine force maps to the contract's. Explicit
+solvers cannot run algebraic equations, so a constrained mechanism runs
+``constrained_solver`` (GeneralizedAlpha, rho 0.9, or TrapezoidalIndex2; order 2).
 
 Prescribed motion (convention 9) is an algebraic equation on the tree as well: each
-prescribed coordinate, one engine joint value q = scale u_p + shift, is held by an
-``ObjectConnectorCoordinate`` whose offset user functions give q(t), q'(t) (`plan.Motion`,
-symbolic derivatives) at the solver's own times; the prescribed coordinates start on the
-motion whatever the initial state says. Exudyn's explicit solvers silently ignore the
-offset, so a driven mechanism runs the implicit ``driven_solver``, started from consistent
-accelerations and multipliers the backend computes (Exudyn's own leave the constraints'
-time terms out: `_consistent_start`). The actuator force is -lam / scale (virtual work);
-reactions of a driven prismatic joint exclude it along the slide, like a coordinate force.
+prescribed coordinate, one engine joint value, is held by a coordinate constraint whose
+offset user functions give q(t), q'(t) at the solver's own times. Exudyn's explicit
+solvers silently ignore the offset, so a driven mechanism runs the implicit
+``driven_solver``, started from consistent accelerations and multipliers the backend
+computes (`_consistent_start`). The actuator force is -lam / scale (virtual work); it acts
+through the joint, so the reactions include it (`reactions`).
 """
 from __future__ import annotations
 
@@ -80,8 +64,8 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, LinkFrames, Motion,
-                   axis_aligned, constrained_bodies, coordinate_map, driven_start,
-                   gravity_vector, link_axis, link_frames, massive_below, num, prescribed_start, rot, rot_z,
+                   axis_aligned, driven_start, gravity_vector, held_below, link_axis,
+                   link_frames, num, one_joint_value, prescribed_start, rot, rot_z,
                    spatial_tree_reason, turned)
 from .reactions import subtree_bodies, subtree_newton
 
@@ -156,8 +140,7 @@ _builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
                            "descendant carries its coordinates, or a closure constraint holds "
                            "it (augmented matrix [M C^T; C 0])",
                     when="a massive body below it, or a constraint on its subtree",
-                    applies=lambda mech, body: massive_below(mech, body) or bool(
-                        constrained_bodies(mech) & set(mech.subtree(body.name)))),
+                    applies=held_below),
          Expression(UNSUPPORTED, "it carries no mass and no constraint holds it: the "
                                  "kinematic tree's mass matrix would be singular",
                     when="only massless bodies below it, none constrained"))
@@ -416,9 +399,7 @@ def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
                       "accelerations; actuator force -multiplier / scale; order 2 "
                       "(TrapezoidalIndex2) in the coordinates and the force",
                when="the prescribed coordinate is one engine joint value",
-               # its row of q = T u + c has one entry (T is triangular, its diagonal whole)
-               applies=lambda mech, prescribed: np.count_nonzero(coordinate_map(mech).T[
-                   mech.coordinates.index(prescribed.coordinate)]) == 1),
+               applies=one_joint_value),
     Expression(UNSUPPORTED, "an absolute angle on a turning parent is a combination of "
                             "engine joint values, which Exudyn's coordinate constraint (one "
                             "coordinate, time offset) cannot hold",

@@ -226,6 +226,14 @@ def massive_below(mech: Mechanism, body: Body) -> bool:
     return any(not mech.body(b).massless for b in mech.subtree(body.name))
 
 
+
+def held_below(mech: Mechanism, body: Body) -> bool:
+    """Some body of the subtree from `body` (itself included) has mass or is acted on by a
+    closure constraint (`constrained_bodies`): what keeps a massless link's coordinates
+    determined in a tree of relative joints (an `Expression.applies` condition)."""
+    return massive_below(mech, body) or bool(
+        constrained_bodies(mech) & set(mech.subtree(body.name)))
+
 def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
     """(kind, element) for every element of the description, in description order."""
     for group in (mech.bodies, mech.joints, mech.forces, mech.constraints, mech.prescribed):
@@ -378,6 +386,15 @@ def motions(mech: Mechanism) -> list[Motion]:
     """The prescribed motions of a numeric mechanism, in description order."""
     return [Motion(p, mech.coordinates.index(p.coordinate)) for p in mech.prescribed]
 
+
+
+def one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
+    """Whether a prescribed coordinate is one engine joint value, q_k = T_kk v_k + c_k (not
+    a combination of them, as an absolute angle on a turning parent is): its row of
+    v = A q + b has one entry, and then so has its row of T = A^-1 (A is triangular with
+    a whole diagonal). An `Expression.applies` condition."""
+    i = mech.coordinates.index(prescribed.coordinate)
+    return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
 
 def driven_start(mech: Mechanism, q0, qd0) -> tuple[np.ndarray, np.ndarray]:
     """The initial state (copies) with each prescribed coordinate on its motion at t = 0
