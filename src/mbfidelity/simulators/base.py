@@ -387,6 +387,18 @@ class BeamModes:
     resolution: list[float] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
 
+    @classmethod
+    def from_squared(cls, omega2, count: int, method: str, extra: dict) -> "BeamModes":
+        """The first `count` frequencies from all squared circular frequencies omega^2 of
+        a dense symmetric eigensolver, each with its round-off: about eps omega_max^2 in
+        omega_k^2, relative eps omega_max^2 / omega_k^2 (taken for omega_k as well,
+        conservatively)."""
+        omega2 = np.sort(np.asarray(omega2, dtype=float))
+        count = min(count, len(omega2))
+        roundoff = [float(np.finfo(float).eps * omega2[-1] / w2) for w2 in omega2[:count]]
+        return cls([float(math.sqrt(w2) / (2 * math.pi)) for w2 in omega2[:count]], method,
+                   roundoff, extra)
+
 
 #: the key of the one unsupported entry of an engine without flexible elements
 NO_BEAM_ELEMENT = "none"
@@ -555,6 +567,23 @@ class Backend(ABC):
         for key, value in out.extras.items():
             setattr(run, key, value)
         return run
+
+    def export_start(self, initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]]
+                     ) -> tuple[str, np.ndarray, np.ndarray]:
+        """(scenario, q0, qd0): the first initial state, the one an exported script starts
+        from; ValueError when none is given."""
+        if not initial_states:
+            raise ValueError("the script starts from a scenario's initial state: none given")
+        name, (q0, qd0) = next(iter(initial_states.items()))
+        return name, q0, qd0
+
+    def script_title(self, engine: str, scenario: str, cfg: Mapping, detail: str = "") -> str:
+        """The title of an exported script: the engine and its version, the scenario whose
+        initial state it starts from (`detail` appended to that sentence) and the backend
+        settings, one per line."""
+        return (f"The mechanism as mbfidelity builds it in {engine} {self.version()}, from "
+                f"the initial state of scenario {scenario!r}{detail}.\nBackend settings:\n"
+                + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items()))
 
     def bare_loop(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                   dt: float, settings: Mapping | None = None) -> float:

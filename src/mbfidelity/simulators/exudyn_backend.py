@@ -44,8 +44,6 @@ through the joint, so the reactions include it (`reactions`).
 """
 from __future__ import annotations
 
-import math
-import time
 from dataclasses import dataclass, field
 from functools import singledispatch
 from typing import Callable, Mapping, Sequence
@@ -64,8 +62,8 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, LinkFrames, Motion,
-                   axis_aligned, driven_start, gravity_vector, held_below, link_axis,
-                   link_frames, num, one_joint_value, prescribed_start, rot, rot_z,
+                   axis_aligned, coupling_row, driven_start, gravity_vector, held_below,
+                   link_axis, link_frames, num, one_joint_value, prescribed_start, rot_z,
                    spatial_tree_reason, turned)
 from .reactions import subtree_bodies, subtree_newton
 
@@ -127,8 +125,8 @@ class _DrivenItem:
 # --- element builders, registered per element kind with their expressions ------------------
 
 #: element kind -> (its builder, the expressions it declares: contract point 5). A body's
-#: builder gives its link's mass and central tensor, a joint's its link frame, any other
-#: element's adds its items to the `_System` being built.
+#: builder gives its link's mass and central tensor, a joint's its Exudyn joint type, any
+#: other element's adds its items to the `_System` being built.
 _ELEMENTS = ElementBuilders()
 _builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
 
@@ -325,15 +323,14 @@ def _native_spring_damper(f: PointToPoint, system: _System) -> None:
                                                     "engine coordinate, otherwise the tree's "
                                                     "forceUserFunction"))
 def _pd_terms(f: CoordinateForce, system: _System) -> None:
-    law = system.native(f)
     # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
-    target = system.geo.cmap.law_target(f.weights(system.mech.coordinates))
-    if law is None or target is None:
+    spring = system.geo.cmap.joint_spring(f.weights(system.mech.coordinates), system.native(f))
+    if spring is None:
         return _user_law(f, system)
-    (j, s), (a0, ax, av) = target, law
-    system.force[j] += s * a0
-    system.P[j] += -s * s * ax
-    system.D[j] += -s * s * av
+    j, force, stiffness, damping = spring
+    system.force[j] += force
+    system.P[j] += stiffness
+    system.D[j] += damping
 
 
 @_builds(POINT_ON_POINT, Expression(EXACT, "ObjectJointRevolute2D: index-3 algebraic "
@@ -351,9 +348,7 @@ def _revolute_2d(c: PointOnPoint, system: _System) -> None:
                                           "exact pin in slot"))
 def _prismatic_2d(c: PointOnLine, system: _System) -> None:
     geo = system.geo
-    d = np.array([num(v) for v in c.direction])
-    d = d / float(np.hypot(*d))
-    normal_local = rot(-geo.beta[c.line_body]) @ np.array([-d[1], d[0]])  # the slot normal
+    normal_local = geo.local_normal(c.line_body, c.direction)  # the slot normal
     # Exudyn: (p1 - p0) . A1 n1 = 0, p0 the pin, p1 the slot point
     obj = system.mbs.AddObject(system.items.ObjectJointPrismatic2D(
         markerNumbers=[system.marker(c.body, c.point, rigid=True),
@@ -374,10 +369,8 @@ def _prismatic_2d(c: PointOnLine, system: _System) -> None:
                                             "the coupling stays linear)"))
 def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
     mbs, items = system.mbs, system.items
-    a = np.zeros(system.geo.n)
-    for name, coef in c.coefficients:
-        a[system.mech.coordinates.index(name)] += num(coef)
-    row, constant = system.geo.cmap.on_engine_values(a, num(c.constant))  # row . u = constant
+    # row . u = constant
+    row, constant = system.geo.cmap.on_engine_values(*coupling_row(system.mech, c))
     node_marker, ground_marker = system.once("coordinate markers", lambda: (
         mbs.AddMarker(items.MarkerNodeCoordinates(nodeNumber=system.node)),
         mbs.AddMarker(items.MarkerNodeCoordinates(nodeNumber=system.ground_node()))))
@@ -452,9 +445,7 @@ def _build(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict) -> _Syst
     import exudyn.itemInterface as items
 
     geo = link_frames(mech)
-    Tinv = np.linalg.inv(geo.cmap.T)
-    u0 = Tinv @ (np.asarray(q0, dtype=float) - geo.cmap.c)
-    ud0 = Tinv @ np.asarray(qd0, dtype=float)
+    u0, ud0 = geo.values(q0, qd0)
     SC = exu.SystemContainer()
     system = _System(exu, items, SC, SC.AddSystem(), mech, geo, cfg)
     system.node = system.mbs.AddNode(items.NodeGenericODE2(
@@ -694,9 +685,7 @@ class ExudynBackend(Backend):
         out of the items and listed."""
         from .script_export import exudyn_script
 
-        if not initial_states:
-            raise ValueError("the script starts from a scenario's initial state: none given")
-        name, (q0, qd0) = next(iter(initial_states.items()))
+        name, q0, qd0 = self.export_start(initial_states)
         cfg, _ = self._run_frame(mechanism, 1.0, dt, settings)  # support and settings
         solver = self._solver_for(mechanism, cfg)
         system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
@@ -717,9 +706,7 @@ class ExudynBackend(Backend):
                            "consistent start the harness computes: "
                            + ", ".join(p.name for p in mechanism.prescribed))
         text = exudyn_script(
-            title=(f"The mechanism as mbfidelity builds it in Exudyn {self.version()}, from "
-                   f"the initial state of scenario {name!r}, solver {solver}.\nBackend "
-                   f"settings:\n" + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
+            title=self.script_title("Exudyn", name, cfg, f", solver {solver}"),
             items=items, simulation=sim.GetDictionary(), solver=solver, node=int(system.node),
             coordinates=coordinates, T=system.geo.cmap.T, c=system.geo.cmap.c, dt=dt,
             not_in_script=outside)
@@ -917,10 +904,10 @@ class ExudynBackend(Backend):
                                 K: np.ndarray, D: np.ndarray, eps: float
                                 ) -> tuple[np.ndarray, str, dict]:
         """(eigenvalues, method, extra): the linearization on the constraint manifold
-        (`constraint_manifold_eigenvalues`) from the engine's own matrices: M, K, D of the tree (``ComputeLinearizedSystem``, Richardson as above), the constraint
-        Jacobian C (n x m, Exudyn's ``ComputeJacobianAE``), the static multipliers from
-        the engine's forces (C lam = f at the equilibrium) and the constraint stiffness
-        d(C lam)/du by central differences of Exudyn's C; then the null-space projection
+        (`constraint_manifold_eigenvalues`) from the engine's own matrices: M, K, D of the
+        tree (``ComputeLinearizedSystem``, Richardson as above), the constraint Jacobian C
+        (n x m, Exudyn's ``ComputeJacobianAE``) and Exudyn's forces f, which give the
+        static multipliers and the constraint stiffness; then the null-space projection
         Exudyn's ``ComputeODE2Eigenvalues`` uses. (``ComputeODE2Eigenvalues`` itself has no
         d(C lam)/du term: the loaded slot of the eccentric cam came out 2.7 % low.)"""
         exu, mbs, cfg, cmap = system.exu, system.mbs, system.cfg, system.geo.cmap
@@ -1022,21 +1009,13 @@ class ExudynBackend(Backend):
         # node coordinates: ANCF (x, y, x', y'), geometrically exact (x, y, theta)
         axial = first + ([i + 2 for i in first] if kind == ANCF_CABLE else [])
         held = sorted(set(axial + [first[0] + 1, first[-1] + 1]))
-        t0 = time.process_time()
-        omega2, _ = mbs.ComputeODE2Eigenvalues(constrainedCoordinates=held)
-        cpu = time.process_time() - t0
-        omega2 = np.sort(np.asarray(omega2, dtype=float))
-        count = min(count, len(omega2))
-        # a dense symmetric eigensolver's round-off in omega_k^2 is about eps omega_max^2,
-        # relative eps omega_max^2 / omega_k^2 (taken for omega_k as well, conservatively)
-        roundoff = [float(np.finfo(float).eps * omega2[-1] / w2) for w2 in omega2[:count]]
-        return BeamModes(
-            [float(math.sqrt(w2) / (2 * math.pi)) for w2 in omega2[:count]],
-            "exudyn mbs.ComputeODE2Eigenvalues (dense, constrained coordinates: supports "
-            "and axial coordinates held)",
-            roundoff,
+        with Stopwatch() as clock:
+            omega2, _ = mbs.ComputeODE2Eigenvalues(constrainedCoordinates=held)
+        return BeamModes.from_squared(
+            omega2, count, "exudyn mbs.ComputeODE2Eigenvalues (dense, constrained "
+            "coordinates: supports and axial coordinates held)",
             {"coordinates": len(omega2),
-             "axial_stiffness": EA, "cpu_time": cpu,
+             "axial_stiffness": EA, "cpu_time": clock.cpu,
              **({"shear_stiffness": _GE_SHEAR_FACTOR * EI / l**2,
                  "rotary_inertia_per_length": _GE_ROTARY_FACTOR * rho * l**2}
                 if kind == GEOMETRICALLY_EXACT else {})})

@@ -560,6 +560,18 @@ class CoordinateMap:
             return None
         return int(target[0]), float(row[target[0]])
 
+    def joint_spring(self, weights: dict[int, int], linear: tuple[float, float, float] | None
+                     ) -> tuple[int, float, float, float] | None:
+        """(j, force, stiffness, damping) where a linear coordinate law F = a + b COORD +
+        c COORD' (`linear`; None: not linear) acts on one engine joint value, COORD = r v_j
+        (`law_target`): tau_j = r F(r v_j, r v_j') = force - stiffness v_j - damping v_j'
+        with force = r a, stiffness = -r^2 b, damping = -r^2 c; None otherwise."""
+        target = self.law_target(weights)
+        if linear is None or target is None:
+            return None
+        (j, r), (a, b, c) = target, linear
+        return j, r * a, -r * r * b, -r * r * c
+
     def on_engine_values(self, coefficients: np.ndarray, constant: float
                          ) -> tuple[np.ndarray, float]:
         """A linear relation sum a_k q_k = C on the coordinates written on the engine
@@ -1511,6 +1523,20 @@ class LinkFrames:
         """Joint values and rates (rows) -> the description's coordinates and rates."""
         T = self.cmap.T
         return u @ T.T + self.cmap.c, ut @ T.T
+
+    def values(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+        """The description's coordinates and rates (one state) -> joint values and rates,
+        by the inverse of `coordinates`."""
+        Tinv = np.linalg.inv(self.cmap.T)
+        return (Tinv @ (np.asarray(q, dtype=float) - self.cmap.c),
+                Tinv @ np.asarray(qd, dtype=float))
+
+    def local_normal(self, body: str, direction) -> np.ndarray:
+        """The unit normal (turned +90 degrees) of a planar body-frame direction, in the
+        body's link frame (2 components)."""
+        d = np.array([num(v) for v in direction])
+        d = d / float(np.hypot(*d))
+        return rot(-self.beta[body]) @ np.array([-d[1], d[0]])
 
 
 def joint_frame_turn(mech: Mechanism, joint: Revolute | Prismatic) -> tuple[float, float]:
