@@ -258,9 +258,10 @@ class _System:
                          jointVelocityOffsetVector=[0.0] * n)
         if np.any(self.force):
             terms.update(jointForceVector=self.force.tolist())
-        if self.python_laws:
-            terms.update(forceUserFunction=_coordinate_user_function(
-                self.geo, CoordinateLaws(self.mech, self.python_laws)))
+        if self.python_laws:  # their generalized force on the engine coordinates, T^T Q
+            law = CoordinateLaws(self.mech, self.python_laws).on_engine_values(
+                self.geo.cmap.T, self.geo.cmap.c)
+            terms.update(forceUserFunction=lambda mbs, t, item, u, u_t: law(u, u_t, t))
         for key, value in terms.items():
             self.mbs.SetObjectParameter(self.tree, key, value)
 
@@ -291,42 +292,37 @@ def _spring_damper(f: PointToPoint, system: _System, **law) -> None:
 @_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, "ObjectConnectorSpringDamper with a "
                                                   "springForceUserFunction, called at every "
                                                   "integrator stage"))
-@singledispatch
-def _user_law(element, system: _System) -> None:
-    """A law through a Python user function, called at every integrator stage."""
-    raise TypeError(f"no user-function route for {type(element).__name__}")
-
-
-@_user_law.register
-def _(f: PointToPoint, system: _System) -> None:
-    _spring_damper(f, system, springForceUserFunction=_tension_user_function(
-        ForceLaw.of(f).law))
-
-
-@_user_law.register
-def _(f: CoordinateForce, system: _System) -> None:
-    system.python_laws.append(f)
-
-
 @_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, "ObjectConnectorSpringDamper with its own "
                                                   "stiffness, damping and force (C++)"))
-def _native_spring_damper(f: PointToPoint, system: _System) -> None:
-    law = system.native(f)
-    if law is None:
-        return _user_law(f, system)
-    b0, bl, bv = law  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
-    _spring_damper(f, system, stiffness=bl, damping=bv, force=b0)
-
-
 @_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, "the tree's PD terms and joint force "
                                                     "vector (C++) where the coordinate is one "
                                                     "engine coordinate, otherwise the tree's "
                                                     "forceUserFunction"))
-def _pd_terms(f: CoordinateForce, system: _System) -> None:
+@singledispatch
+def _force_element(element, system: _System) -> None:
+    """A force element on the engine's own terms (C++) where its law is affine and free of
+    TIME (`_System.native`), otherwise through a Python user function, called at every
+    integrator stage with the stage time."""
+    raise TypeError(f"no force route for {type(element).__name__}")
+
+
+@_force_element.register
+def _(f: PointToPoint, system: _System) -> None:
+    law = system.native(f)
+    if law is None:
+        return _spring_damper(f, system, springForceUserFunction=_tension_user_function(
+            ForceLaw.of(f).law))
+    b0, bl, bv = law  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
+    _spring_damper(f, system, stiffness=bl, damping=bv, force=b0)
+
+
+@_force_element.register
+def _(f: CoordinateForce, system: _System) -> None:
     # native when COORD is s u_j, one engine coordinate (then Q_u = s F(s u, s u_t))
     spring = system.geo.cmap.joint_spring(f.weights(system.mech.coordinates), system.native(f))
-    if spring is None:
-        return _user_law(f, system)
+    if spring is None:  # the tree's forceUserFunction (`_System.set_tree_forces`)
+        system.python_laws.append(f)
+        return
     j, force, stiffness, damping = spring
     system.force[j] += force
     system.P[j] += stiffness
@@ -425,15 +421,6 @@ def _offset_function(f: Callable[[float], float], scale: float, shift: float):
 def _tension_user_function(law: Callable[..., float]):
     def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
         return law(delta_l, delta_l_t, t)  # referenceLength 0: delta_l is the length
-    return uf
-
-
-def _coordinate_user_function(geo: LinkFrames, laws: CoordinateLaws):
-    """The laws' generalized force on the engine coordinates (T^T Q)."""
-    on_engine_values = laws.on_engine_values(geo.cmap.T, geo.cmap.c)
-
-    def uf(mbs, t, item, u, u_t):
-        return on_engine_values(u, u_t, t)
     return uf
 
 
@@ -636,10 +623,9 @@ class ExudynBackend(Backend):
         their time terms (its documentation: dg/dt 'not implemented'), i.e. as if q''(0)
         were 0; the trapezoidal rule then carries that error as a step-to-step
         alternation of the multiplier that never decays, generalized-alpha as one that
-        decays slowly. Here: u_p'' = q_p''(0) / scale, M_ff u_f'' = f_f - M_fp u_p'' with
-        the engine's M and f at t = 0, lam_p = f_p - (M u'')_p (Exudyn: M u'' + C^T lam =
-        f with C = e_p^T), written into the initial state that the solver starts from
-        (computeInitialAccelerations off for driven runs). Returns lam (the solver records
+        decays slowly. Here: `plan.prescribed_start` with u_p'' = q_p''(0) / scale and the
+        engine's M and f at t = 0, written into the initial state that the solver starts
+        from (computeInitialAccelerations off for driven runs). Returns lam (the solver records
         zero multipliers for the sample at t = 0)."""
         mass, rhs = self._mass_and_rhs(system, explicit=False)
         acc, lam = prescribed_start(mass, rhs, {d.motion.index: d.motion.acceleration(0.0)
@@ -845,7 +831,6 @@ class ExudynBackend(Backend):
                    "ignore the offset function of a CoordinateConstraint, so the "
                    "prescribed coordinate would not move"))
         return solver
-
 
     def _initial_accelerations(self, system: _System, sensors: dict) -> dict[str, np.ndarray]:
         """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
