@@ -629,6 +629,17 @@ class Backend(ABC):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         return None
 
+    def linearization_frame(self, mechanism: Mechanism, settings: Mapping | None
+                            ) -> tuple[dict, Mechanism] | None:
+        """(the resolved settings, the autonomous mechanism: its time loads removed, as
+        the excitation e(t) does not belong to the equilibrium) for `linearize`; None
+        where no linearization is taken: an unsupported mechanism, or a driven one (it
+        moves about a motion, not about an equilibrium)."""
+        cfg = self.resolve_settings(settings)
+        if not self.support(mechanism).ok or mechanism.prescribed:
+            return None
+        return cfg, mechanism.without_time_loads()
+
     #: per kind of the engine's own flexible element, its declaration (contract point 12)
     BEAM_ELEMENTS: ClassVar[Mapping[str, BeamElement]] = {
         NO_BEAM_ELEMENT: BeamElement(Expression(UNSUPPORTED, "no flexible element declared"))}

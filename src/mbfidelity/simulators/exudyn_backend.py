@@ -119,7 +119,6 @@ class _DrivenItem:
     obj: int
     motion: Motion
     scale: float
-    shift: float
 
 
 # --- element builders, registered per element kind with their expressions ------------------
@@ -409,7 +408,7 @@ def _coordinate_constraint(p: Prescribed, system: _System) -> None:
         markerNumbers=[ground_marker, marker],
         offsetUserFunction=_offset_function(motion.position, scale, shift),
         offsetUserFunction_t=_offset_function(motion.rate, scale, 0.0)))
-    system.driven.append(_DrivenItem(p.name, obj, motion, scale, shift))
+    system.driven.append(_DrivenItem(p.name, obj, motion, scale))
 
 
 def _offset_function(f: Callable[[float], float], scale: float, shift: float):
@@ -844,15 +843,13 @@ class ExudynBackend(Backend):
     # --- linearization ---------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        cfg = self.resolve_settings(settings)
-        support = self.support(mechanism)
-        # a driven mechanism moves about a motion, not an equilibrium; Exudyn linearizes
-        # about a static state only (ComputeLinearizedSystem)
-        if not support.ok or mechanism.prescribed:
+        # Exudyn linearizes about a static state only (ComputeLinearizedSystem)
+        frame = self.linearization_frame(mechanism, settings)
+        if frame is None:
             return None
+        cfg, autonomous = frame
         q_eq = np.asarray(q_eq, dtype=float)
-        # the autonomous system: the excitation e(t) does not belong to the equilibrium
-        system = _build(mechanism.without_time_loads(), q_eq, np.zeros_like(q_eq), cfg)
+        system = _build(autonomous, q_eq, np.zeros_like(q_eq), cfg)
         system.mbs.Assemble()
         M, K, D = self._tree_mkd(system.exu, system.mbs, cfg)
         eps = float(cfg["linearization_relative_epsilon"])
