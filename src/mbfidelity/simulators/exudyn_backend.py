@@ -54,7 +54,7 @@ from ..analytic.linear import quadratic_eigenvalues
 from ..systems._continua import Beam
 from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mechanism,
                              PointOnLine, PointOnPoint, PointToPoint, Prescribed, Prismatic,
-                             Revolute, inertia_matrix)
+                             Revolute)
 from .base import (EXACT, RK3_STABILITY, RK4_STABILITY, SOFT, UNSUPPORTED, Backend, BareLoop,
                    BeamElement, BeamModes, ElementBuilders, Expression, Linearization, Samples,
                    Scheme, Setting, Stopwatch, constraint_manifold_eigenvalues)
@@ -62,7 +62,7 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, LinkFrames, Motion,
-                   axis_aligned, coupling_row, driven_start, gravity_vector, held_below,
+                   axis_aligned, central_tensor, coupling_row, driven_start, gravity_vector, held_below,
                    link_axis, link_frames, num, one_joint_value, prescribed_start, rot_z,
                    spatial_tree_reason, turned)
 from .reactions import subtree_bodies, subtree_newton
@@ -142,11 +142,10 @@ _builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
                                  "kinematic tree's mass matrix would be singular",
                     when="only massless bodies below it, none constrained"))
 def _link_inertia(body: Body, mech: Mechanism) -> tuple[float, np.ndarray]:
-    """The link's mass and central tensor (link frame): a spatial body's full 3 x 3
-    tensor, stored as given (`stored_inertia`), a planar body's inertia about z."""
-    if mech.spatial:
-        return num(body.mass), np.array(inertia_matrix(body).tolist(), dtype=float)
-    return num(body.mass), np.diag([0.0, 0.0, num(body.inertia)])
+    """The link's mass and central tensor (`plan.central_tensor`; the link frame is
+    aligned with the body frame: beta = 0 in a spatial tree, and a planar tensor is
+    diagonal about z), stored as given (`stored_inertia`)."""
+    return num(body.mass), central_tensor(mech, body)
 
 
 @_builds(REVOLUTE,
@@ -680,8 +679,7 @@ class ExudynBackend(Backend):
             ("Object", data.NumberOfObjects(), mbs.GetObject),
             ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
             ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
-        sim = self._simulation_settings(system.exu, cfg, 1.0, int(round(1.0 / dt)))
-        self._algebraic_settings(sim, system)
+        sim = self._run_settings(system, 1.0, int(round(1.0 / dt)))
         outside = []
         if mechanism.forces:
             outside.append("the force laws computed in Python user functions: "
@@ -784,24 +782,25 @@ class ExudynBackend(Backend):
         q, qd = system.geo.coordinates(u[None, :], ut[None, :])
         return BareLoop(clock.cpu, q[0], qd[0])
 
-    @staticmethod
-    def _algebraic_settings(sim, system: _System) -> None:
-        """A driven run starts from the consistent accelerations already in its initial
-        state (`_consistent_start`) instead of the implicit solver's own; a run with
-        algebraic equations uses the constrained spectral radius."""
+    def _run_settings(self, system: _System, t_run: float, steps: int):
+        """The simulation settings of a run of the system: a driven run starts from the
+        consistent accelerations already in its initial state (`_consistent_start`)
+        instead of the implicit solver's own; a run with algebraic equations uses the
+        constrained spectral radius."""
+        sim = self._simulation_settings(system.exu, system.cfg, t_run, steps)
         ti = sim.timeIntegration
         ti.generalizedAlpha.computeInitialAccelerations = not system.driven
         if system.closures or system.driven:
             ti.generalizedAlpha.spectralRadius = float(system.cfg["constrained_spectral_radius"])
+        return sim
 
     def _solve(self, system: _System, solver: str, t_run: float, steps: int) -> Stopwatch:
         """SolveDynamic over `steps` steps of the assembled system, timed."""
         import exudyn.solver as exu_solver
 
         solver_type = getattr(system.exu.DynamicSolverType, solver)
-        sim = self._simulation_settings(system.exu, system.cfg, t_run, steps)
+        sim = self._run_settings(system, t_run, steps)
         sim.timeIntegration.solverType = solver_type
-        self._algebraic_settings(sim, system)
         # Python user functions allocate on every call; Exudyn then prints a speed hint
         # after the run. The hint is expected here, so it is silenced for this call only.
         threshold = exu_solver.solverCheckMemoryAllocationsThreshold

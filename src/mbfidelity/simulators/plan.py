@@ -63,6 +63,7 @@ from ..systems.model import (
     Revolute,
     RollingContact,
     compile_law,
+    inertia_matrix,
 )
 
 
@@ -111,6 +112,14 @@ def gravity_vector(mech: Mechanism) -> tuple[float, float, float]:
         return 0.0, -g, 0.0
     up = np.array([num(u) for u in mech.up] + [0.0] * (3 - len(mech.up)), dtype=float)
     return tuple(float(v) for v in -g * up / np.linalg.norm(up))
+
+
+def central_tensor(mech: Mechanism, body: Body) -> np.ndarray:
+    """A body's 3 x 3 central inertia tensor in its frame (numbers): a spatial body's
+    full tensor as given (model convention 10), a planar body's inertia about z."""
+    if mech.spatial:
+        return np.array(inertia_matrix(body).tolist(), dtype=float)
+    return np.diag([0.0, 0.0, num(body.inertia)])
 
 
 def linear_law(expr, x: sp.Symbol, xd: sp.Symbol) -> tuple[float, float, float] | None:
