@@ -623,8 +623,8 @@ class ExudynBackend(Backend):
         alternation of the multiplier that never decays, generalized-alpha as one that
         decays slowly. Here: `plan.prescribed_start` with u_p'' = q_p''(0) / scale and the
         engine's M and f at t = 0, written into the initial state that the solver starts
-        from (computeInitialAccelerations off for driven runs). Returns lam (the solver records
-        zero multipliers for the sample at t = 0)."""
+        from (computeInitialAccelerations off for driven runs). Returns lam (the solver
+        records zero multipliers for the sample at t = 0)."""
         mass, rhs = self._mass_and_rhs(system, explicit=False)
         acc, lam = prescribed_start(mass, rhs, {d.motion.index: d.motion.acceleration(0.0)
                                                 / d.scale for d in system.driven})
