@@ -30,7 +30,11 @@ them and lives here:
   mass (`EliminatedFrames`);
 - a coupling of hinge coordinates on the absolute body angles (`angle_coupling`) and as
   rolling of pitch circles on a carrier (`pitch_pairs`), and small facts a translation
-  asks for (`line_through_origin`, `rotation_fixed`, `effective_mass`).
+  asks for (`line_through_origin`, `rotation_fixed`, `effective_mass`);
+- for an engine with a tree of relative joints, its link frames (`LinkFrames`: one link
+  per joint, its frame at the joint, a slide's joint frame turned to its axis), the
+  conditions such a tree needs (`axis_aligned`, `one_joint_value`, `held_below`) and a
+  driven run's consistent start (`prescribed_start`).
 """
 from __future__ import annotations
 
