@@ -56,7 +56,9 @@ from .plan import (
     coupling_row,
     element_kind,
     elements,
+    foldable_massless,
     gravity_vector,
+    joint_chains,
     length_scale,
     num,
     point_mass,
@@ -275,16 +277,6 @@ _BUILDERS = ElementBuilders()
 _builds = _BUILDERS.builds
 
 
-def _foldable(mech: Mechanism) -> set[str]:
-    """Massless bodies whose joints are folded into their single child (exact). A massless
-    body with another number of child joints, or that a constraint or a point-to-point
-    element refers to, has no such child frame: it becomes a substitute body of small mass
-    (setting ``massless_mass_ratio``)."""
-    used = pair_element_bodies(mech)
-    return {b.name for b in mech.bodies if b.massless and b.name not in used
-            and sum(1 for j in mech.joints if j.parent == b.name) == 1}
-
-
 @_builds(
     BODY,
     Expression(EXACT, "an MJCF body whose frame is the centre-of-mass frame, with an "
@@ -320,7 +312,7 @@ def _body(build: Build, body) -> None:
                       "child's MJCF body, anchors and axes at the reference "
                       "configuration",
                when="one child joint, and no constraint or point force on it",
-               applies=lambda mech, body: body.name in _foldable(mech)),
+               applies=lambda mech, body: body.name in foldable_massless(mech)),
     Expression(SUBSTITUTE, "a body of small mass (link_mass_ratio of the lightest "
                            "body for a kinematic link, massless_mass_ratio where a "
                            "constraint or a point force loads it), weight cancelled: "
@@ -593,24 +585,11 @@ def translate(mech: Mechanism, settings: dict, autonomous: bool = False,
           dt: float | None = None) -> Build:
     """The build of a numeric mechanism under the (resolved) settings; `autonomous`
     leaves the time loads out; `dt`: the step the file is written for."""
-    cmap = coordinate_map(mech)
-    foldable = _foldable(mech)
-    carrier: dict[str, str] = {}
-    for body in reversed([j.child for j in mech.joints]):
-        if body in foldable:
-            child = next(j.child for j in mech.joints if j.parent == body)
-            carrier[body] = carrier[child]
-        else:
-            carrier[body] = body
-    chains: dict[str, list[int]] = {}
-    for i, j in enumerate(mech.joints):
-        chains.setdefault(carrier[j.child], []).append(i)
-    mj_parent = {name: WORLD if mech.joints[chain[0]].parent == WORLD
-                 else carrier[mech.joints[chain[0]].parent] for name, chain in chains.items()}
+    cmap, jc = coordinate_map(mech), joint_chains(mech)
     # the reference configuration of the MJCF: every engine joint value 0
     frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
-    build = Build(mech, cmap, carrier, chains, mj_parent, settings, dt or 0.002,
-                 bool(settings["native_springs"]), autonomous, foldable, frames)
+    build = Build(mech, cmap, jc.carrier, jc.chains, jc.parent, settings, dt or 0.002,
+                  bool(settings["native_springs"]), autonomous, jc.foldable, frames)
     for kind, element in elements(mech):
         _BUILDERS[kind](build, element)
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a

@@ -698,6 +698,54 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool,
     return ""
 
 
+# --- massless bodies folded into joint chains ------------------------------------------
+
+
+def foldable_massless(mech: Mechanism) -> set[str]:
+    """Massless bodies whose joints can be folded into their single child (exact) by an
+    engine whose bodies carry a chain of joints. A massless body with another number of
+    child joints, or that a constraint or a point-to-point element refers to, has no such
+    child frame."""
+    from .reactions import pair_element_bodies  # reactions builds on this module
+
+    used = pair_element_bodies(mech)
+    return {b.name for b in mech.bodies if b.massless and b.name not in used
+            and sum(1 for j in mech.joints if j.parent == b.name) == 1}
+
+
+@dataclass(frozen=True)
+class JointChains:
+    """The joints regrouped for an engine whose bodies carry a chain of joints but that
+    has no massless bodies: each `foldable` body (`foldable_massless`) is folded, its
+    joints join the chain of the body it carries. `carrier`: description body -> the
+    engine body carrying it; `chains`: engine body -> description joint indices, in order
+    (the engine applies a body's joints in order); `parent`: engine body -> its engine
+    parent."""
+
+    foldable: set[str]
+    carrier: dict[str, str]
+    chains: dict[str, list[int]]
+    parent: dict[str, str]
+
+
+def joint_chains(mech: Mechanism) -> JointChains:
+    """The `JointChains` of a mechanism."""
+    foldable = foldable_massless(mech)
+    carrier: dict[str, str] = {}
+    for body in reversed([j.child for j in mech.joints]):
+        if body in foldable:
+            child = next(j.child for j in mech.joints if j.parent == body)
+            carrier[body] = carrier[child]
+        else:
+            carrier[body] = body
+    chains: dict[str, list[int]] = {}
+    for i, j in enumerate(mech.joints):
+        chains.setdefault(carrier[j.child], []).append(i)
+    parent = {name: WORLD if mech.joints[chain[0]].parent == WORLD
+              else carrier[mech.joints[chain[0]].parent] for name, chain in chains.items()}
+    return JointChains(foldable, carrier, chains, parent)
+
+
 # --- planar kinematics on numbers or on arrays of samples ------------------------------
 
 
