@@ -409,7 +409,7 @@ class _ClosureSamples:
                 forces[name] = f[:, :2]
                 violation[name] = np.array([math.hypot(x, y) for x, y in pos[:, :2].tolist()])
             else:
-                # the slider's mass belongs to the pin (mujoco_mjcf._slider_masses): the
+                # the slider's mass belongs to the pin (plan.slider_masses): the
                 # slot's force on pin + slider is the slide joint's force on the slider,
                 # m_s a_s - (weight not cancelled) + (connect force on the pin); MuJoCo's
                 # body accelerations are proper accelerations a - g

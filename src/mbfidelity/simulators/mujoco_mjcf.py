@@ -54,7 +54,6 @@ from .plan import (
     body_states,
     coordinate_map,
     coupling_row,
-    element_kind,
     elements,
     foldable_massless,
     gravity_vector,
@@ -66,6 +65,7 @@ from .plan import (
     ring_of_boxes,
     rolling_geometry,
     rot,
+    slider_masses,
     spatial_tree_reason,
 )
 from .reactions import pair_element_bodies
@@ -458,51 +458,22 @@ def _hinge_closure(build: Build, c: HingeClosure) -> None:
         build.add_site(body, f"{c.name}:axis:{tag}", fmt(*(p + span * n / np.linalg.norm(n))))
 
 
-def _slider_masses(build: Build, pin_body: str) -> None:
-    """The sliders' masses of the slots whose pin is on `pin_body`. The slider follows the
-    pin point, so its mass is taken out of the pin body (mass, centre of mass and inertia
-    adjusted so that body + slider have the description's mass, first and second moments:
-    exact while the constraint holds); it can then be a sizeable fraction of the pin
-    body's mass, which keeps the constraint's rows well conditioned (MuJoCo's
-    regularisation is relative to each world-axis row's diagonal, and a tiny slider mass
-    makes the row along the slot dominate and soften the row across it). A slider on a
-    fixed pin does not move: its weight is cancelled (gravcomp) and its mass is a fraction
-    of the slot body's; a massless pin's substitute carries its sliders."""
-    mech = build.mech
-    ratio = float(build.settings["slider_mass_ratio"])
-    cons = [c for c in mech.constraints
-            if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
-    if pin_body == WORLD:
-        for c in cons:
-            lb = c.line_body
-            heavy = lb != WORLD and not mech.body(lb).massless
-            build.slider_mass[c.name] = ratio * (num(mech.body(lb).mass) if heavy else build.m_min)
-        return
-    if pin_body in build.substitutes:
-        for c in cons:
-            build.slider_mass[c.name] = ratio * build.substitutes[pin_body][0]
-        return
-    body = mech.body(pin_body)
-    pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
-    mp, ip = num(body.mass), num(body.inertia)
-    # the largest point masses at the pins that leave a positive inertia
-    bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
-    masses = [ratio * bound for _ in cons]
-    build.slider_mass.update({c.name: mc for c, mc in zip(cons, masses)})
-    rest = mp - sum(masses)
-    com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
-    inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
-               - rest * float(com @ com))
-    build.inertial[pin_body] = _inertial(rest, inertia, com)
-
-
 @_builds(POINT_ON_LINE, _soft_equality(
     SUBSTITUTE, "no point-on-line equality: a slider body on the slot body (slide joint "
                 "along the slot) connected to the pin, its mass taken out of the pin body "
                 "(exact while the constraint holds); the connect is soft"))
 def _point_on_line(build: Build, c: PointOnLine) -> None:
     if c.name not in build.slider_mass:
-        _slider_masses(build, c.body)
+        # a slider of a sizeable fraction of the pin body's mass keeps the connect's rows
+        # well conditioned: MuJoCo's regularisation is relative to each world-axis row's
+        # diagonal, and a tiny slider mass makes the row along the slot dominate and soften
+        # the row across it
+        substitute = build.substitutes.get(c.body, (None,))[0]
+        split = slider_masses(build.mech, c.body, float(build.settings["slider_mass_ratio"]),
+                              build.m_min, substitute)
+        build.slider_mass.update(split.masses)
+        if split.kept is not None:
+            build.inertial[c.body] = _inertial(*split.kept)
     mass = build.slider_mass[c.name]
     inertia = mass * SLIDER_GYRATION**2
     cl = Closure(c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider")

@@ -1481,6 +1481,51 @@ def rolling_geometry(mech: Mechanism, c: RollingContact) -> RollingGeometry:
                            mech.joints.index(hub), (float(u[0]), float(u[1])))
 
 
+@dataclass(frozen=True)
+class SliderSplit:
+    """The masses of the sliders of the slots whose pin is on one body (`slider_masses`),
+    by slot name, and what the pin body keeps: (mass, planar inertia about its centre of
+    mass, centre of mass in its frame), or None where it keeps its own."""
+
+    masses: dict[str, float]
+    kept: tuple[float, float, np.ndarray] | None
+
+
+def slider_masses(mech: Mechanism, pin_body: str, ratio: float, lightest: float,
+                  substitute: float | None = None) -> SliderSplit:
+    """The point masses of the sliders of the PointOnLine constraints whose pin is on
+    `pin_body`, for an engine that holds a slot by a slider body sliding along it,
+    connected to the pin. The slider follows the pin point, so its mass is taken out of
+    the pin body (mass, centre of mass and inertia adjusted so that body + sliders have
+    the description's mass, first and second moments: exact while the constraints hold):
+    `ratio` times the largest equal point masses at the pins that leave a positive
+    inertia. A slider on a fixed pin does not move: `ratio` times the slot body's mass
+    (`lightest`, the lightest body's, where the slot body is the world or massless); on a
+    massless pin body, `ratio` times its `substitute` mass, which carries the sliders."""
+    cons = [c for c in mech.constraints
+            if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
+    if pin_body == WORLD:
+        masses = {}
+        for c in cons:
+            lb = c.line_body
+            heavy = lb != WORLD and not mech.body(lb).massless
+            masses[c.name] = ratio * (num(mech.body(lb).mass) if heavy else lightest)
+        return SliderSplit(masses, None)
+    if substitute is not None:
+        return SliderSplit({c.name: ratio * substitute for c in cons}, None)
+    body = mech.body(pin_body)
+    pts = [np.array([num(c.point[0]), num(c.point[1])]) for c in cons]
+    mp, ip = num(body.mass), num(body.inertia)
+    # the largest point masses at the pins that leave a positive inertia
+    bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
+    masses = [ratio * bound for _ in cons]
+    rest = mp - sum(masses)
+    com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
+    inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
+               - rest * float(com @ com))
+    return SliderSplit({c.name: mc for c, mc in zip(cons, masses)}, (rest, inertia, com))
+
+
 def rolling_contact_report(mech: Mechanism, coupling: LinearCoupling,
                            geometry: RollingGeometry, cmap: CoordinateMap, q: np.ndarray,
                            qd: np.ndarray, penetration: np.ndarray, force: np.ndarray,
