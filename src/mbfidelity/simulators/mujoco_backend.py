@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import time
 from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
@@ -20,6 +19,9 @@ from ..systems._continua import Beam
 from ..systems.model import Mechanism
 from . import mujoco_mjcf
 from .base import (
+    RELEASE_AMPLITUDE,
+    RELEASE_OMEGA_DT,
+    RELEASE_PERIODS,
     RK4_STABILITY,
     SEMI_IMPLICIT_EULER_STABILITY,
     SUBSTITUTE,
@@ -33,6 +35,8 @@ from .base import (
     Scheme,
     Setting,
     Stopwatch,
+    semi_implicit_euler_modes,
+    stiffness_by_central_differences,
 )
 from .mujoco_mjcf import (
     POINT_MASS_GYRATION,
@@ -508,12 +512,6 @@ FLEX_1D = "flexcomp_1d"
 _FLEX_NAME = "beam"
 #: vertex radius, a fraction of l: geometry only (contacts are off); young follows from it
 _FLEX_RADIUS_FACTOR = 0.01
-#: release amplitude, a fraction of l: the geometric nonlinearity stays ~1e-12
-_FLEX_AMPLITUDE = 1e-6
-#: periods of each mode in its record
-_FLEX_PERIODS = 5
-#: omega_max h of the fits' step (semi-implicit Euler is stable below 2)
-_FLEX_OMEGA_DT = 0.5
 #: central-difference step of the linearization, a fraction of l (passive forces are
 #: linear in it to ~1e-12; round-off ~1e-10 relative)
 _FLEX_FD_STEP = 1e-6
@@ -998,26 +996,19 @@ class MujocoBackend(Backend):
         vertices, pinned ones included, so the flexcomp gets rho l (N + 1) / N and each
         moving vertex carries rho l / N.
 
-        Frequencies by free-vibration fits: each mode is released alone, from the mode shape
-        of the engine's own elastic forces (central differences of ``qfrc_passive`` in the
-        vertices' y coordinates with MuJoCo's mass matrix: the engine's linearization,
-        kept as a cross-check), at the amplitude `_FLEX_AMPLITUDE` l, and integrated with
-        MuJoCo's Euler (semi-implicit: v += h a, then q += h v; its implicit integrators do
-        not run flex) for `_FLEX_PERIODS` periods at a step with omega_max h =
-        `_FLEX_OMEGA_DT`. The record is the modal coordinate
-        (mass-weighted projection on the shape); for one undamped mode it obeys
-        s[n+1] + s[n-1] = 2 cos(theta) s[n] exactly, so cos(theta) is fitted by least
-        squares on all samples (linear prediction), and omega = 2 sin(theta / 2) / h
-        inverts the semi-implicit Euler's dispersion (cos theta = 1 - (omega h)^2 / 2 for a
-        linear undamped mode), which otherwise adds (omega h)^2 / 24. The fit's own error
-        (`resolution`) is taken as its distance to the linearization, which bounds it:
+        Frequencies by free-vibration fits (`base.semi_implicit_euler_modes`): each mode is
+        released alone, from the mode shape of the engine's own elastic forces (central
+        differences of ``qfrc_passive`` in the vertices' y coordinates with MuJoCo's mass
+        matrix: the engine's linearization, kept as a cross-check), at the amplitude
+        `RELEASE_AMPLITUDE` l, and integrated with MuJoCo's Euler (semi-implicit; its
+        implicit integrators do not run flex). The fit's own error (`resolution`, its
+        distance to the linearization, which bounds it):
         measured 1e-12..5e-8 (the linear prediction's residual is ~1e-14 of the record, so
         most of that distance is the linearization's round-off), far below the element's
         error (>= 8e-4 at N = 32)."""
         self.check_beam_request(beam, kind, elements, settings,
                                 "the flex route (its integrator and step are fixed)")
         import mujoco
-        import scipy.linalg
 
         N, l = elements, beam.length
         radius = _FLEX_RADIUS_FACTOR * l
@@ -1040,58 +1031,35 @@ class MujocoBackend(Backend):
         mujoco.mj_forward(model, data)
         M = np.zeros((model.nv, model.nv))
         mujoco.mj_fullM(model, data, M)
+
+        def passive(q: np.ndarray) -> np.ndarray:
+            data.qpos[:] = q  # slide and hinge joints: qpos j is dof j
+            mujoco.mj_forward(model, data)
+            return data.qfrc_passive
+
         # the engine's linearization: K = -d qfrc_passive / dq by central differences
-        q0 = data.qpos.copy()
-        step = _FLEX_FD_STEP * l
-        K = np.zeros((model.nv, model.nv))
-        for j in range(model.nv):
-            for sign in (1.0, -1.0):
-                data.qpos[:] = q0
-                data.qpos[j] += sign * step  # slide and hinge joints: qpos j is dof j
-                mujoco.mj_forward(model, data)
-                K[:, j] -= sign * data.qfrc_passive / (2 * step)
-        data.qpos[:] = q0
-        K = 0.5 * (K + K.T)
-        omega_max = math.sqrt(max(scipy.linalg.eigh(K, M, eigvals_only=True)[-1], 0.0))
+        K = stiffness_by_central_differences(passive, data.qpos.copy(), _FLEX_FD_STEP * l)
         y = [int(model.jnt_dofadr[j]) for j in range(model.njnt)
              if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE
              and np.allclose(model.jnt_axis[j], (0.0, 1.0, 0.0))]
-        lam, shapes = scipy.linalg.eigh(K[np.ix_(y, y)], M[np.ix_(y, y)])
-        # N - 1 moving vertices have N - 1 bending modes: fewer than `count` at small N
-        count = min(count, len(lam))
-        dt = _FLEX_OMEGA_DT / omega_max
-        model.opt.timestep = dt
-        frequencies, resolution, raw, cpu = [], [], [], 0.0
-        for k in range(count):
-            omega_lin = math.sqrt(lam[k])
-            shape = shapes[:, k] * (_FLEX_AMPLITUDE * l / np.max(np.abs(shapes[:, k])))
-            weights = M[np.ix_(y, y)] @ shapes[:, k]
+
+        def release(shape: np.ndarray) -> None:
             mujoco.mj_resetData(model, data)
             data.qpos[y] = shape
-            steps = int(math.ceil(_FLEX_PERIODS * 2 * math.pi / omega_lin / dt))
-            record = np.empty(steps + 1)
-            record[0] = data.qpos[y] @ weights
-            t0 = time.process_time()
-            for n in range(steps):
-                mujoco.mj_step(model, data)
-                record[n + 1] = data.qpos[y] @ weights
-            cpu += time.process_time() - t0
-            middle = record[1:-1]
-            cos_theta = float(middle @ (record[2:] + record[:-2]) / (2 * middle @ middle))
-            theta = math.acos(min(max(cos_theta, -1.0), 1.0))
-            omega = 2 * math.sin(theta / 2) / dt
-            frequencies.append(omega / (2 * math.pi))
-            resolution.append(abs(omega / omega_lin - 1))
-            raw.append(theta / dt / (2 * math.pi))
+
+        fit = semi_implicit_euler_modes(
+            M, K, y, count, RELEASE_AMPLITUDE * l,
+            lambda dt: setattr(model.opt, "timestep", dt), release,
+            lambda: mujoco.mj_step(model, data), lambda: data.qpos[y])
         return BeamModes(
-            frequencies,
+            fit.frequency_hz,
             "mujoco free-vibration fit: single-mode release, semi-implicit Euler, linear "
             "prediction of the modal coordinate, Euler's dispersion inverted",
-            resolution,
-            {"timestep": dt, "omega_max_dt": _FLEX_OMEGA_DT, "periods": _FLEX_PERIODS,
-             "amplitude": _FLEX_AMPLITUDE * l, "young": young, "radius": radius,
-             "linearized_hz": [float(math.sqrt(v) / (2 * math.pi)) for v in lam[:count]],
-             "uncorrected_fit_hz": raw, "cpu_time": cpu})
+            fit.resolution,
+            {"timestep": fit.step, "omega_max_dt": RELEASE_OMEGA_DT,
+             "periods": RELEASE_PERIODS, "amplitude": RELEASE_AMPLITUDE * l, "young": young,
+             "radius": radius, "linearized_hz": fit.linearized_hz,
+             "uncorrected_fit_hz": fit.uncorrected_hz, "cpu_time": fit.cpu_time})
 
 
 BACKEND = MujocoBackend()
