@@ -46,7 +46,7 @@ from .mujoco_mjcf import (
     spatial_reason,
     translate,
 )
-from .plan import ForceLaw, coupled, motions, num
+from .plan import ForceLaw, coupled, motions, num, stage_time
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -173,9 +173,7 @@ class _Compiled:
         def passive(m, d) -> None:
             if m is not model:  # the callback is global: act on our model only
                 return
-            # the stage times of a fixed-step run from t = 0 are multiples of h/2; MuJoCo's
-            # own clock drifts from them by ~N eps t (see the control callback)
-            t = round(d.time / half) * half
+            t = stage_time(d.time, half)  # MuJoCo's clock adds h at every step
             qfrc = d.qfrc_passive
             if coord_terms:
                 qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
@@ -274,10 +272,7 @@ class _Compiled:
         def control(m, d) -> None:
             if m is not model:  # the callback is global: act on our model only
                 return
-            # MuJoCo's clock adds h at every step and drifts by ~N eps t after N steps,
-            # a phase error of the motion that does not shrink with h; the stage times
-            # of a fixed-step run from t = 0 are multiples of h/2
-            t = round(d.time / half) * half
+            t = stage_time(d.time, half)  # MuJoCo's clock adds h at every step
             subtract(passive, bias_force, out=stack[0])
             if damping is None:
                 solve_m(m, d, solved, stack)

@@ -363,15 +363,7 @@ def _point_to_point(build: Build, f: PointToPoint) -> None:
     MuJoCo's tendon spring (stiffness >= 0, free length >= 0) and damper can hold is
     native, any other the passive callback's."""
     law = ForceLaw.of(f)
-    lin = law.linear if build.native else None
-    spec = None
-    if lin is not None:
-        a, k, c = lin
-        if k > 0 and -a / k >= 0 and c >= 0:
-            spec = (k, -a / k + 0.0, c)
-        elif k == 0 and a == 0 and c >= 0:
-            spec = (0.0, 0.0, c)
-    build.p2p.append(_P2P(f, f.name, spec, law.law))
+    build.p2p.append(_P2P(f, f.name, law.tendon_spring if build.native else None, law.law))
     for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
         build.add_site(body, f"{f.name}:{tag}", _xyz(point))
 

@@ -290,6 +290,20 @@ class ForceLaw:
         return linear_law(self.expr, *self.args[:2])
 
     @property
+    def tendon_spring(self) -> tuple[float, float, float] | None:
+        """(stiffness, free length, damping) where the law is linear and a tendon's own
+        spring and damper hold it: a + k L + c L' with k > 0 and a free length -a/k >= 0,
+        or a pure damper (k = a = 0), and c >= 0; None otherwise."""
+        if self.linear is None:
+            return None
+        a, k, c = self.linear
+        if k > 0 and -a / k >= 0 and c >= 0:
+            return k, -a / k + 0.0, c
+        if k == 0 and a == 0 and c >= 0:
+            return 0.0, 0.0, c
+        return None
+
+    @property
     def kind(self) -> str:
         point = isinstance(self.element, PointToPoint)
         if self.time_dependent:
@@ -400,7 +414,6 @@ def motions(mech: Mechanism) -> list[Motion]:
     return [Motion(p, mech.coordinates.index(p.coordinate)) for p in mech.prescribed]
 
 
-
 def one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
     """Whether a prescribed coordinate is one engine joint value, q_k = T_kk v_k + c_k (not
     a combination of them, as an absolute angle on a turning parent is): its row of
@@ -408,6 +421,15 @@ def one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
     a whole diagonal). An `Expression.applies` condition."""
     i = mech.coordinates.index(prescribed.coordinate)
     return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
+
+
+def stage_time(clock: float, half_step: float) -> float:
+    """The stage time nearest an engine's clock in a fixed-step run from t = 0: the stage
+    times are multiples of h/2, while a clock that adds h at every step drifts from them
+    by ~N eps t after N steps, a phase error of time-dependent laws and motions that does
+    not shrink with h."""
+    return round(clock / half_step) * half_step
+
 
 def driven_start(mech: Mechanism, q0, qd0) -> tuple[np.ndarray, np.ndarray]:
     """The initial state (copies) with each prescribed coordinate on its motion at t = 0
