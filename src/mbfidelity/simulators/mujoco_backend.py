@@ -46,7 +46,8 @@ from .mujoco_mjcf import (
     spatial_reason,
     translate,
 )
-from .plan import ForceLaw, coupled, motions, num, stage_time
+from .plan import (ForceLaw, constrained_modes, coupled, geometric_stiffness, motions, num,
+                   stage_time)
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -882,16 +883,15 @@ class MujocoBackend(Backend):
         rhs = d.qfrc_bias - d.qfrc_passive
         load = np.linalg.norm(d.qfrc_bias) + np.linalg.norm(d.qfrc_passive)
         f = np.linalg.lstsq(J.T, rhs, rcond=None)[0]
-        G = np.zeros((nv, nv))
-        for i in range(nv):
-            cols = []
-            for h in (eps, -eps):
-                dq = np.zeros(nv)
-                dq[i] = h
-                d.qpos[:] = qpos0
-                mujoco.mj_integratePos(m, d.qpos, dq, 1.0)
-                cols.append(jacobian().T @ f)
-            G[:, i] = (cols[0] - cols[1]) / (2 * eps)
+
+        def jacobian_at(i: int, h: float) -> np.ndarray:
+            dq = np.zeros(nv)
+            dq[i] = h
+            d.qpos[:] = qpos0
+            mujoco.mj_integratePos(m, d.qpos, dq, 1.0)
+            return jacobian()
+
+        G = geometric_stiffness(jacobian_at, f, nv, eps)
         d.qpos[:] = qpos0
 
         def reset() -> None:
@@ -903,14 +903,7 @@ class MujocoBackend(Backend):
             K, C, M = comp.inverse_fd(reset, eps)
         finally:
             m.opt.disableflags &= ~dsbl_eq
-        K = K - G
-        U, sv, Vt = np.linalg.svd(J)
-        rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
-        T = Vt[rank:].T
-        Mr, Cr, Kr = (T.T @ X @ T for X in (M, C, K))
-        eig = quadratic_eigenvalues(Mr, Cr, Kr)
-        # rigid modes (a free pulley) come out as round-off: make them exact zeros
-        eig[np.abs(eig) < 1e-10 * max(np.max(np.abs(eig)), 1e-300)] = 0.0
+        eig, T, (Mr, Cr, Kr) = constrained_modes(M, C, K - G, J)
         residual = float(np.linalg.norm(J.T @ f - rhs) / max(load, 1e-300))
         return eig, {"M_reduced": Mr, "C_reduced": Cr, "K_reduced": Kr, "basis": T,
                      "closure_forces": f, "balance_residual": residual}

@@ -47,6 +47,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 import numpy as np
 import sympy as sp
 
+from ..analytic.linear import quadratic_eigenvalues
 from ..systems.model import (
     COORD,
     COORD_RATE,
@@ -1546,6 +1547,33 @@ def slider_masses(mech: Mechanism, pin_body: str, ratio: float, lightest: float,
     inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
                - rest * float(com @ com))
     return SliderSplit({c.name: mc for c, mc in zip(cons, masses)}, (rest, inertia, com))
+
+
+def geometric_stiffness(jacobian_at: Callable[[int, float], np.ndarray],
+                        forces: np.ndarray, n: int, eps: float) -> np.ndarray:
+    """d(J^T f)/dq at fixed closure forces f, by central differences: column i from the
+    constraint Jacobian J at the state moved by +eps and by -eps along coordinate i
+    (`jacobian_at(i, h)`)."""
+    G = np.zeros((n, n))
+    for i in range(n):
+        cols = [jacobian_at(i, h).T @ forces for h in (eps, -eps)]
+        G[:, i] = (cols[0] - cols[1]) / (2 * eps)
+    return G
+
+
+def constrained_modes(M: np.ndarray, C: np.ndarray, K: np.ndarray, J: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """The eigenvalues of M, C, K with the constraints of Jacobian J held exactly: with
+    T a basis of J's null space (the right singular vectors beyond its numerical rank),
+    those of T^T M T, T^T C T, T^T K T. Returns (eigenvalues, T, the reduced matrices)."""
+    U, sv, Vt = np.linalg.svd(J)
+    rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
+    T = Vt[rank:].T
+    Mr, Cr, Kr = (T.T @ X @ T for X in (M, C, K))
+    eig = quadratic_eigenvalues(Mr, Cr, Kr)
+    # rigid modes (a free pulley) come out as round-off: make them exact zeros
+    eig[np.abs(eig) < 1e-10 * max(np.max(np.abs(eig)), 1e-300)] = 0.0
+    return eig, T, (Mr, Cr, Kr)
 
 
 def rolling_contact_report(mech: Mechanism, coupling: LinearCoupling,
