@@ -46,8 +46,8 @@ from .mujoco_mjcf import (
     spatial_reason,
     translate,
 )
-from .plan import (ForceLaw, constrained_modes, coupled, geometric_stiffness, motions, num,
-                   stage_time)
+from .plan import (ForceLaw, ImposedMotions, constrained_modes, coupled, geometric_stiffness,
+                   num, stage_time)
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -193,38 +193,23 @@ class _Compiled:
         return passive
 
     def _make_control(self, integrator: str, dt: float):
-        """The control callback that imposes the prescribed motions, or None.
-
-        The prescribed coordinates are rows of q = T (v - b), so their accelerations are
-        T_p v'' and their actuator forces Q_p enter as the engine forces T_p^T Q_p
-        (virtual work). With v'' = H^-1 (f + T_p^T Q_p), f = qfrc_passive - qfrc_bias
-        (the passive callback's forces are already in qfrc_passive), the k x k system
-        (T_p H^-1 T_p^T) Q_p = target - T_p H^-1 f gives Q_p, written to qfrc_applied.
-        RK4 calls the callback at every stage with the stage time: target = q''(t) and
-        H = M. The first-order integrators move the velocity by h H^-1 (force) with H the
-        matrix they solve (Euler: M + h diag(dof_damping), its implicit damping;
-        implicitfast and implicit: also the tendon dampers' J^T b J; implicit adds the
-        velocity derivative of the bias forces, by central differences, exact for a
-        quadratic), and the target is the discrete acceleration ((q(t+h) - q)/h - q')/h
-        that lands the coordinate on q(t+h) after the step."""
-        build, model = self.build, self.model
-        moves = motions(build.mech)
-        if not moves:
-            return None
-        mujoco = self.mujoco
-        nv, k = model.nv, len(moves)
-        rows = build.cmap.T[[mv.index for mv in moves]]  # q_p = rows (v - b)
-        Tp = np.zeros((k, nv))
-        Tp[:, self.vadr] = rows
-        qadr, b = self.qadr, build.cmap.b
-        stack = np.zeros((1 + k, nv))  # the free force and the actuators' columns
-        stack[1:] = Tp
-        solved = np.zeros_like(stack)
-        positions = [mv.position for mv in moves]
-        accelerations = [mv.acceleration for mv in moves]
-        actuator = self.actuator
+        """The control callback that imposes the prescribed motions (`plan.ImposedMotions`:
+        Q_p written to qfrc_applied, f = qfrc_passive - qfrc_bias, the passive callback's
+        forces being in qfrc_passive), or None. RK4 calls the callback at every stage with
+        the stage time, H = M. The first-order integrators move the velocity by h H^-1
+        (force) with H the matrix they solve (Euler: M + h diag(dof_damping), its implicit
+        damping; implicitfast and implicit: also the tendon dampers' J^T b J; implicit adds
+        the velocity derivative of the bias forces, by central differences, exact for a
+        quadratic)."""
+        build, model, mujoco = self.build, self.model, self.mujoco
         discrete = integrator != "RK4"
-        h = float(dt)
+        imposed = ImposedMotions(build.mech, build.cmap, self.vadr, model.nv, discrete, dt)
+        if not imposed.k:
+            return None
+        nv, h, qadr, actuator = model.nv, float(dt), self.qadr, self.actuator
+        stack = np.zeros((1 + imposed.k, nv))  # the free force and the actuators' columns
+        stack[1:] = imposed.Tp
+        solved = np.zeros_like(stack)
         # Euler damps implicitly unless eulerdamp is disabled
         eulerdamp = not model.opt.disableflags & int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
         damping = (np.diag(model.dof_damping) if discrete and (integrator != "Euler" or eulerdamp)
@@ -265,10 +250,7 @@ class _Compiled:
         passive, bias_force, applied = data.qfrc_passive, data.qfrc_bias, data.qfrc_applied
         qpos, qvel = data.qpos, data.qvel
         solve_m, subtract = mujoco.mj_solveM, np.subtract
-        single = k == 1
         half = h / 2
-        Tp_t = np.ascontiguousarray(Tp.T)
-        column = Tp[0]
 
         def control(m, d) -> None:
             if m is not model:  # the callback is global: act on our model only
@@ -279,21 +261,8 @@ class _Compiled:
                 solve_m(m, d, solved, stack)
             else:
                 solved[:] = np.linalg.solve(matrix(m, d), stack.T).T
-            if discrete:
-                q_now = rows @ (qpos[qadr] - b)
-                qd_now = Tp @ qvel
-                target = [((f(t + h) - x) / h - xd) / h
-                          for f, x, xd in zip(positions, q_now.tolist(), qd_now.tolist())]
-            else:
-                target = [f(t) for f in accelerations]
-            if single:
-                free, w = (solved @ column).tolist()  # T_p H^-1 f and T_p H^-1 T_p^T
-                actuator[0] = (target[0] - free) / w
-                np.multiply(column, actuator[0], out=applied)
-            else:
-                W = solved[1:] @ Tp_t  # T_p H^-1 T_p^T
-                actuator[:] = np.linalg.solve(W, np.asarray(target) - Tp @ solved[0])
-                np.dot(Tp_t, actuator, out=applied)
+            target = imposed.targets(t, qpos[qadr], qvel)
+            imposed.actuator_forces(solved, target, actuator, applied)
 
         return control
 

@@ -424,6 +424,58 @@ def one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
     return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
 
 
+class ImposedMotions:
+    """The prescribed motions imposed through generalized forces, for an engine without
+    an exact imposed motion. The prescribed coordinates are rows of q = T (v - b)
+    (`rows`), so their accelerations are T_p v'' and their actuator forces Q_p enter as
+    the engine forces T_p^T Q_p (virtual work; `Tp` spans the engine's `nv` velocity
+    entries, the joints' at `dofs`). With v'' = H^-1 (f + T_p^T Q_p), f the engine's
+    free force and H the matrix its integrator solves with, the k x k system
+    (T_p H^-1 T_p^T) Q_p = target - T_p H^-1 f gives Q_p (`actuator_forces`). The target
+    is q''(t) where the engine calls back at every stage with the stage time; for a
+    first-order integrator (`discrete`, step h) it is the discrete acceleration
+    ((q(t+h) - q)/h - q')/h that lands the coordinate on q(t+h) after the step."""
+
+    def __init__(self, mech: Mechanism, cmap: CoordinateMap, dofs: np.ndarray, nv: int,
+                 discrete: bool, h: float) -> None:
+        moves = motions(mech)
+        self.k = len(moves)
+        self.rows = cmap.T[[mv.index for mv in moves]]  # q_p = rows (v - b)
+        self.Tp = np.zeros((self.k, nv))
+        self.Tp[:, dofs] = self.rows
+        self.Tp_t = np.ascontiguousarray(self.Tp.T)
+        self.b = cmap.b
+        self.positions = [mv.position for mv in moves]
+        self.accelerations = [mv.acceleration for mv in moves]
+        self.discrete, self.h = discrete, float(h)
+
+    def targets(self, t: float, values: np.ndarray, rates: np.ndarray) -> list[float]:
+        """The prescribed coordinates' target accelerations at the stage time t, from the
+        engine joint values v and the engine's velocity entries."""
+        if not self.discrete:
+            return [f(t) for f in self.accelerations]
+        h = self.h
+        q_now = self.rows @ (values - self.b)
+        qd_now = self.Tp @ rates
+        return [((f(t + h) - x) / h - xd) / h
+                for f, x, xd in zip(self.positions, q_now.tolist(), qd_now.tolist())]
+
+    def actuator_forces(self, solved: np.ndarray, target: Sequence[float],
+                        actuator: np.ndarray, applied: np.ndarray) -> None:
+        """Q_p into `actuator` and the engine forces T_p^T Q_p into `applied`, from
+        `solved` = H^-1 [f, T_p^T] (one row per column: the free force's, then each
+        prescribed coordinate's) and the `target` accelerations."""
+        if self.k == 1:
+            column = self.Tp[0]
+            free, w = (solved @ column).tolist()  # T_p H^-1 f and T_p H^-1 T_p^T
+            actuator[0] = (target[0] - free) / w
+            np.multiply(column, actuator[0], out=applied)
+        else:
+            W = solved[1:] @ self.Tp_t  # T_p H^-1 T_p^T
+            actuator[:] = np.linalg.solve(W, np.asarray(target) - self.Tp @ solved[0])
+            np.dot(self.Tp_t, actuator, out=applied)
+
+
 def stage_time(clock: float, half_step: float) -> float:
     """The stage time nearest an engine's clock in a fixed-step run from t = 0: the stage
     times are multiples of h/2, while a clock that adds h at every step drifts from them
