@@ -630,6 +630,13 @@ class Backend(ABC):
                 return Support(False, f"{kind} {element.name}: {e.how}")
         return Support(True)
 
+    def check_support(self, mechanism: Mechanism) -> None:
+        """ValueError naming the engine and the reason where `support` refuses the
+        mechanism."""
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"{self.id} cannot express this mechanism: {support.reason}")
+
     def simulate(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, t_end: float,
                  dt: float, settings: Mapping | None = None,
                  reaction_joints: Sequence[str] = ()) -> RunResult:

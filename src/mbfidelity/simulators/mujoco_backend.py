@@ -46,8 +46,9 @@ from .mujoco_mjcf import (
     spatial_reason,
     translate,
 )
-from .plan import (ForceLaw, ImposedMotions, constrained_modes, coupled, geometric_stiffness,
-                   num, stage_time)
+from .plan import (ImposedMotions, constrained_modes, coupled, geometric_stiffness, num,
+                   stage_time)
+from .reactions import tension_pair_force
 
 _INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
@@ -445,9 +446,9 @@ class _Transmitted:
             transmitted[name] = r
         pairs: dict[str, np.ndarray] = {}
         for i, e in enumerate(self.p2p):
-            tension = ForceLaw.of(e.element).vector_law(self.ten[:, i, 0], self.ten[:, i, 1], t)
-            ab = self.spos[:, i, 1] - self.spos[:, i, 0]
-            pairs[e.element.name] = tension[:, None] * (ab / np.linalg.norm(ab, axis=1)[:, None])
+            pairs[e.element.name] = tension_pair_force(e.element, self.ten[:, i, 0],
+                                                       self.ten[:, i, 1], t,
+                                                       self.spos[:, i, 0], self.spos[:, i, 1])
         return transmitted, pairs
 
 
@@ -651,9 +652,7 @@ class MujocoBackend(Backend):
     # --- translation ---------------------------------------------------------------------
     def _build(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
               dt: float | None = None) -> Build:
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"mujoco cannot express this mechanism: {support.reason}")
+        self.check_support(mechanism)
         return translate(mechanism, settings, autonomous, dt)
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,

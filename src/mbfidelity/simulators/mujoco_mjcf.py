@@ -67,6 +67,7 @@ from .plan import (
     rot,
     slider_masses,
     spatial_tree_reason,
+    vec3,
 )
 from .reactions import pair_element_bodies
 
@@ -96,14 +97,9 @@ def fmt(*xs: float) -> str:
     return " ".join(format(float(x), ".17g") for x in xs)
 
 
-def _vec3(vector) -> list[float]:
-    """A description vector, planar or spatial, as three numbers (planar: z = 0)."""
-    return [num(v) for v in vector] + [0.0] * (3 - len(vector))
-
-
 def _xyz(point) -> str:
     """A point of the description as an MJCF position."""
-    return fmt(*_vec3(point))
+    return fmt(*vec3(point))
 
 
 def _z_quat(angle: float) -> str:
@@ -238,7 +234,7 @@ class Build:
         configuration (spatial: parent_anchor - child_anchor, model convention 10)."""
         if self.mech.spatial:
             j = self.mech.joints[self.chains[body][0]]
-            pa, ca = (np.array(_vec3(a)) for a in (j.parent_anchor, j.child_anchor))
+            pa, ca = (np.array(vec3(a)) for a in (j.parent_anchor, j.child_anchor))
             self.heads[body] = f'name="{body}" pos="{fmt(*(pa - ca))}"'
             return
         x, y, th = self.frames[body][:3]
@@ -336,7 +332,7 @@ def _revolute(build: Build, joint) -> None:
     i, body = build.mech.joints.index(joint), build.carrier[joint.child]
     if build.mech.spatial:  # about the description's axis at child_anchor
         axis = [num(v) for v in (joint.axis if joint.axis is not None else (0, 0, 1))]
-        pos = _vec3(joint.child_anchor)
+        pos = vec3(joint.child_anchor)
     else:
         axis = (0, 0, 1)
         loc = build.local(body, build.anchor(joint) - np.array(build.frames[body][:2]))
@@ -350,7 +346,7 @@ def _prismatic(build: Build, joint) -> None:
     i, body = build.mech.joints.index(joint), build.carrier[joint.child]
     # no MuJoCo joint limits: a limit is a soft constraint that would only act outside the
     # description's admissible interval
-    axis = _vec3(joint.axis)
+    axis = vec3(joint.axis)
     if not build.mech.spatial:  # the axis turns with the parent
         world = rot(build.frames[joint.parent][2]) @ np.array(axis[:2])
         ax = build.local(body, world)
@@ -372,8 +368,7 @@ def _coordinate_force(build: Build, f: CoordinateForce) -> None:
     """Joint stiffness/springref/damping where the law is linear and its argument is one
     engine joint value (`CoordinateMap.law_target`), otherwise the passive callback."""
     law, weights = ForceLaw.of(f), f.weights(build.mech.coordinates)
-    row = sum(sign * build.cmap.T[k] for k, sign in weights.items())
-    row = np.where(np.abs(row) < 1e-12, 0.0, row)
+    row = build.cmap.law_row(weights)
     j = build.mech.coordinates.index(f.coordinate)
     lin = law.linear if build.native else None
     target = build.cmap.law_target(weights)
@@ -572,7 +567,7 @@ def _shape_geom(shape) -> str:
 
 def _segment_geom(shape: Segment) -> str:
     # a spatial segment has three-component ends; a planar one lies at z = 0
-    a, b = (_vec3(end) for end in (shape.a, shape.b))
+    a, b = (vec3(end) for end in (shape.a, shape.b))
     r = num(shape.width) / 2
     if a == b:
         return f'<geom type="sphere" size="{fmt(r)}" pos="{fmt(*a)}"/>'

@@ -84,6 +84,11 @@ def num(x) -> float:
     return float(value)
 
 
+def vec3(vector) -> list[float]:
+    """A description vector, planar or spatial, as three numbers (planar: z = 0)."""
+    return [num(v) for v in vector] + [0.0] * (3 - len(vector))
+
+
 def rot(theta: float) -> np.ndarray:
     """The planar rotation matrix R(theta) (body frame to world axes)."""
     c, s = math.cos(theta), math.sin(theta)
@@ -634,6 +639,13 @@ class CoordinateMap:
     def angle(self, body: str, q: np.ndarray) -> np.ndarray:
         """The body's angle at q (rows of q give one angle per row)."""
         return q @ self.angle_c[body] + self.angle_d[body]
+
+    def law_row(self, weights: dict[int, int]) -> np.ndarray:
+        """The row r with COORD = sum sign q_i = r . (v - b) (`weights`, as in
+        `CoordinateForce.weights`), so that the law's force acts with r F on the engine
+        joint values; weights below 1e-12 are round-off of T and set to zero."""
+        row = sum(sign * self.T[i] for i, sign in weights.items())
+        return np.where(np.abs(row) < 1e-12, 0.0, row)
 
     def law_target(self, weights: dict[int, int]) -> tuple[int, float] | None:
         """(j, r) when a coordinate law's argument COORD = sum sign q_i (`weights`, as in

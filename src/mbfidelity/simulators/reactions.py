@@ -183,6 +183,16 @@ def joint_reactions(mech: Mechanism, joints: Sequence[str],
             for name in joints}
 
 
+def tension_pair_force(element: PointToPoint, length: np.ndarray, rate: np.ndarray,
+                       t: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The force (N, 2) of a point-to-point element on its first body (`joint_reaction`'s
+    sign), from its length, its rate and the world positions (N, 2) of its points on
+    body_a (`a`) and body_b (`b`) at the sample times t: the tension along a -> b."""
+    tension = ForceLaw.of(element).vector_law(length, rate, t)
+    ab = b - a
+    return tension[:, None] * (ab / np.linalg.norm(ab, axis=1)[:, None])
+
+
 def pair_element_names(mech: Mechanism) -> set[str]:
     """The names of the mechanism's pair elements (`PAIR_ELEMENTS`: force elements and
     closure constraints whose force is a pair of opposite forces on two bodies)."""
