@@ -50,7 +50,8 @@ from .plan import (ImposedMotions, constrained_modes, coupled, geometric_stiffne
                    stage_time)
 from .reactions import tension_pair_force
 
-_INTEGRATORS = {"Euler": 1, "implicit": 1, "implicitfast": 1, "RK4": 4}
+#: the integrators; their orders are declared once, in `scheme`
+_INTEGRATORS = ("Euler", "implicit", "implicitfast", "RK4")
 _LINEARIZATIONS = ("inverseFD", "transitionFD")
 
 
@@ -487,7 +488,7 @@ class MujocoBackend(Backend):
     id = "mujoco"
     SETTINGS = {
         "integrator": Setting(
-            "RK4", tuple(_INTEGRATORS),
+            "RK4", _INTEGRATORS,
             "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) phase "
             "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
             "every custom and time-dependent force, is evaluated at each stage at the "
