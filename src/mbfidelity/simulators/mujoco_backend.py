@@ -43,11 +43,10 @@ from .mujoco_mjcf import (
     Closure,
     Build,
     fmt,
-    spatial_reason,
     translate,
 )
 from .plan import (ImposedMotions, constrained_modes, coupled, geometric_stiffness, num,
-                   stage_time)
+                   spatial_tree_reason, stage_time)
 from .reactions import tension_pair_force
 
 #: the integrators; their orders are declared once, in `scheme`
@@ -645,7 +644,9 @@ class MujocoBackend(Backend):
 
     def translation_reason(self, mechanism: Mechanism) -> str:
         if mechanism.spatial:
-            return spatial_reason(mechanism)
+            # closures become equalities, slides slide joints, point-to-point elements
+            # spatial tendons between sites
+            return spatial_tree_reason(mechanism, closures=True, slides=True, point_forces=True)
         if all(b.massless for b in mechanism.bodies):
             return "every body is massless (no mass scale for the substitute bodies)"
         return ""

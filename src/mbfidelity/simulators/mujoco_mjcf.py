@@ -66,7 +66,6 @@ from .plan import (
     rolling_geometry,
     rot,
     slider_masses,
-    spatial_tree_reason,
     vec3,
 )
 from .reactions import pair_element_bodies
@@ -466,6 +465,7 @@ def _point_on_line(build: Build, c: PointOnLine) -> None:
     cl = Closure(c, "slider", f"{c.name}:pin", f"{c.name}:slider", f"{c.name}:slider")
     build.closures.append(cl)
     build.add_site(c.body, cl.site1, _xyz(c.point))
+    # the weight of a slider on a fixed pin (it does not move) or on a substitute is cancelled
     gravcomp = (c.body == WORLD or c.body in build.substitutes) and build.gravcomp
     dr = [num(v) for v in c.direction]
     # the slot body's MJCF frame is its description frame (slot bodies are never folded):
@@ -585,13 +585,6 @@ _SHAPE_GEOMS = {
     Circle: lambda s: f'<geom type="sphere" size="{fmt(num(s.radius))}" pos="{_xyz(s.center)}"/>',
     Rectangle: _rectangle_geom,
 }
-
-
-def spatial_reason(mech: Mechanism) -> str:
-    """Why the spatial build cannot hold a spatial mechanism (empty: it can): closures
-    become equalities, slides slide joints, point-to-point elements spatial tendons
-    between sites."""
-    return spatial_tree_reason(mech, closures=True, slides=True, point_forces=True)
 
 
 def mjcf(build: Build) -> str:
