@@ -34,7 +34,14 @@ them and lives here:
 - for an engine with a tree of relative joints, its link frames (`LinkFrames`: one link
   per joint, its frame at the joint, a slide's joint frame turned to its axis), the
   conditions such a tree needs (`axis_aligned`, `one_joint_value`, `held_below`) and a
-  driven run's consistent start (`prescribed_start`).
+  driven run's consistent start (`prescribed_start`);
+- for an engine whose bodies carry chains of joints but not massless bodies, the massless
+  links folded into them (`joint_chains`); for one that holds a slot by a slider body, the
+  sliders' masses taken out of the pin body (`slider_masses`); for one without an exact
+  imposed motion, the prescribed motions imposed by generalized forces (`ImposedMotions`,
+  at the stage time `stage_time`); for a linearization with the closures held exactly,
+  the closure forces' geometric stiffness and the modes on the constraint's null space
+  (`geometric_stiffness`, `constrained_modes`).
 """
 from __future__ import annotations
 

@@ -1,0 +1,126 @@
+"""Shared steps of simulators/plan.py and base.py that an engine's translation calls
+(the sliders' masses, a semi-implicit Euler engine's free-vibration fit, modes with
+constraints held exactly, the geometric stiffness of constraint forces), each checked
+against an independent statement of what it computes."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mbfidelity.simulators.base import RELEASE_PERIODS, semi_implicit_euler_modes
+from mbfidelity.simulators.plan import (
+    POINT_ON_LINE,
+    constrained_modes,
+    element_kind,
+    geometric_stiffness,
+    num,
+    slider_masses,
+)
+from mbfidelity.systems.model import WORLD
+
+#: round-off bound: a few dozen operations on values of order 1-100
+TOL = 1e-10
+
+
+def _slotted_pin_bodies() -> list:
+    """(id, mechanism, pin body) of every catalog slot whose pin is on a body with mass."""
+    from mbfidelity.comparisons.runner import _engine_mechanism
+    from mbfidelity.systems import all_systems
+
+    out = []
+    for sid, system in sorted(all_systems().items()):
+        mech = _engine_mechanism(system, system.parameter_values(None), None)
+        for c in mech.constraints:
+            if (element_kind(c) == POINT_ON_LINE and c.body != WORLD
+                    and not mech.body(c.body).massless):
+                out.append((sid, mech, c.body))
+    return out
+
+
+def test_sliders_take_their_mass_out_of_the_pin_body_and_keep_its_moments():
+    """Body + sliders keep the description's mass, centre of mass (the body frame's
+    origin) and moment about it (parallel-axis theorem), with a positive inertia left."""
+    cases = _slotted_pin_bodies()
+    assert cases, "the catalog has slots with a massive pin body"
+    for sid, mech, pin_body in cases:
+        split = slider_masses(mech, pin_body, 0.3, 1.0)
+        rest, inertia, com = split.kept
+        body = mech.body(pin_body)
+        pins = [np.array([num(c.point[0]), num(c.point[1])]) for c in mech.constraints
+                if element_kind(c) == POINT_ON_LINE and c.body == pin_body]
+        masses = list(split.masses.values())
+        assert len(masses) == len(pins) and all(m > 0 for m in masses), sid
+        mass, first = rest + sum(masses), rest * com + sum(m * p for m, p in zip(masses, pins))
+        second = inertia + rest * com @ com + sum(m * p @ p for m, p in zip(masses, pins))
+        assert mass == pytest.approx(num(body.mass), rel=TOL), sid
+        assert np.allclose(first, 0.0, atol=TOL * num(body.mass)), sid
+        assert second == pytest.approx(num(body.inertia), rel=TOL), sid
+        assert inertia > 0, sid
+
+
+def test_free_vibration_fit_inverts_semi_implicit_euler():
+    """Two masses on springs (wall - k1 - m1 - k2 - m2) stepped by semi-implicit Euler
+    (v += h M^-1 (-K q), q += h v): the fit returns the continuous frequencies, the roots
+    of det(K - w^2 M) = 0 in closed form, although each mode's discrete frequency is
+    (w h)^2 / 24 away from them (about 1 % at the fit's w_max h = 0.5). The linear
+    prediction is exact for a linear mode: only round-off stays (each of the ~100 steps a
+    period adds ~1e-16 relative to the record)."""
+    m1, m2, k1, k2 = 1.0, 0.5, 40.0, 25.0
+    M = np.diag([m1, m2])
+    K = np.array([[k1 + k2, -k2], [-k2, k2]])
+    # det(K - L M) = m1 m2 L^2 - (m1 k2 + m2 (k1 + k2)) L + k1 k2
+    a, b, c = m1 * m2, -(m1 * k2 + m2 * (k1 + k2)), k1 * k2
+    roots = sorted(((-b - math.sqrt(b * b - 4 * a * c)) / (2 * a),
+                    (-b + math.sqrt(b * b - 4 * a * c)) / (2 * a)))
+    expected = [math.sqrt(L) / (2 * math.pi) for L in roots]
+    state = {"q": np.zeros(2), "v": np.zeros(2), "h": 0.0}
+    Minv = np.linalg.inv(M)
+
+    def release(shape: np.ndarray) -> None:
+        state["q"], state["v"] = shape.copy(), np.zeros(2)
+
+    def advance() -> None:
+        state["v"] = state["v"] + state["h"] * (Minv @ (-K @ state["q"]))
+        state["q"] = state["q"] + state["h"] * state["v"]
+
+    fit = semi_implicit_euler_modes(M, K, [0, 1], 3, 1e-3,
+                                    lambda h: state.__setitem__("h", h), release, advance,
+                                    lambda: state["q"])
+    assert len(fit.frequency_hz) == 2  # two coordinates: two modes, not three
+    assert fit.frequency_hz == pytest.approx(expected, rel=1e-12)
+    assert fit.linearized_hz == pytest.approx(expected, rel=TOL)
+    # the uncorrected fit carries the integrator's dispersion: it must differ
+    assert abs(fit.uncorrected_hz[-1] / expected[-1] - 1) > 1e-3
+    assert fit.step == pytest.approx(0.5 / (2 * math.pi * expected[-1]), rel=TOL)
+    assert RELEASE_PERIODS >= 2
+
+
+def test_constrained_modes_hold_the_constraint_exactly():
+    """Two masses m on springs k to the ground, held together (x1 = x2, J = [1, -1]): one
+    mode, of mass 2 m and stiffness 2 k, eigenvalues +- i sqrt(k / m); the basis spans
+    x1 = x2."""
+    m, k = 2.0, 50.0
+    M, C, K = np.diag([m, m]), np.zeros((2, 2)), np.diag([k, k])
+    eig, T, (Mr, Cr, Kr) = constrained_modes(M, C, K, np.array([[1.0, -1.0]]))
+    assert T.shape == (2, 1) and abs(T[0, 0] - T[1, 0]) < TOL
+    assert sorted(eig.imag) == pytest.approx([-math.sqrt(k / m), math.sqrt(k / m)], rel=TOL)
+    assert np.allclose(eig.real, 0.0, atol=TOL)
+    assert Kr[0, 0] / Mr[0, 0] == pytest.approx(k / m, rel=TOL)
+
+
+def test_geometric_stiffness_of_a_circle_constraint():
+    """g(q) = |q|^2 - L^2 (a point held on a circle), J = 2 q^T: J^T f = 2 f q, whose
+    derivative at fixed f is 2 f I; central differences of a linear function leave only
+    round-off."""
+    q0, f = np.array([0.3, -1.2, 0.7]), 4.5
+
+    def jacobian_at(i: int, h: float) -> np.ndarray:
+        q = q0.copy()
+        q[i] += h
+        return (2 * q)[None, :]
+
+    G = geometric_stiffness(jacobian_at, np.array([f]), 3, 1e-6)
+    # round-off: eps |J^T f| / step = 1e-16 * 10 / 1e-6, i.e. ~1e-9
+    assert np.allclose(G, 2 * f * np.eye(3), rtol=0, atol=1e-8)
