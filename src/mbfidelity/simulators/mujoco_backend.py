@@ -262,7 +262,7 @@ class _Compiled:
                 solve_m(m, d, solved, stack)
             else:
                 solved[:] = np.linalg.solve(matrix(m, d), stack.T).T
-            target = imposed.targets(t, qpos[qadr], qvel)
+            target = imposed.targets(t, qpos[qadr] if discrete else None, qvel)
             imposed.actuator_forces(solved, target, actuator, applied)
 
         return control

@@ -461,9 +461,10 @@ class ImposedMotions:
         self.accelerations = [mv.acceleration for mv in moves]
         self.discrete, self.h = discrete, float(h)
 
-    def targets(self, t: float, values: np.ndarray, rates: np.ndarray) -> list[float]:
-        """The prescribed coordinates' target accelerations at the stage time t, from the
-        engine joint values v and the engine's velocity entries."""
+    def targets(self, t: float, values: np.ndarray | None, rates: np.ndarray) -> list[float]:
+        """The prescribed coordinates' target accelerations at the stage time t; the
+        engine joint values v and the engine's velocity entries are read by a first-order
+        integrator's target only."""
         if not self.discrete:
             return [f(t) for f in self.accelerations]
         h = self.h
