@@ -63,8 +63,10 @@ class _Compiled:
         import mujoco
 
         self.mujoco, self.build, s, dt = mujoco, build, build.settings, build.dt
+        # the file carries the step and the settings' options (`mujoco_mjcf.mjcf`); the
+        # integrator and autoreset given here may differ (a linearization's Euler copy), and
+        # diagexact holds for the contacts of a file without equalities too
         self.model = m = mujoco.MjModel.from_xml_string(build.xml)
-        m.opt.timestep = dt
         m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
         for field_name, bit, on in (
                 ("disableflags", mujoco.mjtDisableBit.mjDSBL_AUTORESET, not autoreset),
@@ -92,9 +94,6 @@ class _Compiled:
         contacts = [cl for cl in build.closures if cl.kind == "contact"]
         self.radial_qadr, self.radial_vadr = addresses([cl.slider for cl in contacts])
         self.disc_geom = [m.geom(f"{cl.element.name}:disc").id for cl in contacts]
-        m.opt.cone = getattr(mujoco.mjtCone, f"mjCONE_{s['contact_cone'].upper()}")
-        m.opt.impratio = float(s["impratio"])
-        m.opt.noslip_iterations = int(s["noslip_iterations"])
         self.callback = self._make_callback(dt)
         #: the actuator forces (description coordinates) the control callback applied last
         self.actuator = np.zeros(len(build.mech.prescribed))
@@ -663,21 +662,7 @@ class MujocoBackend(Backend):
         solver settings, the flags `_Compiled` sets and, when given, the time step), to
         save and load with ``MjModel.from_xml_path``. Laws that need the passive callback
         are not in the file."""
-        s = self.resolve_settings(settings)
-        xml = self._build(mechanism, s, dt=dt).xml
-        opt = (f'integrator="{s["integrator"]}" cone="{s["contact_cone"]}" '
-               f'impratio="{fmt(s["impratio"])}" '
-               f'noslip_iterations="{int(s["noslip_iterations"])}"'
-               + (f' timestep="{fmt(dt)}"' if dt else ""))
-        xml = xml.replace("<option ", f"<option {opt} ", 1)
-        flags = [flag for flag, on in (
-            ('autoreset="disable"', not s["autoreset"]), ('refsafe="disable"', not s["refsafe"]),
-            ('diagexact="enable"', s["diagexact"] and "<equality>" in xml)) if on]
-        if flags:
-            head, tail = xml.split("<flag ", 1)
-            attrs, rest = tail.split("/>", 1)
-            xml = f"{head}<flag {attrs} {' '.join(flags)}/>{rest}"
-        return xml
+        return self._build(mechanism, self.resolve_settings(settings), dt=dt).xml
 
     def export(self, mechanism: Mechanism, coordinates: Sequence[str],
                initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]],

@@ -557,7 +557,7 @@ def translate(mech: Mechanism, settings: dict, autonomous: bool = False,
             for e in build.coord:
                 if e.j == i:
                     e.native = None
-    build.xml = mjcf(build)
+    build.xml = mjcf(build, dt)
     return build
 
 
@@ -587,8 +587,10 @@ _SHAPE_GEOMS = {
 }
 
 
-def mjcf(build: Build) -> str:
-    """The MJCF text of a build, from the fragments its builders made."""
+def mjcf(build: Build, dt: float | None = None) -> str:
+    """The MJCF text of a build, from the fragments its builders made, with the
+    integrator, the contact solver options and the flags of its settings and, when given,
+    the time step `dt`."""
     mech = build.mech
     native_joint = {e.j for e in build.coord if e.native is not None}
 
@@ -617,13 +619,22 @@ def mjcf(build: Build) -> str:
                 lines += ["</body>"]
         return lines + [x for slider in build.sliders.get(name, []) for x in slider]
 
-    gravity = gravity_vector(mech)
+    s = build.settings
+    equalities = [cl for cl in build.closures if cl.kind != "contact"]
+    option = (f'integrator="{s["integrator"]}" cone="{s["contact_cone"]}" '
+              f'impratio="{fmt(s["impratio"])}" '
+              f'noslip_iterations="{int(s["noslip_iterations"])}"'
+              + (f' timestep="{fmt(dt)}"' if dt else ""))
+    flags = ['contact="disable"'] if not build.geoms else ['contact="enable"',
+                                                            'filterparent="disable"']
+    flags += [flag for flag, on in (
+        ('autoreset="disable"', not s["autoreset"]), ('refsafe="disable"', not s["refsafe"]),
+        ('diagexact="enable"', s["diagexact"] and equalities)) if on]
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
-        f'  <option gravity="{fmt(*gravity)}">',
-        ('    <flag contact="disable"/>' if not build.geoms else
-         '    <flag contact="enable" filterparent="disable"/>'),
+        f'  <option {option} gravity="{fmt(*gravity_vector(mech))}">',
+        f'    <flag {" ".join(flags)}/>',
         "  </option>",
         '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
         "  <worldbody>",
@@ -645,9 +656,7 @@ def mjcf(build: Build) -> str:
                     f'      <site site="{e.element.name}:b"/>',
                     "    </spatial>"]
         out.append("  </tendon>")
-    equalities = [cl for cl in build.closures if cl.kind != "contact"]
     if equalities:
-        s = build.settings
         tau = float(s["constraint_timeconst_steps"]) * build.dt
         soft = (f' solref="{fmt(tau, s["constraint_dampratio"])}"'
                 f' solimp="{fmt(*s["constraint_solimp"])}"')
