@@ -690,8 +690,7 @@ class MujocoBackend(Backend):
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
-        xml = self.to_mjcf(mechanism, settings, dt)
-        head, tail = xml.rsplit("</mujoco>", 1)
+        head, tail = build.xml.rsplit("</mujoco>", 1)
         xml = f"{head}{custom}{keyframes}</mujoco>{tail}"
         outside = []
         laws = [e.element.name for e in build.coord + build.p2p if e.native is None]
