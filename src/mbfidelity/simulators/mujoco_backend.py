@@ -651,10 +651,9 @@ class MujocoBackend(Backend):
         return ""
 
     # --- translation ---------------------------------------------------------------------
-    def _build(self, mechanism: Mechanism, settings: dict, autonomous: bool = False,
-              dt: float | None = None) -> Build:
+    def _build(self, mechanism: Mechanism, settings: dict, dt: float | None = None) -> Build:
         self.check_support(mechanism)
-        return translate(mechanism, settings, autonomous, dt)
+        return translate(mechanism, settings, dt)
 
     def to_mjcf(self, mechanism: Mechanism, settings: Mapping | None = None,
                 dt: float | None = None) -> str:
@@ -866,13 +865,12 @@ class MujocoBackend(Backend):
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
         import mujoco
 
-        if mechanism.prescribed:
-            # the engine's linearization would differentiate the imposed motion's force
-            # as a state feedback; the free coordinates' linearization is not built
+        frame = self.linearization_frame(mechanism, settings)
+        if frame is None:
             return None
-        s = self.resolve_settings(settings)
+        s, mechanism = frame
         mechanism = coupled(mechanism)  # a contact has no linearization: the exact coupling
-        build = self._build(mechanism, s, autonomous=True, dt=dt)
+        build = self._build(mechanism, s, dt=dt)
         n, eps = build.n, float(s["fd_eps"])
         q_eq = np.asarray(q_eq, dtype=float)
         # MuJoCo refuses both derivative routines on an RK4 model: use an Euler copy (the

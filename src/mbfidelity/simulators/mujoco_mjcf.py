@@ -198,7 +198,6 @@ class Build:
     #: the step the file is written for (MJCF's default 0.002 s when written without one)
     dt: float
     native: bool  # linear laws as MuJoCo's own springs and dampers
-    autonomous: bool  # time-dependent laws left out (linearization)
     foldable: set[str]
     frames: dict[str, tuple[float, ...]]  # body frames at the reference configuration
     heads: dict[str, str] = field(default_factory=dict)
@@ -400,8 +399,7 @@ _FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
 @_builds(TIME_LOAD, Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
                                       "stage time"))
 def _time_load(build: Build, f) -> None:
-    if not build.autonomous:  # a linearization leaves time loads out
-        _FORCES[type(f)](build, f)
+    _FORCES[type(f)](build, f)
 
 
 @_builds(POINT_ON_POINT, _soft_equality(SOFT, "connect equality between two sites"))
@@ -539,15 +537,14 @@ _builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by a control cal
 EXPRESSIONS = _BUILDERS.declared()
 
 
-def translate(mech: Mechanism, settings: dict, autonomous: bool = False,
-          dt: float | None = None) -> Build:
-    """The build of a numeric mechanism under the (resolved) settings; `autonomous`
-    leaves the time loads out; `dt`: the step the file is written for."""
+def translate(mech: Mechanism, settings: dict, dt: float | None = None) -> Build:
+    """The build of a numeric mechanism under the (resolved) settings; `dt`: the step the
+    file is written for."""
     cmap, jc = coordinate_map(mech), joint_chains(mech)
     # the reference configuration of the MJCF: every engine joint value 0
     frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
     build = Build(mech, cmap, jc.carrier, jc.chains, jc.parent, settings, dt or 0.002,
-                  bool(settings["native_springs"]), autonomous, jc.foldable, frames)
+                  bool(settings["native_springs"]), jc.foldable, frames)
     for kind, element in elements(mech):
         _BUILDERS[kind](build, element)
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
