@@ -29,7 +29,6 @@ from ..systems.model import (
     Rectangle,
     RollingContact,
     Segment,
-    inertia_matrix,
 )
 from .base import EXACT, SOFT, SUBSTITUTE, UNSUPPORTED, ElementBuilders, Expression
 from .plan import (
@@ -52,6 +51,7 @@ from .plan import (
     ForceLaw,
     RollingGeometry,
     body_states,
+    central_tensor,
     coordinate_map,
     coupling_row,
     elements,
@@ -289,7 +289,7 @@ def _body(build: Build, body) -> None:
     build.add_frame(body.name)
     mass, inertia = num(body.mass), num(body.inertia)
     if build.mech.spatial:  # the full central tensor (read back by `stored_inertia`)
-        I = np.array(inertia_matrix(body).tolist(), dtype=float)
+        I = central_tensor(build.mech, body)
         build.inertial[body.name] = (
             f'<inertial pos="0 0 0" mass="{fmt(mass)}" fullinertia="'
             f'{fmt(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])}"/>')
