@@ -4,7 +4,6 @@ Expected values are the problems' closed forms and published solutions, never ou
 import math
 from dataclasses import replace
 
-import numpy as np
 import pytest
 import sympy as sp
 from scipy.special import ellipk

@@ -6,7 +6,6 @@ tests/faults/."""
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
 import time

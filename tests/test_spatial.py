@@ -71,7 +71,7 @@ def test_angular_velocity_from_rotation_matrices():
         Revolute("first", "world", "one", "a", axis=(0, 0, 1)),
         Revolute("second", "one", "two", "b", axis=(1, 0, 0))), up=(0, 0, 1))
     d = Derivation(mech)
-    (qa, qb), (va, vb) = list(d.q), list(d.qd)
+    (_, qb), (va, vb) = list(d.q), list(d.qd)
     want = rotation3((1, 0, 0), qb).T * sp.Matrix([0, 0, va]) + sp.Matrix([vb, 0, 0])
     assert (d.angular_velocity("two") - want).applyfunc(sp.simplify) == sp.zeros(3, 1)
     # the frame's inertia about the vertical: 1 + 2 sin^2 b + 3 cos^2 b (Euler's equations)

@@ -64,8 +64,7 @@ class _Compiled:
 
         self.mujoco, self.build, s, dt = mujoco, build, build.settings, build.dt
         # the file carries the step and the settings' options (`mujoco_mjcf.mjcf`); the
-        # integrator and autoreset given here may differ (a linearization's Euler copy), and
-        # diagexact holds for the contacts of a file without equalities too
+        # integrator and autoreset given here may differ (a linearization's Euler copy)
         self.model = m = mujoco.MjModel.from_xml_string(build.xml)
         m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
         for field_name, bit, on in (

@@ -626,7 +626,7 @@ def mjcf(build: Build, dt: float | None = None) -> str:
                                                             'filterparent="disable"']
     flags += [flag for flag, on in (
         ('autoreset="disable"', not s["autoreset"]), ('refsafe="disable"', not s["refsafe"]),
-        ('diagexact="enable"', s["diagexact"] and equalities)) if on]
+        ('diagexact="enable"', s["diagexact"])) if on]
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',

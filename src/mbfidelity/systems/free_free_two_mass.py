@@ -31,7 +31,6 @@ of mass), eq. 5.50 with 5.44-5.49 (mass 2 in the relative coordinates), and eq. 
 Exact solution: the centre of mass uniformly accelerated, the stretch harmonic at
 sqrt(2k/m) about -F/(2k) (`analytic/closed_forms.py`, `free_pair_under_constant_force`).
 """
-import sympy as sp
 
 from . import PrintedFormula, System, coordinate_symbols
 from .model import (Body, CoordinateForce, Mechanism, Parameter, Prismatic, Rectangle,

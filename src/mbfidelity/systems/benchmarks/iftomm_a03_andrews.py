@@ -38,7 +38,6 @@ Parameters: the masses, inertias, drive torque, spring constant and free length,
 the lengths and fixed points are the published geometry's (a length alone changed would
 leave the loops unable to close at the published initial state).
 """
-import sympy as sp
 
 from .. import (BenchmarkError, Expectation, OrderCap, Published, System,
                 coordinate_symbols)
