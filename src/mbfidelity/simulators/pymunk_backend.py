@@ -11,7 +11,8 @@ kind has one builder, registered with the expressions it declares (`_builds`;
 * Chipmunk has no massless bodies: they are eliminated (`plan.Elimination`: folded
   links, arms, free groups) and stand for one constraint between the bodies around them
   (`_eliminated`); their frames follow from the engine bodies (`plan.EliminatedFrames`),
-  and loads on them reach the engine bodies by virtual power (`_Compiled.engine_loads`).
+  and loads on them reach the engine bodies by virtual power
+  (`plan.MaximalFrames.engine_loads`).
 * ``PointOnLine`` -> ``GrooveJoint``, exact only in the poses `_GROOVE_LIMIT` states;
   otherwise a slider substitute runs in an exact groove, its mass taken out of its host
   (settings ``slider_mass_fraction``, ``slider_compensation``), so that the composite
@@ -36,8 +37,8 @@ kind has one builder, registered with the expressions it declares (`_builds`;
 * Reactions, constraint and actuator forces: Chipmunk reports only the magnitude of an
   impulse, so the forces are reconstructed from Newton-Euler over each step, at the
   configuration where Chipmunk computed them (sample n + 1): in a tree, on the joint
-  child's subtree (`reactions.joint_reaction`, `reactions.actuator_force`); with closure
-  constraints, the balance of every description body (`reactions.balance_forces`).
+  child's subtree; with closure constraints, the balance of every description body
+  (`reactions.motion_forces`).
 
 Chipmunk's step (cpSpaceStep): positions x += h v (old velocity); constraints pre-step at
 the new positions; v += h (g + F/m); warm-started Gauss-Seidel velocity iterations that
@@ -49,7 +50,6 @@ from __future__ import annotations
 import math
 from types import SimpleNamespace
 from dataclasses import astuple, dataclass, field
-from functools import cached_property
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -59,16 +59,15 @@ from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, Poin
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE, UNSUPPORTED,
                    Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
                    Samples, Scheme, Setting, Stopwatch)
-from .reactions import actuator_force, balance_forces, body_wrenches, motion_reactions
+from .reactions import motion_forces
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
-                   ROLLING_CONTACT, TIME_LOAD, EliminatedFrames, Elimination, Fold, Load,
-                   NotEliminable, PitchPair, angle_coupling, body_states, continued_angles,
-                   cos_sin, coupled, coupling_residual, description_reason, effective_mass,
-                   element_kind, element_loads, force_bodies, hung_frame, joint_coordinates,
+                   ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, Load, MaximalFrames,
+                   NotEliminable, PitchPair, angle_coupling, body_states, coupled,
+                   description_reason, effective_mass, element_kind, element_loads,
                    line_through_origin, motions, num, pitch_pairs, point_mass, point_state,
-                   rigid_body, rot, rotation_fixed, sample_columns, traced, wrench)
+                   rigid_body, rot, rotation_fixed)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -582,124 +581,17 @@ def _pin_exact(layout: _Layout, g: _Groove) -> bool:
     return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
 
 
-def _after_first(values: np.ndarray) -> np.ndarray:
-    """Forces over the steps n -> n+1 given to samples 1..N (where Chipmunk computed the
-    impulses); sample 0 has no step before it and is NaN."""
-    values = np.asarray(values)
-    out = np.full((len(values) + 1, *values.shape[1:]), np.nan)
-    out[1:] = values
-    return out
-
-
-_ZERO = (0.0, 0.0, 0.0)
-_UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-
-
-def _split(row: Sequence, H=0.0) -> tuple[list, list]:
-    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from a
-    state row (numbers, symbols or columns of samples; 6 entries per engine body)."""
-    P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
-    V = [tuple(row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
-    return P, V
-
-
-class _Compiled:
-    """What the runs of one mechanism on one layout use, read once. How every description
-    body's frame follows from the engine bodies' states (centre of gravity, angle and
-    their rates; `frames`): a body with mass is an engine body (its frame placed from the
-    centre of gravity); an eliminated massless link follows them
-    (`plan.EliminatedFrames`). And the force elements' loads, and the engine bodies they
-    reach (`loaded`)."""
+class _Compiled(MaximalFrames):
+    """What the runs of one mechanism on one layout use, read once: how every description
+    body's frame follows from the engine bodies' states, and the force elements' loads
+    (from their builders) on the engine bodies they reach (`plan.MaximalFrames`; the
+    substitute carriers follow no description frame)."""
 
     def __init__(self, mech: Mechanism, layout: _Layout):
-        self.mech, self.layout = mech, layout
-        self.index = {name: k for k, name in enumerate(layout.engine)}
-        self.n = len(layout.engine)
-        self.cogs = {name: tuple(map(float, layout.cog[name])) for name in layout.dynamic
-                     if layout.cog.get(name)}
-        #: per eliminated body, the engine bodies it follows
-        self.follows = {name: tuple(sorted(self.index[b] for b in set(bodies)
-                                           if b in self.index))
-                        for name, bodies in layout.elimination.follows.items()}
-        self.elements = [_builder(f)(mech, f) for f in mech.forces]
-        loaded: set[int] = set()
-        for f in mech.forces:
-            for body in set(force_bodies(mech, f)) - {WORLD}:
-                loaded |= set(self.follows[body]) if body in self.follows else {self.index[body]}
-        self.loaded = sorted(loaded)  # engine bodies that receive element loads
-        self.phis: dict[str, Callable] = {}  # compiled `pitch_phi`s
-
-    def at(self, P: Sequence, V: Sequence) -> EliminatedFrames:
-        """The frames from the engine bodies' positions P and rates V (x, y, theta of the
-        centre of gravity and their rates, per engine body)."""
-        def massive(body: str) -> tuple:
-            k, cog = self.index[body], self.cogs.get(body)
-            (x, y, th), (vx, vy, w) = P[k], V[k]
-            if cog:  # the frame whose point cog is the centre of gravity
-                return hung_frame((x, y, vx, vy), th, w, cog)
-            return (x, y, th, *cos_sin(th), vx, vy, w)
-
-        return EliminatedFrames(self.layout.elimination, massive)
-
-    def frames(self, S: np.ndarray, H: float = 0.0) -> EliminatedFrames:
-        """The frames over state rows S (one sample per row) at x + H v."""
-        return self.at(*_split(np.asarray(S, dtype=float).T, H))
-
-    def body_loads(self, frames: EliminatedFrames, t) -> list[Load]:
-        """The element loads on the description bodies."""
-        return [load for element in self.elements for load in element(frames, t)]
-
-    def pitch_phi(self, pitch: _Pitch) -> Callable[..., float]:
-        """The residual Phi = sum k q - const of a pitch pair's coupling, as a compiled
-        function of the engine bodies' positions (x, y, theta each)."""
-        if pitch.name in self.phis:
-            return self.phis[pitch.name]
-        residual = coupling_residual(self.mech, next(c for c in self.mech.constraints
-                                                     if c.name == pitch.name))
-
-        def phi(*pos: float) -> list:
-            return [residual(self.at([pos[k:k + 3] for k in range(0, len(pos), 3)],
-                                     [_ZERO] * self.n))]
-
-        compiled = traced(phi, 3 * self.n)
-        self.phis[pitch.name] = lambda *pos: compiled(*pos)[0]
-        return self.phis[pitch.name]
-
-    @cached_property
-    def loads_math(self) -> Callable | None:
-        """`engine_loads` compiled: (*state row, H, t) -> flat (fx, fy, tau) of the
-        `loaded` engine bodies (None without force elements)."""
-        if not self.elements:
-            return None
-        return traced(lambda *args: self.engine_loads(args[:-2], args[-2], args[-1]),
-                      6 * self.n + 2)
-
-    def engine_loads(self, row: Sequence, H, t) -> list:
-        """The element loads (fx, fy at the centre of gravity, tau) on the `loaded`
-        engine bodies at the position-updated state x + H v of one state row. A load on
-        an eliminated massless body reaches the engine bodies it follows by virtual
-        power, J^T f, J's columns its velocities for a unit rate of each engine state."""
-        P, V = _split(row, H)
-        frames = self.at(P, V)
-        out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
-        for load in self.body_loads(frames, t):
-            body, force, point, torque = load
-            if body == WORLD:
-                continue
-            if body not in self.follows:
-                k = self.index[body]
-                out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
-                continue
-            x, y = frames.state(body)[:2]
-            for k in self.follows[body]:
-                for i, unit in enumerate(_UNITS):
-                    rates = [_ZERO] * len(P)
-                    rates[k] = unit
-                    vx, vy, w = self.at(P, rates).state(body)[5:]
-                    out[k][i] += torque * w if force is None else (
-                        torque * w + force[0] * (vx - w * (point[1] - y))
-                        + force[1] * (vy + w * (point[0] - x)))
-        return [v for k in self.loaded for v in out[k]]
+        super().__init__(mech, layout.elimination, layout.engine,
+                         {name: layout.cog.get(name) for name in layout.dynamic},
+                         [_builder(f)(mech, f) for f in mech.forces])
+        self.layout = layout
 
 
 _CACHE: dict[tuple, _Compiled] = {}
@@ -714,6 +606,20 @@ def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
             _CACHE.clear()
         _CACHE[key] = _Compiled(mech, layout)
     return _CACHE[key]
+
+
+def _parts(mech: Mechanism, layout: _Layout) -> list[tuple[str, float, float]]:
+    """Per engine body, the description body it makes up (a substitute's host), its mass
+    and its moment (`reactions.maximal_balance`); an infinite moment is a fixed rotation
+    (alpha = 0: the described inertia) or a point-mass slider (none)."""
+    carriers = {c.name: c for c in layout.carriers}
+    out = []
+    for name in layout.engine:
+        m, inertia = layout.engine_mass[name]
+        if inertia == math.inf:
+            inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
+        out.append((name if name in layout.dynamic else carriers[name].host, m, inertia))
+    return out
 
 
 def _default_layout(mech: Mechanism) -> _Layout | None:
@@ -939,7 +845,7 @@ class PymunkBackend(Backend):
                 PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
             else:
                 constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch,
-                                                              comp.pitch_phi(pitch)))
+                                                              comp.coupling_phi(pitch.name)))
         for c in constraints:
             c.error_bias = float(cfg["error_bias"])
         space.add(*constraints)
@@ -1188,8 +1094,7 @@ class PymunkBackend(Backend):
         state at the start of each step, the rest runs step after step. Angles of
         eliminated links (read by atan2) are given on the branch nearest the start."""
         run = self._run(mechanism, q0, qd0, n_steps, float(dt), cfg, record=False)
-        q, qd = self._coordinates(run.mechanism, run.comp, np.array([run.read()]), q0,
-                                  np.array([n_steps * float(dt)]))
+        q, qd = run.comp.coordinates(np.array([run.read()]), q0)
         return BareLoop(run.clock.cpu, q[0], qd[0])
 
     def _run(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, n_steps: int,
@@ -1269,93 +1174,35 @@ class PymunkBackend(Backend):
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                        n_steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
-        """The samples and the forces. Chipmunk reports only an impulse's magnitude, so
-        the forces over each step n -> n+1 come from Newton-Euler over the step, minus the
-        element loads as applied in it (at the position-updated state x + H v and
-        t + shift h): in a tree, on the joint child's subtree (`reactions.motion_reactions`,
-        `reactions.actuator_force`); with closure constraints, the balance of every body
-        (`_forces`). Chipmunk computes that impulse at the position-updated configuration
+        """The samples and the forces. Chipmunk reports only an impulse's magnitude, and a
+        closure may be a substitute (slider, pitch pivot, contact), so the forces over each
+        step n -> n+1 come from Newton-Euler over the step, minus the element loads as
+        applied in it (at the position-updated state x + H v and t + shift h;
+        `reactions.motion_forces`): in a tree, on the joint child's subtree; with closure
+        constraints, the balance of every description body, made of its engine parts
+        (`_parts`). Chipmunk computes that impulse at the position-updated configuration
         x(n+1), so it is given to sample n+1 (measured on the pendulums: 3.5-40x closer to
         the model's reaction at that sample than at sample n); sample 0 has no step before
         it and is NaN. A start with angular velocity shows an O(1) transient at sample 1
         of a tree's reactions: the first step also builds the steady O(h^2) joint gap of
-        the position update, and its impulse contains that correction."""
+        the position update, and its impulse contains that correction. With closures a
+        start with velocity shows one too: Chipmunk's velocity is staggered (v_n ~ v(t_n +
+        h/2), whose constraint component is -h times the curvature term), the exact
+        initial velocity is not, and the first impulse makes up the difference: 1.5 times
+        the centripetal part (eccentric cam spinning at 40 rad/s: contact force 0.38 off at
+        sample 1, 5e-4 at sample 2)."""
         h = float(dt)
         run = self._run(mechanism, q0, qd0, n_steps, h, cfg, record=True)
         mechanism, comp = run.mechanism, run.comp
         S = np.array(run.rows)
         t = np.arange(n_steps + 1) * h
-        q, qd = self._coordinates(mechanism, comp, S, q0, t)
-        frames, ahead = comp.frames(S), comp.frames(S[:-1], run.H)
-        t_applied = t[:-1] + run.shift * h
-        loads = (comp.body_loads(ahead, t_applied)
-                 if mechanism.constraints or comp.layout.drives else [])
-        reactions: dict[str, np.ndarray] = {}
-        constraint_forces: dict[str, np.ndarray] = {}
-        if mechanism.constraints:
-            joint_forces, constraint_forces = self._forces(mechanism, comp, S, ahead, loads, h)
-            reactions = {j: joint_forces[j] for j in reaction_joints}
-        elif reaction_joints:
-            reactions = motion_reactions(mechanism, reaction_joints, frames, ahead,
-                                         comp.elements, t_applied, h)
-        actuator_forces = {d.name: actuator_force(mechanism, d.joint, frames, ahead, loads, h)
-                           for d in comp.layout.drives}
-        reactions, constraint_forces, actuator_forces = (
-            {name: _after_first(f) for name, f in forces.items()}
-            for forces in (reactions, constraint_forces, actuator_forces))
+        q, qd = comp.coordinates(S, q0)
+        reactions, constraint_forces, actuator_forces, residual = motion_forces(
+            mechanism, comp, S, _parts(mechanism, comp.layout), run.H, t[:-1] + run.shift * h,
+            h, reaction_joints, {d.name: d.joint for d in comp.layout.drives})
+        if residual is not None:
+            self.diagnostics = {"balance_residual": residual, "notes": list(comp.layout.notes)}
         return Samples(q, qd, run.clock, reactions, constraint_forces, actuator_forces)
-
-    @staticmethod
-    def _coordinates(mechanism: Mechanism, comp: _Compiled, S: np.ndarray, q0: np.ndarray,
-                     t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Engine body states (rows of `S`) -> the description's coordinates and rates;
-        the angles of eliminated links, which come from atan2, continued from q0."""
-        q, qd = (sample_columns(cols, len(t))
-                 for cols in joint_coordinates(mechanism, comp.frames(S)))
-        return continued_angles(mechanism, q, q0), qd
-
-    def _forces(self, mech: Mechanism, comp: _Compiled, S: np.ndarray, ahead: EliminatedFrames,
-                loads: list[Load], h: float) -> tuple[dict, dict]:
-        """Joint reactions and closure-constraint forces of a constrained mechanism over
-        each step (state rows `S`; the element `loads` as applied in it, at `ahead`).
-
-        Chipmunk's `impulse` is a magnitude, and a closure may be a substitute (slider,
-        pitch pivot, contact), so the forces are taken from momentum balance
-        (`reactions.balance_forces`, which also says why not `joint_reaction`): for every
-        description body, over the step n -> n+1, the engine parts that make it up give
-        sum m (a - g) and sum (I alpha + r x m (a - g)) about its centre of mass; minus the
-        element loads, that is the wrench of the unknown joint reactions and closure
-        multipliers at the configuration x(n+1) where Chipmunk computed its impulses. A
-        start with velocity shows a transient at sample 1: Chipmunk's velocity is
-        staggered (v_n ~ v(t_n + h/2), whose constraint component is -h times the
-        curvature term), the exact initial velocity is not, and the first impulse makes up
-        the difference: 1.5 times the centripetal part (eccentric cam spinning at 40
-        rad/s: contact force 0.38 off at sample 1, 5e-4 at sample 2)."""
-        layout = comp.layout
-        m_steps = len(S) - 1
-        bodies = [b.name for b in mech.bodies]
-        frames = comp.frames(S[1:])
-        rhs = np.zeros((m_steps, 3 * len(bodies)))
-        g = num(mech.gravity)
-        carriers = {c.name: c for c in layout.carriers}
-        for k, name in enumerate(layout.engine):
-            host = name if name in layout.dynamic else carriers[name].host
-            i = bodies.index(host)
-            m, inertia = layout.engine_mass[name]
-            fx = m * np.diff(S[:, 6 * k + 3]) / h
-            fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
-            alpha = np.diff(S[:, 6 * k + 5]) / h
-            if inertia == math.inf:  # rotation fixed (alpha = 0) or a point-mass slider
-                inertia = num(mech.body(name).inertia) if name in layout.dynamic else 0.0
-            cx, cy = sample_columns(frames.state(host)[:2], m_steps).T
-            rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
-            rhs[:, 3 * i] += fx
-            rhs[:, 3 * i + 1] += fy
-            rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
-        rhs -= body_wrenches(bodies, loads, ahead, m_steps)
-        joint_forces, constraint_forces, residual = balance_forces(mech, frames, rhs)
-        self.diagnostics = {"balance_residual": residual, "notes": list(layout.notes)}
-        return joint_forces, constraint_forces
 
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:

@@ -57,6 +57,7 @@ from ..systems.model import (
 )
 from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
                    joint_coordinates, num, point_state, sample_columns, turned, wrench)
+from .plan import MaximalFrames
 
 #: the elements whose force is a pair of opposite forces on two bodies
 PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
@@ -381,3 +382,79 @@ def motion_reactions(mech: Mechanism, joints: Sequence[str], frames: Mapping,
     q, qd = (sample_columns(cols, n) for cols in joint_coordinates(mech, ahead))
     transmitted = {j: subtree_force(mech, j, t_applied, accelerations) for j in joints}
     return joint_reactions(mech, joints, transmitted, t_applied, q, qd, pair_forces=pairs)
+
+
+# --- every force of an engine in maximal coordinates that reports none -----------------
+
+
+def after_first_step(values: np.ndarray) -> np.ndarray:
+    """Forces over the steps n -> n+1 (N rows) given to samples 1..N; sample 0 has no
+    step before it and is NaN."""
+    values = np.asarray(values)
+    out = np.full((len(values) + 1, *values.shape[1:]), np.nan)
+    out[1:] = values
+    return out
+
+
+def maximal_balance(mech: Mechanism, parts: Sequence[tuple[str, float, float]],
+                    S: np.ndarray, frames: Mapping, ahead: Mapping, loads: Sequence[Load],
+                    h: float) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], float]:
+    """`balance_forces` over each step n -> n+1 of h for an engine in maximal coordinates:
+    its state rows `S` (samples 0..N; per engine body its centre of gravity x, y, its
+    angle and their rates) and per engine body, in the same order, `parts`: the
+    description body it makes up (with the others of that body), its mass and its moment
+    about its centre of gravity. For every description body, the parts give sum m (a - g)
+    and sum (I alpha + r x m (a - g)) about its frame origin at n+1 (`frames`, samples
+    1..N); minus the element `loads` as applied in the step (at `ahead`), that is the
+    wrench of the unknown joint reactions and closure multipliers at n+1."""
+    m_steps = len(S) - 1
+    bodies = [b.name for b in mech.bodies]
+    rhs = np.zeros((m_steps, 3 * len(bodies)))
+    g = num(mech.gravity)
+    for k, (host, m, inertia) in enumerate(parts):
+        i = bodies.index(host)
+        fx = m * np.diff(S[:, 6 * k + 3]) / h
+        fy = m * (np.diff(S[:, 6 * k + 4]) / h + g)
+        alpha = np.diff(S[:, 6 * k + 5]) / h
+        cx, cy = sample_columns(frames.state(host)[:2], m_steps).T
+        rx, ry = S[1:, 6 * k] - cx, S[1:, 6 * k + 1] - cy
+        rhs[:, 3 * i] += fx
+        rhs[:, 3 * i + 1] += fy
+        rhs[:, 3 * i + 2] += inertia * alpha + rx * fy - ry * fx
+    rhs -= body_wrenches(bodies, loads, ahead, m_steps)
+    return balance_forces(mech, frames, rhs)
+
+
+def motion_forces(mech: Mechanism, engine: MaximalFrames, S: np.ndarray,
+                  parts: Sequence[tuple[str, float, float]], H: float, t_applied: np.ndarray,
+                  h: float, reaction_joints: Sequence[str],
+                  drives: Mapping[str, Revolute | Prismatic]
+                  ) -> tuple[dict, dict, dict, float | None]:
+    """The contract's forces of a run of an engine in maximal coordinates that reports no
+    force, from its state rows `S` (samples 0..N; `parts`: see `maximal_balance`): over
+    each step n -> n+1 of h, with the element loads as applied in it (at x + H v and
+    `t_applied`), given to sample n+1 (`after_first_step`). With closure constraints, the
+    reactions at `reaction_joints` and the closure forces from the balance of every body
+    (`maximal_balance`); in a tree, the reactions on the joint child's subtree
+    (`motion_reactions`); the actuator force of each prescribed coordinate (`drives`: its
+    element's name -> its joint) on its child's subtree (`actuator_force`). Returns
+    (reactions, constraint forces, actuator forces, the balance's relative residual or
+    None in a tree)."""
+    frames, ahead = engine.frames(S), engine.frames(S[:-1], H)
+    loads = engine.body_loads(ahead, t_applied) if mech.constraints or drives else []
+    reactions: dict[str, np.ndarray] = {}
+    constraint_forces: dict[str, np.ndarray] = {}
+    residual = None
+    if mech.constraints:
+        joint_forces, constraint_forces, residual = maximal_balance(
+            mech, parts, S, engine.frames(S[1:]), ahead, loads, h)
+        reactions = {j: joint_forces[j] for j in reaction_joints}
+    elif reaction_joints:
+        reactions = motion_reactions(mech, reaction_joints, frames, ahead, engine.elements,
+                                     t_applied, h)
+    actuator_forces = {name: actuator_force(mech, joint, frames, ahead, loads, h)
+                       for name, joint in drives.items()}
+    reactions, constraint_forces, actuator_forces = (
+        {name: after_first_step(f) for name, f in forces.items()}
+        for forces in (reactions, constraint_forces, actuator_forces))
+    return reactions, constraint_forces, actuator_forces, residual
