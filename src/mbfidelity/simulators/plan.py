@@ -121,6 +121,15 @@ def ring_of_boxes(centre, R: float, count: int
     return boxes, thick, R * math.tan(math.pi / count)
 
 
+def ring_of_chords(centre, R: float, count: int) -> tuple[list[tuple[float, float]], float]:
+    """The circle of radius R about `centre` as the `count` vertices of its inscribed
+    regular polygon, and the polygon's sagitta R (1 - cos(pi / count)), the largest gap
+    between a chord and the circle."""
+    points = [(centre[0] + R * math.cos(2 * math.pi * i / count),
+               centre[1] + R * math.sin(2 * math.pi * i / count)) for i in range(count)]
+    return points, R * (1 - math.cos(math.pi / count))
+
+
 def gravity_vector(mech: Mechanism) -> tuple[float, float, float]:
     """The acceleration of gravity in world axes: along -y, or in a spatial mechanism
     (model convention 10) against its `up`."""
@@ -522,6 +531,16 @@ def prescribed_start(mass: np.ndarray, rhs: np.ndarray, prescribed: Mapping[int,
         acc[free] = np.linalg.solve(mass[np.ix_(free, free)],
                                     rhs[free] - mass[np.ix_(free, held)] @ acc[held])
     return acc, rhs[held] - (mass @ acc)[held]
+
+
+def stepped_start(mech: Mechanism, q0, qd0, h: float) -> np.ndarray:
+    """qd0 (a copy) with each prescribed coordinate's rate that of its first step,
+    (q(h) - q0)/h, for an engine that moves a prescribed coordinate with (q(t + h) - q)/h
+    in every step: started with q'(0), its first step would miss q(h) by h^2 q''/2."""
+    qd0 = np.array(qd0, dtype=float)
+    for motion in motions(mech):
+        qd0[motion.index] = (motion.position(h) - q0[motion.index]) / h
+    return qd0
 
 
 def coupled(mech: Mechanism) -> Mechanism:
@@ -1105,6 +1124,24 @@ class Fold:
         j = self.revolute
         return _pt(j.child_anchor if self.turns_with_child else j.parent_anchor)
 
+    @property
+    def slot_line(self) -> tuple[np.ndarray, np.ndarray]:
+        """The line base + u direction in the partner's frame on which the pin point
+        (`pin_point`) runs: the pair of joints as one pin-in-slot."""
+        rev, pri = self.revolute, self.prismatic
+        if self.turns_with_child:
+            # the link turns with its child: the pivot (a point of the parent) slides on a
+            # line of the child
+            back = rot(-num(pri.angle_offset))
+            base = np.array(_pt(pri.child_anchor)) - back @ (
+                np.array(_pt(pri.parent_anchor)) - np.array(_pt(rev.child_anchor)))
+            return base, -back @ np.array(_pt(pri.axis))
+        # the link turns with its parent: the pin (a point of the child) slides on a line
+        # of the parent
+        base = np.array(_pt(pri.parent_anchor)) + rot(num(pri.angle_offset)) @ (
+            np.array(_pt(rev.parent_anchor)) - np.array(_pt(pri.child_anchor)))
+        return base, np.array(_pt(pri.axis))
+
 
 @dataclass(frozen=True)
 class Arm:
@@ -1451,6 +1488,28 @@ class PitchPair:
     def lam(self) -> float:
         return self.k_a / (self.k_a + self.k_b)
 
+    @property
+    def circles(self) -> tuple:
+        """The pitch circles (a, its centre hub_a, radius, b, its centre hub_b, radius,
+        internal): radii |lam| d and |lam - 1| d, one inside the other unless 0 < lam < 1."""
+        return (self.a, self.hub_a, abs(self.lam) * self.d, self.b, self.hub_b,
+                abs(self.lam - 1) * self.d, not 0.0 < self.lam < 1.0)
+
+    def pitch_points(self, ha, hb, phi: float) -> tuple[tuple, tuple]:
+        """The pitch point as a point of a and as a point of b (world axes), from the world
+        positions ha, hb of the hubs: on the line of the hubs, lam d from a's hub; b's is
+        moved along the pitch tangent by the coupling's residual phi as a length,
+        phi d / (k_a + k_b), so that a joint holding the two points together holds the
+        coupling, its position error the joint's gap."""
+        scale = self.d / (self.k_a + self.k_b)
+        dx, dy = hb[0] - ha[0], hb[1] - ha[1]
+        dist = math.hypot(dx, dy)
+        ux, uy = dx / dist, dy / dist
+        e = scale * phi
+        ra, rb = self.lam * self.d, (self.lam - 1.0) * self.d
+        return ((ha[0] + ra * ux, ha[1] + ra * uy),
+                (hb[0] + rb * ux + e * uy, hb[1] + rb * uy - e * ux))
+
 
 def pitch_pairs(mech: Mechanism, k: Mapping[str, float], bodies: Sequence[str],
                 scale: float) -> Iterator[PitchPair]:
@@ -1512,6 +1571,22 @@ def effective_mass(m: float, inertia: float, d: float) -> float:
     """Mass of a rigid body felt at a point at distance d from its centre of mass, across
     the radius: m I / (I + m d^2)."""
     return m * inertia / (inertia + m * d * d)
+
+
+def compensated_host(m: float, inertia: float, parts: Sequence[tuple[float, tuple, float]]
+                     ) -> tuple[float, np.ndarray, float]:
+    """What is left of a body of mass m and central moment `inertia` when substitute
+    bodies take over part of it (`parts`: each one's mass, its centre of gravity in the
+    body's frame and its own central moment), so that the body and its substitutes
+    together have exactly the described inertia: (mass m1 = m - sum m_i, centre of
+    gravity c1 = -sum m_i p_i / m1 in the body's frame, central moment I - sum (I_i +
+    m_i |p_i|^2) - m1 |c1|^2); the caller checks that m1 and the moment stay positive."""
+    m1 = m - sum(mi for mi, _, _ in parts)
+    first = sum(mi * np.array(p) for mi, p, _ in parts)
+    c1 = -first / m1 if m1 > 0 else np.zeros(2)
+    i1 = inertia - sum(ii + mi * float(np.dot(p, p)) for mi, p, ii in parts
+                       ) - m1 * float(c1 @ c1)
+    return m1, c1, i1
 
 
 def continued_angles(mech: Mechanism, q: np.ndarray, q0: np.ndarray) -> np.ndarray:

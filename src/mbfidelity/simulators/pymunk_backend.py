@@ -64,10 +64,10 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, Load, MaximalFrames,
-                   NotEliminable, PitchPair, angle_coupling, body_states, coupled,
-                   description_reason, effective_mass, element_kind, element_loads,
+                   NotEliminable, PitchPair, angle_coupling, body_states, compensated_host,
+                   coupled, description_reason, effective_mass, element_kind, element_loads,
                    line_through_origin, motions, num, pitch_pairs, point_mass, point_state,
-                   rigid_body, rot, rotation_fixed)
+                   rigid_body, ring_of_chords, rot, rotation_fixed, stepped_start)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -209,8 +209,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
             if pair.carrier not in massless:  # its hinges would keep the distance: _build
                 raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
                                "massless carrier arm, which the contact replaces")
-            circles = (pair.a, pair.hub_a, abs(pair.lam) * pair.d, pair.b, pair.hub_b,
-                       abs(pair.lam - 1) * pair.d, not 0.0 < pair.lam < 1.0)
+            circles = pair.circles
         wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
         return "pitch", _Pitch(*astuple(pair), c.name, wrap, circles)
     raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
@@ -283,33 +282,19 @@ def _eliminated(ctx, body) -> None:
 
 
 def _folded_groove(fold: Fold) -> _Groove:
-    """The GrooveJoint of a folded link; refused when it would not be exact in Chipmunk."""
-    rev, pri = fold.revolute, fold.prismatic
-    if fold.turns_with_child:
-        # the link turns with its child: the pivot (a point of the parent) slides on a
-        # line of the child, base + q direction in the child's frame
-        back = rot(-num(pri.angle_offset))
-        base = _vec(pri.child_anchor) - back @ (_vec(pri.parent_anchor) - _vec(rev.child_anchor))
-        direction = -back @ _vec(pri.axis)
-        anchor = _vec(rev.parent_anchor)
-        slot_ok = line_through_origin(base, direction)
-        pin_ok = rev.parent == WORLD or not anchor.any()
-    else:
-        # the link turns with its parent: the pin (a point of the child) slides on a
-        # line of the parent
-        base = _vec(pri.parent_anchor) + rot(num(pri.angle_offset)) @ (
-            _vec(rev.parent_anchor) - _vec(pri.child_anchor))
-        direction = _vec(pri.axis)
-        anchor = _vec(rev.child_anchor)
-        slot_ok = pri.parent == WORLD or line_through_origin(base, direction)
-        pin_ok = not anchor.any()
+    """The GrooveJoint of a folded link, its pin point on its partner's line
+    (`plan.Fold.slot_line`); refused when it would not be exact in Chipmunk."""
+    base, direction = fold.slot_line
+    anchor = _vec(fold.pin_point)
+    slot_ok = fold.partner == WORLD or line_through_origin(base, direction)
+    pin_ok = fold.pin_body == WORLD or not anchor.any()
     if not (slot_ok and pin_ok):
         where = ("slot line off the slot body's centre of mass" if not slot_ok
                  else "pin off the pin body's centre of mass")
         raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
                        f"{_GROOVE_LIMIT}")
     return _Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
-                   *_limits(pri), tuple(anchor), None)
+                   *_limits(fold.prismatic), tuple(anchor), None)
 
 
 def _limits(j: Prismatic) -> tuple[float | None, float | None]:
@@ -539,13 +524,10 @@ def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
     if layout.carriers and cfg.get("slider_compensation", True):
         for host in dict.fromkeys(car.host for car in layout.carriers):
             cars = [car for car in layout.carriers if car.host == host]
-            m, inertia = num(mech.body(host).mass), num(mech.body(host).inertia)
-            m1 = m - sum(car.mass for car in cars)
-            first = sum(car.mass * np.array(car.point) for car in cars)
-            c1 = -first / m1 if m1 > 0 else np.zeros(2)
-            i1 = inertia - sum((car.moment if car.kind == "slot" else 0.0)
-                               + car.mass * float(np.dot(car.point, car.point)) for car in cars
-                               ) - m1 * float(c1 @ c1)
+            m1, c1, i1 = compensated_host(
+                num(mech.body(host).mass), num(mech.body(host).inertia),
+                [(car.mass, car.point, car.moment if car.kind == "slot" else 0.0)
+                 for car in cars])
             if m1 <= 0 or i1 <= 0:
                 layout.notes.append(f"slider substitutes on {host} not compensated "
                                     f"(mass {m1:.3g}, moment {i1:.3g} left)")
@@ -946,7 +928,6 @@ class PymunkBackend(Backend):
         a, b = bodies[pitch.a], bodies[pitch.b]
         engine = [bodies[n] for n in comp.layout.engine]
         cogs = [comp.layout.cog.get(n) for n in comp.layout.engine]
-        scale = pitch.d / (pitch.k_a + pitch.k_b)
         last: list[float | None] = [None]
 
         def anchors():
@@ -958,14 +939,8 @@ class PymunkBackend(Backend):
             if pitch.wrap and last[0] is not None:  # a massless carrier's angle wrapped
                 value += pitch.wrap * round((last[0] - value) / pitch.wrap)
             last[0] = value
-            ha, hb = a.local_to_world(pitch.hub_a), b.local_to_world(pitch.hub_b)
-            dx, dy = hb.x - ha.x, hb.y - ha.y
-            dist = math.hypot(dx, dy)
-            ux, uy = dx / dist, dy / dist
-            e = scale * value
-            ra, rb = pitch.lam * pitch.d, (pitch.lam - 1.0) * pitch.d
-            ca = (ha.x + ra * ux, ha.y + ra * uy)
-            cb = (hb.x + rb * ux + e * uy, hb.y + rb * uy - e * ux)
+            ca, cb = pitch.pitch_points(a.local_to_world(pitch.hub_a),
+                                        b.local_to_world(pitch.hub_b), value)
             return a.world_to_local(ca), b.world_to_local(cb)
 
         pa, pb = anchors()
@@ -989,13 +964,11 @@ class PymunkBackend(Backend):
             (ring, centre, rho), (disc, dcentre, drho) = sorted(
                 [(a, hub_a, rho_a), (b, hub_b, rho_b)], key=lambda s: -s[2])
             n = int(cfg["contact_segments"])
-            pts = [(centre[0] + rho * math.cos(2 * math.pi * i / n),
-                    centre[1] + rho * math.sin(2 * math.pi * i / n)) for i in range(n)]
             # chords inscribed in the pitch circle, rounded with the sagitta: the disc on
             # the pitch circle overlaps them by between 1 and 2 sagittas everywhere (at a
             # vertex too), so the contact never opens; a slop of 3 sagittas keeps Chipmunk
             # from pushing the disc out of that overlap
-            sagitta = rho * (1 - math.cos(math.pi / n))
+            pts, sagitta = ring_of_chords(centre, rho, n)
             segs = [pymunk.Segment(bodies[ring], pts[i], pts[(i + 1) % n], sagitta)
                     for i in range(n)]
             for i, seg in enumerate(segs):
@@ -1031,14 +1004,11 @@ class PymunkBackend(Backend):
         except _Refused as refused:
             raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
         if layout.drives:
-            # a prescribed coordinate starts with the rate of its first step, (q(h) - q0)/h,
-            # as every later step moves it with (q(t + h) - q)/h: started with q'(0) the
-            # first step would miss q(h) by h^2 q''/2 and the driven body's velocity would
-            # jump by h q'' twice (actuator force 0.62 and 0.31 of its range off at
-            # samples 1 and 2 on a shaker driven by cos, whatever h)
-            qd0 = qd0.copy()
-            for m in motions(mechanism):
-                qd0[m.index] = (m.position(h) - q0[m.index]) / h
+            # every step moves a prescribed coordinate with (q(t + h) - q)/h: started with
+            # q'(0), the driven body's velocity would jump by h q'' twice (actuator force
+            # 0.62 and 0.31 of its range off at samples 1 and 2 on a shaker driven by cos,
+            # whatever h)
+            qd0 = stepped_start(mechanism, q0, qd0, h)
         # a RollingContact's force is balanced as the coupling it stands for (the layout
         # holds the contact itself)
         mechanism = coupled(mechanism)
