@@ -982,6 +982,28 @@ def wrench(load: Load, centre) -> tuple:
             (point[0] - centre[0]) * force[1] - (point[1] - centre[1]) * force[0] + torque)
 
 
+def joint_pose(joint: Revolute | Prismatic) -> Callable[[float], object]:
+    """Where a joint's coordinate q puts its child, relative to the parent (the world for
+    an absolute angle), as a function of q: a slide's point parent_anchor + q axis of the
+    parent, on which the child's anchor sits; a hinge's angle s q + angle_offset of the
+    child (s = -1 for a clockwise coordinate)."""
+    if isinstance(joint, Revolute):
+        s, offset = -1.0 if joint.clockwise else 1.0, num(joint.angle_offset)
+        return lambda q: s * q + offset
+    pa, axis = np.array(_pt(joint.parent_anchor)), np.array(_pt(joint.axis))
+    return lambda q: tuple(pa + q * axis)
+
+
+def joint_velocity(joint: Revolute | Prismatic, rate) -> tuple:
+    """The velocity (vx, vy) of a joint's child at its anchor and its angular velocity,
+    relative to the parent and in the parent's axes, when the coordinate moves at `rate`
+    (a hinge turns the child about the anchor; a slide moves it along the axis)."""
+    if isinstance(joint, Revolute):
+        return 0.0, 0.0, -rate if joint.clockwise else rate
+    axis = np.array(_pt(joint.axis))
+    return rate * axis[0], rate * axis[1], 0.0
+
+
 def coordinate_load(joint: Revolute | Prismatic) -> Callable[[Mapping, object], list[Load]]:
     """The loads of a generalized force Q on a joint's coordinate (virtual power of
     Q q'), as a function of (the bodies' frame states, Q): torques s Q on a hinge's child
@@ -1465,6 +1487,15 @@ def angle_coupling(mech: Mechanism, coupling: LinearCoupling) -> tuple[dict[str,
             k[j.parent] = k.get(j.parent, 0.0) - coef * s
         k0 += coef * s * num(j.angle_offset)
     return k, k0
+
+
+def coupled_angles(mech: Mechanism, coupling: LinearCoupling
+                   ) -> tuple[dict[str, float], float, list[str], float]:
+    """`angle_coupling` (k, k0), the bodies whose angle enters it (a coefficient above the
+    round-off of the coefficients' size), in order, and that size."""
+    k, k0 = angle_coupling(mech, coupling)
+    scale = max((abs(v) for v in k.values()), default=0.0)
+    return k, k0, [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale], scale
 
 
 @dataclass(frozen=True)

@@ -57,17 +57,18 @@ import numpy as np
 from ..systems.model import (WORLD, LinearCoupling, Mechanism, PointOnLine, PointOnPoint, Prismatic,
                              Revolute, RollingContact)
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE, UNSUPPORTED,
-                   Backend, BareLoop, BeamElement, ElementBuilders, Expression, Linearization,
-                   Samples, Scheme, Setting, Stopwatch)
+                   Backend, BareLoop, BeamElement, ElementBuilders, Expression, Samples, Scheme,
+                   Setting, Stopwatch)
 from .reactions import motion_forces
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
                    ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, Load, MaximalFrames,
-                   NotEliminable, PitchPair, angle_coupling, body_states, compensated_host,
-                   coupled, description_reason, effective_mass, element_kind, element_loads,
-                   line_through_origin, motions, num, pitch_pairs, point_mass, point_state,
-                   rigid_body, ring_of_chords, rot, rotation_fixed, stepped_start)
+                   NotEliminable, PitchPair, body_states, compensated_host, coupled,
+                   coupled_angles, description_reason, effective_mass, element_kind,
+                   element_loads, joint_pose, joint_velocity, line_through_origin, motions, num,
+                   pitch_pairs, point_mass, point_state, rigid_body, ring_of_chords, rot,
+                   rotation_fixed, stepped_start)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -114,12 +115,11 @@ class _Carrier:
 @dataclass(frozen=True)
 class _Pitch(PitchPair):
     """The pitch pair of the LinearCoupling `name`: a PivotJoint between a and b at the
-    pitch point (see the module docstring), or with `contact` (ring body, ring centre,
-    ring radius, disc body, centre, radius, internal) colliding pitch circles."""
+    pitch point (see the module docstring), or with `contact` colliding pitch circles."""
 
     name: str
     wrap: float  # Phi jumps by this when a massless carrier's angle wraps (0: none)
-    contact: tuple | None
+    contact: bool
 
 
 @dataclass(frozen=True)
@@ -190,9 +190,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     if slides:
         raise _Refused(f"coupling {c.name}: coordinate {slides[0]} is prismatic; Chipmunk "
                        "couples only angles (GearJoint)")
-    k, k0 = angle_coupling(mech, c)
-    scale = max((abs(v) for v in k.values()), default=0.0)
-    bodies = [b for b, v in k.items() if b != WORLD and abs(v) > 1e-12 * scale]
+    k, k0, bodies, scale = coupled_angles(mech, c)
     if not bodies:
         raise _Refused(f"coupling {c.name}: no body angle enters it")
     if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
@@ -204,14 +202,11 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     for pair in pitch_pairs(mech, k, bodies, scale):
         if not (engine_ok(pair.a) and engine_ok(pair.b)):
             continue
-        circles = None
-        if contact:
-            if pair.carrier not in massless:  # its hinges would keep the distance: _build
-                raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
-                               "massless carrier arm, which the contact replaces")
-            circles = pair.circles
+        if contact and pair.carrier not in massless:  # its hinges would keep the distance
+            raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
+                           "massless carrier arm, which the contact replaces")
         wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
-        return "pitch", _Pitch(*astuple(pair), c.name, wrap, circles)
+        return "pitch", _Pitch(*astuple(pair), c.name, wrap, contact)
     raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
                    "couples the absolute angles of two bodies, and a coupling of three is "
                    "expressible here only as two bodies hinged on a common carrier (gear pair, "
@@ -807,7 +802,7 @@ class PymunkBackend(Backend):
         # a rolling contact holds the disc itself: the arm that stood for it goes (kept, the
         # distance would be enforced twice and Gauss-Seidel may leave the contact's normal
         # impulse, hence its friction, at zero)
-        replaced = {p.carrier for p in layout.pitches if p.contact is not None}
+        replaced = {p.carrier for p in layout.pitches if p.contact}
         for a, b, pa, pb, link in layout.pins:
             if link not in replaced:
                 constraints.append(pymunk.PinJoint(bodies[a], bodies[b], pa, pb))
@@ -823,7 +818,7 @@ class PymunkBackend(Backend):
         for a, b, phase, ratio in layout.gears:
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
         for i, pitch in enumerate(layout.pitches):
-            if pitch.contact is not None:
+            if pitch.contact:
                 PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
             else:
                 constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch,
@@ -836,15 +831,12 @@ class PymunkBackend(Backend):
 
     @staticmethod
     def _drive_constraints(mech: Mechanism, layout: _Layout, space, bodies: dict, spins, q0):
-        """The constraints that impose the prescribed coordinates, added to the space,
-        and per coordinate (constraint, attribute, value of q): the
-        attribute that moves its target. A slide: a PivotJoint from the parent's point
-        parent_anchor + q axis to the child's anchor (and the GearJoint that locks the
-        rotation); a hinge (its PivotJoint is built with the other hinges): a GearJoint
-        of ratio 1 whose phase is the relative angle s q + angle_offset (on the world for
-        an absolute angle). Their error_bias is 0 whatever the setting: the gap to the
-        target is removed in one step (bias velocity -gap/h), which is how the target
-        becomes the position of the next step."""
+        """The constraints that impose the prescribed coordinates (the PRESCRIBED
+        expression; a hinge's PivotJoint is built with the other hinges), added to the
+        space, and per coordinate (constraint, attribute, value of q): the attribute that
+        moves its target to the pose q gives (`plan.joint_pose`). Their error_bias is 0
+        whatever the setting: the gap to the target is removed in one step (bias velocity
+        -gap/h), which is how the target becomes the position of the next step."""
         import pymunk
 
         movers = []
@@ -853,25 +845,17 @@ class PymunkBackend(Backend):
             if d.kinematic:
                 movers.append(None)
                 continue
-            child = bodies[j.child]
-            q = float(q0[d.index])
+            child, pose, q = bodies[j.child], joint_pose(j), float(q0[d.index])
             if element_kind(j) == PRISMATIC:
-                pa, axis = _vec(j.parent_anchor), _vec(j.axis)
                 parent = bodies[j.parent]
-                pivot = pymunk.PivotJoint(parent, child, tuple(pa + q * axis),
-                                          tuple(_vec(j.child_anchor)))
-                added = [pivot]
+                added = [pymunk.PivotJoint(parent, child, pose(q), tuple(_vec(j.child_anchor)))]
                 if spins(j.parent) or spins(j.child):
                     added.append(pymunk.GearJoint(parent, child, num(j.angle_offset), 1.0))
-                movers.append((pivot, "anchor_a",
-                               lambda q, pa=pa, axis=axis: tuple(pa + q * axis)))
+                movers.append((added[0], "anchor_a", pose))
             else:
-                s = -1.0 if j.clockwise else 1.0
-                offset = num(j.angle_offset)
                 parent = bodies[WORLD if j.absolute else j.parent]
-                gear = pymunk.GearJoint(parent, child, s * q + offset, 1.0)
-                added = [gear]
-                movers.append((gear, "phase", lambda q, s=s, offset=offset: s * q + offset))
+                added = [pymunk.GearJoint(parent, child, pose(q), 1.0)]
+                movers.append((added[0], "phase", pose))
             for c in added:
                 c.error_bias = 0.0
             space.add(*added)
@@ -902,15 +886,10 @@ class PymunkBackend(Backend):
         the positions moved to t_(k+1), before the solve) sets the velocity that carries
         it to q(t_(k+2)) in step k + 1, so the free bodies' constraints are solved against
         the driver's velocity of the next position update, as with a moving constraint.
-        Its engine centre of gravity is the hinge point (or it does not turn)."""
+        Its engine centre of gravity is the hinge point (or it does not turn), whose
+        velocity is the joint's (`plan.joint_velocity`: its parent is the world)."""
         rates = np.diff([position(h), *targets]) / h
-        j = d.joint
-        if element_kind(j) == REVOLUTE:
-            values = [(0.0, 0.0, -r if j.clockwise else r) for r in rates]
-        else:
-            axis = _vec(j.axis)
-            values = [(r * axis[0], r * axis[1], 0.0) for r in rates]
-        step = iter(values)
+        step = iter([joint_velocity(d.joint, r) for r in rates])
 
         def velocity_func(body, gravity, damping, dt):
             vx, vy, w = next(step)
@@ -957,7 +936,7 @@ class PymunkBackend(Backend):
         """The pitch circles as colliding shapes with friction (a RollingContact)."""
         import pymunk
 
-        a, hub_a, rho_a, b, hub_b, rho_b, internal = pitch.contact
+        a, hub_a, rho_a, b, hub_b, rho_b, internal = pitch.circles
         flt = pymunk.ShapeFilter(categories=1 << (index % 32), mask=1 << (index % 32))
         shapes = []
         if internal:
@@ -1103,6 +1082,7 @@ class PymunkBackend(Backend):
         return SimpleNamespace(mechanism=mechanism, comp=comp, clock=clock, read=read,
                                rows=rows, H=H, shift=shift)
 
+    # no `linearize`: Chipmunk has no linearization facility, frequencies come from the fits
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         return Scheme("semi-implicit Euler", 1, SEMI_IMPLICIT_EULER_STABILITY)
 
@@ -1173,11 +1153,6 @@ class PymunkBackend(Backend):
         if residual is not None:
             self.diagnostics = {"balance_residual": residual, "notes": list(comp.layout.notes)}
         return Samples(q, qd, run.clock, reactions, constraint_forces, actuator_forces)
-
-    def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
-                  settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        # Chipmunk has no linearization facility: frequencies come from the fits
-        return None
 
 
     # --- flexible elements (contract point 12) ----------------------------------------------
