@@ -994,6 +994,14 @@ def joint_pose(joint: Revolute | Prismatic) -> Callable[[float], object]:
     return lambda q: tuple(pa + q * axis)
 
 
+def slide_path(joint: Prismatic) -> tuple[np.ndarray, np.ndarray]:
+    """The line base + q axis (parent frame) on which a prismatic joint's child's frame
+    origin travels: parent_anchor - R(angle_offset) child_anchor + q axis."""
+    return (np.array(_pt(joint.parent_anchor))
+            - rot(num(joint.angle_offset)) @ np.array(_pt(joint.child_anchor)),
+            np.array(_pt(joint.axis)))
+
+
 def joint_velocity(joint: Revolute | Prismatic, rate) -> tuple:
     """The velocity (vx, vy) of a joint's child at its anchor and its angular velocity,
     relative to the parent and in the parent's axes, when the coordinate moves at `rate`

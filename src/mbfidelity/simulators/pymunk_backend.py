@@ -67,8 +67,8 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    NotEliminable, PitchPair, body_states, compensated_host, coupled,
                    coupled_angles, description_reason, effective_mass, element_kind,
                    element_loads, joint_pose, joint_velocity, line_through_origin, motions, num,
-                   pitch_pairs, point_mass, point_state, rigid_body, ring_of_chords, rot,
-                   rotation_fixed, stepped_start)
+                   pitch_pairs, point_mass, point_state, rigid_body, ring_of_chords,
+                   rotation_fixed, slide_path, stepped_start)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -310,10 +310,8 @@ def _hinge(ctx, j: Revolute) -> None:
 def _slide(ctx, j: Prismatic) -> None:
     if id(j) in ctx.eliminated:
         return
-    # the child's centre of mass travels on pa - R(offset) ca + q axis (parent frame);
-    # with the rotation locked the pin can be the child's centre of mass
-    base = _vec(j.parent_anchor) - rot(num(j.angle_offset)) @ _vec(j.child_anchor)
-    axis = _vec(j.axis)
+    # with the rotation locked the pin can be the child's centre of mass, its frame origin
+    base, axis = slide_path(j)
     if j.parent != WORLD and not line_through_origin(base, axis):
         raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                        f"parent's centre of mass. {_GROOVE_LIMIT}")
@@ -353,8 +351,7 @@ def _drive(ctx, p) -> None:
         raise _Refused(f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
                        "the constraint that imposes the motion acts between bodies with mass "
                        "(or the world)")
-    kinematic = (ctx.cfg.get("prescribed_motion", _DRIVE_ROUTES[0]) == _DRIVE_ROUTES[0]
-                 and j.parent == WORLD)
+    kinematic = ctx.cfg["prescribed_motion"] == _DRIVE_ROUTES[0] and j.parent == WORLD
     layout.drives.append(_Drive(p.name, j, index, kinematic))
     if element_kind(j) == PRISMATIC or kinematic:  # its joint is the drive's constraint
         ctx.eliminated.add(id(j))
@@ -452,11 +449,8 @@ def _gear(ctx, c: LinearCoupling) -> None:
     (ctx.layout.gears if kind == "gear" else ctx.layout.pitches).append(value)
 
 
-@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "Pymunk is a planar (2-D) engine: a spatial "
-                                              "closed loop has no expression in it"))
-def _hinge_closure(ctx, c) -> None:
-    raise _Refused(f"hinge closure {c.name}: Pymunk is a planar (2-D) engine, a spatial "
-                   "closed loop has no expression in it")
+_ELEMENTS.refuses(HINGE_CLOSURE, "Pymunk is a planar (2-D) engine: a spatial closed loop "
+                                  "has no expression in it", "pymunk")
 
 
 def _moment(body, cfg: Mapping) -> float:
@@ -466,16 +460,16 @@ def _moment(body, cfg: Mapping) -> float:
     inertia = num(body.inertia)
     if inertia > 0:
         return inertia
-    return num(body.mass) * float(cfg.get("point_mass_gyration", POINT_MASS_GYRATION)) ** 2
+    return num(body.mass) * float(cfg["point_mass_gyration"]) ** 2
 
 
-def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
+def _plan(mech: Mechanism, cfg: Mapping) -> _Layout:
     """The engine layout (bodies, folded links, pivots, grooves, substitutes), built by
     each element's registered builder; refused (`_Refused`, with the reason) when the
     mechanism cannot be expressed. The bodies and prescribed motions come first (which
     bodies are engine bodies, which joints a drive holds), then the eliminated links'
-    shapes (`plan.Elimination`), the joints, the links, the closures."""
-    cfg = cfg or {}
+    shapes (`plan.Elimination`), the joints, the links, the closures. `cfg`: resolved
+    settings."""
     reason = description_reason(mech)
     if reason:
         raise _Refused(reason)
@@ -485,8 +479,8 @@ def _plan(mech: Mechanism, cfg: Mapping | None = None) -> _Layout:
                           massless={b.name for b in massless},
                           engine_ok=lambda b: b == WORLD or b in layout.dynamic,
                           eliminated=set(),  # ids of joints that build no constraint of their own
-                          half=float(cfg.get("groove_half_length", 1000.0)),
-                          fraction=float(cfg.get("slider_mass_fraction", 0.5)))
+                          half=float(cfg["groove_half_length"]),
+                          fraction=float(cfg["slider_mass_fraction"]))
     for body in mech.bodies:
         if body.name not in ctx.massless:  # a massless body's builder runs after the joints
             _builder(body)(ctx, body)
@@ -516,7 +510,7 @@ def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
                                     math.inf if name in layout.infinite else _moment(b, cfg))
     for car in layout.carriers:
         layout.engine_mass[car.name] = (car.mass, car.moment)
-    if layout.carriers and cfg.get("slider_compensation", True):
+    if layout.carriers and cfg["slider_compensation"]:
         for host in dict.fromkeys(car.host for car in layout.carriers):
             cars = [car for car in layout.carriers if car.host == host]
             m1, c1, i1 = compensated_host(
@@ -1096,9 +1090,7 @@ class PymunkBackend(Backend):
         the harness's compiled functions, which are not written out)."""
         from .script_export import pymunk_script
 
-        if not initial_states:
-            raise ValueError("the script starts from a scenario's initial state: none given")
-        name, (q0, qd0) = next(iter(initial_states.items()))
+        name, q0, qd0 = self.script_start(initial_states)
         cfg = self.resolve_settings(settings)
         layout, comp, space, bodies, balanced, movers = self._prepare(
             mechanism, np.asarray(q0, float), np.asarray(qd0, float), cfg, float(dt))
@@ -1112,11 +1104,8 @@ class PymunkBackend(Backend):
         if any(c.pre_solve is not None for c in space.constraints):
             outside.append("the pre-solve callbacks that move rolling pitch points")
         text = pymunk_script(
-            title=(f"The mechanism as mbfidelity builds it in Pymunk {self.version()}, from "
-                   f"the initial state of scenario {name!r}.\nBackend settings:\n"
-                   + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items())),
-            space=space, first_iterations=max(int(cfg["iterations"]),
-                                              int(cfg["start_iterations"])),
+            title=self.script_title("Pymunk", name, cfg), space=space,
+            first_iterations=max(int(cfg["iterations"]), int(cfg["start_iterations"])),
             iterations=int(cfg["iterations"]),
             names=dict(zip(bodies, layout.engine)), dt=dt, not_in_script=outside)
         return text, outside
