@@ -28,6 +28,10 @@ them and lives here:
 - for an engine without massless bodies, the massless links eliminated by their shape
   (`Elimination`: folded, arms, free groups) and every body's frame from the bodies with
   mass (`EliminatedFrames`);
+- for an engine in maximal coordinates, the description's frames and coordinates from
+  its bodies' states and the element loads on those bodies (`MaximalFrames`), and the
+  joint and link geometry its constraints and drivers are placed by (`slide_path`,
+  `joint_pose`, `joint_velocity`, `Fold.slot_line`, `PitchPair.pitch_points`);
 - a coupling of hinge coordinates on the absolute body angles (`angle_coupling`) and as
   rolling of pitch circles on a carrier (`pitch_pairs`), and small facts a translation
   asks for (`line_through_origin`, `rotation_fixed`, `effective_mass`);
@@ -1477,6 +1481,128 @@ def sample_columns(values: Sequence, n: int) -> np.ndarray:
     return np.column_stack([np.broadcast_to(np.asarray(v, float), (n,)) for v in values])
 
 
+# --- an engine in maximal coordinates: its bodies' states and the description's frames ---
+
+_ZERO = (0.0, 0.0, 0.0)
+_UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def split_state_row(row: Sequence, H=0.0) -> tuple[list, list]:
+    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from a
+    state row (numbers, symbols or columns of samples; 6 entries per engine body)."""
+    P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
+    V = [tuple(row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
+    return P, V
+
+
+class MaximalFrames:
+    """How every description body's frame follows from the states of an engine in maximal
+    coordinates, read once. The engine's bodies (`engine`, in the order of its state rows:
+    per body its centre of gravity x, y, its angle and their rates) are the description's
+    bodies with mass, whose frames are placed from their centre of gravity (at the point
+    `cogs` of the body's frame where it is off the frame's origin), and substitutes of the
+    engine's own; an eliminated massless link follows them (`EliminatedFrames` of
+    `elimination`). `elements`: per force element, its loads as a function of the frames
+    and t (`element_loads`), which reach the engine bodies `loaded`."""
+
+    def __init__(self, mech: Mechanism, elimination: Elimination, engine: Sequence[str],
+                 cogs: Mapping[str, Sequence[float] | None], elements: Sequence[Callable]):
+        self.mech, self.elimination = mech, elimination
+        self.index = {name: k for k, name in enumerate(engine)}
+        self.n = len(engine)
+        self.cogs = {name: tuple(map(float, cog)) for name, cog in cogs.items() if cog}
+        #: per eliminated body, the engine bodies it follows
+        self.follows = {name: tuple(sorted(self.index[b] for b in set(bodies)
+                                           if b in self.index))
+                        for name, bodies in elimination.follows.items()}
+        self.elements = list(elements)
+        loaded: set[int] = set()
+        for f in mech.forces:
+            for body in set(force_bodies(mech, f)) - {WORLD}:
+                loaded |= set(self.follows[body]) if body in self.follows else {self.index[body]}
+        self.loaded = sorted(loaded)  # engine bodies that receive element loads
+        self.phis: dict[str, Callable] = {}  # compiled `coupling_phi`s
+
+    def at(self, P: Sequence, V: Sequence) -> EliminatedFrames:
+        """The frames from the engine bodies' positions P and rates V (x, y, theta of the
+        centre of gravity and their rates, per engine body)."""
+        def massive(body: str) -> tuple:
+            k, cog = self.index[body], self.cogs.get(body)
+            (x, y, th), (vx, vy, w) = P[k], V[k]
+            if cog:  # the frame whose point cog is the centre of gravity
+                return hung_frame((x, y, vx, vy), th, w, cog)
+            return (x, y, th, *cos_sin(th), vx, vy, w)
+
+        return EliminatedFrames(self.elimination, massive)
+
+    def frames(self, S: np.ndarray, H: float = 0.0) -> EliminatedFrames:
+        """The frames over state rows S (one sample per row) at x + H v."""
+        return self.at(*split_state_row(np.asarray(S, dtype=float).T, H))
+
+    def coordinates(self, S: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Engine body states (rows of `S`) -> the description's coordinates and rates;
+        the angles of eliminated links, which come from atan2, continued from q0."""
+        q, qd = (sample_columns(cols, len(S))
+                 for cols in joint_coordinates(self.mech, self.frames(S)))
+        return continued_angles(self.mech, q, q0), qd
+
+    def body_loads(self, frames: EliminatedFrames, t) -> list[Load]:
+        """The element loads on the description bodies."""
+        return [load for element in self.elements for load in element(frames, t)]
+
+    def coupling_phi(self, name: str) -> Callable[..., float]:
+        """The residual Phi = sum k q - const of the coupling `name`, as a compiled
+        function of the engine bodies' positions (x, y, theta each)."""
+        if name in self.phis:
+            return self.phis[name]
+        residual = coupling_residual(self.mech, next(c for c in self.mech.constraints
+                                                     if c.name == name))
+
+        def phi(*pos: float) -> list:
+            return [residual(self.at([pos[k:k + 3] for k in range(0, len(pos), 3)],
+                                     [_ZERO] * self.n))]
+
+        compiled = traced(phi, 3 * self.n)
+        self.phis[name] = lambda *pos: compiled(*pos)[0]
+        return self.phis[name]
+
+    @cached_property
+    def loads_math(self) -> Callable | None:
+        """`engine_loads` compiled: (*state row, H, t) -> flat (fx, fy, tau) of the
+        `loaded` engine bodies (None without force elements)."""
+        if not self.elements:
+            return None
+        return traced(lambda *args: self.engine_loads(args[:-2], args[-2], args[-1]),
+                      6 * self.n + 2)
+
+    def engine_loads(self, row: Sequence, H, t) -> list:
+        """The element loads (fx, fy at the centre of gravity, tau) on the `loaded`
+        engine bodies at the position-updated state x + H v of one state row. A load on
+        an eliminated massless body reaches the engine bodies it follows by virtual
+        power, J^T f, J's columns its velocities for a unit rate of each engine state."""
+        P, V = split_state_row(row, H)
+        frames = self.at(P, V)
+        out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
+        for load in self.body_loads(frames, t):
+            body, force, point, torque = load
+            if body == WORLD:
+                continue
+            if body not in self.follows:
+                k = self.index[body]
+                out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
+                continue
+            x, y = frames.state(body)[:2]
+            for k in self.follows[body]:
+                for i, unit in enumerate(_UNITS):
+                    rates = [_ZERO] * len(P)
+                    rates[k] = unit
+                    vx, vy, w = self.at(P, rates).state(body)[5:]
+                    out[k][i] += torque * w if force is None else (
+                        torque * w + force[0] * (vx - w * (point[1] - y))
+                        + force[1] * (vy + w * (point[0] - x)))
+        return [v for k in self.loaded for v in out[k]]
+
+
 # --- a coupling of hinge angles on the bodies' absolute angles --------------------------
 
 
@@ -1917,124 +2043,3 @@ def link_frames(mech: Mechanism) -> LinkFrames:
         rotations.append(angle - beta[p])
         com[j.child] = -rot_z(-beta[j.child]) @ column(j.child_anchor)
     return LinkFrames(coordinate_map(mech), link_of, parents, offsets, rotations, beta, com)
-
-# --- an engine in maximal coordinates: its bodies' states and the description's frames ---
-
-_ZERO = (0.0, 0.0, 0.0)
-_UNITS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-
-
-def split_state_row(row: Sequence, H=0.0) -> tuple[list, list]:
-    """Per engine body, (x, y, theta) moved by H times the rates, and the rates, from a
-    state row (numbers, symbols or columns of samples; 6 entries per engine body)."""
-    P = [tuple(row[k + i] + H * row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
-    V = [tuple(row[k + 3 + i] for i in range(3)) for k in range(0, len(row), 6)]
-    return P, V
-
-
-class MaximalFrames:
-    """How every description body's frame follows from the states of an engine in maximal
-    coordinates, read once. The engine's bodies (`engine`, in the order of its state rows:
-    per body its centre of gravity x, y, its angle and their rates) are the description's
-    bodies with mass, whose frames are placed from their centre of gravity (at the point
-    `cogs` of the body's frame where it is off the frame's origin), and substitutes of the
-    engine's own; an eliminated massless link follows them (`EliminatedFrames` of
-    `elimination`). `elements`: per force element, its loads as a function of the frames
-    and t (`element_loads`), which reach the engine bodies `loaded`."""
-
-    def __init__(self, mech: Mechanism, elimination: Elimination, engine: Sequence[str],
-                 cogs: Mapping[str, Sequence[float] | None], elements: Sequence[Callable]):
-        self.mech, self.elimination = mech, elimination
-        self.index = {name: k for k, name in enumerate(engine)}
-        self.n = len(engine)
-        self.cogs = {name: tuple(map(float, cog)) for name, cog in cogs.items() if cog}
-        #: per eliminated body, the engine bodies it follows
-        self.follows = {name: tuple(sorted(self.index[b] for b in set(bodies)
-                                           if b in self.index))
-                        for name, bodies in elimination.follows.items()}
-        self.elements = list(elements)
-        loaded: set[int] = set()
-        for f in mech.forces:
-            for body in set(force_bodies(mech, f)) - {WORLD}:
-                loaded |= set(self.follows[body]) if body in self.follows else {self.index[body]}
-        self.loaded = sorted(loaded)  # engine bodies that receive element loads
-        self.phis: dict[str, Callable] = {}  # compiled `coupling_phi`s
-
-    def at(self, P: Sequence, V: Sequence) -> EliminatedFrames:
-        """The frames from the engine bodies' positions P and rates V (x, y, theta of the
-        centre of gravity and their rates, per engine body)."""
-        def massive(body: str) -> tuple:
-            k, cog = self.index[body], self.cogs.get(body)
-            (x, y, th), (vx, vy, w) = P[k], V[k]
-            if cog:  # the frame whose point cog is the centre of gravity
-                return hung_frame((x, y, vx, vy), th, w, cog)
-            return (x, y, th, *cos_sin(th), vx, vy, w)
-
-        return EliminatedFrames(self.elimination, massive)
-
-    def frames(self, S: np.ndarray, H: float = 0.0) -> EliminatedFrames:
-        """The frames over state rows S (one sample per row) at x + H v."""
-        return self.at(*split_state_row(np.asarray(S, dtype=float).T, H))
-
-    def coordinates(self, S: np.ndarray, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Engine body states (rows of `S`) -> the description's coordinates and rates;
-        the angles of eliminated links, which come from atan2, continued from q0."""
-        q, qd = (sample_columns(cols, len(S))
-                 for cols in joint_coordinates(self.mech, self.frames(S)))
-        return continued_angles(self.mech, q, q0), qd
-
-    def body_loads(self, frames: EliminatedFrames, t) -> list[Load]:
-        """The element loads on the description bodies."""
-        return [load for element in self.elements for load in element(frames, t)]
-
-    def coupling_phi(self, name: str) -> Callable[..., float]:
-        """The residual Phi = sum k q - const of the coupling `name`, as a compiled
-        function of the engine bodies' positions (x, y, theta each)."""
-        if name in self.phis:
-            return self.phis[name]
-        residual = coupling_residual(self.mech, next(c for c in self.mech.constraints
-                                                     if c.name == name))
-
-        def phi(*pos: float) -> list:
-            return [residual(self.at([pos[k:k + 3] for k in range(0, len(pos), 3)],
-                                     [_ZERO] * self.n))]
-
-        compiled = traced(phi, 3 * self.n)
-        self.phis[name] = lambda *pos: compiled(*pos)[0]
-        return self.phis[name]
-
-    @cached_property
-    def loads_math(self) -> Callable | None:
-        """`engine_loads` compiled: (*state row, H, t) -> flat (fx, fy, tau) of the
-        `loaded` engine bodies (None without force elements)."""
-        if not self.elements:
-            return None
-        return traced(lambda *args: self.engine_loads(args[:-2], args[-2], args[-1]),
-                      6 * self.n + 2)
-
-    def engine_loads(self, row: Sequence, H, t) -> list:
-        """The element loads (fx, fy at the centre of gravity, tau) on the `loaded`
-        engine bodies at the position-updated state x + H v of one state row. A load on
-        an eliminated massless body reaches the engine bodies it follows by virtual
-        power, J^T f, J's columns its velocities for a unit rate of each engine state."""
-        P, V = split_state_row(row, H)
-        frames = self.at(P, V)
-        out = {k: [0.0, 0.0, 0.0] for k in self.loaded}
-        for load in self.body_loads(frames, t):
-            body, force, point, torque = load
-            if body == WORLD:
-                continue
-            if body not in self.follows:
-                k = self.index[body]
-                out[k] = [a + b for a, b in zip(out[k], wrench(load, P[k][:2]))]
-                continue
-            x, y = frames.state(body)[:2]
-            for k in self.follows[body]:
-                for i, unit in enumerate(_UNITS):
-                    rates = [_ZERO] * len(P)
-                    rates[k] = unit
-                    vx, vy, w = self.at(P, rates).state(body)[5:]
-                    out[k][i] += torque * w if force is None else (
-                        torque * w + force[0] * (vx - w * (point[1] - y))
-                        + force[1] * (vy + w * (point[0] - x)))
-        return [v for k in self.loaded for v in out[k]]

@@ -21,12 +21,12 @@ kind has one builder, registered with the expressions it declares (`_builds`;
   bodies -> ``GearJoint`` (exact). Three bodies A, B, K with sum k = 0, A and B hinged
   on the carrier K (belt pulleys on an arm, a disc rolling in a moving track): that is
   an internal/external gear pair on the carrier, i.e. rolling of the pitch circles at
-  the pitch point C = a + lam (b - a), lam = k_A / (k_A + k_B), on the line of the hubs
-  a, b. It is a ``PivotJoint`` between A and B whose anchors are moved to C before every
-  solve (pre-solve callback, at the position-updated configuration): its tangential
-  row is the coupling, its normal row is implied by the carrier (redundant), and the
-  coupling's position error is put into the tangential anchor gap so that Chipmunk's
-  own error correction removes it. A ``RollingContact`` (a variant's stand-in for such
+  the pitch point C (`plan.PitchPair`). It is a ``PivotJoint`` between A and B whose
+  anchors are moved to C before every solve (pre-solve callback, at the
+  position-updated configuration): its tangential row is the coupling, its normal row
+  is implied by the carrier (redundant), and the coupling's position error is put into
+  the tangential anchor gap (`plan.PitchPair.pitch_points`) so that Chipmunk's own error
+  correction removes it. A ``RollingContact`` (a variant's stand-in for such
   a coupling) makes the pitch circles colliding shapes instead, and the massless carrier
   arm is removed (the contact holds the disc). Other couplings (three bodies without a
   common carrier, prismatic coordinates) are refused with the reason.
@@ -894,10 +894,8 @@ class PymunkBackend(Backend):
 
     @staticmethod
     def _pitch_pivot(pymunk, bodies, comp: _Compiled, pitch: _Pitch, phi_fn):
-        """PivotJoint between the two coupled bodies, moved to the pitch point at the
-        position-updated configuration before every solve; the coupling's position error
-        e (metres along the pitch tangent) is left as the tangential gap of the anchors so
-        that Chipmunk removes it like any joint error."""
+        """PivotJoint between the two coupled bodies, moved to the pitch points before
+        every solve (the module docstring)."""
         a, b = bodies[pitch.a], bodies[pitch.b]
         engine = [bodies[n] for n in comp.layout.engine]
         cogs = [comp.layout.cog.get(n) for n in comp.layout.engine]

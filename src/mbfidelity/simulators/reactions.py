@@ -29,7 +29,8 @@ of a prismatic joint's own slide, which every build applies as joint forces. An 
 that reports no force at all (only an impulse's magnitude) measures the bodies' motion
 over each step: a prescribed coordinate's actuator force is Newton-Euler on its child
 subtree (`actuator_force`), and with closure constraints the joint reactions and the
-closure forces come together from the momentum balance of every body (`balance_forces`).
+closure forces come together from the momentum balance of every body (`balance_forces`);
+`motion_forces` gathers them all from the state rows of an engine in maximal coordinates.
 
 Sign convention of every force handed in (the contract's, base.py point 6), by element
 name: a pair element (PointToPoint, PointOnPoint, PointOnLine) gives the force on its first
