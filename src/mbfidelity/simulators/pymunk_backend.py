@@ -193,7 +193,11 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
     k, k0, bodies, scale = coupled_angles(mech, c)
     if not bodies:
         raise _Refused(f"coupling {c.name}: no body angle enters it")
+    arm = (f"contact {c.name}: the disc and the track must be hinged on a massless carrier "
+           "arm, which the contact replaces")
     if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
+        if contact:
+            raise _Refused(arm)
         if len(bodies) == 1:
             a = bodies[0]
             return "gear", (a, WORLD, -k0 / k[a], 1.0)
@@ -203,8 +207,7 @@ def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], boo
         if not (engine_ok(pair.a) and engine_ok(pair.b)):
             continue
         if contact and pair.carrier not in massless:  # its hinges would keep the distance
-            raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
-                           "massless carrier arm, which the contact replaces")
+            raise _Refused(arm)
         wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
         return "pitch", _Pitch(*astuple(pair), c.name, wrap, contact)
     raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
@@ -427,11 +430,8 @@ def _slot(ctx, c: PointOnLine) -> None:
                 "error 2-10 % of the amplitude (coupling 2-2.6e-3), slip up to 3e-4 m, "
                 "single-step losses of contact from one chord to the next"))
 def _contact(ctx, c: RollingContact) -> None:
-    kind, value = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
-    if kind == "gear":
-        raise _Refused(f"contact {c.name}: the disc and the track must be hinged on a "
-                       "massless carrier arm, which the contact replaces")
-    ctx.layout.pitches.append(value)
+    _, pitch = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
+    ctx.layout.pitches.append(pitch)
 
 
 @_builds(
