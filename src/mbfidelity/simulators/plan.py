@@ -1160,8 +1160,9 @@ class Fold:
 
     @property
     def slot_line(self) -> tuple[np.ndarray, np.ndarray]:
-        """The line base + u direction in the partner's frame on which the pin point
-        (`pin_point`) runs: the pair of joints as one pin-in-slot."""
+        """The line (base, direction) in the partner's frame on which the pin point
+        (`pin_point`) runs, at base + q direction for the slide's coordinate q: the pair
+        of joints as one pin-in-slot."""
         rev, pri = self.revolute, self.prismatic
         if self.turns_with_child:
             # the link turns with its child: the pivot (a point of the parent) slides on a
