@@ -1088,7 +1088,7 @@ class PymunkBackend(Backend):
         the harness's compiled functions, which are not written out)."""
         from .script_export import pymunk_script
 
-        name, q0, qd0 = self.script_start(initial_states)
+        name, q0, qd0 = self.export_start(initial_states)
         cfg = self.resolve_settings(settings)
         layout, comp, space, bodies, balanced, movers = self._prepare(
             mechanism, np.asarray(q0, float), np.asarray(qd0, float), cfg, float(dt))
