@@ -29,9 +29,11 @@ them and lives here:
   (`Elimination`: folded, arms, free groups) and every body's frame from the bodies with
   mass (`EliminatedFrames`);
 - for an engine in maximal coordinates, the description's frames and coordinates from
-  its bodies' states and the element loads on those bodies (`MaximalFrames`), and the
+  its bodies' states and the element loads on those bodies (`MaximalFrames`), the
   joint and link geometry its constraints and drivers are placed by (`slide_path`,
-  `joint_pose`, `joint_velocity`, `Fold.slot_line`, `PitchPair.pitch_points`);
+  `joint_pose`, `joint_velocity`, `Fold.slot_line`, `coupled_angles`, `PitchPair`'s
+  circles and pitch points, `ring_of_chords`), what a host keeps of its inertia beside
+  its substitutes (`compensated_host`) and a drive's first-step rate (`stepped_start`);
 - a coupling of hinge coordinates on the absolute body angles (`angle_coupling`) and as
   rolling of pitch circles on a carrier (`pitch_pairs`), and small facts a translation
   asks for (`line_through_origin`, `rotation_fixed`, `effective_mass`);
