@@ -1857,10 +1857,7 @@ def slider_masses(mech: Mechanism, pin_body: str, ratio: float, lightest: float,
     # the largest point masses at the pins that leave a positive inertia
     bound = mp * ip / (ip + mp * sum(float(p @ p) for p in pts)) / len(cons)
     masses = [ratio * bound for _ in cons]
-    rest = mp - sum(masses)
-    com = -sum(mc * p for mc, p in zip(masses, pts)) / rest
-    inertia = (ip - sum(mc * float(p @ p) for mc, p in zip(masses, pts))
-               - rest * float(com @ com))
+    rest, com, inertia = compensated_host(mp, ip, [(mc, p, 0.0) for mc, p in zip(masses, pts)])
     return SliderSplit({c.name: mc for c, mc in zip(cons, masses)}, (rest, inertia, com))
 
 
