@@ -2043,3 +2043,36 @@ def link_frames(mech: Mechanism) -> LinkFrames:
         rotations.append(angle - beta[p])
         com[j.child] = -rot_z(-beta[j.child]) @ column(j.child_anchor)
     return LinkFrames(coordinate_map(mech), link_of, parents, offsets, rotations, beta, com)
+
+
+# --- conditions of an element's expression that follow from the description alone -------
+
+
+def carries_child(mech: Mechanism, body: Body) -> bool:
+    """Some joint of the description has `body` as its parent."""
+    return any(j.parent == body.name for j in mech.joints)
+
+
+def held_by_closure(mech: Mechanism, body: Body) -> bool:
+    """A closure constraint acts on `body` (`constrained_bodies`)."""
+    return body.name in constrained_bodies(mech)
+
+
+def engine_coupling(mech: Mechanism, coupling: LinearCoupling) -> tuple[np.ndarray, float]:
+    """A coupling written on the engine joint values: (its row, its constant)
+    (`CoordinateMap.on_engine_values` of `coupling_row`)."""
+    return coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
+
+
+def couples_two_engine_values(mech: Mechanism, coupling: LinearCoupling) -> bool:
+    """The coupling, written on the engine joint values, involves exactly two of them."""
+    return int(np.count_nonzero(engine_coupling(mech, coupling)[0])) == 2
+
+
+def smallest_mass_and_inertia(mech: Mechanism) -> tuple[float, float]:
+    """The smallest positive body mass and central inertia (1 where there is none): the
+    scale of a substitute's small mass or inertia."""
+    masses = [num(b.mass) for b in mech.bodies]
+    inertias = [num(b.inertia) for b in mech.bodies]
+    return (min((m for m in masses if m > 0), default=1.0),
+            min((i for i in inertias if i > 0), default=1.0))

@@ -43,10 +43,11 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
-                   RollingGeometry, constrained_bodies, coordinate_map, coupling_row,
-                   element_kind, element_loads, elements, gravity_vector, num, point_state,
-                   principal_inertia, ring_of_boxes, rolling_contact_report,
-                   rolling_geometry, spatial_tree_reason, turned)
+                   RollingGeometry, carries_child, coordinate_map, couples_two_engine_values,
+                   coupling_row, element_kind, element_loads, elements, engine_coupling,
+                   gravity_vector, held_by_closure, num, one_joint_value, point_state,
+                   principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
+                   smallest_mass_and_inertia, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -163,18 +164,6 @@ def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
             c1 = c1 / np.linalg.norm(c1)
             return float(c1[0]), float(c1[1])
     raise ValueError("zero slot direction")
-
-
-def _two_joint_gear(mech: Mechanism, coupling: LinearCoupling) -> bool:
-    """The coupling, written on the engine joint values, involves exactly two of them."""
-    row, _ = coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
-    return int(np.count_nonzero(row)) == 2
-
-
-def _one_joint_value(mech: Mechanism, prescribed: Prescribed) -> bool:
-    """The prescribed coordinate is one engine joint value (not a sum of them)."""
-    i = mech.coordinates.index(prescribed.coordinate)
-    return int(np.count_nonzero(coordinate_map(mech).A[i])) == 1
 
 
 # --- closure constraints: one class per PyBullet construct ---------------------------
@@ -386,10 +375,7 @@ class _Translation:
         self.n = len(mech.joints)
         self.map = coordinate_map(mech)
         self.gravity_vector = gravity_vector(mech)
-        masses = [num(b.mass) for b in mech.bodies]
-        inertias = [num(b.inertia) for b in mech.bodies]
-        self.m_min = min((m for m in masses if m > 0), default=1.0)
-        self.i_min = min((i for i in inertias if i > 0), default=1.0)
+        self.m_min, self.i_min = smallest_mass_and_inertia(mech)
         self.link_of: dict[str, int] = {WORLD: -1}
         self.anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
         self.inertia_of: dict[str, tuple[float, float]] = {}  # body -> (mass, inertia)
@@ -443,29 +429,21 @@ def _massive_body(model: _Translation, body) -> None:
     model.inertia_of[body.name] = (num(body.mass), num(body.inertia))
 
 
-def _carries_child(mech: Mechanism, body) -> bool:
-    return any(j.parent == body.name for j in mech.joints)
-
-
-def _held_by_closure(mech: Mechanism, body) -> bool:
-    return body.name in constrained_bodies(mech)
-
-
 @_builds(MASSLESS_BODY,
          Expression(EXACT, "a link of mass 0 and inertia 0: the articulated-body algorithm "
                            "inverts only each joint's articulated inertia, which its child "
-                           "carries", when="it carries a child", applies=_carries_child),
+                           "carries", when="it carries a child", applies=carries_child),
          Expression(SUBSTITUTE, "a small mass and inertia (massless_leaf_mass_ratio of the "
                                 "smallest body's), since zero would make the articulated-"
                                 "body algorithm singular",
                     when="it carries nothing but a closure constraint holds it",
-                    applies=_held_by_closure),
+                    applies=held_by_closure),
          Expression(UNSUPPORTED, "a massless link that carries nothing is singular for the "
                                  "articulated-body algorithm",
                     when="it carries nothing and no constraint holds it"))
 def _massless_body(model: _Translation, body) -> None:
     mass, inertia = float(model.cfg["massless_link_mass"]), 0.0
-    if not _carries_child(model.mech, body) and _held_by_closure(model.mech, body):
+    if not carries_child(model.mech, body) and held_by_closure(model.mech, body):
         ratio = float(model.cfg["massless_leaf_mass_ratio"])
         hinged = element_kind(model.mech.joint_of_child(body.name)) == REVOLUTE
         mass, inertia = ratio * model.m_min, ratio * model.i_min if hinged else 0.0
@@ -577,7 +555,7 @@ def _point_on_line(model: _Translation, c) -> None:
 @_builds(LINEAR_COUPLING,
          Expression(EXACT, "JOINT_GEAR on the two engine joint values it involves, solved at "
                            "velocity level (exact for a linear constraint)",
-                    when="two engine joint values", applies=_two_joint_gear),
+                    when="two engine joint values", applies=couples_two_engine_values),
          Expression(UNSUPPORTED, "PyBullet's JOINT_GEAR constrains exactly two joints "
                                  "(jv_a + ratio jv_b = target); its gearAuxLink only adds that "
                                  "joint's current velocity as a target, it is not a three-term "
@@ -585,7 +563,7 @@ def _point_on_line(model: _Translation, c) -> None:
                     when="one, or three or more, engine joint values"))
 def _linear_coupling(model: _Translation, c) -> None:
     cvec, const = coupling_row(model.mech, c)
-    w, rhs = model.map.on_engine_values(cvec, const)
+    w, rhs = engine_coupling(model.mech, c)
     nz = np.flatnonzero(w)
     if len(nz) != 2:  # guarded by support()
         raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
@@ -700,7 +678,7 @@ def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, flo
          Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
                            "force that never saturates (prescribed_motion): the coordinate "
                            "lands on q(t+h) at every step; actuator force from getJointState",
-                    when="the coordinate is one engine joint value", applies=_one_joint_value),
+                    when="the coordinate is one engine joint value", applies=one_joint_value),
          Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an absolute "
                                  "angle on a turning parent): one joint motor cannot impose "
                                  "it without the parent's angle at t+h before the step",
