@@ -2076,3 +2076,96 @@ def smallest_mass_and_inertia(mech: Mechanism) -> tuple[float, float]:
     inertias = [num(b.inertia) for b in mech.bodies]
     return (min((m for m in masses if m > 0), default=1.0),
             min((i for i in inertias if i > 0), default=1.0))
+
+
+# --- the geometry of elements between two bodies, from the bodies' frame states ----------
+#
+# `states` and the arguments `pin`, `line`, `state_a`, `state_b` are frame states
+# (x, y, theta, vx, vy, omega) of description bodies, as `body_states` gives them.
+
+
+@dataclass(frozen=True)
+class PairLoad:
+    """A point-to-point element in numbers: its bodies, its points (body frames), its
+    loads (`element_loads`) and whether its law reads the time."""
+
+    name: str
+    body_a: str
+    body_b: str
+    point_a: tuple[float, float]
+    point_b: tuple[float, float]
+    loads: Callable[[Mapping, float], list]
+    time_dependent: bool
+
+    def force(self, states: Mapping, t: float
+              ) -> tuple[float, float, float, float, float, float]:
+        """(force on b x, y, point a x, y, point b x, y) at the bodies' frame states; the
+        force on a is opposite."""
+        try:
+            (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
+        except ZeroDivisionError:  # the points coincide: the force has no direction
+            ax, ay = point_state(states[self.body_a], self.point_a)[:2]
+            bx, by = point_state(states[self.body_b], self.point_b)[:2]
+            return 0.0, 0.0, ax, ay, bx, by
+        return fx, fy, ax, ay, bx, by
+
+
+def pair_load(mech: Mechanism, f: PointToPoint) -> PairLoad:
+    """The `PairLoad` of a point-to-point element."""
+    return PairLoad(f.name, f.body_a, f.body_b, _pt(f.point_a), _pt(f.point_b),
+                    element_loads(mech, f), ForceLaw.of(f).time_dependent)
+
+
+def point_distance(state_a: tuple, point_a, state_b: tuple, point_b) -> float:
+    """Distance between a point of one body and a point of another (body frames): a
+    PointOnPoint's violation."""
+    ax, ay, _, _ = point_state(state_a, point_a)
+    bx, by, _, _ = point_state(state_b, point_b)
+    return math.hypot(ax - bx, ay - by)
+
+
+@dataclass(frozen=True)
+class SlotGeometry:
+    """A PointOnLine in numbers (body frames): the pin's body and point, the slot body,
+    the point L of its line and the line's unit direction u."""
+
+    pin_body: str
+    pin_point: tuple[float, float]
+    line_body: str
+    line_point: tuple[float, float]
+    direction: tuple[float, float]
+
+    def frame(self, pin: tuple, line: tuple
+              ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, float]]:
+        """World position and velocity of the pin P and of the slot body's point L, and
+        the slot's direction u in world axes."""
+        c, s = math.cos(line[2]), math.sin(line[2])
+        u = (c * self.direction[0] - s * self.direction[1],
+             s * self.direction[0] + c * self.direction[1])
+        return point_state(pin, self.pin_point), point_state(line, self.line_point), u
+
+    def along(self, pin: tuple, line: tuple) -> tuple[float, float]:
+        """Where the pin is along the slot, s = (P - L) . u, and its rate (v_P - v_L) . u
+        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
+        the rotation of u adds nothing)."""
+        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self.frame(pin, line)
+        return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
+
+    def gap(self, pin: tuple, line: tuple) -> float:
+        """Signed distance n . (P - L) of the pin from the slot line (the violation),
+        n = (-u_y, u_x)."""
+        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self.frame(pin, line)
+        return -uy * (px - lx) + ux * (py - ly)
+
+    def line_point_at(self, s: float) -> tuple[float, float]:
+        """The slot body's point of its line at s along it: L + s u (body frame)."""
+        ux, uy = self.direction
+        return self.line_point[0] + s * ux, self.line_point[1] + s * uy
+
+
+def slot_geometry(c: PointOnLine) -> SlotGeometry:
+    """The `SlotGeometry` of a PointOnLine (its direction made a unit vector)."""
+    u = np.array([num(c.direction[0]), num(c.direction[1])])
+    u = u / float(np.hypot(*u))
+    return SlotGeometry(c.body, _pt(c.point), c.line_body, _pt(c.line_point),
+                        (float(u[0]), float(u[1])))

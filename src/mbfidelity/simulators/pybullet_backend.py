@@ -43,10 +43,11 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
-                   RollingGeometry, carries_child, coordinate_map, couples_two_engine_values,
-                   coupling_row, element_kind, element_loads, elements, engine_coupling,
-                   gravity_vector, held_by_closure, num, one_joint_value, point_state,
-                   principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
+                   PairLoad, RollingGeometry, SlotGeometry, carries_child, coordinate_map,
+                   couples_two_engine_values, coupling_row, element_kind, elements,
+                   engine_coupling, gravity_vector, held_by_closure, num, one_joint_value,
+                   pair_load, point_distance, principal_inertia, ring_of_boxes,
+                   rolling_contact_report, rolling_geometry, slot_geometry,
                    smallest_mass_and_inertia, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
@@ -91,11 +92,6 @@ def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
     return com[0], com[1], 2.0 * math.atan2(quat[2], quat[3]), vel[0], vel[1], omega
 
 
-def _point(ls, link: int, point) -> tuple[float, float, float, float]:
-    """World position and velocity of a body point (centre-of-mass frame)."""
-    return point_state(_pose(ls, link), point)
-
-
 @dataclass
 class _Link:
     name: str          # joint name
@@ -125,30 +121,18 @@ def _extra_link(name: str, parent: int, revolute: bool, mass: float, inertia: fl
 
 @dataclass
 class _PointForce:
-    """A point-to-point element on the links `link_a`, `link_b` (-1: world), its loads
-    from the shared plan (`plan.element_loads`)."""
+    """A point-to-point element (`plan.PairLoad`) on the links `link_a`, `link_b` (-1:
+    world)."""
 
-    name: str
+    pair: PairLoad
     link_a: int
     link_b: int
-    point_a: tuple[float, float]  # in the body frames
-    point_b: tuple[float, float]
-    body_a: str
-    body_b: str
-    loads: Callable[[Mapping, float], list]
-    time_dependent: bool
 
     def force(self, ls, t: float) -> tuple[float, float, float, float, float, float]:
         """(force on b x, y, point a x, y, point b x, y) from link states (`ls[link]`);
         the force on a is opposite."""
-        states = {self.body_a: _pose(ls, self.link_a), self.body_b: _pose(ls, self.link_b)}
-        try:
-            (_, (fx, fy), (bx, by), _), (_, _, (ax, ay), _) = self.loads(states, t)
-        except ZeroDivisionError:  # the points coincide: the force has no direction
-            ax, ay = _point(ls, self.link_a, self.point_a)[:2]
-            bx, by = _point(ls, self.link_b, self.point_b)[:2]
-            return 0.0, 0.0, ax, ay, bx, by
-        return fx, fy, ax, ay, bx, by
+        return self.pair.force({self.pair.body_a: _pose(ls, self.link_a),
+                                self.pair.body_b: _pose(ls, self.link_b)}, t)
 
 
 def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
@@ -214,44 +198,27 @@ class _Pin:
 
     def violation(self, ls) -> float:
         """Distance of the two points (m)."""
-        px, py, _, _ = _point(ls, self.parent, self.parent_point)
-        bx, by, _, _ = _point(ls, self.child, self.child_point)
-        return math.hypot(px - bx, py - by)
+        return point_distance(_pose(ls, self.parent), self.parent_point,
+                              _pose(ls, self.child), self.child_point)
 
 
 @dataclass
 class _Slot(_Pin):
-    """PointOnLine: the pin (`pin_link`, `pin_point`), the slot's line (`line_link`,
-    `line_point`, unit `direction` in the slot body's frame) and the extra link `aux`."""
+    """PointOnLine: its geometry (`slot`), the links of the pin's body (`pin_link`) and
+    of the slot body (`line_link`), and the extra link `aux`."""
 
+    slot: SlotGeometry | None = None
     pin_link: int = -1
-    pin_point: tuple[float, float] = (0.0, 0.0)
     line_link: int = -1
-    line_point: tuple[float, float] = (0.0, 0.0)
-    direction: tuple[float, float] = (1.0, 0.0)
     aux: int = -1
 
-    def _line(self, ls) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, float]]:
-        """World position and velocity of the pin P and of the slot body's point L, and
-        the slot's direction u in world axes, from link states."""
-        th = _pose(ls, self.line_link)[2]
-        c, s = math.cos(th), math.sin(th)
-        u = (c * self.direction[0] - s * self.direction[1],
-             s * self.direction[0] + c * self.direction[1])
-        return (_point(ls, self.pin_link, self.pin_point),
-                _point(ls, self.line_link, self.line_point), u)
-
-    def _along(self, ls) -> tuple[float, float]:
-        """Where the pin is along the slot, s = (P - L) . u, and its rate (v_P - v_L) . u
-        with v_L the velocity of the slot body's material point L ((P - L) is along u, so
-        the rotation of u adds nothing), from link states."""
-        (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self._line(ls)
-        return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
+    def _states(self, ls) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """The frame states of the pin's body and of the slot body, from link states."""
+        return _pose(ls, self.pin_link), _pose(ls, self.line_link)
 
     def violation(self, ls) -> float:
         """Signed distance n . (P - L) of the pin from the slot line (m)."""
-        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self._line(ls)
-        return -uy * (px - lx) + ux * (py - ly)
+        return self.slot.gap(*self._states(ls))
 
 
 @dataclass
@@ -261,8 +228,10 @@ class _Slider(_Slot):
     (child); its force on the pin (parent) is minus the rows."""
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
-        """The slider sits under the pin and moves with it along the slot (`_along`)."""
-        p.resetJointState(body, eidx[self.aux], *self._along(ls), physicsClientId=cid)
+        """The slider sits under the pin and moves with it along the slot
+        (`SlotGeometry.along`)."""
+        p.resetJointState(body, eidx[self.aux], *self.slot.along(*self._states(ls)),
+                          physicsClientId=cid)
 
 
 @dataclass
@@ -277,7 +246,7 @@ class _Rotor(_Slot):
     follows_pin = True
 
     def frames(self, p) -> tuple:
-        return (p.JOINT_PRISMATIC, [self.direction[0], self.direction[1], 0.0],
+        return (p.JOINT_PRISMATIC, [self.slot.direction[0], self.slot.direction[1], 0.0],
                 [0.0, 0.0, 0.0], _xyz(self.child_point))
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
@@ -293,14 +262,13 @@ class _Rotor(_Slot):
             th = model.map.angle(model.links[self.line_link].body, q)
         else:
             th = np.zeros(len(rows))
-        return rows[:, 1:2] * turned(th, *_slider_row_normal(self.direction))
+        return rows[:, 1:2] * turned(th, *_slider_row_normal(self.slot.direction))
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
         slot body's frame: L + ((P - L) . u) u (why: the setting point_on_line's note)."""
-        s, _ = self._along({lk: ls[m] for lk, m in slot_of.items()})
-        ux, uy = self.direction
-        return [self.line_point[0] + s * ux, self.line_point[1] + s * uy, 0.0]
+        s, _ = self.slot.along(*self._states({lk: ls[m] for lk, m in slot_of.items()}))
+        return [*self.slot.line_point_at(s), 0.0]
 
 
 @dataclass
@@ -492,10 +460,8 @@ def _slide(model: _Translation, j) -> None:
 @_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _POINT_FORCE))
 @_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, _POINT_FORCE))
 def _point_force(model: _Translation, f) -> None:
-    law = ForceLaw.of(f)
-    model.point_forces.append(_PointForce(
-        f.name, model.link_of[f.body_a], model.link_of[f.body_b], _xy(f.point_a),
-        _xy(f.point_b), f.body_a, f.body_b, element_loads(model.mech, f), law.time_dependent))
+    model.point_forces.append(_PointForce(pair_load(model.mech, f), model.link_of[f.body_a],
+                                          model.link_of[f.body_b]))
 
 
 @_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _JOINT_FORCE))
@@ -529,13 +495,11 @@ def _point_on_point(model: _Translation, c) -> None:
                                                "the only substitute (point_on_line='slider': "
                                                "a slider link of small mass)"))
 def _point_on_line(model: _Translation, c) -> None:
-    u = np.array([num(c.direction[0]), num(c.direction[1])])
-    u = u / float(np.hypot(*u))
-    lp, pp = _xy(c.line_point), _xy(c.point)
+    slot = slot_geometry(c)
+    lp, pp, u = slot.line_point, slot.pin_point, slot.direction
     lpin, lline = model.link_of[c.body], model.link_of[c.line_body]
     k = len(model.links)
-    geo = dict(pin_link=lpin, pin_point=pp, line_link=lline, line_point=lp,
-               direction=(float(u[0]), float(u[1])), aux=k)
+    geo = dict(slot=slot, pin_link=lpin, line_link=lline, aux=k)
     if model.cfg["point_on_line"] == "slider":
         anchor = model.anchor_of[c.line_body]
         mass = float(model.cfg["slider_mass_ratio"]) * model.m_min
@@ -1284,7 +1248,7 @@ class PyBulletBackend(Backend):
                 # description's arm and coupling carried, so it counts as transmitted
                 # through the joints (contract point 6). Checked by Newton's law on the
                 # scotch yoke's disc and the slotted bar (3e-14 N)
-                pairs = {pf.name: -f_point[: steps + 1, e]
+                pairs = {pf.pair.name: -f_point[: steps + 1, e]
                          for e, pf in enumerate(model.point_forces)}
                 pairs.update({c.element.name: forces[c.element.name] for c in closures
                               if c.pair})
@@ -1387,7 +1351,7 @@ class PyBulletBackend(Backend):
                 q = model.map.coordinates(jv)
                 qd = model.map.rates(jvd)
                 tau = model.coordinate_torques(q, qd, 0.0, autonomous=True)
-                pfs = [pf for pf in model.point_forces if not pf.time_dependent]
+                pfs = [pf for pf in model.point_forces if not pf.pair.time_dependent]
                 if not pfs:
                     return tau
                 for i in range(n):
@@ -1398,8 +1362,8 @@ class PyBulletBackend(Backend):
                       for lk in model.point_links}
                 for pf in pfs:
                     fx, fy, *_ = pf.force(ls, 0.0)
-                    for link, point, sign in ((pf.link_b, pf.point_b, 1.0),
-                                              (pf.link_a, pf.point_a, -1.0)):
+                    for link, point, sign in ((pf.link_b, pf.pair.point_b, 1.0),
+                                              (pf.link_a, pf.pair.point_a, -1.0)):
                         if link < 0:
                             continue
                         # calculateJacobian takes the point in the URDF link frame (the
