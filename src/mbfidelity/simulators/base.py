@@ -582,9 +582,15 @@ class Backend(ABC):
                 return False, f"{name} is not importable: {exc}"
         return True, ""
 
-    @abstractmethod
+    #: the engine's distribution (its package's name), whose installed version `version`
+    #: reports; a backend that reads its engine's version otherwise overrides `version`
+    ENGINE_DISTRIBUTION: ClassVar[str] = ""
+
     def version(self) -> str:
-        """See the contract in the module docstring."""
+        """See the contract in the module docstring (point 3)."""
+        from importlib.metadata import version
+
+        return version(self.ENGINE_DISTRIBUTION)
 
     def default_settings(self) -> dict:
         """Every setting's default, from `SETTINGS` (fresh copies: callers may mutate)."""
@@ -622,6 +628,12 @@ class Backend(ABC):
         """Why the engine's structure cannot hold the mechanism although no single element
         is unsupported (empty string: it can)."""
         return ""
+
+    def checked_support(self, mechanism: Mechanism) -> None:
+        """ValueError naming the reason when the backend cannot express the mechanism."""
+        support = self.support(mechanism)
+        if not support.ok:
+            raise ValueError(f"{self.id} cannot express this mechanism: {support.reason}")
 
     def support(self, mechanism: Mechanism) -> Support:
         """Contract point 5: from the description's checks, the engine's structure and the
@@ -709,9 +721,7 @@ class Backend(ABC):
         cfg = self.resolve_settings(settings)
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError(f"the step must be positive and finite; got {dt!r}")
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"{self.id} cannot express this mechanism: {support.reason}")
+        self.checked_support(mechanism)
         return cfg, step_count(t_end, dt)
 
     @abstractmethod

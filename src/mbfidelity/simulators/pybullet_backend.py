@@ -651,10 +651,8 @@ def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
     model.driven.append(Motion(prescribed, model.mech.coordinates.index(prescribed.coordinate)))
 
 
-@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "the spatial build closes no loop: a spatial "
-                                                "closed loop has no constraint in it"))
-def _hinge_closure(model: _Translation, c) -> None:
-    raise ValueError(f"pybullet builds no hinge closure ({c.name}): support() refuses it")
+_BUILDERS.refuses(HINGE_CLOSURE, "the spatial build closes no loop: a spatial closed loop "
+                                  "has no constraint in it", "pybullet")
 
 
 @dataclass
@@ -841,14 +839,7 @@ class PyBulletBackend(Backend):
 
     # --- contract points 1-5 ---------------------------------------------------------
     ENGINE_MODULES = ('pybullet',)
-
-    def version(self) -> str:
-        try:
-            from importlib.metadata import version
-            return version("pybullet")
-        except Exception:  # pragma: no cover
-            import pybullet
-            return f"api {pybullet.getAPIVersion()}"
+    ENGINE_DISTRIBUTION = "pybullet"
 
     EXPRESSIONS = _BUILDERS.declared()
 
@@ -975,9 +966,7 @@ class PyBulletBackend(Backend):
         """Connect a DIRECT client, build the mechanism and set the state (q0, qd0);
         enable the joint force/torque sensor on the joints `sensor_joints` (description
         joint indices). The client is disconnected on leaving."""
-        ok = self.support(mechanism)
-        if not ok.ok:
-            raise ValueError(f"pybullet cannot express this mechanism: {ok.reason}")
+        self.checked_support(mechanism)
         model = _Translation(mechanism, cfg)
         n = model.n
         cid = p.connect(p.DIRECT)
