@@ -303,6 +303,22 @@ class RunResult:
             raise ValueError("RunResult: t, q and qd lengths differ")
 
 
+def central_differences(residual: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                        x: np.ndarray, h_rel: float) -> tuple[np.ndarray, np.ndarray]:
+    """(K, C): the derivatives of `residual(x, v)` (the generalized forces an engine's
+    inverse dynamics leaves unbalanced) by x and by v at (x, 0), by central differences
+    (contract point 7), the step in x_i h_rel max(1, |x_i|), in v_i h_rel."""
+    n = len(x)
+    K = np.zeros((n, n))
+    C = np.zeros((n, n))
+    v0 = np.zeros(n)
+    for i, e in enumerate(np.eye(n)):
+        h = h_rel * max(1.0, abs(x[i]))
+        K[:, i] = (residual(x + h * e, v0) - residual(x - h * e, v0)) / (2 * h)
+        C[:, i] = (residual(x, v0 + h_rel * e) - residual(x, v0 - h_rel * e)) / (2 * h_rel)
+    return K, C
+
+
 def step_count(t_end: float, dt: float) -> int:
     """The number of fixed steps of a run of `t_end` seconds (contract point 6)."""
     return int(round(t_end / dt))

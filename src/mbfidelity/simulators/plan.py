@@ -2169,3 +2169,37 @@ def slot_geometry(c: PointOnLine) -> SlotGeometry:
     u = u / float(np.hypot(*u))
     return SlotGeometry(c.body, _pt(c.point), c.line_body, _pt(c.line_point),
                         (float(u[0]), float(u[1])))
+
+
+def engine_joint_forces(cmap: CoordinateMap, laws: CoordinateLaws, v, vd,
+                        t: float) -> np.ndarray:
+    """The engine joint forces tau = T^T Q of coordinate laws at the engine joint values
+    and rates (v, vd; the description coordinates q = T (v - b), q' = T v')."""
+    if cmap.identity:
+        q, qd = v, vd
+    else:
+        q = cmap.T @ (np.asarray(v) - cmap.b)
+        qd = cmap.T @ np.asarray(vd)
+    return cmap.T.T @ np.asarray(laws.generalized(q, qd, t))
+
+
+def spatial_joint(j: Revolute | Prismatic) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A joint's parent anchor, child anchor and unit axis as 3-vectors (a planar entry
+    lies at z = 0; a hinge without an axis turns about z)."""
+    pa, ca, axis = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
+                    for a in (j.parent_anchor, j.child_anchor,
+                              j.axis if j.axis is not None else (0, 0, 1)))
+    return pa, ca, axis / np.linalg.norm(axis)
+
+
+def parents_first(parents: Sequence[int]) -> list[int]:
+    """An order of the links of a tree (`parents[i]`: the index of link i's parent, < 0 for
+    the root) with every parent before its children, the given order where it allows."""
+    done: set[int] = set()
+    order: list[int] = []
+    while len(order) < len(parents):
+        for i, parent in enumerate(parents):
+            if i not in done and (parent < 0 or parent in done):
+                order.append(i)
+                done.add(i)
+    return order

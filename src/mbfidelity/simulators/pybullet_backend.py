@@ -38,17 +38,18 @@ from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, 
                              Prescribed, inertia_matrix)
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
-                   Linearization, Samples, Scheme, Setting, Stopwatch)
+                   Linearization, Samples, Scheme, Setting, Stopwatch, central_differences)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
                    PairLoad, RollingGeometry, SlotGeometry, carries_child, coordinate_map,
                    couples_two_engine_values, coupling_row, element_kind, elements,
-                   engine_coupling, gravity_vector, held_by_closure, num, one_joint_value,
-                   pair_load, point_distance, principal_inertia, ring_of_boxes,
-                   rolling_contact_report, rolling_geometry, slot_geometry,
-                   smallest_mass_and_inertia, spatial_tree_reason, turned)
+                   engine_coupling, engine_joint_forces, gravity_vector, held_by_closure, num,
+                   one_joint_value, pair_load, parents_first, point_distance,
+                   principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
+                   slot_geometry, smallest_mass_and_inertia, spatial_joint,
+                   spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -316,16 +317,14 @@ def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
     description's axis, the body's full tensor given by its principal moments and axes."""
     j = mech.joints[i]
     body = mech.body(j.child)
-    pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
-              for a in (j.parent_anchor, j.child_anchor))
-    axis = np.array([num(v) for v in (j.axis if j.axis is not None else (0, 0, 1))])
+    pa, ca, axis = spatial_joint(j)
     tensor = np.array(inertia_matrix(body).tolist(), dtype=float)
     return _Link(name=j.name, body=j.child, parent=parent, revolute=True,
                  mass=num(body.mass), inertia=float(tensor[2, 2]),
                  position=[float(v) for v in pa - np.array([*parent_anchor, 0.0][:3])],
                  orientation=[0.0, 0.0, 0.0, 1.0],
                  inertial_position=[float(v) for v in -ca],
-                 axis=[float(v) for v in axis / np.linalg.norm(axis)],
+                 axis=[float(v) for v in axis],
                  principal=principal_inertia(tensor))
 
 
@@ -367,14 +366,7 @@ class _Translation:
     def creation_order(self) -> list[int]:
         """Link indices with every parent before its children (the link order unless a
         link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
-        done: set[int] = set()
-        order: list[int] = []
-        while len(order) < len(self.links):
-            for i, lk in enumerate(self.links):
-                if i not in done and (lk.parent < 0 or lk.parent in done):
-                    order.append(i)
-                    done.add(i)
-        return order
+        return parents_first([lk.parent for lk in self.links])
 
     def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
         """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
@@ -1037,8 +1029,7 @@ class PyBulletBackend(Backend):
         links = eidx[:n]
         point_links = [eidx[k] for k in model.point_links]
         pos_of = {k: m for m, k in enumerate(model.point_links)}
-        Ainv, A, bvec = model.map.T, model.map.A, model.map.b
-        identity = model.map.identity
+        A, bvec = model.map.A, model.map.b
         moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
                                if lk >= 0})
         moving_eidx = [eidx[lk] for lk in moving_links]
@@ -1052,12 +1043,7 @@ class PyBulletBackend(Backend):
             t = k * dt
             forces = None
             if has_cf:
-                if identity:
-                    tau = model.coordinate_torques(jv[:n], jvd[:n], t)
-                else:
-                    q = Ainv @ (np.asarray(jv[:n]) - bvec)
-                    qd = Ainv @ np.asarray(jvd[:n])
-                    tau = model.coordinate_torques(q, qd, t)
+                tau = engine_joint_forces(model.map, model.coordinate_laws, jv[:n], jvd[:n], t)
                 set_motors(body, links, torque_mode, forces=tau.tolist(), physicsClientId=cid)
             if n_pf:
                 ls = get_links(body, point_links, computeLinkVelocity=1,
@@ -1372,14 +1358,7 @@ class PyBulletBackend(Backend):
 
             M = np.atleast_2d(np.array(p.calculateMassMatrix(
                 body, engine(jv_eq), physicsClientId=cid)))[np.ix_(perm, perm)]
-            K = np.zeros((n, n))
-            C = np.zeros((n, n))
-            v0 = np.zeros(n)
-            for i, e in enumerate(np.eye(n)):
-                h = h_rel * max(1.0, abs(jv_eq[i]))
-                K[:, i] = (residual(jv_eq + h * e, v0) - residual(jv_eq - h * e, v0)) / (2 * h)
-                C[:, i] = (residual(jv_eq, v0 + h_rel * e)
-                           - residual(jv_eq, v0 - h_rel * e)) / (2 * h_rel)
+            K, C = central_differences(residual, jv_eq, h_rel)
         eig = quadratic_eigenvalues(M, C, K)
         return Linearization(
             eigenvalues=eig,
