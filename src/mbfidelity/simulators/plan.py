@@ -2203,3 +2203,37 @@ def parents_first(parents: Sequence[int]) -> list[int]:
                 order.append(i)
                 done.add(i)
     return order
+
+
+class EnginePlan:
+    """What every engine's translation of a numeric mechanism starts from, computed once:
+    the mechanism and the backend's resolved settings (`cfg`), the number of joints `n`,
+    the coordinate map (`map`), the gravity vector, the smallest mass and inertia (the
+    scale of a substitute's: `m_min`, `i_min`), the coordinate laws (`coordinate_laws`;
+    `autonomous_laws` without those that read the time) and the prescribed motions
+    (`driven`). A backend's translation extends it with its engine's terms, built element
+    by element by its builders (`build`)."""
+
+    def __init__(self, mech: Mechanism, cfg: Mapping) -> None:
+        self.mech, self.cfg = mech, cfg
+        self.n = len(mech.joints)
+        self.map = coordinate_map(mech)
+        self.gravity_vector = gravity_vector(mech)
+        self.m_min, self.i_min = smallest_mass_and_inertia(mech)
+        laws = [f for f in mech.forces if isinstance(f, CoordinateForce)]
+        self.coordinate_laws = CoordinateLaws(mech, laws)
+        self.autonomous_laws = CoordinateLaws(
+            mech, [f for f in laws if not ForceLaw.of(f).time_dependent])
+        self.driven = motions(mech)
+
+    def build(self, builders: Mapping[str, Callable]) -> None:
+        """Every element of the description into this translation, by its kind's builder
+        (`base.ElementBuilders`), in description order."""
+        for kind, element in elements(self.mech):
+            builders[kind](self, element)
+
+    def joint_forces(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
+        """The engine joint forces tau = T^T Q of the coordinate laws (all, or only the
+        autonomous ones) at the description state (q, qd)."""
+        laws = self.autonomous_laws if autonomous else self.coordinate_laws
+        return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))

@@ -42,14 +42,12 @@ from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTI
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
-                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, CoordinateLaws, ForceLaw, Motion,
-                   PairLoad, RollingGeometry, SlotGeometry, carries_child, coordinate_map,
-                   couples_two_engine_values, coupling_row, element_kind, elements,
-                   engine_coupling, engine_joint_forces, gravity_vector, held_by_closure, num,
+                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
+                   SlotGeometry, carries_child, couples_two_engine_values, coupling_row,
+                   element_kind, engine_coupling, engine_joint_forces, held_by_closure, num,
                    one_joint_value, pair_load, parents_first, point_distance,
                    principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
-                   slot_geometry, smallest_mass_and_inertia, spatial_joint,
-                   spatial_tree_reason, turned)
+                   slot_geometry, spatial_joint, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -328,38 +326,27 @@ def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
                  principal=principal_inertia(tensor))
 
 
-class _Translation:
+class _Translation(EnginePlan):
     """The mechanism in PyBullet's terms, built element by element by the builders
-    registered per element kind (`_BUILDERS`) from the shared plan's numbers and coordinate
-    map (`map`): `links`, one per description joint (the first `n`), then the extra links
-    (the rolling contact's radial slider, one rotor or slider per PointOnLine), with
-    `creation_order` putting parents first; the `closures`, the point-to-point elements
-    (`point_forces`), the coordinate laws, the rolling `contact` and the `driven`
-    (prescribed) coordinates."""
+    registered per element kind (`_BUILDERS`) on the shared plan (`plan.EnginePlan`):
+    `links`, one per description joint (the first `n`), then the extra links (the rolling
+    contact's radial slider, one rotor or slider per PointOnLine), with `creation_order`
+    putting parents first; the `closures`, the point-to-point elements (`point_forces`)
+    and the rolling `contact`."""
 
     def __init__(self, mech: Mechanism, cfg: Mapping) -> None:
-        self.mech, self.cfg = mech, cfg
-        self.n = len(mech.joints)
-        self.map = coordinate_map(mech)
-        self.gravity_vector = gravity_vector(mech)
-        self.m_min, self.i_min = smallest_mass_and_inertia(mech)
+        super().__init__(mech, cfg)
         self.link_of: dict[str, int] = {WORLD: -1}
         self.anchor_of: dict[str, tuple[float, float]] = {WORLD: (0.0, 0.0)}
         self.inertia_of: dict[str, tuple[float, float]] = {}  # body -> (mass, inertia)
         self.links: list[_Link] = []
         self.closures: list[_Pin | _Gear] = []
         self.point_forces: list[_PointForce] = []
-        self.coordinate_forces: list[CoordinateForce] = []
         self.contact: RollingGeometry | None = None
         self.coupling: LinearCoupling | None = None  # the rolling coupling a contact stands for
         self.radial_link = -1
         self.fixed_links: list[int] = []  # engine links of the contact ring (`_build`)
-        self.driven: list[Motion] = []
-        for kind, element in elements(mech):
-            _BUILDERS[kind](self, element)
-        self.coordinate_laws = CoordinateLaws(mech, self.coordinate_forces)
-        self.autonomous_laws = CoordinateLaws(
-            mech, [f for f in self.coordinate_forces if not ForceLaw.of(f).time_dependent])
+        self.build(_BUILDERS)
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
@@ -367,11 +354,6 @@ class _Translation:
         """Link indices with every parent before its children (the link order unless a
         link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
         return parents_first([lk.parent for lk in self.links])
-
-    def coordinate_torques(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
-        """Engine joint forces of all CoordinateForce elements (tau = A^-T Q)."""
-        laws = self.autonomous_laws if autonomous else self.coordinate_laws
-        return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))
 
 
 # --- the builders, registered per element kind with the expressions they build ---------
@@ -459,7 +441,7 @@ def _point_force(model: _Translation, f) -> None:
 @_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _JOINT_FORCE))
 @_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, _JOINT_FORCE))
 def _coordinate_force(model: _Translation, f) -> None:
-    model.coordinate_forces.append(f)
+    """Nothing to build: the plan's coordinate laws are applied before every step."""
 
 
 #: a time load is built as the element it is
@@ -640,7 +622,8 @@ def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, flo
                                  "it without the parent's angle at t+h before the step",
                     when="otherwise"))
 def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
-    model.driven.append(Motion(prescribed, model.mech.coordinates.index(prescribed.coordinate)))
+    """Nothing to build: the plan's motion (`EnginePlan.driven`) drives the joint's motor
+    before every step."""
 
 
 _BUILDERS.refuses(HINGE_CLOSURE, "the spatial build closes no loop: a spatial closed loop "
@@ -1325,7 +1308,7 @@ class PyBulletBackend(Backend):
                 """Engine joint forces of the autonomous force elements at (jv, jvd)."""
                 q = model.map.coordinates(jv)
                 qd = model.map.rates(jvd)
-                tau = model.coordinate_torques(q, qd, 0.0, autonomous=True)
+                tau = model.joint_forces(q, qd, 0.0, autonomous=True)
                 pfs = [pf for pf in model.point_forces if not pf.pair.time_dependent]
                 if not pfs:
                     return tau
