@@ -2237,3 +2237,18 @@ class EnginePlan:
         autonomous ones) at the description state (q, qd)."""
         laws = self.autonomous_laws if autonomous else self.coordinate_laws
         return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))
+
+
+def plane_point(point) -> tuple[float, float]:
+    """A description point's (x, y) as numbers."""
+    return num(point[0]), num(point[1])
+
+
+def slide_axis(j: Prismatic) -> tuple[float, float]:
+    """A prismatic joint's unit axis in its joint frame (the parent's frame turned by the
+    angle offset): the description's axis, given in the parent's frame, turned by
+    -angle_offset and normalised (its length is the slide's scale in `CoordinateMap.A`)."""
+    length = math.hypot(num(j.axis[0]), num(j.axis[1]))
+    ax, ay = num(j.axis[0]) / length, num(j.axis[1]) / length
+    c, s = math.cos(-num(j.angle_offset)), math.sin(-num(j.angle_offset))
+    return c * ax - s * ay, s * ax + c * ay

@@ -45,9 +45,9 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
                    SlotGeometry, carries_child, couples_two_engine_values, coupling_row,
                    element_kind, engine_coupling, engine_joint_forces, held_by_closure, num,
-                   one_joint_value, pair_load, parents_first, point_distance,
+                   one_joint_value, pair_load, parents_first, plane_point, point_distance,
                    principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
-                   slot_geometry, spatial_joint, spatial_tree_reason, turned)
+                   slide_axis, slot_geometry, spatial_joint, spatial_tree_reason, turned)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -63,11 +63,6 @@ _MAX_LINKS = 127
 def _quat_z(angle: float) -> list[float]:
     """Quaternion (x, y, z, w) of a rotation by `angle` about z."""
     return [0.0, 0.0, math.sin(angle / 2.0), math.cos(angle / 2.0)]
-
-
-def _xy(point) -> tuple[float, float]:
-    """A description point's numbers."""
-    return num(point[0]), num(point[1])
 
 
 def _xyz(point) -> list[float]:
@@ -257,10 +252,7 @@ class _Rotor(_Slot):
         p.resetJointState(body, eidx[self.aux], rel, w_l - w_p, physicsClientId=cid)
 
     def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
-        if self.line_link >= 0:
-            th = model.map.angle(model.links[self.line_link].body, q)
-        else:
-            th = np.zeros(len(rows))
+        th = model.map.angle(self.slot.line_body, q)  # the world's: 0
         return rows[:, 1:2] * turned(th, *_slider_row_normal(self.slot.direction))
 
     def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
@@ -402,7 +394,7 @@ def _joint_link(model: _Translation, j, revolute: bool, axis: list[float]) -> No
                                          model.anchor_of[j.parent]))
         model.anchor_of[j.child] = tuple(-v for v in model.links[-1].inertial_position)
     else:
-        pa, ca = _xy(j.parent_anchor), _xy(j.child_anchor)
+        pa, ca = plane_point(j.parent_anchor), plane_point(j.child_anchor)
         panchor = model.anchor_of[j.parent]
         mass, inertia = model.inertia_of[j.child]
         model.links.append(_Link(
@@ -423,12 +415,8 @@ def _hinge(model: _Translation, j) -> None:
 @_builds(PRISMATIC, Expression(EXACT, "prismatic link along the unit axis (its length in "
                                       "v = A q + b)"))
 def _slide(model: _Translation, j) -> None:
-    """The axis in the x-y plane of the joint frame: the parent-frame axis turned by
-    -angle_offset, normalised (its length goes into A)."""
-    i = model.mech.joints.index(j)
-    axis = np.array([num(j.axis[0]), num(j.axis[1])]) / model.map.A[i, i]
-    c, s = math.cos(-num(j.angle_offset)), math.sin(-num(j.angle_offset))
-    _joint_link(model, j, False, [c * axis[0] - s * axis[1], s * axis[0] + c * axis[1], 0.0])
+    """The axis in the x-y plane of the joint frame (`plan.slide_axis`)."""
+    _joint_link(model, j, False, [*slide_axis(j), 0.0])
 
 
 @_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _POINT_FORCE))
@@ -458,8 +446,8 @@ def _time_load(model: _Translation, f) -> None:
                                            "erp 1 (no regularisation; the position error of "
                                            "a step is removed in the next)"))
 def _point_on_point(model: _Translation, c) -> None:
-    model.closures.append(_Pin(c, model.link_of[c.body_a], _xy(c.point_a),
-                               model.link_of[c.body_b], _xy(c.point_b)))
+    model.closures.append(_Pin(c, model.link_of[c.body_a], plane_point(c.point_a),
+                               model.link_of[c.body_b], plane_point(c.point_b)))
 
 
 @_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
