@@ -1080,9 +1080,7 @@ class PyBulletBackend(Backend):
 
         from .script_export import Recorder, script
 
-        if not initial_states:
-            raise ValueError("the script starts from a scenario's initial state: none given")
-        name, (q0, qd0) = next(iter(initial_states.items()))
+        name, q0, qd0 = self.script_start(initial_states)
         cfg = self.resolve_settings(settings)
         recorder = Recorder(pybullet)
         with self._open(recorder, mechanism, q0, qd0, dt, cfg) as world:
@@ -1096,10 +1094,7 @@ class PyBulletBackend(Backend):
                                "step: " + ", ".join(p.name for p in mechanism.prescribed))
             n = world.model.n
             text = script(
-                title=(f"The mechanism as mbfidelity builds it in PyBullet "
-                       f"{self.version()}, from the initial state of scenario {name!r}.\n"
-                       f"Backend settings:\n" + "\n".join(f"  {k} = {v!r}"
-                                                           for k, v in cfg.items())),
+                title=self.script_title("PyBullet", name, cfg),
                 module="pybullet", connect="pybullet.connect(pybullet.DIRECT)",
                 client_id=world.cid, calls=recorder.calls,
                 step="pybullet.stepSimulation(physicsClientId=cid)",
