@@ -116,7 +116,7 @@ from .plan import (
     CoordinateMap,
     ForceLaw,
     coordinate_map,
-    coupling_row,
+    engine_coupling,
     element_kind,
     elements,
     motions,
@@ -242,7 +242,7 @@ def _coupler(mech: Mechanism, coupling: LinearCoupling
     """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset: the coupling
     written on the engine joint values (`CoordinateMap.on_engine_values`); None unless it
     relates exactly two of them."""
-    row, constant = coordinate_map(mech).on_engine_values(*coupling_row(mech, coupling))
+    row, constant = engine_coupling(mech, coupling)
     nonzero = np.flatnonzero(row)
     if len(nonzero) != 2:
         return None
@@ -527,11 +527,8 @@ def _linear_coupling(build: _Built, c: LinearCoupling) -> None:
               build.joints[i0], build.joints[i1], ratio, offset)
 
 
-@_builds(ROLLING_CONTACT, Expression(UNSUPPORTED, "no contact geometry is built: the "
-                                                  "continuous plant's point contact is a "
-                                                  "penalty (compliant) model"))
-def _rolling_contact(build: _Built, c) -> None:
-    raise ValueError(f"drake builds no rolling contact ({c.name}): support() refuses it")
+_BUILDERS.refuses(ROLLING_CONTACT, "no contact geometry is built: the continuous plant's "
+                                   "point contact is a penalty (compliant) model", "drake")
 
 
 @_builds(PRESCRIBED, Expression(EXACT, "the acceleration imposed by the LeafSystem's applied "
@@ -544,10 +541,8 @@ def _prescribed(build: _Built, p) -> None:
     build.driven += [m for m in motions(build.mech) if m.element is p]
 
 
-@_builds(HINGE_CLOSURE, Expression(UNSUPPORTED, "the build is planar: a spatial closed loop "
-                                                "has no constraint in it"))
-def _hinge_closure(build: _Built, c) -> None:
-    raise ValueError(f"drake builds no hinge closure ({c.name}): support() refuses it")
+_BUILDERS.refuses(HINGE_CLOSURE, "the build is planar: a spatial closed loop has no "
+                                  "constraint in it", "drake")
 
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
@@ -618,11 +613,7 @@ class DrakeBackend(Backend):
 
     # --- identity --------------------------------------------------------------------------
     ENGINE_MODULES = ('pydrake.multibody.plant', 'pydrake.systems.analysis')
-
-    def version(self) -> str:
-        from importlib.metadata import version
-
-        return version("drake")
+    ENGINE_DISTRIBUTION = "drake"
 
     # --- support ---------------------------------------------------------------------------
     EXPRESSIONS = EXPRESSIONS
@@ -657,9 +648,7 @@ class DrakeBackend(Backend):
         from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
         from pydrake.systems.framework import DiagramBuilder
 
-        support = self.support(mech)
-        if not support.ok:
-            raise ValueError(f"drake cannot express this mechanism: {support.reason}")
+        self.checked_support(mech)
         rec = recorder or _Recorder()
         builder = DiagramBuilder()
         discrete = _discrete(mech, cfg)
@@ -710,9 +699,7 @@ class DrakeBackend(Backend):
         integrator, one second advanced sample by sample, and the description's
         coordinates at the end. The Python force system (laws Drake's own elements do not
         hold) cannot be written out: its laws are listed."""
-        if not initial_states:
-            raise ValueError("the script starts from a scenario's initial state: none given")
-        name, (q0, qd0) = next(iter(initial_states.items()))
+        name, q0, qd0 = self.script_start(initial_states)
         cfg = self.resolve_settings(settings)
         recorder = _Recorder()
         built = self._build(mechanism, cfg, dt, recorder)
