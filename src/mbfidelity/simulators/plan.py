@@ -47,7 +47,11 @@ them and lives here:
   imposed motion, the prescribed motions imposed by generalized forces (`ImposedMotions`,
   at the stage time `stage_time`); for a linearization with the closures held exactly,
   the closure forces' geometric stiffness and the modes on the constraint's null space
-  (`geometric_stiffness`, `constrained_modes`).
+  (`geometric_stiffness`, `constrained_modes`);
+- what every translation starts from (`EnginePlan`), more conditions of an expression
+  that follow from the description alone (`carries_child`, `held_by_closure`,
+  `couples_two_engine_values`), and the elements between two bodies read from their
+  frame states (`PairLoad`, `point_distance`, `SlotGeometry`).
 """
 from __future__ import annotations
 
