@@ -813,23 +813,6 @@ class Backend(ABC):
         raise NotImplementedError(f"{self.id}: {self.beam_element(kind).expression.how}")
 
     # helpers shared by backends
-    @staticmethod
-    def script_start(initial_states: Mapping[str, tuple[np.ndarray, np.ndarray]]
-                     ) -> tuple[str, np.ndarray, np.ndarray]:
-        """(scenario, q0, qd0): the initial state an exported script starts from, the first
-        given; ValueError when none is given."""
-        if not initial_states:
-            raise ValueError("the script starts from a scenario's initial state: none given")
-        name, (q0, qd0) = next(iter(initial_states.items()))
-        return name, q0, qd0
-
-    def script_title(self, engine: str, scenario: str, cfg: Mapping, detail: str = "") -> str:
-        """An exported script's title: the engine and its version, the scenario whose
-        initial state it starts from (and `detail`), the backend settings one a line."""
-        return (f"The mechanism as mbfidelity builds it in {engine} {self.version()}, from "
-                f"the initial state of scenario {scenario!r}{detail}.\nBackend settings:\n"
-                + "\n".join(f"  {k} = {v!r}" for k, v in cfg.items()))
-
     def resolve_settings(self, settings: Mapping | None) -> dict:
         """The defaults with the user's overrides, each checked against `SETTINGS`."""
         merged = self.default_settings()

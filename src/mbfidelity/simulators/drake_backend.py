@@ -699,7 +699,7 @@ class DrakeBackend(Backend):
         integrator, one second advanced sample by sample, and the description's
         coordinates at the end. The Python force system (laws Drake's own elements do not
         hold) cannot be written out: its laws are listed."""
-        name, q0, qd0 = self.script_start(initial_states)
+        name, q0, qd0 = self.export_start(initial_states)
         cfg = self.resolve_settings(settings)
         recorder = _Recorder()
         built = self._build(mechanism, cfg, dt, recorder)

@@ -2187,15 +2187,6 @@ def engine_joint_forces(cmap: CoordinateMap, laws: CoordinateLaws, v, vd,
     return cmap.T.T @ np.asarray(laws.generalized(q, qd, t))
 
 
-def spatial_joint(j: Revolute | Prismatic) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A joint's parent anchor, child anchor and unit axis as 3-vectors (a planar entry
-    lies at z = 0; a hinge without an axis turns about z)."""
-    pa, ca, axis = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
-                    for a in (j.parent_anchor, j.child_anchor,
-                              j.axis if j.axis is not None else (0, 0, 1)))
-    return pa, ca, axis / np.linalg.norm(axis)
-
-
 def parents_first(parents: Sequence[int]) -> list[int]:
     """An order of the links of a tree (`parents[i]`: the index of link i's parent, < 0 for
     the root) with every parent before its children, the given order where it allows."""

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..analytic.linear import quadratic_eigenvalues
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
-                             Prescribed, inertia_matrix)
+                             Prescribed)
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
                    Linearization, Samples, Scheme, Setting, Stopwatch, central_differences)
@@ -43,11 +43,12 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
-                   SlotGeometry, carries_child, couples_two_engine_values, coupling_row,
-                   element_kind, engine_coupling, engine_joint_forces, held_by_closure, num,
-                   one_joint_value, pair_load, parents_first, plane_point, point_distance,
-                   principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
-                   slide_axis, slot_geometry, spatial_joint, spatial_tree_reason, turned)
+                   SlotGeometry, carries_child, central_tensor, couples_two_engine_values,
+                   coupling_row, element_kind, engine_coupling, engine_joint_forces,
+                   held_by_closure, num, one_joint_value, pair_load, parents_first,
+                   plane_point, point_distance, principal_inertia, ring_of_boxes,
+                   rolling_contact_report, rolling_geometry, slide_axis, slot_geometry,
+                   spatial_tree_reason, turned, unit_axis)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -307,14 +308,15 @@ def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
     description's axis, the body's full tensor given by its principal moments and axes."""
     j = mech.joints[i]
     body = mech.body(j.child)
-    pa, ca, axis = spatial_joint(j)
-    tensor = np.array(inertia_matrix(body).tolist(), dtype=float)
+    pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
+              for a in (j.parent_anchor, j.child_anchor))
+    tensor = central_tensor(mech, body)
     return _Link(name=j.name, body=j.child, parent=parent, revolute=True,
                  mass=num(body.mass), inertia=float(tensor[2, 2]),
                  position=[float(v) for v in pa - np.array([*parent_anchor, 0.0][:3])],
                  orientation=[0.0, 0.0, 0.0, 1.0],
                  inertial_position=[float(v) for v in -ca],
-                 axis=[float(v) for v in axis],
+                 axis=list(unit_axis(j)),
                  principal=principal_inertia(tensor))
 
 
@@ -1080,7 +1082,7 @@ class PyBulletBackend(Backend):
 
         from .script_export import Recorder, script
 
-        name, q0, qd0 = self.script_start(initial_states)
+        name, q0, qd0 = self.export_start(initial_states)
         cfg = self.resolve_settings(settings)
         recorder = Recorder(pybullet)
         with self._open(recorder, mechanism, q0, qd0, dt, cfg) as world:
