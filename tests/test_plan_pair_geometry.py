@@ -1,7 +1,7 @@
 """The engine-neutral helpers of simulators/plan.py and base.py that a backend calls in
 place of its own geometry and numerics: the pin and slot geometry from the bodies' frame
-states, a point-to-point element's pair force, a slide's unit axis, the coordinate laws'
-engine joint forces, a parents-first link order and the linearization's central
+states, a point-to-point element's pair force, a slide's unit axis, the coordinate laws
+on engine joint values, a parents-first link order and the linearization's central
 differences, each against a value built independently (by construction or in closed
 form)."""
 from __future__ import annotations
@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from mbfidelity.simulators.base import central_differences
-from mbfidelity.simulators.plan import (CoordinateLaws, coordinate_map, engine_joint_forces,
-                                        pair_load, parents_first, point_distance,
-                                        slide_axis, slot_geometry)
+from mbfidelity.simulators.plan import (CoordinateLaws, coordinate_map, pair_load,
+                                        parents_first, point_distance, slide_axis,
+                                        slot_geometry)
 from mbfidelity.systems.model import (LENGTH, CoordinateForce, PointOnLine, PointToPoint,
                                       Prismatic)
 
@@ -82,7 +82,7 @@ def test_slide_axis_is_the_unit_axis_turned_into_the_joint_frame():
     assert slide_axis(joint) == pytest.approx((0.8, -0.6), abs=TOL)
 
 
-def test_engine_joint_forces_keep_the_power_of_the_coordinate_laws():
+def test_coordinate_laws_on_engine_values_keep_their_power():
     """On every planar catalog mechanism with coordinate laws and engine joint values that
     differ from its coordinates, tau . v' equals Q . q' (the power does not depend on the
     coordinates it is written in), with Q the laws' generalized force."""
@@ -100,7 +100,7 @@ def test_engine_joint_forces_keep_the_power_of_the_coordinate_laws():
         coordinate_laws = CoordinateLaws(mech, laws)
         v, vd = rng.uniform(-1, 1, (2, len(mech.coordinates)))
         q, qd = cmap.coordinates(v), cmap.rates(vd)
-        tau = engine_joint_forces(cmap, coordinate_laws, v, vd, 0.3)
+        tau = np.asarray(coordinate_laws.on_engine_values(cmap.T, cmap.c)(v, vd, 0.3))
         Q = np.asarray(coordinate_laws.generalized(q, qd, 0.3))
         assert tau @ vd == pytest.approx(Q @ qd, rel=1e-10, abs=1e-10), system.id
         checked += 1

@@ -2175,18 +2175,6 @@ def slot_geometry(c: PointOnLine) -> SlotGeometry:
                         (float(u[0]), float(u[1])))
 
 
-def engine_joint_forces(cmap: CoordinateMap, laws: CoordinateLaws, v, vd,
-                        t: float) -> np.ndarray:
-    """The engine joint forces tau = T^T Q of coordinate laws at the engine joint values
-    and rates (v, vd; the description coordinates q = T (v - b), q' = T v')."""
-    if cmap.identity:
-        q, qd = v, vd
-    else:
-        q = cmap.T @ (np.asarray(v) - cmap.b)
-        qd = cmap.T @ np.asarray(vd)
-    return cmap.T.T @ np.asarray(laws.generalized(q, qd, t))
-
-
 def parents_first(parents: Sequence[int]) -> list[int]:
     """An order of the links of a tree (`parents[i]`: the index of link i's parent, < 0 for
     the root) with every parent before its children, the given order where it allows."""

@@ -44,11 +44,10 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
                    SlotGeometry, carries_child, central_tensor, couples_two_engine_values,
-                   coupling_row, element_kind, engine_coupling, engine_joint_forces,
-                   held_by_closure, num, one_joint_value, pair_load, parents_first,
-                   plane_point, point_distance, principal_inertia, ring_of_boxes,
-                   rolling_contact_report, rolling_geometry, slide_axis, slot_geometry,
-                   spatial_tree_reason, turned, unit_axis)
+                   coupling_row, element_kind, engine_coupling, held_by_closure, num,
+                   one_joint_value, pair_load, parents_first, plane_point, point_distance,
+                   principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
+                   slide_axis, slot_geometry, spatial_tree_reason, turned, unit_axis)
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
@@ -988,6 +987,7 @@ class PyBulletBackend(Backend):
         model, cid, body, eidx = world.model, world.cid, world.body, world.eidx
         n = model.n
         has_cf = bool(model.coordinate_laws)
+        joint_forces = model.coordinate_laws.on_engine_values(model.map.T, model.map.c)
         n_pf = len(model.point_forces)
         moving = [(world.cids[r], c) for r, c in enumerate(model.closures) if c.follows_pin]
         driven = model.driven
@@ -1016,8 +1016,8 @@ class PyBulletBackend(Backend):
             t = k * dt
             forces = None
             if has_cf:
-                tau = engine_joint_forces(model.map, model.coordinate_laws, jv[:n], jvd[:n], t)
-                set_motors(body, links, torque_mode, forces=tau.tolist(), physicsClientId=cid)
+                set_motors(body, links, torque_mode, forces=joint_forces(jv[:n], jvd[:n], t),
+                           physicsClientId=cid)
             if n_pf:
                 ls = get_links(body, point_links, computeLinkVelocity=1,
                                computeForwardKinematics=1, physicsClientId=cid)
