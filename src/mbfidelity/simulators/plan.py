@@ -2192,10 +2192,9 @@ class EnginePlan:
     """What every engine's translation of a numeric mechanism starts from, computed once:
     the mechanism and the backend's resolved settings (`cfg`), the number of joints `n`,
     the coordinate map (`map`), the gravity vector, the smallest mass and inertia (the
-    scale of a substitute's: `m_min`, `i_min`), the coordinate laws (`coordinate_laws`;
-    `autonomous_laws` without those that read the time) and the prescribed motions
-    (`driven`). A backend's translation extends it with its engine's terms, built element
-    by element by its builders (`build`)."""
+    scale of a substitute's: `m_min`, `i_min`), the coordinate laws (`coordinate_laws`)
+    and the prescribed motions (`driven`). A backend's translation extends it with its
+    engine's terms, built element by element by its builders (`build`)."""
 
     def __init__(self, mech: Mechanism, cfg: Mapping) -> None:
         self.mech, self.cfg = mech, cfg
@@ -2203,10 +2202,8 @@ class EnginePlan:
         self.map = coordinate_map(mech)
         self.gravity_vector = gravity_vector(mech)
         self.m_min, self.i_min = smallest_mass_and_inertia(mech)
-        laws = [f for f in mech.forces if isinstance(f, CoordinateForce)]
-        self.coordinate_laws = CoordinateLaws(mech, laws)
-        self.autonomous_laws = CoordinateLaws(
-            mech, [f for f in laws if not ForceLaw.of(f).time_dependent])
+        self.coordinate_laws = CoordinateLaws(
+            mech, [f for f in mech.forces if isinstance(f, CoordinateForce)])
         self.driven = motions(mech)
 
     def build(self, builders: Mapping[str, Callable]) -> None:
@@ -2215,11 +2212,10 @@ class EnginePlan:
         for kind, element in elements(self.mech):
             builders[kind](self, element)
 
-    def joint_forces(self, q, qd, t: float, autonomous: bool = False) -> np.ndarray:
-        """The engine joint forces tau = T^T Q of the coordinate laws (all, or only the
-        autonomous ones) at the description state (q, qd)."""
-        laws = self.autonomous_laws if autonomous else self.coordinate_laws
-        return self.map.T.T @ np.asarray(laws.generalized(q, qd, t))
+    def joint_forces(self, q, qd, t: float) -> np.ndarray:
+        """The engine joint forces tau = T^T Q of the coordinate laws at the description
+        state (q, qd)."""
+        return self.map.T.T @ np.asarray(self.coordinate_laws.generalized(q, qd, t))
 
 
 def plane_point(point) -> tuple[float, float]:

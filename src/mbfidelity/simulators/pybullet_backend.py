@@ -1264,19 +1264,18 @@ class PyBulletBackend(Backend):
     # --- contract point 7 --------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        if mechanism.prescribed:
-            return None  # inverse dynamics about a rest state: a driven joint does not rest
-        import pybullet as p
-
-        cfg = self.resolve_settings(settings)
-        ok = self.support(mechanism)
-        if not ok.ok or mechanism.constraints:
+        frame = self.linearization_frame(mechanism, settings)
+        if frame is None or mechanism.constraints:
+            # inverse dynamics about a rest state (a driven joint does not rest):
             # calculateMassMatrix / calculateInverseDynamics describe the open tree only;
             # PyBullet has no constrained linearization (the free-vibration fit remains)
             return None
+        import pybullet as p
+
+        cfg, autonomous = frame
         h_rel = float(cfg["linearize_step"])
         q_eq = np.asarray(q_eq, dtype=float)
-        with self._open(p, mechanism, q_eq, np.zeros(len(q_eq)), dt, cfg) as world:
+        with self._open(p, autonomous, q_eq, np.zeros(len(q_eq)), dt, cfg) as world:
             cid, body, eidx, model = world.cid, world.body, world.eidx, world.model
             n = model.n
             jv_eq = model.map.engine_values(q_eq)
@@ -1290,12 +1289,11 @@ class PyBulletBackend(Backend):
                 return [float(v) for v in y]
 
             def applied(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
-                """Engine joint forces of the autonomous force elements at (jv, jvd)."""
+                """Engine joint forces of the (autonomous) force elements at (jv, jvd)."""
                 q = model.map.coordinates(jv)
                 qd = model.map.rates(jvd)
-                tau = model.joint_forces(q, qd, 0.0, autonomous=True)
-                pfs = [pf for pf in model.point_forces if not pf.pair.time_dependent]
-                if not pfs:
+                tau = model.joint_forces(q, qd, 0.0)
+                if not model.point_forces:
                     return tau
                 for i in range(n):
                     p.resetJointState(body, eidx[i], float(jv[i]), float(jvd[i]),
@@ -1303,7 +1301,7 @@ class PyBulletBackend(Backend):
                 ls = {lk: p.getLinkState(body, eidx[lk], computeLinkVelocity=1,
                                          computeForwardKinematics=1, physicsClientId=cid)
                       for lk in model.point_links}
-                for pf in pfs:
+                for pf in model.point_forces:
                     fx, fy, *_ = pf.force(ls, 0.0)
                     for link, point, sign in ((pf.link_b, pf.pair.point_b, 1.0),
                                               (pf.link_a, pf.pair.point_a, -1.0)):
