@@ -645,12 +645,6 @@ class Backend(ABC):
         is unsupported (empty string: it can)."""
         return ""
 
-    def checked_support(self, mechanism: Mechanism) -> None:
-        """ValueError naming the reason when the backend cannot express the mechanism."""
-        support = self.support(mechanism)
-        if not support.ok:
-            raise ValueError(f"{self.id} cannot express this mechanism: {support.reason}")
-
     def support(self, mechanism: Mechanism) -> Support:
         """Contract point 5: from the description's checks, the engine's structure and the
         declared expression of every element."""
@@ -737,7 +731,7 @@ class Backend(ABC):
         cfg = self.resolve_settings(settings)
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError(f"the step must be positive and finite; got {dt!r}")
-        self.checked_support(mechanism)
+        self.check_support(mechanism)
         return cfg, step_count(t_end, dt)
 
     @abstractmethod

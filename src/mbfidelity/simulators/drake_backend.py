@@ -648,7 +648,7 @@ class DrakeBackend(Backend):
         from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
         from pydrake.systems.framework import DiagramBuilder
 
-        self.checked_support(mech)
+        self.check_support(mech)
         rec = recorder or _Recorder()
         builder = DiagramBuilder()
         discrete = _discrete(mech, cfg)

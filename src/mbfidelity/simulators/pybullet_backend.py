@@ -930,7 +930,7 @@ class PyBulletBackend(Backend):
         """Connect a DIRECT client, build the mechanism and set the state (q0, qd0);
         enable the joint force/torque sensor on the joints `sensor_joints` (description
         joint indices). The client is disconnected on leaving."""
-        self.checked_support(mechanism)
+        self.check_support(mechanism)
         model = _Translation(mechanism, cfg)
         n = model.n
         cid = p.connect(p.DIRECT)
