@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from mbfidelity.comparisons import power
+from mbfidelity.comparisons import out_of_the_box, power
 from mbfidelity.comparisons.runner import compare
 from mbfidelity.simulators import all_backends, get_backend
 from mbfidelity.systems import get_system
@@ -92,7 +92,7 @@ def test_smallest_rejected_length_error_matches_the_gates():
     it must (that error taken as subtracting)."""
     _installed("pybullet")
     system = get_system("compound_pendulum")
-    entry = power.power_entry("compound_pendulum", "pybullet", kinds=("length",),
+    entry = out_of_the_box.power_entry("compound_pendulum", "pybullet", kinds=("length",),
                               defaults=False)
     found = entry.errors[0]
     assert found.parameter == "l" and found.smallest_rejected is not None
@@ -236,7 +236,7 @@ def test_an_error_the_motion_does_not_depend_on_is_below_the_gates():
     reason, not as a blind gate, after the single run the grid's top needs (a gate that
     rejected an error the motion does not see would be a false alarm)."""
     _installed("mujoco")
-    entry = power.power_entry("mass_spring_damper", "mujoco", kinds=("gravity",),
+    entry = out_of_the_box.power_entry("mass_spring_damper", "mujoco", kinds=("gravity",),
                               defaults=False)
     (found,) = entry.errors
     assert found.parameter == "g" and found.smallest_rejected is None
@@ -310,7 +310,7 @@ def test_each_modes_change_is_set_against_the_gate_of_that_mode():
     trajectory, the second mode), not against the second mode's gate for the first mode's
     change (which made it a blind gate)."""
     _installed("pymunk")
-    entry = power.power_entry("belt_pulleys", "pymunk", kinds=("inertia",), defaults=False)
+    entry = out_of_the_box.power_entry("belt_pulleys", "pymunk", kinds=("inertia",), defaults=False)
     (found,) = entry.errors
     judged = found.motion_change["against_gates"]
     for quantity, gate in judged.items():

@@ -58,7 +58,7 @@ from ..simulators import get_backend
 from ..systems import get_system
 from .budget import become_worker
 from .isolation import WorkerCrashed, WorkerTimedOut, isolated
-from .power import (RUN_TIMEOUT_FACTOR, RUN_TIMEOUT_FLOOR, DefaultPower, PowerEntry,
+from .power import (ERROR_KINDS, RUN_TIMEOUT_FACTOR, RUN_TIMEOUT_FLOOR, DefaultPower, PowerEntry,
                     classify_default, effect_against, engine_defaults, error_powers,
                     free_coordinates, largest_change, metric_named, out_of_the_box_document,
                     power_document, rejecting_metrics, same_metrics, worst_scenario)
@@ -223,6 +223,16 @@ def defaults_entry(system_id: str, simulator: str, dt: float | None = None,
             neutral, run, motion, declared, time.perf_counter() - began))
     entry.wall_time_s = time.perf_counter() - started
     return entry
+
+
+def power_entry(system_id: str, simulator: str, dt: float | None = None,
+                kinds: Iterable[str] = tuple(ERROR_KINDS), defaults: bool = True
+                ) -> PowerEntry:
+    """The power study of one system on one engine (comparisons/power.py): the model
+    errors of `kinds`, and with `defaults` the out-of-the-box reading from the same
+    baseline (`defaults_entry`)."""
+    return defaults_entry(system_id, simulator, dt, only=None if defaults else (),
+                          kinds=tuple(kinds))
 
 
 def _cpu_seconds() -> float:

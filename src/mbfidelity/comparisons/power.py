@@ -483,18 +483,6 @@ def same_metrics(a: Comparison, b: Comparison) -> bool:
         va[k] == vb[k] or (math.isnan(va[k]) and math.isnan(vb[k])) for k in va)
 
 
-def power_entry(system_id: str, simulator: str, dt: float | None = None,
-                kinds: Iterable[str] = tuple(ERROR_KINDS), defaults: bool = True
-                ) -> PowerEntry:
-    """The power study of one system on one engine (see the module doc): the model
-    errors of `kinds`, and with `defaults` the out-of-the-box reading from the same
-    baseline (`out_of_the_box.defaults_entry`)."""
-    from .out_of_the_box import defaults_entry  # it builds on this module's readings
-
-    return defaults_entry(system_id, simulator, dt, only=None if defaults else (),
-                          kinds=tuple(kinds))
-
-
 def error_powers(system, simulator: str, kinds: Iterable[str], baseline: Comparison,
                  dt: float, run) -> list[ErrorPower]:
     """Each kind's smallest rejected eps against `baseline` (the neutralised, unmutated

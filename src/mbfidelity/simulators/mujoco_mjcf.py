@@ -62,13 +62,13 @@ from .plan import (
     num,
     point_mass,
     rigid_body,
+    pair_element_bodies,
     ring_of_boxes,
     rolling_geometry,
     rot,
     slider_masses,
     vec3,
 )
-from .reactions import pair_element_bodies
 
 #: what MuJoCo's soft equalities cost (docs/engines.md; the numbers per mechanism are
 #: measured in the results)

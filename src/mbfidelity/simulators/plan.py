@@ -822,6 +822,16 @@ def spatial_tree_reason(mech: Mechanism, *, closures: bool, slides: bool,
     return ""
 
 
+#: the elements whose force is a pair of opposite forces on two bodies
+PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
+
+
+def pair_element_bodies(mech: Mechanism) -> set[str]:
+    """The bodies a pair element (`PAIR_ELEMENTS`) acts on."""
+    return ({b for c in mech.constraints if isinstance(c, PAIR_ELEMENTS) for b in c.bodies}
+            | {b for f in mech.forces if isinstance(f, PointToPoint) for b in (f.body_a, f.body_b)})
+
+
 # --- massless bodies folded into joint chains ------------------------------------------
 
 
@@ -830,8 +840,6 @@ def foldable_massless(mech: Mechanism) -> set[str]:
     engine whose bodies carry a chain of joints. A massless body with another number of
     child joints, or that a constraint or a point-to-point element refers to, has no such
     child frame."""
-    from .reactions import pair_element_bodies  # reactions builds on this module
-
     used = pair_element_bodies(mech)
     return {b.name for b in mech.bodies if b.massless and b.name not in used
             and sum(1 for j in mech.joints if j.parent == b.name) == 1}

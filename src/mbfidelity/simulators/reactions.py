@@ -58,10 +58,7 @@ from ..systems.model import (
 )
 from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
                    joint_coordinates, num, point_state, sample_columns, turned, wrench)
-from .plan import MaximalFrames
-
-#: the elements whose force is a pair of opposite forces on two bodies
-PAIR_ELEMENTS = (PointToPoint, PointOnPoint, PointOnLine)
+from .plan import PAIR_ELEMENTS, MaximalFrames
 
 
 def slide_direction(mech: Mechanism, joint: Prismatic, q: np.ndarray,
@@ -199,12 +196,6 @@ def pair_element_names(mech: Mechanism) -> set[str]:
     """The names of the mechanism's pair elements (`PAIR_ELEMENTS`: force elements and
     closure constraints whose force is a pair of opposite forces on two bodies)."""
     return {e.name for e in (*mech.forces, *mech.constraints) if isinstance(e, PAIR_ELEMENTS)}
-
-
-def pair_element_bodies(mech: Mechanism) -> set[str]:
-    """The bodies a pair element (`PAIR_ELEMENTS`) acts on."""
-    return ({b for c in mech.constraints if isinstance(c, PAIR_ELEMENTS) for b in c.bodies}
-            | {b for f in mech.forces if isinstance(f, PointToPoint) for b in (f.body_a, f.body_b)})
 
 
 # --- forces from Newton-Euler over each step, for an engine that reports none ----------
