@@ -637,9 +637,10 @@ def _measure_scenario(system, backend, sc, values, mech, ref, run, dt, settings,
         result.metrics.append(_judge(system, backend.id, f"{name}.reaction_{j}", value, tol))
     if "constraint_force" in sc.checks:
         # relative to the largest force any constraint of the mechanism carries in the
-        # run: a force that vanishes by symmetry is not divided by its own round-off
-        force_scale = max((float(np.nanmax(np.abs(f))) for f in (ref.constraint_forces or {}).values()),
-                          default=1.0)
+        # run: a force that vanishes by symmetry is not divided by its own round-off (a
+        # force the reference cannot give, NaN throughout, takes no part)
+        carried = [np.abs(f)[np.isfinite(f)] for f in (ref.constraint_forces or {}).values()]
+        force_scale = max((float(np.max(a)) for a in carried if a.size), default=1.0)
         for cname, f_ref in (ref.constraint_forces or {}).items():
             f_run = run.constraint_forces.get(cname)
             value = (metrics.relative_vector_error(f_run[:n], f_ref[:n], force_scale)
