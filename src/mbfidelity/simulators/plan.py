@@ -1008,16 +1008,16 @@ def joint_pose(joint: Revolute | Prismatic) -> Callable[[float], object]:
     if isinstance(joint, Revolute):
         s, offset = -1.0 if joint.clockwise else 1.0, num(joint.angle_offset)
         return lambda q: s * q + offset
-    pa, axis = np.array(_pt(joint.parent_anchor)), np.array(_pt(joint.axis))
+    pa, axis = np.array(plane_point(joint.parent_anchor)), np.array(plane_point(joint.axis))
     return lambda q: tuple(pa + q * axis)
 
 
 def slide_path(joint: Prismatic) -> tuple[np.ndarray, np.ndarray]:
     """The line base + q axis (parent frame) on which a prismatic joint's child's frame
     origin travels: parent_anchor - R(angle_offset) child_anchor + q axis."""
-    return (np.array(_pt(joint.parent_anchor))
-            - rot(num(joint.angle_offset)) @ np.array(_pt(joint.child_anchor)),
-            np.array(_pt(joint.axis)))
+    return (np.array(plane_point(joint.parent_anchor))
+            - rot(num(joint.angle_offset)) @ np.array(plane_point(joint.child_anchor)),
+            np.array(plane_point(joint.axis)))
 
 
 def joint_velocity(joint: Revolute | Prismatic, rate) -> tuple:
@@ -1026,7 +1026,7 @@ def joint_velocity(joint: Revolute | Prismatic, rate) -> tuple:
     (a hinge turns the child about the anchor; a slide moves it along the axis)."""
     if isinstance(joint, Revolute):
         return 0.0, 0.0, -rate if joint.clockwise else rate
-    axis = np.array(_pt(joint.axis))
+    axis = np.array(plane_point(joint.axis))
     return rate * axis[0], rate * axis[1], 0.0
 
 
@@ -1120,10 +1120,6 @@ class NotEliminable(ValueError):
     """Massless bodies whose frames do not follow from the bodies around them (why)."""
 
 
-def _pt(v) -> tuple[float, float]:
-    return (num(v[0]), num(v[1]))
-
-
 def _closure_bodies(c) -> tuple[str, ...]:
     """The two bodies of a PointOnPoint or PointOnLine; () for other closures."""
     return c.bodies if isinstance(c, (PointOnPoint, PointOnLine)) else ()
@@ -1164,13 +1160,13 @@ class Fold:
     def pin_point(self) -> tuple[float, float]:
         """The revolute point in the pin body's frame."""
         j = self.revolute
-        return _pt(j.parent_anchor if self.turns_with_child else j.child_anchor)
+        return plane_point(j.parent_anchor if self.turns_with_child else j.child_anchor)
 
     @property
     def link_point(self) -> tuple[float, float]:
         """The revolute point in the link's frame."""
         j = self.revolute
-        return _pt(j.child_anchor if self.turns_with_child else j.parent_anchor)
+        return plane_point(j.child_anchor if self.turns_with_child else j.parent_anchor)
 
     @property
     def slot_line(self) -> tuple[np.ndarray, np.ndarray]:
@@ -1182,14 +1178,14 @@ class Fold:
             # the link turns with its child: the pivot (a point of the parent) slides on a
             # line of the child
             back = rot(-num(pri.angle_offset))
-            base = np.array(_pt(pri.child_anchor)) - back @ (
-                np.array(_pt(pri.parent_anchor)) - np.array(_pt(rev.child_anchor)))
-            return base, -back @ np.array(_pt(pri.axis))
+            base = np.array(plane_point(pri.child_anchor)) - back @ (
+                np.array(plane_point(pri.parent_anchor)) - np.array(plane_point(rev.child_anchor)))
+            return base, -back @ np.array(plane_point(pri.axis))
         # the link turns with its parent: the pin (a point of the child) slides on a line
         # of the parent
-        base = np.array(_pt(pri.parent_anchor)) + rot(num(pri.angle_offset)) @ (
-            np.array(_pt(rev.parent_anchor)) - np.array(_pt(pri.child_anchor)))
-        return base, np.array(_pt(pri.axis))
+        base = np.array(plane_point(pri.parent_anchor)) + rot(num(pri.angle_offset)) @ (
+            np.array(plane_point(rev.parent_anchor)) - np.array(plane_point(pri.child_anchor)))
+        return base, np.array(plane_point(pri.axis))
 
 
 @dataclass(frozen=True)
@@ -1227,7 +1223,7 @@ def _arm(mech: Mechanism, name: str, massless: set[str]) -> Arm:
             own, other, at = j.parent_anchor, j.child, j.child_anchor
         else:
             own, other, at = j.child_anchor, j.parent, j.parent_anchor
-        own, at = np.array(_pt(own)), np.array(_pt(at))
+        own, at = np.array(plane_point(own)), np.array(plane_point(at))
         if other in massless:
             raise NotEliminable(f"massless body {name} is hinged to another massless body "
                                 f"{other}")
@@ -1301,17 +1297,17 @@ def _group_equations(group: FreeGroup) -> tuple:
     for j in group.joints:
         slide = None
         if isinstance(j, Prismatic):
-            slide, extra = (extra, j.parent, _pt(j.axis), 1.0), extra + 1
-        equations.append((((1.0, j.parent, _pt(j.parent_anchor)),
-                           (-1.0, j.child, _pt(j.child_anchor))), slide))
+            slide, extra = (extra, j.parent, plane_point(j.axis), 1.0), extra + 1
+        equations.append((((1.0, j.parent, plane_point(j.parent_anchor)),
+                           (-1.0, j.child, plane_point(j.child_anchor))), slide))
     for c in group.closures:
         if isinstance(c, PointOnPoint):
-            equations.append((((1.0, c.body_a, _pt(c.point_a)),
-                               (-1.0, c.body_b, _pt(c.point_b))), None))
+            equations.append((((1.0, c.body_a, plane_point(c.point_a)),
+                               (-1.0, c.body_b, plane_point(c.point_b))), None))
         else:
-            equations.append((((1.0, c.body, _pt(c.point)),
-                               (-1.0, c.line_body, _pt(c.line_point))),
-                              (extra, c.line_body, _pt(c.direction), -1.0)))
+            equations.append((((1.0, c.body, plane_point(c.point)),
+                               (-1.0, c.line_body, plane_point(c.line_point))),
+                              (extra, c.line_body, plane_point(c.direction), -1.0)))
             extra += 1
     return column, extra, group.angles, tuple(equations)
 
@@ -1702,11 +1698,11 @@ def pitch_pairs(mech: Mechanism, k: Mapping[str, float], bodies: Sequence[str],
         for j in mech.joints:
             if isinstance(j, Revolute) and K in (j.parent, j.child):
                 if j.parent == K:
-                    hubs[j.child] = (tuple(np.array(_pt(j.child_anchor))),
-                                     tuple(np.array(_pt(j.parent_anchor))))
+                    hubs[j.child] = (tuple(np.array(plane_point(j.child_anchor))),
+                                     tuple(np.array(plane_point(j.parent_anchor))))
                 else:
-                    hubs[j.parent] = (tuple(np.array(_pt(j.parent_anchor))),
-                                      tuple(np.array(_pt(j.child_anchor))))
+                    hubs[j.parent] = (tuple(np.array(plane_point(j.parent_anchor))),
+                                      tuple(np.array(plane_point(j.child_anchor))))
         if not set(others) <= set(hubs):
             continue
         if len(others) == 2:
@@ -2124,7 +2120,7 @@ class PairLoad:
 
 def pair_load(mech: Mechanism, f: PointToPoint) -> PairLoad:
     """The `PairLoad` of a point-to-point element."""
-    return PairLoad(f.name, f.body_a, f.body_b, _pt(f.point_a), _pt(f.point_b),
+    return PairLoad(f.name, f.body_a, f.body_b, plane_point(f.point_a), plane_point(f.point_b),
                     element_loads(mech, f), ForceLaw.of(f).time_dependent)
 
 
@@ -2179,7 +2175,7 @@ def slot_geometry(c: PointOnLine) -> SlotGeometry:
     """The `SlotGeometry` of a PointOnLine (its direction made a unit vector)."""
     u = np.array([num(c.direction[0]), num(c.direction[1])])
     u = u / float(np.hypot(*u))
-    return SlotGeometry(c.body, _pt(c.point), c.line_body, _pt(c.line_point),
+    return SlotGeometry(c.body, plane_point(c.point), c.line_body, plane_point(c.line_point),
                         (float(u[0]), float(u[1])))
 
 

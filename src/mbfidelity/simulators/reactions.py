@@ -58,7 +58,7 @@ from ..systems.model import (
 )
 from .plan import (CoordinateMap, ForceLaw, Load, coordinate_load, coordinate_map, cos_sin,
                    joint_coordinates, num, point_state, sample_columns, turned, wrench)
-from .plan import PAIR_ELEMENTS, MaximalFrames
+from .plan import PAIR_ELEMENTS, MaximalFrames, plane_point
 
 
 def slide_direction(mech: Mechanism, joint: Prismatic, q: np.ndarray,
@@ -206,10 +206,6 @@ def pair_element_names(mech: Mechanism) -> set[str]:
 # step, at the frames `ahead` where the engine evaluated them.
 
 
-def _point(v) -> tuple[float, float]:
-    return (num(v[0]), num(v[1]))
-
-
 def _world_axis(states: Mapping, body: str, v) -> tuple:
     """A body-frame vector of `body` in world axes."""
     c, s = cos_sin(states[body][2])
@@ -233,8 +229,8 @@ def actuator_force(mech: Mechanism, joint: Revolute | Prismatic, frames: Mapping
 
     def geometry(states: Mapping) -> tuple:  # a slide's world axis, or the hinge point
         if slide:
-            return _world_axis(states, joint.parent, _point(joint.axis))
-        return point_state(states[joint.child], _point(joint.child_anchor))[:2]
+            return _world_axis(states, joint.parent, plane_point(joint.axis))
+        return point_state(states[joint.child], plane_point(joint.child_anchor))[:2]
 
     n = len(frames[joint.child][0]) - 1
     gx, gy = (np.broadcast_to(np.asarray(v, float), (n + 1,))[1:] for v in geometry(frames))
@@ -274,11 +270,12 @@ def _balance_columns(mech: Mechanism, frames: Mapping) -> list[tuple]:
                     force))
 
     def normal(body, d):  # the unit normal of direction d of `body`, in world axes
-        dx, dy = _world_axis(frames, body, np.array(_point(d)) / float(np.linalg.norm(_point(d))))
+        direction = np.array(plane_point(d))
+        dx, dy = _world_axis(frames, body, direction / float(np.linalg.norm(direction)))
         return -dy, dx
 
     def place(body, local):
-        return point_state(frames[body], _point(local))[:2]
+        return point_state(frames[body], plane_point(local))[:2]
 
     for j in mech.joints:
         w = place(j.child, j.child_anchor)
