@@ -62,17 +62,13 @@ class _Compiled:
     def __init__(self, build: Build, integrator: str, autoreset: bool = False) -> None:
         import mujoco
 
-        self.mujoco, self.build, s, dt = mujoco, build, build.settings, build.dt
+        self.mujoco, self.build, dt = mujoco, build, build.dt
         # the file carries the step and the settings' options (`mujoco_mjcf.mjcf`); the
         # integrator and autoreset given here may differ (a linearization's Euler copy)
         self.model = m = mujoco.MjModel.from_xml_string(build.xml)
         m.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
-        for field_name, bit, on in (
-                ("disableflags", mujoco.mjtDisableBit.mjDSBL_AUTORESET, not autoreset),
-                ("disableflags", mujoco.mjtDisableBit.mjDSBL_REFSAFE, not s["refsafe"]),
-                ("enableflags", mujoco.mjtEnableBit.mjENBL_DIAGEXACT, s["diagexact"])):
-            flags = getattr(m.opt, field_name)
-            setattr(m.opt, field_name, flags | int(bit) if on else flags & ~int(bit))
+        bit = int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        m.opt.disableflags = m.opt.disableflags & ~bit if autoreset else m.opt.disableflags | bit
         self.data = mujoco.MjData(m)
 
         def addresses(names: list[str]) -> tuple[np.ndarray, np.ndarray]:
