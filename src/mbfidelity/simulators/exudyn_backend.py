@@ -5,10 +5,9 @@ element kind has one builder, registered with the expressions it declares (`_bui
 `EXPRESSIONS` is read from that registry; each declaration names the Exudyn item built):
 
 - every joint becomes one link of one kinematic tree, in joint order, its frames the
-  shared ones (`plan.LinkFrames`: at the joint, a slide's joint frame turned to its axis):
-  `Revolute` -> ``RevoluteZ``, `Prismatic` -> ``PrismaticX``; a spatial mechanism (model
-  convention 10) gets RevoluteX/Y/Z (PrismaticX/Y/Z) links with the full 3 x 3 central
-  tensor in ``linkInertiasCOM`` (stored as given: `stored_inertia`);
+  shared ones (`plan.LinkFrames`); a spatial mechanism (model convention 10) gets
+  RevoluteX/Y/Z (PrismaticX/Y/Z) links with the full 3 x 3 central tensor in
+  ``linkInertiasCOM`` (stored as given: `stored_inertia`);
 - the engine's joint values ``u`` are relative; description coordinates are the shared
   affine map ``q = T u + c`` (`plan.CoordinateMap`), generalized forces map with ``T^T``;
 - massless bodies are zero-mass links, gravity is the tree's own gravity vector, affine
@@ -18,29 +17,17 @@ element kind has one builder, registered with the expressions it declares (`_bui
   exactly once), and Exudyn's C++ loop runs without Python stepping;
 - reactions: the tree has no joint-force output, so the force parent -> child is Newton's
   law on the child's subtree (`reactions.subtree_newton`), with the engine's
-  centre-of-mass accelerations (kinematic tree sensors, end-of-step accelerations). The
-  solvers record zero accelerations at t = 0, so that sample uses the engine's mass
-  matrix and right-hand side at the initial state (constrained runs: the implicit
-  solver's consistent ones);
-- linearization: `mbs.ComputeLinearizedSystem` (exact M; K and D from Exudyn's
-  forward-difference Jacobian, taken at two steps and Richardson-extrapolated), then the
-  first-order eigenproblem with damping (all 2n eigenvalues); with closure constraints on
-  the constraint manifold from Exudyn's constraint Jacobian
-  (`base.constraint_manifold_eigenvalues`; ``ComputeODE2Eigenvalues`` alone omits the
-  constraint stiffness d(C lam)/du).
+  centre-of-mass accelerations (kinematic tree sensors, end-of-step accelerations);
+- linearization: `mbs.ComputeLinearizedSystem`, with closure constraints on the
+  constraint manifold from Exudyn's constraint Jacobian (`linearize`).
 
-Closure constraints stay on the tree and are exact (index-3 algebraic equations, met to
-round-off); each builder says how its engine force maps to the contract's. Explicit
-solvers cannot run algebraic equations, so a constrained mechanism runs
-``constrained_solver`` (GeneralizedAlpha, rho 0.9, or TrapezoidalIndex2; order 2).
-
-Prescribed motion (convention 9) is an algebraic equation on the tree as well: each
-prescribed coordinate, one engine joint value, is held by a coordinate constraint whose
-offset user functions give q(t), q'(t) at the solver's own times. Exudyn's explicit
-solvers silently ignore the offset, so a driven mechanism runs the implicit
-``driven_solver``, started from consistent accelerations and multipliers the backend
-computes (`_consistent_start`). The actuator force is -lam / scale (virtual work); it acts
-through the joint, so the reactions include it (`reactions`).
+Closure constraints and prescribed coordinates (convention 9) stay on the tree as
+algebraic equations, met to round-off; each builder says how its engine force maps to
+the contract's. Explicit solvers cannot run them (they stop on closure constraints and
+silently ignore a prescribed coordinate's offset), so such mechanisms run the implicit
+``constrained_solver`` or ``driven_solver``, a driven one started from consistent
+accelerations and multipliers (`_consistent_start`). The actuator acts through the joint,
+so the reactions include it (`reactions`).
 """
 from __future__ import annotations
 
@@ -67,17 +54,19 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    spatial_tree_reason, turned)
 from .reactions import subtree_bodies, subtree_newton
 
-#: order of accuracy of the fixed-step solvers offered through the "solver" setting
-#: (measured on the double pendulum; Exudyn's VelocityVerlet is left out: it warns "still
-#: under development" and converged at first order)
-_SOLVER_ORDER = {
-    "RK44": 4,
-    "RK67": 6,
-    "RK33": 3,
-    "ExplicitMidpoint": 2,
-    "ExplicitEuler": 1,
-    "GeneralizedAlpha": 2,
-    "TrapezoidalIndex2": 2,
+#: the fixed-step solvers offered through the "solver" setting: (order of accuracy,
+#: measured on the double pendulum; stability limit: implicit solvers are unconditionally
+#: stable, and of the explicit ones only the Runge-Kutta schemes with a stable stretch of
+#: the imaginary axis have one). Exudyn's VelocityVerlet is left out: it warns "still
+#: under development" and converged at first order.
+_SOLVERS = {
+    "RK44": (4, RK4_STABILITY),
+    "RK67": (6, None),
+    "RK33": (3, RK3_STABILITY),
+    "ExplicitMidpoint": (2, None),
+    "ExplicitEuler": (1, None),
+    "GeneralizedAlpha": (2, None),
+    "TrapezoidalIndex2": (2, None),
 }
 #: the engine's own beam elements (contract point 12)
 ANCF_CABLE = "ANCFCable2D"
@@ -273,16 +262,6 @@ class _System:
         return np.asarray(self.mbs.GetSensorStoredData(sensor))
 
 
-def _spring_damper(f: PointToPoint, system: _System, **law) -> None:
-    """An ``ObjectConnectorSpringDamper`` between the element's points, reference length
-    0 (its deltaL is the length itself), with the given law arguments."""
-    if f.body_a == WORLD and f.body_b == WORLD:
-        return  # acts on nothing
-    markers = [system.marker(f.body_a, f.point_a), system.marker(f.body_b, f.point_b)]
-    system.connectors[f.name] = system.mbs.AddObject(system.items.ObjectConnectorSpringDamper(
-        markerNumbers=markers, referenceLength=0.0, **law))
-
-
 @_builds(TIME_LOAD, Expression(EXACT, "a user function, called at every integrator stage "
                                       "with the stage time"))
 @_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, "the tree's forceUserFunction, called "
@@ -306,12 +285,21 @@ def _force_element(element, system: _System) -> None:
 
 @_force_element.register
 def _(f: PointToPoint, system: _System) -> None:
+    """An ``ObjectConnectorSpringDamper`` between the element's points, reference length
+    0 (its deltaL is the length itself)."""
+    if f.body_a == WORLD and f.body_b == WORLD:
+        return  # acts on nothing
     law = system.native(f)
     if law is None:
-        return _spring_damper(f, system, springForceUserFunction=_tension_user_function(
-            ForceLaw.of(f).law))
-    b0, bl, bv = law  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
-    _spring_damper(f, system, stiffness=bl, damping=bv, force=b0)
+        tension = ForceLaw.of(f).law
+        terms = dict(springForceUserFunction=lambda mbs, t, item, length, rate, stiffness,
+                     damping, force: tension(length, rate, t))
+    else:
+        b0, bl, bv = law  # tension = b0 + bl L + bv L' = k (L - 0) + d L' + force
+        terms = dict(stiffness=bl, damping=bv, force=b0)
+    markers = [system.marker(f.body_a, f.point_a), system.marker(f.body_b, f.point_b)]
+    system.connectors[f.name] = system.mbs.AddObject(system.items.ObjectConnectorSpringDamper(
+        markerNumbers=markers, referenceLength=0.0, **terms))
 
 
 @_force_element.register
@@ -403,23 +391,18 @@ def _coordinate_constraint(p: Prescribed, system: _System) -> None:
     ground_marker = system.once("ground coordinate", lambda: mbs.AddMarker(
         items.MarkerNodeCoordinate(nodeNumber=system.ground_node(), coordinate=0)))
     marker = mbs.AddMarker(items.MarkerNodeCoordinate(nodeNumber=system.node, coordinate=k))
+    position, rate = motion.position, motion.rate
     obj = mbs.AddObject(items.ObjectConnectorCoordinate(
         markerNumbers=[ground_marker, marker],
-        offsetUserFunction=_offset_function(motion.position, scale, shift),
-        offsetUserFunction_t=_offset_function(motion.rate, scale, 0.0)))
+        offsetUserFunction=lambda mbs, t, item, offset: (position(t) - shift) / scale,
+        offsetUserFunction_t=lambda mbs, t, item, offset: rate(t) / scale))
     system.driven.append(_DrivenItem(p.name, obj, motion, scale))
 
 
-def _offset_function(f: Callable[[float], float], scale: float, shift: float):
-    def uf(mbs, t, item, offset):
-        return (f(t) - shift) / scale
-    return uf
-
-
-def _tension_user_function(law: Callable[..., float]):
-    def uf(mbs, t, item, delta_l, delta_l_t, stiffness, damping, force):
-        return law(delta_l, delta_l_t, t)  # referenceLength 0: delta_l is the length
-    return uf
+_ELEMENTS.refuses(ROLLING_CONTACT, "no contact is built on the kinematic tree: Exudyn holds "
+                  "the rolling coupling exactly (LinearCoupling)", "exudyn")
+_ELEMENTS.refuses(HINGE_CLOSURE, "the spatial tree closes no loop: a spatial closed loop has "
+                  "no constraint in it", "exudyn")
 
 
 def _build(mech: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict) -> _System:
@@ -448,13 +431,12 @@ class ExudynBackend(Backend):
     id = "exudyn"
     SETTINGS = {
         "solver": Setting(
-            "RK44", tuple(_SOLVER_ORDER),
+            "RK44", tuple(_SOLVERS),
             "Exudyn defaults to GeneralizedAlpha (2nd order, implicit). RK44 (classical "
-            "Runge-Kutta, order 4) works on the kinematic tree without Newton iterations; "
-            "also offered: RK44, RK67, RK33, ExplicitMidpoint, ExplicitEuler, "
-            "GeneralizedAlpha, TrapezoidalIndex2 (integrator_order reports the order of "
-            "the one used). Mechanisms with closure constraints run constrained_solver, "
-            "with prescribed motion driven_solver. Engine default: Exudyn documentation, "
+            "Runge-Kutta, order 4) works on the kinematic tree without Newton iterations "
+            "(integrator_order reports the order of the solver used). Mechanisms with "
+            "closure constraints run constrained_solver, with prescribed motion "
+            "driven_solver. Engine default: Exudyn documentation, "
             "SolveDynamic(..., solverType=exudyn.DynamicSolverType.GeneralizedAlpha).",
             engine_default="GeneralizedAlpha"),
         "constrained_solver": Setting(
@@ -462,8 +444,7 @@ class ExudynBackend(Backend):
             "Mechanisms with closure constraints (exact index-3 constraints: Exudyn's "
             "explicit solvers stop with 'contains constraints that cannot be solved'): "
             "GeneralizedAlpha (Exudyn's default, order 2) or TrapezoidalIndex2 (order 2, "
-            "index-2 velocity constraints; positions drift slowly); 'solver' applies to "
-            "mechanisms without closure constraints or prescribed motion only."),
+            "index-2 velocity constraints; positions drift slowly)."),
         "driven_solver": Setting(
             "TrapezoidalIndex2", _CONSTRAINT_SOLVERS,
             "Mechanisms with prescribed motion (no Exudyn default: the route is the "
@@ -561,21 +542,10 @@ class ExudynBackend(Backend):
 
     # --- identity --------------------------------------------------------------------------
     ENGINE_MODULES = ('exudyn', 'exudyn.utilities')
-
-    def version(self) -> str:
-        import exudyn
-
-        return str(exudyn.__version__)
+    ENGINE_DISTRIBUTION = "exudyn"
 
     # --- support ---------------------------------------------------------------------------
-    EXPRESSIONS = {
-        **_ELEMENTS.declared(),
-        ROLLING_CONTACT: (Expression(UNSUPPORTED, "no contact is built on the kinematic tree: "
-                                                  "Exudyn holds the rolling coupling exactly "
-                                                  "(LinearCoupling)"),),
-        HINGE_CLOSURE: (Expression(UNSUPPORTED, "the spatial tree closes no loop: a spatial "
-                                                "closed loop has no constraint in it"),),
-    }
+    EXPRESSIONS = _ELEMENTS.declared()
 
     SPATIAL_REASON = ""
 
@@ -670,7 +640,7 @@ class ExudynBackend(Backend):
         from .script_export import exudyn_script
 
         name, q0, qd0 = self.export_start(initial_states)
-        cfg, _ = self._run_frame(mechanism, 1.0, dt, settings)  # support and settings
+        cfg, steps = self._run_frame(mechanism, 1.0, dt, settings)  # support and settings
         solver = self._solver_for(mechanism, cfg)
         system = _build(mechanism, *driven_start(mechanism, q0, qd0), cfg)
         mbs, data = system.mbs, system.mbs.systemData
@@ -679,15 +649,11 @@ class ExudynBackend(Backend):
             ("Object", data.NumberOfObjects(), mbs.GetObject),
             ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
             ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
-        sim = self._run_settings(system, 1.0, int(round(1.0 / dt)))
-        outside = []
-        if mechanism.forces:
-            outside.append("the force laws computed in Python user functions: "
-                           + ", ".join(f.name for f in mechanism.forces))
-        if system.driven:
-            outside.append("the prescribed motions' offset user functions and the "
-                           "consistent start the harness computes: "
-                           + ", ".join(p.name for p in mechanism.prescribed))
+        sim = self._run_settings(system, 1.0, steps)
+        outside = [f"{what}: {', '.join(e.name for e in elements)}" for what, elements in (
+            ("the force laws computed in Python user functions", mechanism.forces),
+            ("the prescribed motions' offset user functions and the consistent start the "
+             "harness computes", mechanism.prescribed)) if elements]
         text = exudyn_script(
             title=self.script_title("Exudyn", name, cfg, f", solver {solver}"),
             items=items, simulation=sim.GetDictionary(), solver=solver, node=int(system.node),
@@ -697,24 +663,18 @@ class ExudynBackend(Backend):
 
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
         solver = self._solver_for(mechanism, self.resolve_settings(settings))
-        # implicit solvers are unconditionally stable; of the explicit ones only the
-        # Runge-Kutta schemes with a stable stretch of the imaginary axis get a limit
-        limits = {"RK44": RK4_STABILITY, "RK33": RK3_STABILITY}
-        return Scheme(solver, _SOLVER_ORDER[solver], limits.get(solver))
+        return Scheme(solver, *_SOLVERS[solver])
 
     # --- simulation ------------------------------------------------------------------------
     def _simulate_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                        steps: int, dt: float, cfg: dict,
                        reaction_joints: tuple[str, ...]) -> Samples:
-        solver = self._solver_for(mechanism, cfg)
         t_run = steps * dt
         system = _build(mechanism, q0, qd0, cfg)
         geo, closures, driven = system.geo, system.closures, system.driven
         ovt = system.exu.OutputVariableType
-        s_u = system.sensor("SensorNode", nodeNumber=system.node,
-                            outputVariableType=ovt.Coordinates)
-        s_ut = system.sensor("SensorNode", nodeNumber=system.node,
-                             outputVariableType=ovt.Coordinates_t)
+        s_u, s_ut = (system.sensor("SensorNode", nodeNumber=system.node, outputVariableType=v)
+                     for v in (ovt.Coordinates, ovt.Coordinates_t))
         # centre-of-mass accelerations of every massive body below a requested joint
         s_acc = {b: system.sensor("SensorKinematicTree", objectNumber=system.tree,
                                   linkNumber=geo.link_of[b], localPosition=list(geo.com[b]),
@@ -737,8 +697,7 @@ class ExudynBackend(Backend):
         # consistent initial accelerations (computeInitialAccelerations)
         acc0 = (self._initial_accelerations(system, s_acc)
                 if s_acc and not (closures or driven) else {})
-        lam0 = self._consistent_start(system) if driven else None
-        clock = self._solve(system, solver, t_run, steps)
+        clock, lam0 = self._solve(system, t_run, steps)
 
         U, Ut = system.stored(s_u), system.stored(s_ut)
         t = U[:, 0]
@@ -749,13 +708,11 @@ class ExudynBackend(Backend):
 
         constraint_forces = {c.name: c.force(system.stored(s_closure[c.name]), u)
                              for c in closures}
-        actuator_forces = {}
-        for k, d in enumerate(driven):
-            lam = system.stored(s_driven[d.name])[:, 1].copy()
-            lam[0] = lam0[k]  # the solver records zero multipliers at t = 0
-            # Exudyn adds C_u^T lam = lam e_p to the engine equations: the constraint
-            # pushes engine coordinate p with -lam, -lam / scale on q (virtual work)
-            actuator_forces[d.name] = -lam / d.scale
+        # the multipliers lam, at t = 0 the consistent start's (the solver records zeros):
+        # Exudyn adds C_u^T lam = lam e_p to the engine equations, so the constraint
+        # pushes engine coordinate p with -lam, -lam / scale on q (virtual work)
+        actuator_forces = {d.name: -np.r_[lam0[k], system.stored(s_driven[d.name])[1:, 1]]
+                           / d.scale for k, d in enumerate(driven)}
         acc = {b: system.stored(s)[:, 1:3] for b, s in s_acc.items()}
         for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
             acc[b][0] = a0
@@ -769,17 +726,12 @@ class ExudynBackend(Backend):
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
         """The system of `simulate` without its sensors, solved by the same solver."""
-        solver = self._solver_for(mechanism, cfg)
         system = _build(mechanism, q0, qd0, cfg)
         system.mbs.Assemble()
-        if system.driven:
-            self._consistent_start(system)
-        clock = self._solve(system, solver, steps * dt, steps)
-        current = system.exu.ConfigurationType.Current
-        data = system.mbs.systemData
-        u = np.asarray(data.GetODE2Coordinates(configuration=current))
-        ut = np.asarray(data.GetODE2Coordinates_t(configuration=current))
-        q, qd = system.geo.coordinates(u[None, :], ut[None, :])
+        clock = self._solve(system, steps * dt, steps)[0]
+        data, current = system.mbs.systemData, system.exu.ConfigurationType.Current
+        q, qd = system.geo.coordinates(*(np.array([read(configuration=current)]) for read in (
+            data.GetODE2Coordinates, data.GetODE2Coordinates_t)))
         return BareLoop(clock.cpu, q[0], qd[0])
 
     def _run_settings(self, system: _System, t_run: float, steps: int):
@@ -794,11 +746,16 @@ class ExudynBackend(Backend):
             ti.generalizedAlpha.spectralRadius = float(system.cfg["constrained_spectral_radius"])
         return sim
 
-    def _solve(self, system: _System, solver: str, t_run: float, steps: int) -> Stopwatch:
-        """SolveDynamic over `steps` steps of the assembled system, timed."""
+    def _solve(self, system: _System, t_run: float, steps: int
+               ) -> tuple[Stopwatch, np.ndarray | None]:
+        """SolveDynamic over `steps` steps of the assembled system by its solver
+        (`_solver_for`), timed, and the multipliers of a driven run's consistent start,
+        computed first (None for other runs)."""
         import exudyn.solver as exu_solver
 
-        solver_type = getattr(system.exu.DynamicSolverType, solver)
+        lam0 = self._consistent_start(system) if system.driven else None
+        solver_type = getattr(system.exu.DynamicSolverType,
+                              self._solver_for(system.mech, system.cfg))
         sim = self._run_settings(system, t_run, steps)
         sim.timeIntegration.solverType = solver_type
         # Python user functions allocate on every call; Exudyn then prints a speed hint
@@ -808,27 +765,20 @@ class ExudynBackend(Backend):
         try:
             with Stopwatch() as clock:
                 system.mbs.SolveDynamic(sim, solverType=solver_type)
-            return clock
+            return clock, lam0
         finally:
             exu_solver.solverCheckMemoryAllocationsThreshold = threshold
 
-    @staticmethod
-    def _solver_for(mechanism: Mechanism, cfg: dict) -> str:
+    def _solver_for(self, mechanism: Mechanism, cfg: dict) -> str:
         """The solver this mechanism runs: 'constrained_solver' with closure constraints,
-        'driven_solver' with prescribed motion, 'solver' otherwise. Both algebraic cases
-        need an implicit solver: the explicit ones stop on closure constraints and
-        silently ignore the offset of a prescribed coordinate."""
+        'driven_solver' with prescribed motion, 'solver' otherwise, checked against its
+        setting. Both algebraic cases admit only implicit solvers: the explicit ones stop
+        on closure constraints and silently ignore the offset of a prescribed
+        coordinate."""
         key = ("constrained_solver" if mechanism.constraints
                else "driven_solver" if mechanism.prescribed else "solver")
-        solver = str(cfg[key])
-        if key != "solver" and solver not in _CONSTRAINT_SOLVERS:
-            raise ValueError(
-                f"exudyn {key} must be an implicit solver ({', '.join(_CONSTRAINT_SOLVERS)}); "
-                f"got {solver!r}: Exudyn's explicit solvers "
-                + ("stop on algebraic equations" if key == "constrained_solver" else
-                   "ignore the offset function of a CoordinateConstraint, so the "
-                   "prescribed coordinate would not move"))
-        return solver
+        self.SETTINGS[key].check(self.id, key, cfg[key])
+        return str(cfg[key])
 
     def _initial_accelerations(self, system: _System, sensors: dict) -> dict[str, np.ndarray]:
         """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
@@ -884,13 +834,12 @@ class ExudynBackend(Backend):
     def _on_constraint_manifold(self, system: _System, q_eq: np.ndarray, M: np.ndarray,
                                 K: np.ndarray, D: np.ndarray, eps: float
                                 ) -> tuple[np.ndarray, str, dict]:
-        """(eigenvalues, method, extra): the linearization on the constraint manifold
-        (`constraint_manifold_eigenvalues`) from the engine's own matrices: M, K, D of the
-        tree (``ComputeLinearizedSystem``, Richardson as above), the constraint Jacobian C
-        (n x m, Exudyn's ``ComputeJacobianAE``) and Exudyn's forces f, which give the
-        static multipliers and the constraint stiffness; then the null-space projection
-        Exudyn's ``ComputeODE2Eigenvalues`` uses. (``ComputeODE2Eigenvalues`` itself has no
-        d(C lam)/du term: the loaded slot of the eccentric cam came out 2.7 % low.)"""
+        """(eigenvalues, method, extra) on the constraint manifold
+        (`constraint_manifold_eigenvalues`) from the tree's M, K, D (`_tree_mkd`) and
+        Exudyn's forces f and constraint Jacobian C (n x m, ``ComputeJacobianAE``): the
+        null-space projection ``ComputeODE2Eigenvalues`` uses, with the constraint stiffness
+        d(C lam)/du it leaves out (without it the loaded slot of the eccentric cam came out
+        2.7 % low)."""
         exu, mbs, cfg, cmap = system.exu, system.mbs, system.cfg, system.geo.cmap
         n = system.geo.n
         u_eq = np.linalg.solve(cmap.T, q_eq - cmap.c)
@@ -967,16 +916,16 @@ class ExudynBackend(Backend):
                                           ObjectMassPoint2D)
 
         l, EI, rho = beam.length, beam.EI, beam.rho
-        # axial stiffness: any positive value (held coordinates); a slender bar's order
         EA = _AXIAL_FACTOR * EI / l**2
-        if kind == ANCF_CABLE:
-            template = ObjectANCFCable2D(massPerLength=rho, bendingStiffness=EI,
-                                         axialStiffness=EA)
-        else:
-            template = ObjectBeamGeometricallyExact2D(
-                massPerLength=rho, crossSectionInertia=_GE_ROTARY_FACTOR * rho * l**2,
-                bendingStiffness=EI, axialStiffness=EA,
-                shearStiffness=_GE_SHEAR_FACTOR * EI / l**2)
+        # the geometrically exact element's shear and rotary terms, reported with its modes
+        terms = ({"shear_stiffness": _GE_SHEAR_FACTOR * EI / l**2,
+                  "rotary_inertia_per_length": _GE_ROTARY_FACTOR * rho * l**2}
+                 if kind == GEOMETRICALLY_EXACT else {})
+        template = (ObjectANCFCable2D(massPerLength=rho, bendingStiffness=EI, axialStiffness=EA)
+                    if kind == ANCF_CABLE else ObjectBeamGeometricallyExact2D(
+                        massPerLength=rho, crossSectionInertia=terms["rotary_inertia_per_length"],
+                        bendingStiffness=EI, axialStiffness=EA,
+                        shearStiffness=terms["shear_stiffness"]))
         SC = exu.SystemContainer()
         mbs = SC.AddSystem()
         built = exudyn.beams.GenerateBeamElementsAlongLine(mbs, [0.0, 0.0, 0.0], [l, 0.0, 0.0],
@@ -995,11 +944,7 @@ class ExudynBackend(Backend):
         return BeamModes.from_squared(
             omega2, count, "exudyn mbs.ComputeODE2Eigenvalues (dense, constrained "
             "coordinates: supports and axial coordinates held)",
-            {"coordinates": len(omega2),
-             "axial_stiffness": EA, "cpu_time": clock.cpu,
-             **({"shear_stiffness": _GE_SHEAR_FACTOR * EI / l**2,
-                 "rotary_inertia_per_length": _GE_ROTARY_FACTOR * rho * l**2}
-                if kind == GEOMETRICALLY_EXACT else {})})
+            {"coordinates": len(omega2), "axial_stiffness": EA, "cpu_time": clock.cpu, **terms})
 
 
 BACKEND = ExudynBackend()
