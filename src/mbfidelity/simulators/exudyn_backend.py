@@ -569,14 +569,12 @@ class ExudynBackend(Backend):
         return spatial_tree_reason(mechanism, closures=False, slides=True, point_forces=True)
 
     # --- model building: the element builders above; the consistent start --------------------
-    def _mass_and_rhs(self, system: _System, explicit: bool) -> tuple[np.ndarray, np.ndarray]:
+    def _mass_and_rhs(self, system: _System) -> tuple[np.ndarray, np.ndarray]:
         """The engine's mass matrix and ODE2 right-hand side at the initial state, from a
-        solver helper (explicit, or the implicit second-order one)."""
+        solver helper (the implicit second-order one)."""
         exu, mbs = system.exu, system.mbs
         sim = self._simulation_settings(exu, system.cfg, 1.0, 1)
-        if explicit:
-            sim.timeIntegration.solverType = exu.DynamicSolverType.RK44
-        helper = exu.MainSolverExplicit() if explicit else exu.MainSolverImplicitSecondOrder()
+        helper = exu.MainSolverImplicitSecondOrder()
         helper.InitializeSolver(mbs, sim)
         helper.ComputeMassMatrix(mbs)
         mass = np.asarray(helper.GetSystemMassMatrix())
@@ -595,7 +593,7 @@ class ExudynBackend(Backend):
         engine's M and f at t = 0, written into the initial state that the solver starts
         from (computeInitialAccelerations off for driven runs). Returns lam (the solver
         records zero multipliers for the sample at t = 0)."""
-        mass, rhs = self._mass_and_rhs(system, explicit=False)
+        mass, rhs = self._mass_and_rhs(system)
         acc, lam = prescribed_start(mass, rhs, {d.motion.index: d.motion.acceleration(0.0)
                                                 / d.scale for d in system.driven})
         initial = system.exu.ConfigurationType.Initial
@@ -783,7 +781,7 @@ class ExudynBackend(Backend):
     def _initial_accelerations(self, system: _System, sensors: dict) -> dict[str, np.ndarray]:
         """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
         right-hand side (the solvers store zero accelerations for the first sample)."""
-        mass, rhs = self._mass_and_rhs(system, explicit=True)
+        mass, rhs = self._mass_and_rhs(system)
         system.mbs.systemData.SetODE2Coordinates_tt(
             np.linalg.solve(mass, rhs).tolist(),
             configuration=system.exu.ConfigurationType.Current)
