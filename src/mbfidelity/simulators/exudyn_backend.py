@@ -87,27 +87,15 @@ _CONSTRAINT_SOLVERS = ("GeneralizedAlpha", "TrapezoidalIndex2")
 
 
 @dataclass
-class _ClosureItem:
-    """One closure constraint as built in Exudyn: its object, the output its sensor reads
-    ("Force" or "ForceLocal") and how that output maps to the contract's physical terms
-    (sensor rows, engine values u -> force)."""
+class _ConstraintItem:
+    """One closure constraint or prescribed coordinate as built in Exudyn: its object, the
+    output its sensor reads ("Force" or "ForceLocal") and how that output maps to the
+    contract's physical terms (sensor rows, engine values u -> force)."""
 
     name: str
     obj: int
     output: str
     force: Callable[[np.ndarray, np.ndarray], np.ndarray]
-
-
-@dataclass
-class _DrivenItem:
-    """One prescribed coordinate as built in Exudyn: the ``CoordinateConstraint`` `obj`
-    holding engine coordinate `motion.index` at (q(t) - shift) / scale, where the
-    description coordinate is q = scale u + shift."""
-
-    name: str
-    obj: int
-    motion: Motion
-    scale: float
 
 
 # --- element builders, registered per element kind with their expressions ------------------
@@ -184,7 +172,8 @@ class _System:
     item classes, the system container (it owns `mbs`: it stays referenced while `mbs` is
     used), the tree node and object, the tree's coordinate-force terms (set on the tree
     once every element is built: `set_tree_forces`), and the connectors, closures and
-    prescribed coordinates built."""
+    prescribed coordinates built, the latter's accelerations u_p''(0) by engine coordinate
+    (`start`)."""
 
     exu: object
     items: object
@@ -200,8 +189,9 @@ class _System:
     force: np.ndarray = field(init=False)
     python_laws: list = field(default_factory=list)
     connectors: dict[str, int] = field(default_factory=dict)
-    closures: list[_ClosureItem] = field(default_factory=list)
-    driven: list[_DrivenItem] = field(default_factory=list)
+    closures: list[_ConstraintItem] = field(default_factory=list)
+    driven: list[_ConstraintItem] = field(default_factory=list)
+    start: dict[int, float] = field(default_factory=dict)
     shared: dict[str, object] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -322,7 +312,7 @@ def _revolute_2d(c: PointOnPoint, system: _System) -> None:
         system.marker(c.body_a, c.point_a, rigid=True),
         system.marker(c.body_b, c.point_b, rigid=True)]))
     # its Force: the force on body_a (marker 0) from body_b, world axes
-    system.closures.append(_ClosureItem(c.name, obj, "Force",
+    system.closures.append(_ConstraintItem(c.name, obj, "Force",
                                         lambda data, u: data[:, 1:3].copy()))
 
 
@@ -343,7 +333,7 @@ def _prismatic_2d(c: PointOnLine, system: _System) -> None:
         world axes."""
         return turned(geo.frame_angle(c.body, u), data[:, 1], data[:, 2])
 
-    system.closures.append(_ClosureItem(c.name, obj, "ForceLocal", slot_force))
+    system.closures.append(_ConstraintItem(c.name, obj, "ForceLocal", slot_force))
 
 
 @_builds(LINEAR_COUPLING, Expression(EXACT, "ObjectConnectorCoordinateVector on the tree's "
@@ -362,7 +352,7 @@ def _coordinate_vector(c: LinearCoupling, system: _System) -> None:
         scalingMarker1=np.zeros((1, 0)), offset=[constant]))
     # its Force is the multiplier, entering as Phi_u^T lam as in the description (Phi
     # identical): the generalized force is -lam
-    system.closures.append(_ClosureItem(c.name, obj, "Force",
+    system.closures.append(_ConstraintItem(c.name, obj, "Force",
                                         lambda data, u: -data[:, 1:2].copy()))
 
 
@@ -396,7 +386,12 @@ def _coordinate_constraint(p: Prescribed, system: _System) -> None:
         markerNumbers=[ground_marker, marker],
         offsetUserFunction=lambda mbs, t, item, offset: (position(t) - shift) / scale,
         offsetUserFunction_t=lambda mbs, t, item, offset: rate(t) / scale))
-    system.driven.append(_DrivenItem(p.name, obj, motion, scale))
+    system.start[k] = motion.acceleration(0.0) / scale
+    # its Force is the multiplier lam: Exudyn adds C_u^T lam = lam e_p to the engine
+    # equations, so the constraint pushes engine coordinate p with -lam, -lam / scale on q
+    # (virtual work)
+    system.driven.append(_ConstraintItem(p.name, obj, "Force",
+                                         lambda data, u: -data[:, 1] / scale))
 
 
 _ELEMENTS.refuses(ROLLING_CONTACT, "no contact is built on the kinematic tree: Exudyn holds "
@@ -594,8 +589,7 @@ class ExudynBackend(Backend):
         from (computeInitialAccelerations off for driven runs). Returns lam (the solver
         records zero multipliers for the sample at t = 0)."""
         mass, rhs = self._mass_and_rhs(system)
-        acc, lam = prescribed_start(mass, rhs, {d.motion.index: d.motion.acceleration(0.0)
-                                                / d.scale for d in system.driven})
+        acc, lam = prescribed_start(mass, rhs, system.start)
         initial = system.exu.ConfigurationType.Initial
         system.mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
         system.mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
@@ -684,12 +678,10 @@ class ExudynBackend(Backend):
                                  outputVariableType=getattr(ovt, output))
 
         # engine force of every connector that can cross a requested joint; of every
-        # closure constraint (its item says which output); the multiplier of every
-        # prescribed coordinate's constraint
+        # closure constraint and prescribed coordinate (its item says which output)
         s_conn = ({name: force_sensor(obj) for name, obj in system.connectors.items()}
                   if reaction_joints else {})
-        s_closure = {c.name: force_sensor(c.obj, c.output) for c in closures}
-        s_driven = {d.name: force_sensor(d.obj) for d in driven}
+        s_items = {c.name: force_sensor(c.obj, c.output) for c in (*closures, *driven)}
         system.mbs.Assemble()
         # constrained and driven runs: the implicit solver's sample at t = 0 holds its
         # consistent initial accelerations (computeInitialAccelerations)
@@ -704,13 +696,11 @@ class ExudynBackend(Backend):
         u, ut = U[:, 1:], Ut[:, 1:]
         q, qd = geo.coordinates(u, ut)
 
-        constraint_forces = {c.name: c.force(system.stored(s_closure[c.name]), u)
-                             for c in closures}
-        # the multipliers lam, at t = 0 the consistent start's (the solver records zeros):
-        # Exudyn adds C_u^T lam = lam e_p to the engine equations, so the constraint
-        # pushes engine coordinate p with -lam, -lam / scale on q (virtual work)
-        actuator_forces = {d.name: -np.r_[lam0[k], system.stored(s_driven[d.name])[1:, 1]]
-                           / d.scale for k, d in enumerate(driven)}
+        data = {name: system.stored(s) for name, s in s_items.items()}
+        for k, d in enumerate(driven):  # the solver records zero multipliers at t = 0
+            data[d.name][0, 1] = lam0[k]
+        constraint_forces = {c.name: c.force(data[c.name], u) for c in closures}
+        actuator_forces = {d.name: d.force(data[d.name], u) for d in driven}
         acc = {b: system.stored(s)[:, 1:3] for b, s in s_acc.items()}
         for b, a0 in acc0.items():  # the solver records zero accelerations at t = 0
             acc[b][0] = a0
