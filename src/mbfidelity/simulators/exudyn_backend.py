@@ -559,9 +559,8 @@ class ExudynBackend(Backend):
         """A spatial mechanism: the common conditions of a spatial tree (its point-to-point
         elements are spring-dampers between tree markers; each joint's axis is checked by
         its builder's declared cases)."""
-        if not mechanism.spatial:
-            return ""
-        return spatial_tree_reason(mechanism, closures=False, slides=True, point_forces=True)
+        return (spatial_tree_reason(mechanism, closures=False, slides=True, point_forces=True)
+                if mechanism.spatial else "")
 
     # --- model building: the element builders above; the consistent start --------------------
     def _mass_and_rhs(self, system: _System) -> tuple[np.ndarray, np.ndarray]:
