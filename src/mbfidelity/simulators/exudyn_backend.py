@@ -387,8 +387,8 @@ def _coordinate_constraint(p: Prescribed, system: _System) -> None:
         offsetUserFunction=lambda mbs, t, item, offset: (position(t) - shift) / scale,
         offsetUserFunction_t=lambda mbs, t, item, offset: rate(t) / scale))
     system.start[k] = motion.acceleration(0.0) / scale
-    # its Force is the multiplier lam: Exudyn adds C_u^T lam = lam e_p to the engine
-    # equations, so the constraint pushes engine coordinate p with -lam, -lam / scale on q
+    # its Force is the multiplier lam: Exudyn adds C_u^T lam = lam e_k to the engine
+    # equations, so the constraint pushes engine coordinate k with -lam, -lam / scale on q
     # (virtual work)
     system.driven.append(_ConstraintItem(p.name, obj, "Force",
                                          lambda data, u: -data[:, 1] / scale))
