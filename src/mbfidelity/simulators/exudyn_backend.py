@@ -563,19 +563,29 @@ class ExudynBackend(Backend):
                 if mechanism.spatial else "")
 
     # --- model building: the element builders above; the consistent start --------------------
-    def _mass_and_rhs(self, system: _System) -> tuple[np.ndarray, np.ndarray]:
-        """The engine's mass matrix and ODE2 right-hand side at the initial state, from a
-        solver helper (the implicit second-order one)."""
-        exu, mbs = system.exu, system.mbs
+    def _engine_terms(self, system: _System, constraint_jacobian: bool = False
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """The engine's mass matrix M, ODE2 right-hand side f and, when asked, constraint
+        Jacobian C (n x m) at the initial state, from Exudyn's static solver helper."""
+        exu, mbs, n = system.exu, system.mbs, system.geo.n
         sim = self._simulation_settings(exu, system.cfg, 1.0, 1)
-        helper = exu.MainSolverImplicitSecondOrder()
+        helper = exu.MainSolverStatic()
         helper.InitializeSolver(mbs, sim)
         helper.ComputeMassMatrix(mbs)
         mass = np.asarray(helper.GetSystemMassMatrix())
         helper.ComputeODE2RHS(mbs)
-        rhs = np.asarray(helper.GetSystemResidual())[:len(mass)]
+        rhs = np.asarray(helper.GetSystemResidual())[:n]
+        C = None
+        if constraint_jacobian:
+            # the ODE2 Jacobian call sizes and clears the system Jacobian, which
+            # ComputeJacobianAE only adds into (ComputeLinearizedSystem does the same)
+            helper.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=-1, scalarFactor_ODE2_t=0,
+                                          scalarFactor_ODE1=0)
+            helper.ComputeJacobianAE(mbs, scalarFactor_ODE2=1.0, scalarFactor_ODE2_t=0.0,
+                                     scalarFactor_ODE1=0.0, velocityLevel=False)
+            C = np.asarray(helper.GetSystemJacobian())[:n, n:]
         helper.FinalizeSolver(mbs, sim)
-        return mass, rhs
+        return mass, rhs, C
 
     def _consistent_start(self, system: _System) -> np.ndarray:
         """Initial accelerations and multipliers that meet the prescribed accelerations
@@ -587,7 +597,7 @@ class ExudynBackend(Backend):
         engine's M and f at t = 0, written into the initial state that the solver starts
         from (computeInitialAccelerations off for driven runs). Returns lam (the solver
         records zero multipliers for the sample at t = 0)."""
-        mass, rhs = self._mass_and_rhs(system)
+        mass, rhs, _ = self._engine_terms(system)
         acc, lam = prescribed_start(mass, rhs, system.start)
         initial = system.exu.ConfigurationType.Initial
         system.mbs.systemData.SetODE2Coordinates_tt(acc.tolist(), configuration=initial)
@@ -770,7 +780,7 @@ class ExudynBackend(Backend):
     def _initial_accelerations(self, system: _System, sensors: dict) -> dict[str, np.ndarray]:
         """Centre-of-mass accelerations at t = 0 from the engine's own mass matrix and
         right-hand side (the solvers store zero accelerations for the first sample)."""
-        mass, rhs = self._mass_and_rhs(system)
+        mass, rhs, _ = self._engine_terms(system)
         system.mbs.systemData.SetODE2Coordinates_tt(
             np.linalg.solve(mass, rhs).tolist(),
             configuration=system.exu.ConfigurationType.Current)
@@ -827,28 +837,14 @@ class ExudynBackend(Backend):
         null-space projection ``ComputeODE2Eigenvalues`` uses, with the constraint stiffness
         d(C lam)/du it leaves out (without it the loaded slot of the eccentric cam came out
         2.7 % low)."""
-        exu, mbs, cfg, cmap = system.exu, system.mbs, system.cfg, system.geo.cmap
-        n = system.geo.n
+        cfg, cmap = system.cfg, system.geo.cmap
         u_eq = np.linalg.solve(cmap.T, q_eq - cmap.c)
 
         def forces_and_jacobian(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             """Exudyn's ODE2 right-hand side f and constraint Jacobian C (n x m) at u."""
-            mbs.systemData.SetODE2Coordinates(u.tolist(),
-                                              configuration=exu.ConfigurationType.Initial)
-            sim = self._simulation_settings(exu, cfg, 1.0, 1)
-            helper = exu.MainSolverStatic()
-            helper.InitializeSolver(mbs, sim)
-            helper.ComputeODE2RHS(mbs)
-            f = np.asarray(helper.GetSystemResidual())[:n]
-            # the ODE2 Jacobian call sizes and clears the system Jacobian, which
-            # ComputeJacobianAE only adds into (ComputeLinearizedSystem does the same)
-            helper.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=-1, scalarFactor_ODE2_t=0,
-                                          scalarFactor_ODE1=0)
-            helper.ComputeJacobianAE(mbs, scalarFactor_ODE2=1.0, scalarFactor_ODE2_t=0.0,
-                                     scalarFactor_ODE1=0.0, velocityLevel=False)
-            C = np.asarray(helper.GetSystemJacobian())[:n, n:]
-            helper.FinalizeSolver(mbs, sim)
-            return f, C
+            system.mbs.systemData.SetODE2Coordinates(
+                u.tolist(), configuration=system.exu.ConfigurationType.Initial)
+            return self._engine_terms(system, constraint_jacobian=True)[1:]
 
         step = float(cfg["linearization_constraint_step"])
         eig, found = constraint_manifold_eigenvalues(M, K, D, forces_and_jacobian, u_eq, step)
