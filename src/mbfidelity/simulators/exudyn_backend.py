@@ -568,7 +568,7 @@ class ExudynBackend(Backend):
         """The engine's mass matrix M, ODE2 right-hand side f and, when asked, constraint
         Jacobian C (n x m) at the initial state, from Exudyn's static solver helper."""
         exu, mbs, n = system.exu, system.mbs, system.geo.n
-        sim = self._simulation_settings(exu, system.cfg, 1.0, 1)
+        sim = self._simulation_settings(system)
         helper = exu.MainSolverStatic()
         helper.InitializeSolver(mbs, sim)
         helper.ComputeMassMatrix(mbs)
@@ -604,8 +604,14 @@ class ExudynBackend(Backend):
         system.mbs.systemData.SetAECoordinates(lam.tolist(), configuration=initial)
         return lam
 
-    def _simulation_settings(self, exu, settings: dict, t_end: float, steps: int):
-        s = exu.SimulationSettings()
+    def _simulation_settings(self, system: _System, t_end: float = 1.0, steps: int = 1):
+        """Exudyn's SimulationSettings of the system for `steps` steps over `t_end` (a solver
+        helper: one step), from the backend settings: a driven run starts from the
+        consistent accelerations already in its initial state (`_consistent_start`)
+        instead of the implicit solver's own; a run with algebraic equations uses the
+        constrained spectral radius."""
+        settings = system.cfg
+        s = system.exu.SimulationSettings()
         ti = s.timeIntegration
         ti.numberOfSteps = steps
         ti.endTime = t_end
@@ -613,8 +619,10 @@ class ExudynBackend(Backend):
         ti.automaticStepSize = bool(settings["automatic_step_size"])
         ti.adaptiveStep = bool(settings["ga_adaptive_step"])
         ti.explicit.computeEndOfStepAccelerations = bool(settings["end_of_step_accelerations"])
-        ti.generalizedAlpha.spectralRadius = float(settings["ga_spectral_radius"])
-        ti.generalizedAlpha.computeInitialAccelerations = True
+        ti.generalizedAlpha.spectralRadius = float(settings[
+            "constrained_spectral_radius" if system.closures or system.driven
+            else "ga_spectral_radius"])
+        ti.generalizedAlpha.computeInitialAccelerations = not system.driven
         ti.newton.relativeTolerance = float(settings["newton_relative_tolerance"])
         ti.newton.absoluteTolerance = float(settings["newton_absolute_tolerance"])
         ti.newton.useModifiedNewton = bool(settings["modified_newton"])
@@ -650,7 +658,7 @@ class ExudynBackend(Backend):
             ("Object", data.NumberOfObjects(), mbs.GetObject),
             ("Marker", data.NumberOfMarkers(), mbs.GetMarker),
             ("Load", data.NumberOfLoads(), mbs.GetLoad)) for i in range(count)]
-        sim = self._run_settings(system, 1.0, steps)
+        sim = self._simulation_settings(system, 1.0, steps)
         outside = [f"{what}: {', '.join(e.name for e in elements)}" for what, elements in (
             ("the force laws computed in Python user functions", mechanism.forces),
             ("the prescribed motions' offset user functions and the consistent start the "
@@ -731,18 +739,6 @@ class ExudynBackend(Backend):
             data.GetODE2Coordinates, data.GetODE2Coordinates_t)))
         return BareLoop(clock.cpu, q[0], qd[0])
 
-    def _run_settings(self, system: _System, t_run: float, steps: int):
-        """The simulation settings of a run of the system: a driven run starts from the
-        consistent accelerations already in its initial state (`_consistent_start`)
-        instead of the implicit solver's own; a run with algebraic equations uses the
-        constrained spectral radius."""
-        sim = self._simulation_settings(system.exu, system.cfg, t_run, steps)
-        ti = sim.timeIntegration
-        ti.generalizedAlpha.computeInitialAccelerations = not system.driven
-        if system.closures or system.driven:
-            ti.generalizedAlpha.spectralRadius = float(system.cfg["constrained_spectral_radius"])
-        return sim
-
     def _solve(self, system: _System, t_run: float, steps: int
                ) -> tuple[Stopwatch, np.ndarray | None]:
         """SolveDynamic over `steps` steps of the assembled system by its solver
@@ -753,7 +749,7 @@ class ExudynBackend(Backend):
         lam0 = self._consistent_start(system) if system.driven else None
         solver_type = getattr(system.exu.DynamicSolverType,
                               self._solver_for(system.mech, system.cfg))
-        sim = self._run_settings(system, t_run, steps)
+        sim = self._simulation_settings(system, t_run, steps)
         sim.timeIntegration.solverType = solver_type
         # Python user functions allocate on every call; Exudyn then prints a speed hint
         # after the run. The hint is expected here, so it is silenced for this call only.
@@ -797,7 +793,7 @@ class ExudynBackend(Backend):
         q_eq = np.asarray(q_eq, dtype=float)
         system = _build(autonomous, q_eq, np.zeros_like(q_eq), cfg)
         system.mbs.Assemble()
-        M, K, D = self._tree_mkd(system.exu, system.mbs, cfg)
+        M, K, D = self._tree_mkd(system)
         eps = float(cfg["linearization_relative_epsilon"])
         if mechanism.constraints:
             eig, method, extra = self._on_constraint_manifold(system, q_eq, M, K, D, eps)
@@ -811,19 +807,19 @@ class ExudynBackend(Backend):
                      "relative_epsilon": eps}
         return Linearization(eigenvalues=eig[np.argsort(eig.imag)], method=method, extra=extra)
 
-    def _tree_mkd(self, exu, mbs, cfg: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _tree_mkd(self, system: _System) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """M, K, D of the assembled tree from ``ComputeLinearizedSystem``; Exudyn
         differentiates forward (error O(eps)), so two steps (eps, eps/2) cancel that term
         when ``linearization_richardson`` is on."""
         def engine_mkd(relative_epsilon: float):
-            sim = self._simulation_settings(exu, cfg, 1.0, 1)
+            sim = self._simulation_settings(system)
             sim.staticSolver.newton.numericalDifferentiation.relativeEpsilon = relative_epsilon
-            M, K, D = mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
+            M, K, D = system.mbs.ComputeLinearizedSystem(simulationSettings=sim)[:3]
             return np.asarray(M), np.asarray(K), np.asarray(D)
 
-        eps = float(cfg["linearization_relative_epsilon"])
+        eps = float(system.cfg["linearization_relative_epsilon"])
         M, K, D = engine_mkd(eps)
-        if cfg["linearization_richardson"]:
+        if system.cfg["linearization_richardson"]:
             _, K2, D2 = engine_mkd(eps / 2)
             K, D = 2 * K2 - K, 2 * D2 - D
         return M, K, D
