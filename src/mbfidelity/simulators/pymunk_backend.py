@@ -46,7 +46,7 @@ from .reactions import motion_forces
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
-                   ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, Load, MaximalFrames, Motion,
+                   ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, MaximalFrames, Motion,
                    NotEliminable, PitchPair, body_states, compensated_host, coupled,
                    coupled_angles, description_reason, effective_mass, element_kind, element_loads,
                    joint_pose, joint_velocity, line_through_origin, num, pitch_pairs, plane_point,
@@ -141,7 +141,6 @@ class _Layout:
     gears: list[tuple[str, str, float, float]] = field(default_factory=list)
     pitches: list[_Pitch] = field(default_factory=list)
     infinite: set[str] = field(default_factory=set)
-    notes: list[str] = field(default_factory=list)
     drives: list[_Drive] = field(default_factory=list)
     #: ids of joints that build no constraint of their own
     eliminated: set[int] = field(default_factory=set)
@@ -176,7 +175,7 @@ _GROOVE_LIMIT = (
 # --- element builders, registered per element kind with their expressions ------------------
 
 #: element kind -> (its builder, the expressions it declares: contract point 5). A body's,
-#: joint's, closure's or prescribed motion's builder takes (plan context, element) and adds
+#: joint's, closure's or prescribed motion's builder takes (layout, element) and adds
 #: its part to the layout (`_plan`), refusing (`_Refused`) what Chipmunk cannot express; a
 #: force element's takes (mechanism, element) and gives its loads as a function of the
 #: frames and t, which the compiled body forces sum (`_compile`).
@@ -260,7 +259,7 @@ def _limits(j: Prismatic) -> tuple[float | None, float | None]:
 def _hinge(layout, j: Revolute) -> None:
     if id(j) not in layout.eliminated:
         layout.pivots.append((j.parent, j.child, plane_point(j.parent_anchor),
-                                  plane_point(j.child_anchor)))
+                              plane_point(j.child_anchor)))
 
 
 @_builds(PRISMATIC, Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and "
@@ -276,17 +275,14 @@ def _slide(layout, j: Prismatic) -> None:
         raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                        f"parent's centre of mass. {_GROOVE_LIMIT}")
     layout.grooves.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *_limits(j),
-                                      (0.0, 0.0), num(j.angle_offset)))
+                                  (0.0, 0.0), num(j.angle_offset)))
 
 
-@_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(TIME_LOAD, Expression(EXACT, _ELEMENT_FORCE + ", at t + h"))
-def _force(mech: Mechanism, f) -> Callable[..., list[Load]]:
-    """A force element's loads on the description bodies (`plan.element_loads`)."""
-    return element_loads(mech, f)
+# a force element's loads on the description bodies
+for _kind in (POINT_TO_POINT_LINEAR, POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR,
+              COORDINATE_FORCE_CUSTOM):
+    _builds(_kind, Expression(EXACT, _ELEMENT_FORCE))(element_loads)
+_builds(TIME_LOAD, Expression(EXACT, _ELEMENT_FORCE + ", at t + h"))(element_loads)
 
 
 @_builds(PRESCRIBED, Expression(EXACT, "on the world: a Body.KINEMATIC child whose velocity "
@@ -329,8 +325,7 @@ def _massless_end(layout, c, bodies) -> None:
 @_builds(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
 def _pivot(layout, c: PointOnPoint) -> None:
     _massless_end(layout, c, (c.body_a, c.body_b))
-    layout.pivots.append((c.body_a, c.body_b, plane_point(c.point_a),
-                              plane_point(c.point_b)))
+    layout.pivots.append((c.body_a, c.body_b, plane_point(c.point_a), plane_point(c.point_b)))
 
 
 @_builds(
@@ -486,21 +481,17 @@ def _engine_masses(layout: _Layout) -> None:
                 num(mech.body(host).mass), num(mech.body(host).inertia),
                 [(car.mass, car.point, car.moment if car.kind == "slot" else 0.0)
                  for car in layout.carriers if car.host == host])
-            if m1 <= 0 or i1 <= 0:
-                layout.notes.append(f"slider substitutes on {host} not compensated "
-                                    f"(mass {m1:.3g}, moment {i1:.3g} left)")
-                continue
-            layout.engine_mass[host] = (m1, i1)
-            layout.cog[host] = (float(c1[0]), float(c1[1]))
-    # every groove must stay exact with the engine centres of mass
+            if m1 > 0 and i1 > 0:  # else not compensated: no mass or moment would be left
+                layout.engine_mass[host] = (m1, i1)
+                layout.cog[host] = (float(c1[0]), float(c1[1]))
+    # every groove must stay exact with the engine centres of mass: not compensated where a
+    # host's centre of gravity must stay on a groove
     for _ in range(2):
         for g in layout.grooves:
             for body, ok in zip((g.slot, g.pin), _groove_exact(layout, g)):
                 if not ok and body in layout.cog:
                     del layout.cog[body]
                     layout.engine_mass[body] = _mass_moment(layout, body)
-                    layout.notes.append(f"slider substitutes on {body} not compensated (its "
-                                        "centre of gravity must stay on a groove)")
     for g in layout.grooves:
         if not all(_groove_exact(layout, g)):
             raise _Refused(f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}")
@@ -687,10 +678,6 @@ class PymunkBackend(Backend):
             "pitch circle; space.collision_slop is set to the chord's sagitta so that the "
             "polygon's penetration is not 'corrected' against the carrier joint."),
     }
-    #: of the last constrained run: relative residual of the momentum balance behind the
-    #: constraint forces (0 when the engine's constraints are exactly the description's),
-    #: and notes on substitutes that could not be compensated
-    diagnostics: dict = {}
 
     ENGINE_MODULES = ('pymunk',)
 
@@ -958,14 +945,11 @@ class PymunkBackend(Backend):
         import pymunk.batch
 
         cogs = [layout.cog.get(n) for n in layout.engine]
+        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
 
-        def read_each() -> list[float]:
-            row: list[float] = []
-            for b, cog in zip(bodies, cogs):
-                row.extend(b.local_to_world(cog) if cog else b.position)
-                row.append(b.angle)
-                row.extend(b.velocity)
-                row.append(b.angular_velocity)
+        def centred(row: list[float]) -> list[float]:
+            for i, b, cog in off_origin:
+                row[i:i + 2] = b.local_to_world(cog)
             return row
 
         fields = pymunk.batch.BodyFields
@@ -974,18 +958,15 @@ class PymunkBackend(Backend):
         get(space, fields.BODY_ID, buffer)
         ids = list(memoryview(buffer.int_buf()).cast("P"))
         if space.sleep_time_threshold != math.inf or ids[:len(bodies)] != [b.id for b in bodies]:
-            return read_each
+            return lambda: centred([v for b in bodies for v in (
+                *b.position, b.angle, *b.velocity, b.angular_velocity)])
         wanted = fields.POSITION | fields.ANGLE | fields.VELOCITY | fields.ANGULAR_VELOCITY
         width = 6 * len(bodies)
-        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
 
         def read_batch() -> list[float]:
             buffer.clear()
             get(space, wanted, buffer)
-            row = memoryview(buffer.float_buf()).cast("d")[:width].tolist()
-            for i, b, cog in off_origin:
-                row[i:i + 2] = b.local_to_world(cog)
-            return row
+            return centred(memoryview(buffer.float_buf()).cast("d")[:width].tolist())
 
         return read_batch
 
@@ -1093,13 +1074,10 @@ class PymunkBackend(Backend):
         S = np.array(run.rows)
         t = np.arange(n_steps + 1) * h
         q, qd = comp.coordinates(S, q0)
-        reactions, constraint_forces, actuator_forces, residual = motion_forces(
+        reactions, constraint_forces, actuator_forces, _ = motion_forces(
             mechanism, comp, S, _parts(mechanism, layout), run.H, t[:-1] + run.shift * h,
             h, reaction_joints, {d.name: d.joint for d in layout.drives})
-        if residual is not None:
-            self.diagnostics = {"balance_residual": residual, "notes": list(layout.notes)}
         return Samples(q, qd, run.clock, reactions, constraint_forces, actuator_forces)
-
 
     # --- flexible elements (contract point 12) ----------------------------------------------
     BEAM_ELEMENTS = {
