@@ -67,8 +67,9 @@ _FORCE_MODES = ("position_updated", "step_start")
 @dataclass(frozen=True)
 class _Groove:
     """A Chipmunk GrooveJoint: the point `anchor` of body `pin` slides on the slot
-    base + u direction, u in [lo, hi] (None: the setting groove_half_length), fixed in body `slot`; `phase` is
-    set when the relative rotation is locked as well (GearJoint, ratio 1)."""
+    base + u direction, u in [lo, hi] (None: the setting groove_half_length), fixed in
+    body `slot`; `phase` is set when the relative rotation is locked as well (GearJoint,
+    ratio 1)."""
 
     slot: str
     pin: str
@@ -499,9 +500,8 @@ def _engine_masses(layout: _Layout) -> None:
 
 def _mass_moment(layout: _Layout, name: str) -> tuple[float, float]:
     """A description body's engine (mass, moment): the moment is infinite where its
-    rotation is fixed (`_engine_body`), else its central inertia, or for a point mass
-    (inertia 0, which Chipmunk inverts to an infinite angular response) m r^2 with r the
-    setting point_mass_gyration."""
+    rotation is fixed (`_engine_body`), else its central inertia, or m r^2 for a point
+    mass (the BODY expressions; r the setting point_mass_gyration)."""
     body = layout.mech.body(name)
     inertia = num(body.inertia)
     if name in layout.infinite:
@@ -778,9 +778,9 @@ class PymunkBackend(Backend):
         expression; a hinge's PivotJoint is built with the other hinges), added to the
         space, and per coordinate (constraint, attribute, value of q): the attribute that
         moves its target to the pose q gives (`plan.joint_pose`); a kinematic driver's is
-        its body. Their error_bias is 0
-        whatever the setting: the gap to the target is removed in one step (bias velocity
-        -gap/h), which is how the target becomes the position of the next step."""
+        its body. Their error_bias is 0 whatever the setting: the gap to the target is
+        removed in one step (bias velocity -gap/h), which is how the target becomes the
+        position of the next step."""
         import pymunk
 
         movers = []
@@ -825,8 +825,7 @@ class PymunkBackend(Backend):
     def _drive_kinematic(d: _Drive, body, targets: list[float], h: float) -> None:
         """A kinematic driver on the world: its velocity_func (called in step k after
         the positions moved to t_(k+1), before the solve) sets the velocity that carries
-        it to q(t_(k+2)) in step k + 1, so the free bodies' constraints are solved against
-        the driver's velocity of the next position update, as with a moving constraint.
+        it to q(t_(k+2)) in step k + 1, as a moving constraint's target does (`_schedule`).
         Its engine centre of gravity is the hinge point (or it does not turn), whose
         velocity is the joint's (`plan.joint_velocity`: its parent is the world)."""
         rates = np.diff([d.position(h), *targets]) / h
