@@ -825,7 +825,8 @@ class PymunkBackend(Backend):
     def _drive_kinematic(d: _Drive, body, targets: list[float], h: float) -> None:
         """A kinematic driver on the world: its velocity_func (called in step k after
         the positions moved to t_(k+1), before the solve) sets the velocity that carries
-        it to q(t_(k+2)) in step k + 1, as a moving constraint's target does (`_schedule`).
+        it to q(t_(k+2)) in step k + 1, so the free bodies' constraints are solved against
+        the driver's velocity of the next position update, as with a moving constraint.
         Its engine centre of gravity is the hinge point (or it does not turn), whose
         velocity is the joint's (`plan.joint_velocity`: its parent is the world)."""
         rates = np.diff([d.position(h), *targets]) / h
