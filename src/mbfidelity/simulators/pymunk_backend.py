@@ -46,7 +46,7 @@ from .reactions import motion_forces
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
-                   ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, MaximalFrames, Motion,
+                   ROLLING_CONTACT, TIME_LOAD, Elimination, MaximalFrames, Motion,
                    NotEliminable, PitchPair, body_states, compensated_host, coupled,
                    coupled_angles, description_reason, effective_mass, element_kind, element_loads,
                    joint_pose, joint_velocity, line_through_origin, num, pitch_pairs, plane_point,
@@ -221,11 +221,23 @@ def _engine_body(layout, body) -> None:
                                           "refused (support)"))
 def _eliminated(layout, body) -> None:
     """The constraint that stands for an eliminated link (`plan.Elimination` found its
-    shape): a folded link's GrooveJoint, an arm's PinJoint and the PivotJoints between
-    bodies hinged at the same point of it; a free group's links impose none."""
+    shape): a folded link's GrooveJoint, its pin point on its partner's line
+    (`plan.Fold.slot_line`), refused when it would not be exact in Chipmunk; an arm's
+    PinJoint and the PivotJoints between bodies hinged at the same point of it; a free
+    group's links impose none."""
     eliminated = layout.elimination
     if body.name in eliminated.folds:
-        layout.grooves.append(_folded_groove(eliminated.folds[body.name]))
+        fold = eliminated.folds[body.name]
+        base, direction = fold.slot_line
+        slot_ok = fold.partner == WORLD or line_through_origin(base, direction)
+        pin_ok = fold.pin_body == WORLD or not any(fold.pin_point)
+        if not (slot_ok and pin_ok):
+            where = ("slot line off the slot body's centre of mass" if not slot_ok
+                     else "pin off the pin body's centre of mass")
+            raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
+                           f"{_GROOVE_LIMIT}")
+        layout.grooves.append(_Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
+                                      *_limits(fold.prismatic), fold.pin_point, None))
     elif body.name in eliminated.arms:
         link = eliminated.arms[body.name]
         (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
@@ -234,22 +246,6 @@ def _eliminated(layout, body) -> None:
         for other, point in link.at_beta[1:]:
             layout.pivots.append((rb, other, pb, point))
         layout.pins.append((ra, rb, pa, pb, link.link))
-
-
-def _folded_groove(fold: Fold) -> _Groove:
-    """The GrooveJoint of a folded link, its pin point on its partner's line
-    (`plan.Fold.slot_line`); refused when it would not be exact in Chipmunk."""
-    base, direction = fold.slot_line
-    anchor = fold.pin_point
-    slot_ok = fold.partner == WORLD or line_through_origin(base, direction)
-    pin_ok = fold.pin_body == WORLD or not any(anchor)
-    if not (slot_ok and pin_ok):
-        where = ("slot line off the slot body's centre of mass" if not slot_ok
-                 else "pin off the pin body's centre of mass")
-        raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
-                       f"{_GROOVE_LIMIT}")
-    return _Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
-                   *_limits(fold.prismatic), anchor, None)
 
 
 def _limits(j: Prismatic) -> tuple[float | None, float | None]:
