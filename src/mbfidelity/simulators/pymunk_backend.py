@@ -695,10 +695,27 @@ class PymunkBackend(Backend):
         return ""
 
     # --- building ------------------------------------------------------------------------
-    @staticmethod
-    def _build(mech: Mechanism, layout: _Layout, comp: MaximalFrames, q0, qd0, cfg: dict):
+    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict,
+                 h: float):
+        """Build: (layout, compiled functions, space, engine bodies, the mechanism as
+        balanced: a RollingContact stands for its coupling, the movers of the prescribed
+        coordinates)."""
         import pymunk
 
+        try:
+            layout = _plan(mechanism, cfg)
+        except _Refused as refused:
+            raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
+        if layout.drives:
+            # every step moves a prescribed coordinate with (q(t + h) - q)/h: started with
+            # q'(0), the driven body's velocity would jump by h q'' twice (actuator force
+            # 0.62 and 0.31 of its range off at samples 1 and 2 on a shaker driven by cos,
+            # whatever h)
+            qd0 = stepped_start(mechanism, q0, qd0, h)
+        # a RollingContact's force is balanced as the coupling it stands for (the layout
+        # holds the contact itself)
+        mech = coupled(mechanism)
+        comp = _compile(mech, layout)
         space = pymunk.Space()
         space.gravity = (0.0, -num(mech.gravity))
         space.damping = float(cfg["damping"])
@@ -758,15 +775,15 @@ class PymunkBackend(Backend):
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
         for i, pitch in enumerate(layout.pitches):
             if pitch.contact:
-                PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
+                self._contact_shapes(space, bodies, pitch, i, cfg)
             else:
-                constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, layout, pitch,
-                                                              comp.coupling_phi(pitch.name)))
+                constraints.append(self._pitch_pivot(pymunk, bodies, layout, pitch,
+                                                     comp.coupling_phi(pitch.name)))
         for c in constraints:
             c.error_bias = float(cfg["error_bias"])
         space.add(*constraints)
-        movers = PymunkBackend._drive_constraints(layout, space, bodies, spins, q0)
-        return space, [bodies[n] for n in layout.engine], movers
+        movers = self._drive_constraints(layout, space, bodies, spins, q0)
+        return layout, comp, space, [bodies[n] for n in layout.engine], mech, movers
 
     @staticmethod
     def _drive_constraints(layout: _Layout, space, bodies: dict, spins, q0):
@@ -908,28 +925,6 @@ class PymunkBackend(Backend):
         space.add(*shapes)
 
     # --- running -------------------------------------------------------------------------
-    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict,
-                 h: float):
-        """Build: (layout, compiled functions, space, engine bodies, the mechanism as
-        balanced: a RollingContact stands for its coupling, the movers of the prescribed
-        coordinates)."""
-        try:
-            layout = _plan(mechanism, cfg)
-        except _Refused as refused:
-            raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
-        if layout.drives:
-            # every step moves a prescribed coordinate with (q(t + h) - q)/h: started with
-            # q'(0), the driven body's velocity would jump by h q'' twice (actuator force
-            # 0.62 and 0.31 of its range off at samples 1 and 2 on a shaker driven by cos,
-            # whatever h)
-            qd0 = stepped_start(mechanism, q0, qd0, h)
-        # a RollingContact's force is balanced as the coupling it stands for (the layout
-        # holds the contact itself)
-        mechanism = coupled(mechanism)
-        comp = _compile(mechanism, layout)
-        space, bodies, movers = self._build(mechanism, layout, comp, q0, qd0, cfg)
-        return layout, comp, space, bodies, mechanism, movers
-
     @staticmethod
     def _reader(space, layout: _Layout, bodies: list) -> Callable[[], list[float]]:
         """A function returning the state row of the engine bodies: per body, the centre
