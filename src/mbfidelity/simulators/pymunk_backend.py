@@ -433,12 +433,11 @@ _ELEMENTS.refuses(HINGE_CLOSURE, "Pymunk is a planar (2-D) engine: a spatial clo
 
 
 def _plan(mech: Mechanism, cfg: Mapping) -> _Layout:
-    """The engine layout (bodies, folded links, pivots, grooves, substitutes), built by
-    each element's registered builder; refused (`_Refused`, with the reason) when the
-    mechanism cannot be expressed. The bodies and prescribed motions come first (which
-    bodies are engine bodies, which joints a drive holds), then the eliminated links'
-    shapes (`plan.Elimination`), the joints, the links, the closures. `cfg`: resolved
-    settings."""
+    """The engine layout at the resolved settings `cfg`, built by each element's
+    registered builder; refused (`_Refused`, with the reason) when the mechanism cannot be
+    expressed. The bodies and prescribed motions come first (which bodies are engine
+    bodies, which joints a drive holds), then the eliminated links' shapes
+    (`plan.Elimination`), the joints, the links, the closures."""
     reason = description_reason(mech)
     if reason:
         raise _Refused(reason)
@@ -522,11 +521,9 @@ _CACHE: dict[tuple, MaximalFrames] = {}
 
 
 def _compile(mech: Mechanism, layout: _Layout) -> MaximalFrames:
-    """What the runs of the mechanism on the layout use, read once and reused by every run
-    on the same engine bodies: how every description body's frame follows from the engine
-    bodies' states, and the force elements' loads (from their builders) on the engine
-    bodies they reach (`plan.MaximalFrames`; the substitute carriers follow no description
-    frame)."""
+    """How every description body's frame follows from the layout's engine bodies and the
+    force elements' loads on them (`plan.MaximalFrames`; the substitute carriers follow no
+    description frame), compiled once and reused by every run on the same engine bodies."""
     key = (mech, tuple(layout.engine), tuple(sorted(layout.cog.items())),
            tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
     if key not in _CACHE:
