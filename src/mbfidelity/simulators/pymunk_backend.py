@@ -723,10 +723,9 @@ class PymunkBackend(Backend):
         bodies: dict[str, pymunk.Body] = {WORLD: space.static_body}
         drivers = {d.joint.child for d in layout.drives if d.kinematic}
         for name in layout.engine:
-            m, inertia = layout.engine_mass[name]
             # no shapes: nothing collides
             body = (pymunk.Body(body_type=pymunk.Body.KINEMATIC) if name in drivers
-                    else pymunk.Body(m, inertia))
+                    else pymunk.Body(*layout.engine_mass[name]))
             if name in layout.dynamic:
                 x, y, th, vx, vy, w = state[name]
                 cog = layout.cog.get(name)
