@@ -2,43 +2,26 @@
 
 Translation of the description (conventions of `mbfidelity.systems.model`). Each element
 kind has one builder, registered with the expressions it declares (`_builds`;
-`EXPRESSIONS` is read from that registry); what each builds is stated there once:
+`EXPRESSIONS` is read from that registry), which state what it builds. Bodies with mass
+are ``pymunk.Body``s, the world is ``space.static_body`` (at the origin, angle 0). No
+shapes are created (except for a RollingContact's circles), so nothing can collide.
+Chipmunk has no massless bodies: they are eliminated (`plan.Elimination`) and stand for
+one constraint between the bodies around them (`_eliminated`); their frames follow from
+the engine bodies (`plan.EliminatedFrames`), and loads on them reach the engine bodies by
+virtual power (`plan.MaximalFrames.engine_loads`).
 
-* Bodies with mass are ``pymunk.Body``s; the world is ``space.static_body`` (at the
-  origin, angle 0). No shapes are created (except for a RollingContact's circles), so
-  nothing can collide. Hinges are ``PivotJoint``s, slides ``GrooveJoint``s with a
-  ``GearJoint`` locking the rotation, point-on-point closures ``PivotJoint``s.
-* Chipmunk has no massless bodies: they are eliminated (`plan.Elimination`: folded
-  links, arms, free groups) and stand for one constraint between the bodies around them
-  (`_eliminated`); their frames follow from the engine bodies (`plan.EliminatedFrames`),
-  and loads on them reach the engine bodies by virtual power
-  (`plan.MaximalFrames.engine_loads`).
-* ``PointOnLine`` -> ``GrooveJoint``, exact only in the poses `_GROOVE_LIMIT` states;
-  otherwise a slider substitute runs in an exact groove, its mass taken out of its host
-  (settings ``slider_mass_fraction``, ``slider_compensation``), so that the composite
-  host + substitute has exactly the described inertia: exact up to the iterative solve.
-* ``LinearCoupling``: written on absolute body angles, sum k_b theta_b = const. Two
-  bodies -> ``GearJoint`` (exact). Three bodies A, B, K with sum k = 0, A and B hinged
-  on the carrier K (belt pulleys on an arm, a disc rolling in a moving track): that is
-  an internal/external gear pair on the carrier, i.e. rolling of the pitch circles at
-  the pitch point C (`plan.PitchPair`). It is a ``PivotJoint`` between A and B whose
-  anchors are moved to C before every solve (pre-solve callback, at the
-  position-updated configuration): its tangential row is the coupling, its normal row
-  is implied by the carrier (redundant), and the coupling's position error is put into
-  the tangential anchor gap (`plan.PitchPair.pitch_points`) so that Chipmunk's own error
-  correction removes it. A ``RollingContact`` (a variant's stand-in for such
-  a coupling) makes the pitch circles colliding shapes instead, and the massless carrier
-  arm is removed (the contact holds the disc). Other couplings (three bodies without a
-  common carrier, prismatic coordinates) are refused with the reason.
-* ``Prescribed``: a kinematic driver or a moving constraint target (setting
-  ``prescribed_motion``; `_drive`, `PymunkBackend._schedule`).
-* Force elements are body forces and torques from one compiled function of the body
-  states, evaluated every step (a Python call per step; setting ``element_forces``).
-* Reactions, constraint and actuator forces: Chipmunk reports only the magnitude of an
-  impulse, so the forces are reconstructed from Newton-Euler over each step, at the
-  configuration where Chipmunk computed them (sample n + 1): in a tree, on the joint
-  child's subtree; with closure constraints, the balance of every description body
-  (`reactions.motion_forces`).
+A ``LinearCoupling`` is written on absolute body angles, sum k_b theta_b = const. Three
+bodies A, B, K with sum k = 0, A and B hinged on the carrier K (belt pulleys on an arm, a
+disc rolling in a moving track), are an internal/external gear pair on the carrier, i.e.
+rolling of the pitch circles at the pitch point C (`plan.PitchPair`). That is a
+``PivotJoint`` between A and B whose anchors are moved to C before every solve (pre-solve
+callback, at the position-updated configuration): its tangential row is the coupling, its
+normal row is implied by the carrier (redundant), and the coupling's position error is put
+into the tangential anchor gap (`plan.PitchPair.pitch_points`) so that Chipmunk's own error
+correction removes it.
+
+Chipmunk reports only the magnitude of an impulse, so the forces are reconstructed from
+Newton-Euler over each step (`PymunkBackend._simulate_impl`).
 
 Chipmunk's step (cpSpaceStep): positions x += h v (old velocity); constraints pre-step at
 the new positions; v += h (g + F/m); warm-started Gauss-Seidel velocity iterations that
@@ -63,12 +46,12 @@ from .reactions import motion_forces
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC, REVOLUTE,
-                   ROLLING_CONTACT, TIME_LOAD, Elimination, Fold, Load, MaximalFrames,
+                   ROLLING_CONTACT, TIME_LOAD, Elimination, MaximalFrames, Motion,
                    NotEliminable, PitchPair, body_states, compensated_host, coupled,
-                   coupled_angles, description_reason, effective_mass, element_kind,
-                   element_loads, joint_pose, joint_velocity, line_through_origin, motions, num,
-                   pitch_pairs, point_mass, point_state, rigid_body, ring_of_chords,
-                   rotation_fixed, slide_path, stepped_start)
+                   coupled_angles, description_reason, effective_mass, element_kind, element_loads,
+                   joint_pose, joint_velocity, line_through_origin, num, pitch_pairs, plane_point,
+                   point_mass, point_state, rigid_body, ring_of_chords, rotation_fixed, slide_path,
+                   stepped_start)
 
 #: how a Prescribed coordinate is imposed (setting prescribed_motion)
 _DRIVE_ROUTES = ("kinematic_on_world", "moving_constraint")
@@ -84,8 +67,9 @@ _FORCE_MODES = ("position_updated", "step_start")
 @dataclass(frozen=True)
 class _Groove:
     """A Chipmunk GrooveJoint: the point `anchor` of body `pin` slides on the slot
-    base + u direction, u in [lo, hi] (None: unbounded), fixed in body `slot`; `phase` is
-    set when the relative rotation is locked as well (GearJoint, ratio 1)."""
+    base + u direction, u in [lo, hi] (None: the setting groove_half_length), fixed in
+    body `slot`; `phase` is set when the relative rotation is locked as well (GearJoint,
+    ratio 1)."""
 
     slot: str
     pin: str
@@ -123,22 +107,28 @@ class _Pitch(PitchPair):
 
 
 @dataclass(frozen=True)
-class _Drive:
-    """A prescribed coordinate (its `Prescribed` element `name`) on `joint`, whose parent
-    is the world or a body with mass and whose child has mass (how it is imposed: the
-    PRESCRIBED expression, `PymunkBackend._schedule`)."""
+class _Drive(Motion):
+    """A prescribed coordinate's motion on `joint`, whose parent is the world or a body
+    with mass and whose child has mass (how it is imposed: the PRESCRIBED expression,
+    `PymunkBackend._schedule`)."""
 
-    name: str
     joint: Revolute | Prismatic
-    index: int  # the coordinate's place among the description coordinates
     kinematic: bool  # the child is a Body.KINEMATIC driver (a joint on the world)
+
+    @property
+    def name(self) -> str:
+        return self.element.name
 
 
 @dataclass
 class _Layout:
-    dynamic: list[str]  # bodies with mass, in description order
-    pivots: list[tuple[str, str, tuple[float, float], tuple[float, float]]]
-    grooves: list[_Groove]
+    """The engine constructs of `mech` at the resolved settings `cfg` (`_plan`)."""
+
+    mech: Mechanism
+    cfg: Mapping
+    dynamic: list[str] = field(default_factory=list)  # bodies with mass, in description order
+    pivots: list[tuple] = field(default_factory=list)  # PivotJoints (a, b, anchor a, anchor b)
+    grooves: list[_Groove] = field(default_factory=list)
     #: the massless links eliminated, and how their frames follow
     elimination: Elimination | None = None
     carriers: list[_Carrier] = field(default_factory=list)
@@ -152,20 +142,24 @@ class _Layout:
     gears: list[tuple[str, str, float, float]] = field(default_factory=list)
     pitches: list[_Pitch] = field(default_factory=list)
     infinite: set[str] = field(default_factory=set)
-    notes: list[str] = field(default_factory=list)
     drives: list[_Drive] = field(default_factory=list)
+    #: ids of joints that build no constraint of their own
+    eliminated: set[int] = field(default_factory=set)
 
     @property
     def engine(self) -> list[str]:
         return self.dynamic + [c.name for c in self.carriers]
 
+    @property
+    def massless(self) -> list[str]:
+        return [b.name for b in self.mech.bodies if element_kind(b) == MASSLESS_BODY]
+
+    def engine_ok(self, body: str) -> bool:
+        return body == WORLD or body in self.dynamic
+
 
 class _Refused(ValueError):
     """Why Chipmunk cannot express the mechanism (`PymunkBackend.translation_reason`)."""
-
-
-def _vec(v) -> np.ndarray:
-    return np.array([num(v[0]), num(v[1])])
 
 
 _GROOVE_LIMIT = (
@@ -179,50 +173,13 @@ _GROOVE_LIMIT = (
     "drift, divergence for large offsets)")
 
 
-def _coupling(mech: Mechanism, c: LinearCoupling, engine_ok: Callable[[str], bool],
-              massless: set[str], contact: bool = False):
-    """('gear', (a, b, phase, ratio)) or ('pitch', _Pitch); refused when the coupling
-    cannot be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
-    circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
-    contact replaces."""
-    slides = [name for name, _ in c.coefficients
-              if element_kind(mech.joints[mech.coordinates.index(name)]) == PRISMATIC]
-    if slides:
-        raise _Refused(f"coupling {c.name}: coordinate {slides[0]} is prismatic; Chipmunk "
-                       "couples only angles (GearJoint)")
-    k, k0, bodies, scale = coupled_angles(mech, c)
-    if not bodies:
-        raise _Refused(f"coupling {c.name}: no body angle enters it")
-    arm = (f"contact {c.name}: the disc and the track must be hinged on a massless carrier "
-           "arm, which the contact replaces")
-    if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
-        if contact:
-            raise _Refused(arm)
-        if len(bodies) == 1:
-            a = bodies[0]
-            return "gear", (a, WORLD, -k0 / k[a], 1.0)
-        a, b = bodies
-        return "gear", (a, b, -k0 / k[a], -k[b] / k[a])
-    for pair in pitch_pairs(mech, k, bodies, scale):
-        if not (engine_ok(pair.a) and engine_ok(pair.b)):
-            continue
-        if contact and pair.carrier not in massless:  # its hinges would keep the distance
-            raise _Refused(arm)
-        wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
-        return "pitch", _Pitch(*astuple(pair), c.name, wrap, contact)
-    raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
-                   "couples the absolute angles of two bodies, and a coupling of three is "
-                   "expressible here only as two bodies hinged on a common carrier (gear pair, "
-                   "belt, rolling: a pivot at the pitch point)")
-
-
 # --- element builders, registered per element kind with their expressions ------------------
 
 #: element kind -> (its builder, the expressions it declares: contract point 5). A body's,
-#: joint's, closure's or prescribed motion's builder takes (plan context, element) and adds
+#: joint's, closure's or prescribed motion's builder takes (layout, element) and adds
 #: its part to the layout (`_plan`), refusing (`_Refused`) what Chipmunk cannot express; a
 #: force element's takes (mechanism, element) and gives its loads as a function of the
-#: frames and t, which the compiled body forces sum (`_Compiled`).
+#: frames and t, which the compiled body forces sum (`_compile`).
 _ELEMENTS = ElementBuilders()
 _builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
 
@@ -241,9 +198,9 @@ _builds, _builder = _ELEMENTS.builds, _ELEMENTS.of
          Expression(UNSUPPORTED, "Chipmunk needs a mass > 0 (or mass and inertia both 0 "
                                  "for a massless link that can be eliminated)",
                     when="mass 0, inertia > 0"))
-def _engine_body(ctx, body) -> None:
+def _engine_body(layout, body) -> None:
     """A body with mass is an engine body (a point mass gets its substitute moment,
-    `_moment`); one whose rotation is fixed gets an infinite moment: it is taken out of
+    `_mass_moment`); one whose rotation is fixed gets an infinite moment: it is taken out of
     every rotational equation, where a GearJoint holding its angle would be solved only
     iteratively (two such bodies in a chain drift apart under a velocity-level groove
     without error correction)."""
@@ -251,9 +208,9 @@ def _engine_body(ctx, body) -> None:
         raise _Refused(f"body {body.name}: mass 0 and inertia {num(body.inertia)}; Chipmunk "
                        "needs a mass > 0 (or both 0 for a massless link that can be "
                        "eliminated)")
-    ctx.layout.dynamic.append(body.name)
-    if rotation_fixed(ctx.mech, body.name):
-        ctx.layout.infinite.add(body.name)
+    layout.dynamic.append(body.name)
+    if rotation_fixed(layout.mech, body.name):
+        layout.infinite.add(body.name)
 
 
 @_builds(MASSLESS_BODY, Expression(EXACT, "eliminated (Chipmunk has no massless bodies): "
@@ -262,13 +219,25 @@ def _engine_body(ctx, body) -> None:
                                           "at two points), or a free group whose positions "
                                           "solve its joint equations; other shapes are "
                                           "refused (support)"))
-def _eliminated(ctx, body) -> None:
+def _eliminated(layout, body) -> None:
     """The constraint that stands for an eliminated link (`plan.Elimination` found its
-    shape): a folded link's GrooveJoint, an arm's PinJoint and the PivotJoints between
-    bodies hinged at the same point of it; a free group's links impose none."""
-    layout, eliminated = ctx.layout, ctx.layout.elimination
+    shape): a folded link's GrooveJoint, its pin point on its partner's line
+    (`plan.Fold.slot_line`), refused when it would not be exact in Chipmunk; an arm's
+    PinJoint and the PivotJoints between bodies hinged at the same point of it; a free
+    group's links impose none."""
+    eliminated = layout.elimination
     if body.name in eliminated.folds:
-        layout.grooves.append(_folded_groove(eliminated.folds[body.name]))
+        fold = eliminated.folds[body.name]
+        base, direction = fold.slot_line
+        slot_ok = fold.partner == WORLD or line_through_origin(base, direction)
+        pin_ok = fold.pin_body == WORLD or not any(fold.pin_point)
+        if not (slot_ok and pin_ok):
+            where = ("slot line off the slot body's centre of mass" if not slot_ok
+                     else "pin off the pin body's centre of mass")
+            raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
+                           f"{_GROOVE_LIMIT}")
+        layout.grooves.append(_Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
+                                      *_limits(fold.prismatic), fold.pin_point, None))
     elif body.name in eliminated.arms:
         link = eliminated.arms[body.name]
         (ra, pa), (rb, pb) = link.at_alpha[0], link.at_beta[0]
@@ -279,57 +248,38 @@ def _eliminated(ctx, body) -> None:
         layout.pins.append((ra, rb, pa, pb, link.link))
 
 
-def _folded_groove(fold: Fold) -> _Groove:
-    """The GrooveJoint of a folded link, its pin point on its partner's line
-    (`plan.Fold.slot_line`); refused when it would not be exact in Chipmunk."""
-    base, direction = fold.slot_line
-    anchor = _vec(fold.pin_point)
-    slot_ok = fold.partner == WORLD or line_through_origin(base, direction)
-    pin_ok = fold.pin_body == WORLD or not anchor.any()
-    if not (slot_ok and pin_ok):
-        where = ("slot line off the slot body's centre of mass" if not slot_ok
-                 else "pin off the pin body's centre of mass")
-        raise _Refused(f"massless link {fold.link} folds into a groove with its {where}. "
-                       f"{_GROOVE_LIMIT}")
-    return _Groove(fold.partner, fold.pin_body, tuple(base), tuple(direction),
-                   *_limits(fold.prismatic), tuple(anchor), None)
-
-
 def _limits(j: Prismatic) -> tuple[float | None, float | None]:
     return tuple(None if v is None else num(v) for v in j.limits)  # type: ignore[return-value]
 
 
 @_builds(REVOLUTE, Expression(EXACT, "PivotJoint at the two anchors"))
-def _hinge(ctx, j: Revolute) -> None:
-    if id(j) not in ctx.eliminated:
-        ctx.layout.pivots.append((j.parent, j.child, tuple(_vec(j.parent_anchor)),
-                                  tuple(_vec(j.child_anchor))))
+def _hinge(layout, j: Revolute) -> None:
+    if id(j) not in layout.eliminated:
+        layout.pivots.append((j.parent, j.child, plane_point(j.parent_anchor),
+                              plane_point(j.child_anchor)))
 
 
 @_builds(PRISMATIC, Expression(EXACT, "GrooveJoint along the child's centre-of-mass path and "
                                       "a GearJoint locking the rotation; refused (support) "
                                       "unless the path passes through the parent's centre "
                                       "of mass or the parent is the world. " + _GROOVE_LIMIT))
-def _slide(ctx, j: Prismatic) -> None:
-    if id(j) in ctx.eliminated:
+def _slide(layout, j: Prismatic) -> None:
+    if id(j) in layout.eliminated:
         return
     # with the rotation locked the pin can be the child's centre of mass, its frame origin
     base, axis = slide_path(j)
     if j.parent != WORLD and not line_through_origin(base, axis):
         raise _Refused(f"prismatic joint {j.name}: the child's centre-of-mass path misses the "
                        f"parent's centre of mass. {_GROOVE_LIMIT}")
-    ctx.layout.grooves.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *_limits(j),
-                                      (0.0, 0.0), num(j.angle_offset)))
+    layout.grooves.append(_Groove(j.parent, j.child, tuple(base), tuple(axis), *_limits(j),
+                                  (0.0, 0.0), num(j.angle_offset)))
 
 
-@_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(POINT_TO_POINT_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(COORDINATE_FORCE_LINEAR, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(COORDINATE_FORCE_CUSTOM, Expression(EXACT, _ELEMENT_FORCE))
-@_builds(TIME_LOAD, Expression(EXACT, _ELEMENT_FORCE + ", at t + h"))
-def _force(mech: Mechanism, f) -> Callable[..., list[Load]]:
-    """A force element's loads on the description bodies (`plan.element_loads`)."""
-    return element_loads(mech, f)
+# a force element's loads on the description bodies
+for _kind in (POINT_TO_POINT_LINEAR, POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_LINEAR,
+              COORDINATE_FORCE_CUSTOM):
+    _builds(_kind, Expression(EXACT, _ELEMENT_FORCE))(element_loads)
+_builds(TIME_LOAD, Expression(EXACT, _ELEMENT_FORCE + ", at t + h"))(element_loads)
 
 
 @_builds(PRESCRIBED, Expression(EXACT, "on the world: a Body.KINEMATIC child whose velocity "
@@ -343,37 +293,36 @@ def _force(mech: Mechanism, f) -> Callable[..., list[Load]]:
                                        "on the child subtree) converge at first order, the "
                                        "scheme's (setting prescribed_motion). Refused "
                                        "(support) on a joint with a massless body"))
-def _drive(ctx, p) -> None:
+def _drive(layout, p) -> None:
     """A prescribed coordinate's `_Drive`: on the world (with the default route) a
     kinematic child, turning about its centre of gravity, which is put on the hinge; a
     prescribed slide is held by a moving PivotJoint instead of a groove."""
-    mech, layout = ctx.mech, ctx.layout
+    mech = layout.mech
     index = mech.coordinates.index(p.coordinate)
     j = mech.joints[index]
-    if not (ctx.engine_ok(j.child) and j.child != WORLD and ctx.engine_ok(j.parent)):
+    if not (layout.engine_ok(j.child) and j.child != WORLD and layout.engine_ok(j.parent)):
         raise _Refused(f"prescribed motion {p.name}: joint {j.name} joins a massless body; "
                        "the constraint that imposes the motion acts between bodies with mass "
                        "(or the world)")
-    kinematic = ctx.cfg["prescribed_motion"] == _DRIVE_ROUTES[0] and j.parent == WORLD
-    layout.drives.append(_Drive(p.name, j, index, kinematic))
+    kinematic = layout.cfg["prescribed_motion"] == _DRIVE_ROUTES[0] and j.parent == WORLD
+    layout.drives.append(_Drive(p, index, j, kinematic))
     if element_kind(j) == PRISMATIC or kinematic:  # its joint is the drive's constraint
-        ctx.eliminated.add(id(j))
-    if kinematic and element_kind(j) == REVOLUTE and _vec(j.child_anchor).any():
-        layout.cog[j.child] = tuple(_vec(j.child_anchor))
+        layout.eliminated.add(id(j))
+    if kinematic and element_kind(j) == REVOLUTE and any(plane_point(j.child_anchor)):
+        layout.cog[j.child] = plane_point(j.child_anchor)
 
 
-def _massless_end(ctx, c, bodies) -> None:
-    bad = [b for b in bodies if not ctx.engine_ok(b)]
+def _massless_end(layout, c, bodies) -> None:
+    bad = [b for b in bodies if not layout.engine_ok(b)]
     if bad:
         raise _Refused(f"constraint {c.name}: on massless body {bad[0]} that cannot be "
                        "eliminated with it")
 
 
 @_builds(POINT_ON_POINT, Expression(EXACT, "PivotJoint"))
-def _pivot(ctx, c: PointOnPoint) -> None:
-    _massless_end(ctx, c, (c.body_a, c.body_b))
-    ctx.layout.pivots.append((c.body_a, c.body_b, tuple(_vec(c.point_a)),
-                              tuple(_vec(c.point_b))))
+def _pivot(layout, c: PointOnPoint) -> None:
+    _massless_end(layout, c, (c.body_a, c.body_b))
+    layout.pivots.append((c.body_a, c.body_b, plane_point(c.point_a), plane_point(c.point_b)))
 
 
 @_builds(
@@ -382,23 +331,23 @@ def _pivot(ctx, c: PointOnPoint) -> None:
                                            "centre of mass (or the slot is on the world or a "
                                            "body whose rotation is fixed) and the pin is the "
                                            "pin body's",
-               applies=lambda mech, slot: not _carried(mech, slot)),
+               applies=lambda mech, slot: not _substituted(mech, slot)),
     Expression(SUBSTITUTE, "a pin slider (point mass pinned to the pin) and/or a slot "
                            "carrier (glued to the slot body, centred on the line) in an exact "
                            "GrooveJoint, their mass taken out of the host "
                            "(slider_compensation). " + _GROOVE_LIMIT,
                when="otherwise"))
-def _slot(ctx, c: PointOnLine) -> None:
-    _massless_end(ctx, c, (c.body, c.line_body))
-    layout = ctx.layout
-    point, base = _vec(c.point), _vec(c.line_point)
-    direction = _vec(c.direction) / float(np.linalg.norm(_vec(c.direction)))
+def _slot(layout, c: PointOnLine) -> None:
+    _massless_end(layout, c, (c.body, c.line_body))
+    point, base, axis = (np.array(plane_point(v)) for v in (c.point, c.line_point, c.direction))
+    direction = axis / float(np.linalg.norm(axis))
 
     def substitute(kind: str, host: str, at: np.ndarray) -> str:
         """A carrier of `host` at its point `at`: a glued slot carrier (kind "slot") or
         a point-mass pin slider (kind "pin"), pinned there."""
-        m, inertia = num(ctx.mech.body(host).mass), num(ctx.mech.body(host).inertia)
-        mass = ctx.fraction * effective_mass(m, inertia, float(np.linalg.norm(at)))
+        m, inertia = num(layout.mech.body(host).mass), num(layout.mech.body(host).inertia)
+        mass = float(layout.cfg["slider_mass_fraction"]) * effective_mass(
+            m, inertia, float(np.linalg.norm(at)))
         name = f"_{kind}_{'carrier' if kind == 'slot' else 'slider'}_{c.name}"
         layout.carriers.append(_Carrier(name, host, kind, tuple(at), mass,
                                         mass * inertia / m if kind == "slot" else math.inf,
@@ -408,18 +357,18 @@ def _slot(ctx, c: PointOnLine) -> None:
 
     slot, pin, anchor = c.line_body, c.body, point
     if slot != WORLD and not line_through_origin(base, direction):
-        if rotation_fixed(ctx.mech, slot):
+        if rotation_fixed(layout.mech, slot):
             layout.infinite.add(slot)
         else:  # slot carrier glued to the slot body, its centre on the line
             foot = base - float(base @ direction) * direction
             slot, base = substitute("slot", slot, foot), base - foot
             layout.gears.append((c.line_body, slot, 0.0, 1.0))
     if pin != WORLD and point.any():
-        if rotation_fixed(ctx.mech, pin):
+        if rotation_fixed(layout.mech, pin):
             layout.infinite.add(pin)
         else:  # pin slider: a point mass pinned to the pin point
             pin, anchor = substitute("pin", pin, point), np.zeros(2)
-    layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), -ctx.half, ctx.half,
+    layout.grooves.append(_Groove(slot, pin, tuple(base), tuple(direction), None, None,
                                   tuple(anchor), None))
 
 
@@ -429,153 +378,160 @@ def _slot(ctx, c: PointOnLine) -> None:
                 "game-physics user would build. Measured on the disc of Fig. 39: trajectory "
                 "error 2-10 % of the amplitude (coupling 2-2.6e-3), slip up to 3e-4 m, "
                 "single-step losses of contact from one chord to the next"))
-def _contact(ctx, c: RollingContact) -> None:
-    _, pitch = _coupling(ctx.mech, c.coupling, ctx.engine_ok, ctx.massless, contact=True)
-    ctx.layout.pitches.append(pitch)
+def _contact(layout, c: RollingContact) -> None:
+    _coupling(layout, c.coupling, contact=True)
 
 
 @_builds(
     LINEAR_COUPLING,
     Expression(EXACT, "GearJoint on the absolute angles of two bodies",
                when="two body angles",
-               applies=lambda mech, coupling: not _pitched(mech, coupling)),
+               applies=lambda mech, coupling: not _substituted(mech, coupling)),
     Expression(EXACT, "a PivotJoint between the two bodies hinged on a common carrier, "
                       "moved to the pitch point before every solve: its tangential row is "
                       "the coupling (gear pair, belt, rolling); other couplings are refused "
                       "(support)",
                when="three body angles, two hinged on a carrier"))
-def _gear(ctx, c: LinearCoupling) -> None:
-    kind, value = _coupling(ctx.mech, c, ctx.engine_ok, ctx.massless)
-    (ctx.layout.gears if kind == "gear" else ctx.layout.pitches).append(value)
+def _coupling(layout, c: LinearCoupling, contact: bool = False) -> None:
+    """A GearJoint (two body angles) or a pitch pair (`_Pitch`); refused when the coupling
+    cannot be expressed. With `contact` (a RollingContact stands for the coupling) the pitch
+    circles collide instead: that needs a pitch pair on a massless carrier, whose arm the
+    contact replaces."""
+    mech, engine_ok, massless = layout.mech, layout.engine_ok, layout.massless
+    slides = [name for name, _ in c.coefficients
+              if element_kind(mech.joints[mech.coordinates.index(name)]) == PRISMATIC]
+    if slides:
+        raise _Refused(f"coupling {c.name}: coordinate {slides[0]} is prismatic; Chipmunk "
+                       "couples only angles (GearJoint)")
+    k, k0, bodies, scale = coupled_angles(mech, c)
+    if not bodies:
+        raise _Refused(f"coupling {c.name}: no body angle enters it")
+    arm = (f"contact {c.name}: the disc and the track must be hinged on a massless carrier "
+           "arm, which the contact replaces")
+    if len(bodies) <= 2 and all(engine_ok(b) for b in bodies):
+        if contact:
+            raise _Refused(arm)
+        a, b = bodies if len(bodies) == 2 else (bodies[0], WORLD)
+        layout.gears.append((a, b, -k0 / k[a], 1.0 if b == WORLD else -k[b] / k[a]))
+        return
+    for pair in pitch_pairs(mech, k, bodies, scale):
+        if not (engine_ok(pair.a) and engine_ok(pair.b)):
+            continue
+        if contact and pair.carrier not in massless:  # its hinges would keep the distance
+            raise _Refused(arm)
+        wrap = 2 * math.pi * abs(k[pair.carrier]) if pair.carrier in massless else 0.0
+        layout.pitches.append(_Pitch(*astuple(pair), c.name, wrap, contact))
+        return
+    raise _Refused(f"coupling {c.name}: on the angles of {sorted(bodies)}; Chipmunk's GearJoint "
+                   "couples the absolute angles of two bodies, and a coupling of three is "
+                   "expressible here only as two bodies hinged on a common carrier (gear pair, "
+                   "belt, rolling: a pivot at the pitch point)")
 
 
 _ELEMENTS.refuses(HINGE_CLOSURE, "Pymunk is a planar (2-D) engine: a spatial closed loop "
                                   "has no expression in it", "pymunk")
 
 
-def _moment(body, cfg: Mapping) -> float:
-    """The engine moment of a body: its central inertia, or for a point mass (inertia 0,
-    which Chipmunk inverts to an infinite angular response) m r^2 with r the setting
-    point_mass_gyration."""
-    inertia = num(body.inertia)
-    if inertia > 0:
-        return inertia
-    return num(body.mass) * float(cfg["point_mass_gyration"]) ** 2
-
-
 def _plan(mech: Mechanism, cfg: Mapping) -> _Layout:
-    """The engine layout (bodies, folded links, pivots, grooves, substitutes), built by
-    each element's registered builder; refused (`_Refused`, with the reason) when the
-    mechanism cannot be expressed. The bodies and prescribed motions come first (which
-    bodies are engine bodies, which joints a drive holds), then the eliminated links'
-    shapes (`plan.Elimination`), the joints, the links, the closures. `cfg`: resolved
-    settings."""
+    """The engine layout at the resolved settings `cfg`, built by each element's
+    registered builder; refused (`_Refused`, with the reason) when the mechanism cannot be
+    expressed. The bodies and prescribed motions come first (which bodies are engine
+    bodies, which joints a drive holds), then the eliminated links' shapes
+    (`plan.Elimination`), the joints, the links, the closures."""
     reason = description_reason(mech)
     if reason:
         raise _Refused(reason)
-    layout = _Layout(dynamic=[], pivots=[], grooves=[])
-    massless = [b for b in mech.bodies if element_kind(b) == MASSLESS_BODY]
-    ctx = SimpleNamespace(mech=mech, cfg=cfg, layout=layout,
-                          massless={b.name for b in massless},
-                          engine_ok=lambda b: b == WORLD or b in layout.dynamic,
-                          eliminated=set(),  # ids of joints that build no constraint of their own
-                          half=float(cfg["groove_half_length"]),
-                          fraction=float(cfg["slider_mass_fraction"]))
+    layout = _Layout(mech, cfg)
+    massless = layout.massless
     for body in mech.bodies:
-        if body.name not in ctx.massless:  # a massless body's builder runs after the joints
-            _builder(body)(ctx, body)
+        if body.name not in massless:  # a massless body's builder runs after the joints
+            _builder(body)(layout, body)
     for p in mech.prescribed:
-        _builder(p)(ctx, p)
+        _builder(p)(layout, p)
     try:
         layout.elimination = Elimination(mech)
     except NotEliminable as reason:
         raise _Refused(f"{reason} (Chipmunk has no massless bodies)") from None
-    ctx.eliminated |= layout.elimination.joints
-    for element in (*mech.joints, *massless):
-        _builder(element)(ctx, element)
+    layout.eliminated |= layout.elimination.joints
+    for element in (*mech.joints, *map(mech.body, massless)):
+        _builder(element)(layout, element)
     for c in mech.constraints:
         if id(c) not in layout.elimination.closures:
-            _builder(c)(ctx, c)
-    _engine_masses(mech, layout, cfg)
+            _builder(c)(layout, c)
+    _engine_masses(layout)
     return layout
 
 
-def _engine_masses(mech: Mechanism, layout: _Layout, cfg: Mapping) -> None:
+def _engine_masses(layout: _Layout) -> None:
     """The engine (mass, moment) of every engine body, the slider substitutes' taken out
     of their hosts (setting slider_compensation) where every groove stays exact; refused
     when a groove is not exact."""
+    mech = layout.mech
     for name in layout.dynamic:
-        b = mech.body(name)
-        layout.engine_mass[name] = (num(b.mass),
-                                    math.inf if name in layout.infinite else _moment(b, cfg))
+        layout.engine_mass[name] = _mass_moment(layout, name)
     for car in layout.carriers:
         layout.engine_mass[car.name] = (car.mass, car.moment)
-    if layout.carriers and cfg["slider_compensation"]:
+    if layout.cfg["slider_compensation"]:
         for host in dict.fromkeys(car.host for car in layout.carriers):
-            cars = [car for car in layout.carriers if car.host == host]
             m1, c1, i1 = compensated_host(
                 num(mech.body(host).mass), num(mech.body(host).inertia),
                 [(car.mass, car.point, car.moment if car.kind == "slot" else 0.0)
-                 for car in cars])
-            if m1 <= 0 or i1 <= 0:
-                layout.notes.append(f"slider substitutes on {host} not compensated "
-                                    f"(mass {m1:.3g}, moment {i1:.3g} left)")
-                continue
-            layout.engine_mass[host] = (m1, i1)
-            layout.cog[host] = (float(c1[0]), float(c1[1]))
-    # every groove must stay exact with the engine centres of mass
+                 for car in layout.carriers if car.host == host])
+            if m1 > 0 and i1 > 0:  # else not compensated: no mass or moment would be left
+                layout.engine_mass[host] = (m1, i1)
+                layout.cog[host] = (float(c1[0]), float(c1[1]))
+    # every groove must stay exact with the engine centres of mass: not compensated where a
+    # host's centre of gravity must stay on a groove
     for _ in range(2):
         for g in layout.grooves:
-            for body, ok in ((g.slot, _slot_exact(layout, g)), (g.pin, _pin_exact(layout, g))):
+            for body, ok in zip((g.slot, g.pin), _groove_exact(layout, g)):
                 if not ok and body in layout.cog:
                     del layout.cog[body]
-                    b = mech.body(body)
-                    layout.engine_mass[body] = (num(b.mass), _moment(b, cfg))
-                    layout.notes.append(f"slider substitutes on {body} not compensated (its "
-                                        "centre of gravity must stay on a groove)")
+                    layout.engine_mass[body] = _mass_moment(layout, body)
     for g in layout.grooves:
-        if not (_slot_exact(layout, g) and _pin_exact(layout, g)):
+        if not all(_groove_exact(layout, g)):
             raise _Refused(f"groove {g.slot}/{g.pin} is not exact in Chipmunk. {_GROOVE_LIMIT}")
 
 
-def _slot_exact(layout: _Layout, g: _Groove) -> bool:
-    if g.slot == WORLD or g.slot in layout.infinite:
-        return True
-    return line_through_origin(np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))),
-                               np.array(g.direction))
+def _mass_moment(layout: _Layout, name: str) -> tuple[float, float]:
+    """A description body's engine (mass, moment): the moment is infinite where its
+    rotation is fixed (`_engine_body`), else its central inertia, or m r^2 for a point
+    mass (the BODY expressions; r the setting point_mass_gyration)."""
+    body = layout.mech.body(name)
+    inertia = num(body.inertia)
+    if name in layout.infinite:
+        inertia = math.inf
+    elif not inertia > 0:
+        inertia = num(body.mass) * float(layout.cfg["point_mass_gyration"]) ** 2
+    return num(body.mass), inertia
 
 
-def _pin_exact(layout: _Layout, g: _Groove) -> bool:
-    if (g.pin == WORLD or g.pin in layout.infinite
-            or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf):
-        return True
-    return np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12)
+def _groove_exact(layout: _Layout, g: _Groove) -> tuple[bool, bool]:
+    """Whether the groove's slot line passes through the slot body's engine centre of
+    mass, and whether its pin is the pin body's (`_GROOVE_LIMIT`): not needed on the world
+    or a body of infinite moment (a fixed rotation, a point-mass slider)."""
+    slot_ok = g.slot == WORLD or g.slot in layout.infinite or line_through_origin(
+        np.subtract(g.base, layout.cog.get(g.slot, (0.0, 0.0))), np.array(g.direction))
+    pin_ok = (g.pin == WORLD or layout.engine_mass.get(g.pin, (1, 1))[1] == math.inf
+              or np.allclose(g.anchor, layout.cog.get(g.pin, (0.0, 0.0)), rtol=0, atol=1e-12))
+    return slot_ok, pin_ok
 
 
-class _Compiled(MaximalFrames):
-    """What the runs of one mechanism on one layout use, read once: how every description
-    body's frame follows from the engine bodies' states, and the force elements' loads
-    (from their builders) on the engine bodies they reach (`plan.MaximalFrames`; the
-    substitute carriers follow no description frame)."""
-
-    def __init__(self, mech: Mechanism, layout: _Layout):
-        super().__init__(mech, layout.elimination, layout.engine,
-                         {name: layout.cog.get(name) for name in layout.dynamic},
-                         [_builder(f)(mech, f) for f in mech.forces])
-        self.layout = layout
+_CACHE: dict[tuple, MaximalFrames] = {}
 
 
-_CACHE: dict[tuple, _Compiled] = {}
-
-
-def _compile(mech: Mechanism, layout: _Layout) -> _Compiled:
-    """The mechanism's `_Compiled`, reused by every run on the same layout."""
+def _compile(mech: Mechanism, layout: _Layout) -> MaximalFrames:
+    """How every description body's frame follows from the layout's engine bodies and the
+    force elements' loads on them (`plan.MaximalFrames`; the substitute carriers follow no
+    description frame), compiled once and reused by every run on the same engine bodies."""
     key = (mech, tuple(layout.engine), tuple(sorted(layout.cog.items())),
            tuple(sorted(layout.engine_mass.items())), tuple(layout.pitches))
     if key not in _CACHE:
         if len(_CACHE) > 64:
             _CACHE.clear()
-        _CACHE[key] = _Compiled(mech, layout)
+        _CACHE[key] = MaximalFrames(mech, layout.elimination, layout.engine,
+                                    {name: layout.cog.get(name) for name in layout.dynamic},
+                                    [_builder(f)(mech, f) for f in mech.forces])
     return _CACHE[key]
 
 
@@ -593,24 +549,15 @@ def _parts(mech: Mechanism, layout: _Layout) -> list[tuple[str, float, float]]:
     return out
 
 
-def _default_layout(mech: Mechanism) -> _Layout | None:
-    """The layout at the default settings (None: refused as a whole, translation_reason)."""
+def _substituted(mech: Mechanism, c: PointOnLine | LinearCoupling) -> bool:
+    """In the layout at the default settings (refused as a whole: translation_reason), a
+    slot's pin or line sits on a substitute carrier body, or a coupling is held by a pivot
+    moved to the pitch point of a carrier."""
     try:
-        return _plan(mech, BACKEND.default_settings())
+        layout = _plan(mech, BACKEND.default_settings())
     except _Refused:
-        return None
-
-
-def _carried(mech: Mechanism, slot: PointOnLine) -> bool:
-    """The slot's pin or line sits on a substitute carrier body."""
-    layout = _default_layout(mech)
-    return layout is not None and any(car.constraint == slot.name for car in layout.carriers)
-
-
-def _pitched(mech: Mechanism, coupling: LinearCoupling) -> bool:
-    """The coupling is held by a pivot moved to the pitch point of a carrier."""
-    layout = _default_layout(mech)
-    return layout is not None and any(p.name == coupling.name for p in layout.pitches)
+        return False
+    return c.name in {car.constraint for car in layout.carriers} | {p.name for p in layout.pitches}
 
 
 class PymunkBackend(Backend):
@@ -724,10 +671,6 @@ class PymunkBackend(Backend):
             "pitch circle; space.collision_slop is set to the chord's sagitta so that the "
             "polygon's penetration is not 'corrected' against the carrier joint."),
     }
-    #: of the last constrained run: relative residual of the momentum balance behind the
-    #: constraint forces (0 when the engine's constraints are exactly the description's),
-    #: and notes on substitutes that could not be compensated
-    diagnostics: dict = {}
 
     ENGINE_MODULES = ('pymunk',)
 
@@ -749,11 +692,27 @@ class PymunkBackend(Backend):
         return ""
 
     # --- building ------------------------------------------------------------------------
-    @staticmethod
-    def _build(mech: Mechanism, comp: _Compiled, q0, qd0, cfg: dict):
+    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict,
+                 h: float):
+        """Build: (layout, compiled functions, space, engine bodies, the mechanism as
+        balanced: a RollingContact stands for its coupling, the movers of the prescribed
+        coordinates)."""
         import pymunk
 
-        layout = comp.layout
+        try:
+            layout = _plan(mechanism, cfg)
+        except _Refused as refused:
+            raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
+        if layout.drives:
+            # every step moves a prescribed coordinate with (q(t + h) - q)/h: started with
+            # q'(0), the driven body's velocity would jump by h q'' twice (actuator force
+            # 0.62 and 0.31 of its range off at samples 1 and 2 on a shaker driven by cos,
+            # whatever h)
+            qd0 = stepped_start(mechanism, q0, qd0, h)
+        # a RollingContact's force is balanced as the coupling it stands for (the layout
+        # holds the contact itself)
+        mech = coupled(mechanism)
+        comp = _compile(mech, layout)
         space = pymunk.Space()
         space.gravity = (0.0, -num(mech.gravity))
         space.damping = float(cfg["damping"])
@@ -764,10 +723,9 @@ class PymunkBackend(Backend):
         bodies: dict[str, pymunk.Body] = {WORLD: space.static_body}
         drivers = {d.joint.child for d in layout.drives if d.kinematic}
         for name in layout.engine:
-            m, inertia = layout.engine_mass[name]
             # no shapes: nothing collides
             body = (pymunk.Body(body_type=pymunk.Body.KINEMATIC) if name in drivers
-                    else pymunk.Body(m, inertia))
+                    else pymunk.Body(*layout.engine_mass[name]))
             if name in layout.dynamic:
                 x, y, th, vx, vy, w = state[name]
                 cog = layout.cog.get(name)
@@ -813,36 +771,37 @@ class PymunkBackend(Backend):
             constraints.append(pymunk.GearJoint(bodies[a], bodies[b], phase, ratio))
         for i, pitch in enumerate(layout.pitches):
             if pitch.contact:
-                PymunkBackend._contact_shapes(space, bodies, pitch, i, cfg)
+                self._contact_shapes(space, bodies, pitch, i, cfg)
             else:
-                constraints.append(PymunkBackend._pitch_pivot(pymunk, bodies, comp, pitch,
-                                                              comp.coupling_phi(pitch.name)))
+                constraints.append(self._pitch_pivot(pymunk, bodies, layout, pitch,
+                                                     comp.coupling_phi(pitch.name)))
         for c in constraints:
             c.error_bias = float(cfg["error_bias"])
         space.add(*constraints)
-        movers = PymunkBackend._drive_constraints(mech, layout, space, bodies, spins, q0)
-        return space, [bodies[n] for n in layout.engine], movers
+        movers = self._drive_constraints(layout, space, bodies, spins, q0)
+        return layout, comp, space, [bodies[n] for n in layout.engine], mech, movers
 
     @staticmethod
-    def _drive_constraints(mech: Mechanism, layout: _Layout, space, bodies: dict, spins, q0):
+    def _drive_constraints(layout: _Layout, space, bodies: dict, spins, q0):
         """The constraints that impose the prescribed coordinates (the PRESCRIBED
         expression; a hinge's PivotJoint is built with the other hinges), added to the
         space, and per coordinate (constraint, attribute, value of q): the attribute that
-        moves its target to the pose q gives (`plan.joint_pose`). Their error_bias is 0
-        whatever the setting: the gap to the target is removed in one step (bias velocity
-        -gap/h), which is how the target becomes the position of the next step."""
+        moves its target to the pose q gives (`plan.joint_pose`); a kinematic driver's is
+        its body. Their error_bias is 0 whatever the setting: the gap to the target is
+        removed in one step (bias velocity -gap/h), which is how the target becomes the
+        position of the next step."""
         import pymunk
 
         movers = []
         for d in layout.drives:
             j = d.joint
             if d.kinematic:
-                movers.append(None)
+                movers.append(bodies[j.child])
                 continue
             child, pose, q = bodies[j.child], joint_pose(j), float(q0[d.index])
             if element_kind(j) == PRISMATIC:
                 parent = bodies[j.parent]
-                added = [pymunk.PivotJoint(parent, child, pose(q), tuple(_vec(j.child_anchor)))]
+                added = [pymunk.PivotJoint(parent, child, pose(q), plane_point(j.child_anchor))]
                 if spins(j.parent) or spins(j.child):
                     added.append(pymunk.GearJoint(parent, child, num(j.angle_offset), 1.0))
                 movers.append((added[0], "anchor_a", pose))
@@ -856,33 +815,30 @@ class PymunkBackend(Backend):
         return movers
 
     @staticmethod
-    def _schedule(mech: Mechanism, layout: _Layout, movers, n_steps: int, h: float,
-                  bodies: dict):
+    def _schedule(layout: _Layout, movers, n_steps: int, h: float):
         """Per mover (constraint, attribute, values): the value to set before step k, the
         target q(t_(k+2)). Chipmunk moves positions with the velocities of the previous
         step's solve, so the velocity solved in step k (at the positions of t_(k+1), bias
         -gap/h) carries the coordinate to q(t_(k+2)) in step k + 1."""
-        by_name = {m.element.name: m for m in motions(mech)}
         out = []
         for d, mover in zip(layout.drives, movers):
-            position = by_name[d.name].position
-            targets = [position((k + 2) * h) for k in range(n_steps)]
-            if mover is None:
-                PymunkBackend._drive_kinematic(d, bodies[d.joint.child], position, targets, h)
+            targets = [d.position((k + 2) * h) for k in range(n_steps)]
+            if d.kinematic:
+                PymunkBackend._drive_kinematic(d, mover, targets, h)
                 continue
             constraint, attribute, value = mover
             out.append((constraint, attribute, [value(q) for q in targets]))
         return out
 
     @staticmethod
-    def _drive_kinematic(d: _Drive, body, position, targets: list[float], h: float) -> None:
+    def _drive_kinematic(d: _Drive, body, targets: list[float], h: float) -> None:
         """A kinematic driver on the world: its velocity_func (called in step k after
         the positions moved to t_(k+1), before the solve) sets the velocity that carries
         it to q(t_(k+2)) in step k + 1, so the free bodies' constraints are solved against
         the driver's velocity of the next position update, as with a moving constraint.
         Its engine centre of gravity is the hinge point (or it does not turn), whose
         velocity is the joint's (`plan.joint_velocity`: its parent is the world)."""
-        rates = np.diff([position(h), *targets]) / h
+        rates = np.diff([d.position(h), *targets]) / h
         step = iter([joint_velocity(d.joint, r) for r in rates])
 
         def velocity_func(body, gravity, damping, dt):
@@ -893,12 +849,12 @@ class PymunkBackend(Backend):
         body.velocity_func = velocity_func
 
     @staticmethod
-    def _pitch_pivot(pymunk, bodies, comp: _Compiled, pitch: _Pitch, phi_fn):
+    def _pitch_pivot(pymunk, bodies, layout: _Layout, pitch: _Pitch, phi_fn):
         """PivotJoint between the two coupled bodies, moved to the pitch points before
         every solve (the module docstring)."""
         a, b = bodies[pitch.a], bodies[pitch.b]
-        engine = [bodies[n] for n in comp.layout.engine]
-        cogs = [comp.layout.cog.get(n) for n in comp.layout.engine]
+        engine = [bodies[n] for n in layout.engine]
+        cogs = [layout.cog.get(n) for n in layout.engine]
         last: list[float | None] = [None]
 
         def anchors():
@@ -965,28 +921,6 @@ class PymunkBackend(Backend):
         space.add(*shapes)
 
     # --- running -------------------------------------------------------------------------
-    def _prepare(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, cfg: dict,
-                 h: float):
-        """Build: (layout, compiled functions, space, engine bodies, the mechanism as
-        balanced: a RollingContact stands for its coupling, the movers of the prescribed
-        coordinates)."""
-        try:
-            layout = _plan(mechanism, cfg)
-        except _Refused as refused:
-            raise ValueError(f"pymunk cannot express this mechanism: {refused}") from None
-        if layout.drives:
-            # every step moves a prescribed coordinate with (q(t + h) - q)/h: started with
-            # q'(0), the driven body's velocity would jump by h q'' twice (actuator force
-            # 0.62 and 0.31 of its range off at samples 1 and 2 on a shaker driven by cos,
-            # whatever h)
-            qd0 = stepped_start(mechanism, q0, qd0, h)
-        # a RollingContact's force is balanced as the coupling it stands for (the layout
-        # holds the contact itself)
-        mechanism = coupled(mechanism)
-        comp = _compile(mechanism, layout)
-        space, bodies, movers = self._build(mechanism, comp, q0, qd0, cfg)
-        return layout, comp, space, bodies, mechanism, movers
-
     @staticmethod
     def _reader(space, layout: _Layout, bodies: list) -> Callable[[], list[float]]:
         """A function returning the state row of the engine bodies: per body, the centre
@@ -998,14 +932,11 @@ class PymunkBackend(Backend):
         import pymunk.batch
 
         cogs = [layout.cog.get(n) for n in layout.engine]
+        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
 
-        def read_each() -> list[float]:
-            row: list[float] = []
-            for b, cog in zip(bodies, cogs):
-                row.extend(b.local_to_world(cog) if cog else b.position)
-                row.append(b.angle)
-                row.extend(b.velocity)
-                row.append(b.angular_velocity)
+        def centred(row: list[float]) -> list[float]:
+            for i, b, cog in off_origin:
+                row[i:i + 2] = b.local_to_world(cog)
             return row
 
         fields = pymunk.batch.BodyFields
@@ -1014,18 +945,15 @@ class PymunkBackend(Backend):
         get(space, fields.BODY_ID, buffer)
         ids = list(memoryview(buffer.int_buf()).cast("P"))
         if space.sleep_time_threshold != math.inf or ids[:len(bodies)] != [b.id for b in bodies]:
-            return read_each
+            return lambda: centred([v for b in bodies for v in (
+                *b.position, b.angle, *b.velocity, b.angular_velocity)])
         wanted = fields.POSITION | fields.ANGLE | fields.VELOCITY | fields.ANGULAR_VELOCITY
         width = 6 * len(bodies)
-        off_origin = [(6 * i, b, cog) for i, (b, cog) in enumerate(zip(bodies, cogs)) if cog]
 
         def read_batch() -> list[float]:
             buffer.clear()
             get(space, wanted, buffer)
-            row = memoryview(buffer.float_buf()).cast("d")[:width].tolist()
-            for i, b, cog in off_origin:
-                row[i:i + 2] = b.local_to_world(cog)
-            return row
+            return centred(memoryview(buffer.float_buf()).cast("d")[:width].tolist())
 
         return read_batch
 
@@ -1042,8 +970,8 @@ class PymunkBackend(Backend):
              h: float, cfg: dict, record: bool) -> SimpleNamespace:
         """Build the space and take `n_steps` steps of `h`, timed; with `record` every
         sample's body states are read (`rows`), otherwise only what the element forces
-        need. Returns the run's parts: mechanism (as balanced), comp, clock, read, rows,
-        H and shift (where the loads are evaluated)."""
+        need. Returns the run's parts: layout, mechanism (as balanced), comp, clock, read,
+        rows, H and shift (where the loads are evaluated)."""
         layout, comp, space, bodies, mechanism, movers = self._prepare(mechanism, q0, qd0, cfg, h)
         # loads at x + h v and t + h (see setting notes), or at the sampled state
         H, shift = (h, 1) if cfg["element_forces"] == "position_updated" else (0.0, 0)
@@ -1052,8 +980,7 @@ class PymunkBackend(Backend):
         step = space.step
         loads = comp.loads_math
         targets = [bodies[k] for k in comp.loaded]
-        schedule = self._schedule(mechanism, layout, movers, n_steps, h, dict(
-            zip(layout.engine, bodies)))
+        schedule = self._schedule(layout, movers, n_steps, h)
         iterations = int(cfg["iterations"])
         # the first step has no cached impulses to start from (see start_iterations)
         space.iterations = max(iterations, int(cfg["start_iterations"]))
@@ -1071,8 +998,8 @@ class PymunkBackend(Backend):
                     rows.append(read())
                 if k == 0:
                     space.iterations = iterations
-        return SimpleNamespace(mechanism=mechanism, comp=comp, clock=clock, read=read,
-                               rows=rows, H=H, shift=shift)
+        return SimpleNamespace(layout=layout, mechanism=mechanism, comp=comp, clock=clock,
+                               read=read, rows=rows, H=H, shift=shift)
 
     # no `linearize`: Chipmunk has no linearization facility, frequencies come from the fits
     def scheme(self, mechanism: Mechanism, settings: Mapping | None = None) -> Scheme:
@@ -1130,17 +1057,14 @@ class PymunkBackend(Backend):
         sample 1, 5e-4 at sample 2)."""
         h = float(dt)
         run = self._run(mechanism, q0, qd0, n_steps, h, cfg, record=True)
-        mechanism, comp = run.mechanism, run.comp
+        mechanism, comp, layout = run.mechanism, run.comp, run.layout
         S = np.array(run.rows)
         t = np.arange(n_steps + 1) * h
         q, qd = comp.coordinates(S, q0)
-        reactions, constraint_forces, actuator_forces, residual = motion_forces(
-            mechanism, comp, S, _parts(mechanism, comp.layout), run.H, t[:-1] + run.shift * h,
-            h, reaction_joints, {d.name: d.joint for d in comp.layout.drives})
-        if residual is not None:
-            self.diagnostics = {"balance_residual": residual, "notes": list(comp.layout.notes)}
+        reactions, constraint_forces, actuator_forces, _ = motion_forces(
+            mechanism, comp, S, _parts(mechanism, layout), run.H, t[:-1] + run.shift * h,
+            h, reaction_joints, {d.name: d.joint for d in layout.drives})
         return Samples(q, qd, run.clock, reactions, constraint_forces, actuator_forces)
-
 
     # --- flexible elements (contract point 12) ----------------------------------------------
     BEAM_ELEMENTS = {
