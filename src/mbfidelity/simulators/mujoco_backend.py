@@ -144,17 +144,15 @@ class _Compiled:
         them), or None."""
         build, model = self.build, self.model
         half = dt / 2
+        # COORD = row . (v - b) over the joints' (qpos, dof) addresses; the law's force F
+        # acts on those dofs as row F (A^-T e_j F: row j of A^-1)
         coord_terms = []
         for e in build.coord:
             if e.native is not None:
                 continue
-            row = e.row
-            nz = np.flatnonzero(row)
-            ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
-            const = float(-row @ build.cmap.b)
-            # generalized force on the engine dofs: A^-T e_j F (row j of A^-1)
-            outs = tuple((int(self.vadr[i]), float(row[i])) for i in nz)
-            coord_terms.append((e.law, ins, const, outs))
+            ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(e.row[i]))
+                        for i in np.flatnonzero(e.row))
+            coord_terms.append((e.law, ins, float(-e.row @ build.cmap.b)))
         p2p_terms = []
         for e in build.p2p:
             if e.native is not None:
@@ -173,13 +171,13 @@ class _Compiled:
             qfrc = d.qfrc_passive
             if coord_terms:
                 qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
-                for law, ins, const, outs in coord_terms:
+                for law, ins, const in coord_terms:
                     x, xd = const, 0.0
                     for qa, va, c in ins:
                         x += c * qpos[qa]
                         xd += c * qvel[va]
                     force = law(x, xd, t)
-                    for va, c in outs:
+                    for _, va, c in ins:
                         qfrc[va] += c * force
             for law, tid, a0, a1, cols in p2p_terms:
                 tension = law(d.ten_length[tid], d.ten_velocity[tid], t)
@@ -438,11 +436,10 @@ class _Transmitted:
                 if g.inner in inside and g.outer not in inside:
                     r += self.ext[:, i]
             transmitted[name] = r
-        pairs: dict[str, np.ndarray] = {}
-        for i, e in enumerate(self.p2p):
-            pairs[e.element.name] = tension_pair_force(e.element, self.ten[:, i, 0],
-                                                       self.ten[:, i, 1], t,
-                                                       self.spos[:, i, 0], self.spos[:, i, 1])
+        pairs = {e.element.name: tension_pair_force(e.element, self.ten[:, i, 0],
+                                                    self.ten[:, i, 1], t, self.spos[:, i, 0],
+                                                    self.spos[:, i, 1])
+                 for i, e in enumerate(self.p2p)}
         return transmitted, pairs
 
 

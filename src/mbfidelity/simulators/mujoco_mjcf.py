@@ -46,7 +46,6 @@ from .plan import (
     PRISMATIC,
     REVOLUTE,
     ROLLING_CONTACT,
-    TIME_LOAD,
     CoordinateMap,
     ForceLaw,
     RollingGeometry,
@@ -393,13 +392,8 @@ _builds(COORDINATE_FORCE_LINEAR,
 _builds(COORDINATE_FORCE_CUSTOM,
         Expression(EXACT, "passive callback (set_mjcb_passive) at every integrator "
                           "stage"))(_coordinate_force)
-_FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
-                                      "stage time"))
-def _time_load(build: Build, f) -> None:
-    _FORCES[type(f)](build, f)
+_BUILDERS.builds_time_load(Expression(EXACT, "passive callback, evaluated at every RK4 stage "
+                                             "at the stage time"))
 
 
 @_builds(POINT_ON_POINT, _soft_equality(SOFT, "connect equality between two sites"))
