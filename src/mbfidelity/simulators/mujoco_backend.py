@@ -49,10 +49,6 @@ from .plan import (ImposedMotions, constrained_modes, coupled, geometric_stiffne
                    spatial_tree_reason, stage_time)
 from .reactions import tension_pair_force
 
-#: the integrators; their orders are declared once, in `scheme`
-_INTEGRATORS = ("Euler", "implicit", "implicitfast", "RK4")
-_LINEARIZATIONS = ("inverseFD", "transitionFD")
-
 
 class _Compiled:
     """A compiled MuJoCo model of a build, stepped at the step its MJCF is written for
@@ -157,7 +153,7 @@ class _Compiled:
         for e in build.p2p:
             if e.native is not None:
                 continue
-            tid = model.tendon(e.tendon).id
+            tid = model.tendon(e.element.name).id
             adr, nnz = int(model.ten_J_rowadr[tid]), int(model.ten_J_rownnz[tid])
             cols = np.array(model.ten_J_colind[adr:adr + nnz])
             p2p_terms.append((e.law, tid, adr, adr + nnz, cols))
@@ -401,7 +397,7 @@ class _Transmitted:
         self.bodies = sorted({build.carrier[build.mech.joint(j).child] for j in joints})
         self.bid = np.array([m.body(b).id for b in self.bodies])
         self.p2p = [e for e in build.p2p if e.native is None]
-        self.tids = np.array([m.tendon(e.tendon).id for e in self.p2p], dtype=int)
+        self.tids = np.array([m.tendon(e.element.name).id for e in self.p2p], dtype=int)
         self.sid = np.array([[m.site(f"{e.element.name}:{x}").id for x in "ab"]
                              for e in self.p2p], dtype=int).reshape(-1, 2)
         # rolling by contact: the contact carries what the description's arm and coupling
@@ -478,7 +474,7 @@ class MujocoBackend(Backend):
     id = "mujoco"
     SETTINGS = {
         "integrator": Setting(
-            "RK4", _INTEGRATORS,
+            "RK4", ("Euler", "implicit", "implicitfast", "RK4"),  # orders: `scheme`
             "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) phase "
             "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
             "every custom and time-dependent force, is evaluated at each stage at the "
@@ -496,7 +492,7 @@ class MujocoBackend(Backend):
             "implicit integrators see the difference (they differentiate native damping "
             "but not callback forces, mujoco #2433)."),
         "linearization": Setting(
-            "inverseFD", _LINEARIZATIONS,
+            "inverseFD", ("inverseFD", "transitionFD"),
             "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD (finite "
             "differences of mj_inverse), central differences by combining +eps and -eps; "
             "eigenvalues of the first-order system. 'transitionFD': mjd_transitionFD "

@@ -113,8 +113,7 @@ def _inertial(mass: float, inertia: float, com: Sequence[float] = (0.0, 0.0)) ->
 
 @dataclass
 class _P2P:
-    element: PointToPoint
-    tendon: str
+    element: PointToPoint  # its spatial tendon is named after it
     native: tuple[float, float, float] | None  # (stiffness, springlength, damping)
     law: Callable[..., float]
 
@@ -356,7 +355,7 @@ def _point_to_point(build: Build, f: PointToPoint) -> None:
     MuJoCo's tendon spring (stiffness >= 0, free length >= 0) and damper can hold is
     native, any other the passive callback's."""
     law = ForceLaw.of(f)
-    build.p2p.append(_P2P(f, f.name, law.tendon_spring if build.native else None, law.law))
+    build.p2p.append(_P2P(f, law.tendon_spring if build.native else None, law.law))
     for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
         build.add_site(body, f"{f.name}:{tag}", _xyz(point))
 
@@ -641,7 +640,7 @@ def mjcf(build: Build, dt: float | None = None) -> str:
             out.append("    </fixed>")
         for e in build.p2p:
             k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
-            out += [f'    <spatial name="{e.tendon}" stiffness="{fmt(k)}" '
+            out += [f'    <spatial name="{e.element.name}" stiffness="{fmt(k)}" '
                     f'springlength="{fmt(l0, l0)}" damping="{fmt(c)}">',
                     f'      <site site="{e.element.name}:a"/>',
                     f'      <site site="{e.element.name}:b"/>',
