@@ -551,10 +551,6 @@ def translate(mech: Mechanism, settings: dict, dt: float | None = None) -> Build
     return build
 
 
-def _shape_geom(shape) -> str:
-    return _SHAPE_GEOMS.get(type(shape), lambda s: "")(shape)
-
-
 def _segment_geom(shape: Segment) -> str:
     # a spatial segment has three-component ends; a planar one lies at z = 0
     a, b = (vec3(end) for end in (shape.a, shape.b))
@@ -604,7 +600,7 @@ def mjcf(build: Build, dt: float | None = None) -> str:
                 lines += [f"<body {build.heads[child]}>"]
                 lines += indent(1, [jt.xml(law(jt.law)) for jt in build.joints[child]]
                                 + [build.inertial[child]]
-                                + [g for g in map(_shape_geom, mech.body(child).shapes) if g]
+                                + [_SHAPE_GEOMS[type(s)](s) for s in mech.body(child).shapes]
                                 + build.geoms.get(child, []) + inside(child))
                 lines += ["</body>"]
         return lines + [x for slider in build.sliders.get(name, []) for x in slider]
