@@ -130,9 +130,9 @@ class _Compiled:
                 and self.disc_geom[k_contact] in d.contact.geom[d.efc_id[r]]]
         # the joint-space force of the disc's contacts
         qfrc = self.efc_jacobian()[rows].T @ d.efc_force[rows] if rows else np.zeros(m.nv)
-        Q = self.build.cmap.A.T @ qfrc[self.vadr]
+        Q = self.build.map.A.T @ qfrc[self.vadr]
         j = cl.contact.hub
-        q = self.build.cmap.coordinates(d.qpos[self.qadr])
+        q = self.build.map.coordinates(d.qpos[self.qadr])
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
@@ -148,7 +148,7 @@ class _Compiled:
                 continue
             ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(e.row[i]))
                         for i in np.flatnonzero(e.row))
-            coord_terms.append((e.law, ins, float(-e.row @ build.cmap.b)))
+            coord_terms.append((e.law, ins, float(-e.row @ build.map.b)))
         p2p_terms = []
         for e in build.p2p:
             if e.native is not None:
@@ -192,7 +192,7 @@ class _Compiled:
         quadratic)."""
         build, model, mujoco = self.build, self.model, self.mujoco
         discrete = integrator != "RK4"
-        imposed = ImposedMotions(build.mech, build.cmap, self.vadr, model.nv, discrete, dt)
+        imposed = ImposedMotions(build.mech, build.map, self.vadr, model.nv, discrete, dt)
         if not imposed.k:
             return None
         nv, h, qadr, actuator = model.nv, float(dt), self.qadr, self.actuator
@@ -261,8 +261,8 @@ class _Compiled:
         value is (P - L) . u and its rate (v_P - v_L) . u, with v_L the velocity of the
         slot body's material point under the slider."""
         mujoco, m, d = self.mujoco, self.model, self.data
-        d.qpos[self.qadr] = self.build.cmap.engine_values(q)
-        d.qvel[self.vadr] = self.build.cmap.A @ np.asarray(qd, dtype=float)
+        d.qpos[self.qadr] = self.build.map.engine_values(q)
+        d.qvel[self.vadr] = self.build.map.A @ np.asarray(qd, dtype=float)
         d.time = t
         d.qpos[self.radial_qadr] = 0.0
         d.qvel[self.radial_vadr] = 0.0
@@ -672,8 +672,8 @@ class MujocoBackend(Backend):
                         f'qvel="{fmt(*comp.data.qvel)}"/>')
         custom = (f'  <custom>\n'
                   f'    <numeric name="mbfidelity_qadr" data="{fmt(*comp.qadr)}"/>\n'
-                  f'    <numeric name="mbfidelity_A" data="{fmt(*build.cmap.A.ravel())}"/>\n'
-                  f'    <numeric name="mbfidelity_b" data="{fmt(*build.cmap.b)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{fmt(*build.map.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{fmt(*build.map.b)}"/>\n'
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
@@ -733,7 +733,7 @@ class MujocoBackend(Backend):
             t = dt * np.arange(steps + 1)
             actuators, forces, violation, transmitted, pairs = self._read_out(
                 comp, qpos, qvel, t, reaction_joints)
-        cmap = comp.build.cmap
+        cmap = comp.build.map
         q, qd = cmap.coordinates(qpos[:, comp.qadr]), cmap.rates(qvel[:, comp.vadr])
         # a coupling's tendon equality acts in joint space: cfrc_int counts it as
         # transmitted
@@ -755,7 +755,7 @@ class MujocoBackend(Backend):
             with Stopwatch() as clock:
                 if steps:
                     mujoco.mj_step(comp.model, comp.data, nstep=steps)
-        return BareLoop.mapped(clock.cpu, comp.build.cmap, comp.data.qpos[comp.qadr],
+        return BareLoop.mapped(clock.cpu, comp.build.map, comp.data.qpos[comp.qadr],
                                comp.data.qvel[comp.vadr])
 
     def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
@@ -879,7 +879,7 @@ class MujocoBackend(Backend):
                 K, C, M = comp.inverse_fd(lambda: comp.set_state(q_eq, np.zeros(n)), eps)
                 K, C, M = (X[np.ix_(comp.vadr, comp.vadr)] for X in (K, C, M))
                 eig = quadratic_eigenvalues(M, C, K)
-                A = build.cmap.A  # v = A q + b: in description coordinates, A^T X A
+                A = build.map.A  # v = A q + b: in description coordinates, A^T X A
                 extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
                 method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central "
                           f"differences of mj_inverse, eps={eps:g})")
