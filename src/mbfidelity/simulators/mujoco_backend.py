@@ -618,11 +618,8 @@ class MujocoBackend(Backend):
     }
 
     ENGINE_MODULES = ('mujoco',)
-
-    def version(self) -> str:
-        import mujoco
-
-        return mujoco.__version__
+    #: the Python package bundles the C library of the same version (mj_versionString)
+    ENGINE_DISTRIBUTION = "mujoco"
 
     #: per element kind, what its registered builder makes (mujoco_mjcf)
     EXPRESSIONS = mujoco_mjcf.EXPRESSIONS
