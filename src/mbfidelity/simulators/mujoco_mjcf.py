@@ -193,7 +193,8 @@ class Build(EnginePlan):
         self.chains, self.mj_parent = chains.chains, chains.parent
         #: the step the file is written for (MJCF's default 0.002 s when written without one)
         self.dt = dt or 0.002
-        self.native = bool(settings["native_springs"])  # linear laws as MuJoCo's own
+        #: linear laws as MuJoCo's own springs and dampers; the substitutes' weight cancelled
+        self.native = bool(settings["native_springs"])
         self.gravcomp = bool(settings["substitute_gravcomp"])
         #: body frames at the reference configuration of the MJCF: every engine joint value 0
         self.frames = body_states(mech, self.map.T @ (-self.map.b), np.zeros(self.n))
