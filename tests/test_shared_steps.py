@@ -124,3 +124,28 @@ def test_geometric_stiffness_of_a_circle_constraint():
     G = geometric_stiffness(jacobian_at, np.array([f]), 3, 1e-6)
     # round-off: eps |J^T f| / step = 1e-16 * 10 / 1e-6, i.e. ~1e-9
     assert np.allclose(G, 2 * f * np.eye(3), rtol=0, atol=1e-8)
+
+
+def test_a_time_load_is_built_by_the_builder_of_its_custom_law():
+    """A load that depends on time is the element it is: a point-to-point element's goes
+    to the builder registered for a point-to-point custom law, a coordinate force's to
+    that of a coordinate custom law, and TIME_LOAD declares the expression given."""
+    import sympy as sp
+
+    from mbfidelity.simulators.base import EXACT, ElementBuilders, Expression
+    from mbfidelity.simulators.plan import (COORDINATE_FORCE_CUSTOM, POINT_TO_POINT_CUSTOM,
+                                            TIME_LOAD)
+    from mbfidelity.systems.model import TIME, CoordinateForce, PointToPoint
+
+    builders, built = ElementBuilders(), []
+    builders.builds(POINT_TO_POINT_CUSTOM)(lambda target, f: built.append((target, "point")))
+    builders.builds(COORDINATE_FORCE_CUSTOM)(lambda target, f: built.append((target, "coord")))
+    declared = Expression(EXACT, "at each stage's time")
+    builders.builds_time_load(declared)
+    loads = (PointToPoint("pull", "a", (0, 0), "b", (1, 0), sp.sin(TIME)),
+             CoordinateForce("push", "x", sp.cos(TIME)))
+    for target, load in enumerate(loads):
+        assert element_kind(load) == TIME_LOAD
+        builders.of(load)(target, load)
+    assert built == [(0, "point"), (1, "coord")]
+    assert builders.declared()[TIME_LOAD] == (declared,)

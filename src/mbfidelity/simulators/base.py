@@ -126,9 +126,9 @@ import numpy as np
 
 from ..systems import Expectation
 from ..systems._continua import Beam
-from ..systems.model import Mechanism
-from .plan import (ELEMENT_KINDS, CoordinateMap, description_reason, driven_start,
-                   element_kind, elements)
+from ..systems.model import Mechanism, PointToPoint
+from .plan import (COORDINATE_FORCE_CUSTOM, ELEMENT_KINDS, POINT_TO_POINT_CUSTOM, TIME_LOAD,
+                   CoordinateMap, description_reason, driven_start, element_kind, elements)
 from .reactions import joint_reactions
 
 EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
@@ -234,6 +234,16 @@ class ElementBuilders(dict):
             self[kind], self.expressions[kind] = builder, expressions
             return builder
         return register
+
+    def builds_time_load(self, *expressions: Expression) -> None:
+        """Register the builder of `plan.TIME_LOAD`, with its expressions: a load that
+        depends on time is built as the element it is, by the builder registered for its
+        custom law's kind (`POINT_TO_POINT_CUSTOM`, `COORDINATE_FORCE_CUSTOM`): a law of
+        TIME is never linear, so no engine holds it as a native element."""
+        def build(target, load) -> None:
+            point = isinstance(load, PointToPoint)
+            self[POINT_TO_POINT_CUSTOM if point else COORDINATE_FORCE_CUSTOM](target, load)
+        self.builds(TIME_LOAD, *expressions)(build)
 
     def of(self, element) -> Callable:
         """The builder of an element of the description."""

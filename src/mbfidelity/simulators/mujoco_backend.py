@@ -49,10 +49,6 @@ from .plan import (ImposedMotions, constrained_modes, coupled, geometric_stiffne
                    spatial_tree_reason, stage_time)
 from .reactions import tension_pair_force
 
-#: the integrators; their orders are declared once, in `scheme`
-_INTEGRATORS = ("Euler", "implicit", "implicitfast", "RK4")
-_LINEARIZATIONS = ("inverseFD", "transitionFD")
-
 
 class _Compiled:
     """A compiled MuJoCo model of a build, stepped at the step its MJCF is written for
@@ -134,9 +130,9 @@ class _Compiled:
                 and self.disc_geom[k_contact] in d.contact.geom[d.efc_id[r]]]
         # the joint-space force of the disc's contacts
         qfrc = self.efc_jacobian()[rows].T @ d.efc_force[rows] if rows else np.zeros(m.nv)
-        Q = self.build.cmap.A.T @ qfrc[self.vadr]
+        Q = self.build.map.A.T @ qfrc[self.vadr]
         j = cl.contact.hub
-        q = self.build.cmap.coordinates(d.qpos[self.qadr])
+        q = self.build.map.coordinates(d.qpos[self.qadr])
         return Q[j] / cl.coef[j], cl.coef @ q - num(cl.element.constant)
 
     def _make_callback(self, dt: float):
@@ -144,22 +140,20 @@ class _Compiled:
         them), or None."""
         build, model = self.build, self.model
         half = dt / 2
+        # COORD = row . (v - b) over the joints' (qpos, dof) addresses; the law's force F
+        # acts on those dofs as row F (A^-T e_j F: row j of A^-1)
         coord_terms = []
         for e in build.coord:
             if e.native is not None:
                 continue
-            row = e.row
-            nz = np.flatnonzero(row)
-            ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(row[i])) for i in nz)
-            const = float(-row @ build.cmap.b)
-            # generalized force on the engine dofs: A^-T e_j F (row j of A^-1)
-            outs = tuple((int(self.vadr[i]), float(row[i])) for i in nz)
-            coord_terms.append((e.law, ins, const, outs))
+            ins = tuple((int(self.qadr[i]), int(self.vadr[i]), float(e.row[i]))
+                        for i in np.flatnonzero(e.row))
+            coord_terms.append((e.law, ins, float(-e.row @ build.map.b)))
         p2p_terms = []
         for e in build.p2p:
             if e.native is not None:
                 continue
-            tid = model.tendon(e.tendon).id
+            tid = model.tendon(e.element.name).id
             adr, nnz = int(model.ten_J_rowadr[tid]), int(model.ten_J_rownnz[tid])
             cols = np.array(model.ten_J_colind[adr:adr + nnz])
             p2p_terms.append((e.law, tid, adr, adr + nnz, cols))
@@ -173,13 +167,13 @@ class _Compiled:
             qfrc = d.qfrc_passive
             if coord_terms:
                 qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
-                for law, ins, const, outs in coord_terms:
+                for law, ins, const in coord_terms:
                     x, xd = const, 0.0
                     for qa, va, c in ins:
                         x += c * qpos[qa]
                         xd += c * qvel[va]
                     force = law(x, xd, t)
-                    for va, c in outs:
+                    for _, va, c in ins:
                         qfrc[va] += c * force
             for law, tid, a0, a1, cols in p2p_terms:
                 tension = law(d.ten_length[tid], d.ten_velocity[tid], t)
@@ -198,7 +192,7 @@ class _Compiled:
         quadratic)."""
         build, model, mujoco = self.build, self.model, self.mujoco
         discrete = integrator != "RK4"
-        imposed = ImposedMotions(build.mech, build.cmap, self.vadr, model.nv, discrete, dt)
+        imposed = ImposedMotions(build.mech, build.map, self.vadr, model.nv, discrete, dt)
         if not imposed.k:
             return None
         nv, h, qadr, actuator = model.nv, float(dt), self.qadr, self.actuator
@@ -267,8 +261,8 @@ class _Compiled:
         value is (P - L) . u and its rate (v_P - v_L) . u, with v_L the velocity of the
         slot body's material point under the slider."""
         mujoco, m, d = self.mujoco, self.model, self.data
-        d.qpos[self.qadr] = self.build.cmap.engine_values(q)
-        d.qvel[self.vadr] = self.build.cmap.A @ np.asarray(qd, dtype=float)
+        d.qpos[self.qadr] = self.build.map.engine_values(q)
+        d.qvel[self.vadr] = self.build.map.A @ np.asarray(qd, dtype=float)
         d.time = t
         d.qpos[self.radial_qadr] = 0.0
         d.qvel[self.radial_vadr] = 0.0
@@ -403,7 +397,7 @@ class _Transmitted:
         self.bodies = sorted({build.carrier[build.mech.joint(j).child] for j in joints})
         self.bid = np.array([m.body(b).id for b in self.bodies])
         self.p2p = [e for e in build.p2p if e.native is None]
-        self.tids = np.array([m.tendon(e.tendon).id for e in self.p2p], dtype=int)
+        self.tids = np.array([m.tendon(e.element.name).id for e in self.p2p], dtype=int)
         self.sid = np.array([[m.site(f"{e.element.name}:{x}").id for x in "ab"]
                              for e in self.p2p], dtype=int).reshape(-1, 2)
         # rolling by contact: the contact carries what the description's arm and coupling
@@ -438,11 +432,10 @@ class _Transmitted:
                 if g.inner in inside and g.outer not in inside:
                     r += self.ext[:, i]
             transmitted[name] = r
-        pairs: dict[str, np.ndarray] = {}
-        for i, e in enumerate(self.p2p):
-            pairs[e.element.name] = tension_pair_force(e.element, self.ten[:, i, 0],
-                                                       self.ten[:, i, 1], t,
-                                                       self.spos[:, i, 0], self.spos[:, i, 1])
+        pairs = {e.element.name: tension_pair_force(e.element, self.ten[:, i, 0],
+                                                    self.ten[:, i, 1], t, self.spos[:, i, 0],
+                                                    self.spos[:, i, 1])
+                 for i, e in enumerate(self.p2p)}
         return transmitted, pairs
 
 
@@ -481,7 +474,7 @@ class MujocoBackend(Backend):
     id = "mujoco"
     SETTINGS = {
         "integrator": Setting(
-            "RK4", _INTEGRATORS,
+            "RK4", ("Euler", "implicit", "implicitfast", "RK4"),  # orders: `scheme`
             "Replaces MuJoCo's default 'Euler' (semi-implicit, first order: an O(h) phase "
             "error on a pendulum) by 'RK4' (fourth order; the passive callback, hence "
             "every custom and time-dependent force, is evaluated at each stage at the "
@@ -499,7 +492,7 @@ class MujocoBackend(Backend):
             "implicit integrators see the difference (they differentiate native damping "
             "but not callback forces, mujoco #2433)."),
         "linearization": Setting(
-            "inverseFD", _LINEARIZATIONS,
+            "inverseFD", ("inverseFD", "transitionFD"),
             "'inverseFD' (default): continuous-time M, C, K from mjd_inverseFD (finite "
             "differences of mj_inverse), central differences by combining +eps and -eps; "
             "eigenvalues of the first-order system. 'transitionFD': mjd_transitionFD "
@@ -625,11 +618,8 @@ class MujocoBackend(Backend):
     }
 
     ENGINE_MODULES = ('mujoco',)
-
-    def version(self) -> str:
-        import mujoco
-
-        return mujoco.__version__
+    #: the Python package bundles the C library of the same version (mj_versionString)
+    ENGINE_DISTRIBUTION = "mujoco"
 
     #: per element kind, what its registered builder makes (mujoco_mjcf)
     EXPRESSIONS = mujoco_mjcf.EXPRESSIONS
@@ -679,8 +669,8 @@ class MujocoBackend(Backend):
                         f'qvel="{fmt(*comp.data.qvel)}"/>')
         custom = (f'  <custom>\n'
                   f'    <numeric name="mbfidelity_qadr" data="{fmt(*comp.qadr)}"/>\n'
-                  f'    <numeric name="mbfidelity_A" data="{fmt(*build.cmap.A.ravel())}"/>\n'
-                  f'    <numeric name="mbfidelity_b" data="{fmt(*build.cmap.b)}"/>\n'
+                  f'    <numeric name="mbfidelity_A" data="{fmt(*build.map.A.ravel())}"/>\n'
+                  f'    <numeric name="mbfidelity_b" data="{fmt(*build.map.b)}"/>\n'
                   f'    <text name="mbfidelity_coordinates" data="{" ".join(coordinates)}"/>\n'
                   f'  </custom>\n')
         keyframes = "  <keyframe>\n" + "\n".join(keys) + "\n  </keyframe>\n" if keys else ""
@@ -740,7 +730,7 @@ class MujocoBackend(Backend):
             t = dt * np.arange(steps + 1)
             actuators, forces, violation, transmitted, pairs = self._read_out(
                 comp, qpos, qvel, t, reaction_joints)
-        cmap = comp.build.cmap
+        cmap = comp.build.map
         q, qd = cmap.coordinates(qpos[:, comp.qadr]), cmap.rates(qvel[:, comp.vadr])
         # a coupling's tendon equality acts in joint space: cfrc_int counts it as
         # transmitted
@@ -762,7 +752,7 @@ class MujocoBackend(Backend):
             with Stopwatch() as clock:
                 if steps:
                     mujoco.mj_step(comp.model, comp.data, nstep=steps)
-        return BareLoop.mapped(clock.cpu, comp.build.cmap, comp.data.qpos[comp.qadr],
+        return BareLoop.mapped(clock.cpu, comp.build.map, comp.data.qpos[comp.qadr],
                                comp.data.qvel[comp.vadr])
 
     def _compiled(self, mechanism: Mechanism, cfg: dict, dt: float, q0: np.ndarray,
@@ -886,7 +876,7 @@ class MujocoBackend(Backend):
                 K, C, M = comp.inverse_fd(lambda: comp.set_state(q_eq, np.zeros(n)), eps)
                 K, C, M = (X[np.ix_(comp.vadr, comp.vadr)] for X in (K, C, M))
                 eig = quadratic_eigenvalues(M, C, K)
-                A = build.cmap.A  # v = A q + b: in description coordinates, A^T X A
+                A = build.map.A  # v = A q + b: in description coordinates, A^T X A
                 extra = {"M": A.T @ M @ A, "C": A.T @ C @ A, "K": A.T @ K @ A}
                 method = ("mujoco mjd_inverseFD: continuous-time M, C, K (central "
                           f"differences of mj_inverse, eps={eps:g})")

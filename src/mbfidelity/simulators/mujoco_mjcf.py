@@ -46,17 +46,13 @@ from .plan import (
     PRISMATIC,
     REVOLUTE,
     ROLLING_CONTACT,
-    TIME_LOAD,
-    CoordinateMap,
+    EnginePlan,
     ForceLaw,
     RollingGeometry,
     body_states,
     central_tensor,
-    coordinate_map,
     coupling_row,
-    elements,
     foldable_massless,
-    gravity_vector,
     joint_chains,
     length_scale,
     num,
@@ -114,8 +110,7 @@ def _inertial(mass: float, inertia: float, com: Sequence[float] = (0.0, 0.0)) ->
 
 @dataclass
 class _P2P:
-    element: PointToPoint
-    tendon: str
+    element: PointToPoint  # its spatial tendon is named after it
     native: tuple[float, float, float] | None  # (stiffness, springlength, damping)
     law: Callable[..., float]
 
@@ -181,48 +176,43 @@ POINT_MASS_GYRATION = 1e-6
 POINT_MASS_INERTIA_FLOOR = 1e-14
 
 
-@dataclass
-class Build:
-    """The MJCF build of a numeric mechanism: the fragments each element's builder adds
-    (per MJCF body: the <body> attributes, joints, <inertial>, sites, contact geoms, slider
+class Build(EnginePlan):
+    """The MJCF build of a numeric mechanism, on its shared plan (`plan.EnginePlan`: the
+    settings `cfg`, the map between the description coordinates q and the engine joint
+    values v, the lightest body's mass): the fragments each element's builder adds (per
+    MJCF body: the <body> attributes, joints, <inertial>, sites, contact geoms, slider
     bodies; the tendons and equalities) and what the callbacks and the read-outs need."""
 
-    mech: Mechanism
-    cmap: CoordinateMap  # description coordinates q <-> engine joint values v
-    carrier: dict[str, str]  # description body -> MJCF body carrying it
-    #: MJCF body -> description joint indices, in order (MuJoCo applies a body's joints
-    #: in order)
-    chains: dict[str, list[int]]
-    mj_parent: dict[str, str]
-    settings: dict  # the resolved settings
-    #: the step the file is written for (MJCF's default 0.002 s when written without one)
-    dt: float
-    native: bool  # linear laws as MuJoCo's own springs and dampers
-    foldable: set[str]
-    frames: dict[str, tuple[float, ...]]  # body frames at the reference configuration
-    heads: dict[str, str] = field(default_factory=dict)
-    joints: dict[str, list[_Joint]] = field(default_factory=dict)
-    inertial: dict[str, str] = field(default_factory=dict)
-    sites: dict[str, list[str]] = field(default_factory=dict)
-    geoms: dict[str, list[str]] = field(default_factory=dict)
-    sliders: dict[str, list[list[str]]] = field(default_factory=dict)
-    p2p: list[_P2P] = field(default_factory=list)
-    coord: list[_Coord] = field(default_factory=list)
-    closures: list[Closure] = field(default_factory=list)
-    #: substitute (mass, inertia) of massless bodies that cannot be folded
-    substitutes: dict[str, tuple[float, float]] = field(default_factory=dict)
-    #: per engine joint, the summed linear coordinate laws (a, k, c) it may carry natively
-    joint_native: dict[int, list[float]] = field(default_factory=dict)
-    slider_mass: dict[str, float] = field(default_factory=dict)
-    xml: str = ""
-
-    @property
-    def n(self) -> int:
-        return len(self.mech.joints)
-
-    @property
-    def m_min(self) -> float:
-        return min(num(b.mass) for b in self.mech.bodies if not b.massless)
+    def __init__(self, mech: Mechanism, settings: dict, dt: float | None) -> None:
+        super().__init__(mech, settings)
+        chains = joint_chains(mech)
+        self.foldable = chains.foldable
+        self.carrier = chains.carrier  # description body -> MJCF body carrying it
+        #: MJCF body -> description joint indices, in order (MuJoCo applies a body's
+        #: joints in order), and its MJCF parent
+        self.chains, self.mj_parent = chains.chains, chains.parent
+        #: the step the file is written for (MJCF's default 0.002 s when written without one)
+        self.dt = dt or 0.002
+        #: linear laws as MuJoCo's own springs and dampers; the substitutes' weight cancelled
+        self.native = bool(settings["native_springs"])
+        self.gravcomp = bool(settings["substitute_gravcomp"])
+        #: body frames at the reference configuration of the MJCF: every engine joint value 0
+        self.frames = body_states(mech, self.map.T @ (-self.map.b), np.zeros(self.n))
+        self.heads: dict[str, str] = {}
+        self.joints: dict[str, list[_Joint]] = {}
+        self.inertial: dict[str, str] = {}
+        self.sites: dict[str, list[str]] = {}
+        self.geoms: dict[str, list[str]] = {}
+        self.sliders: dict[str, list[list[str]]] = {}
+        self.p2p: list[_P2P] = []
+        self.coord: list[_Coord] = []
+        self.closures: list[Closure] = []
+        #: substitute (mass, inertia) of massless bodies that cannot be folded
+        self.substitutes: dict[str, tuple[float, float]] = {}
+        #: per engine joint, the summed linear coordinate laws (a, k, c) it may carry natively
+        self.joint_native: dict[int, list[float]] = {}
+        self.slider_mass: dict[str, float] = {}
+        self.xml = ""
 
     def add_site(self, body: str, name: str, pos: str) -> None:
         self.sites.setdefault(body, []).append(f'<site name="{name}" pos="{pos}"/>')
@@ -243,10 +233,6 @@ class Build:
                             f'quat="{_z_quat(ang)}"'
                             + (' gravcomp="1"' if gravcomp and self.gravcomp else ""))
 
-    @property
-    def gravcomp(self) -> bool:
-        return bool(self.settings["substitute_gravcomp"])
-
     def anchor(self, hinge) -> np.ndarray:
         """A hinge's anchor (world) at the reference configuration."""
         x, y, th = self.frames[hinge.parent][:3]
@@ -259,7 +245,7 @@ class Build:
     def coupling(self, c, kind: str, **extra) -> Closure:
         """A linear relation c . q = C as a fixed tendon over the engine joint values."""
         coef, constant = coupling_row(self.mech, c)
-        w, offset = self.cmap.on_engine_values(coef, constant)
+        w, offset = self.map.on_engine_values(coef, constant)
         weights = {self.mech.joints[i].name: float(w[i]) for i in np.flatnonzero(w)}
         return Closure(c, kind, weights=weights, offset=offset, coef=coef, **extra)
 
@@ -295,7 +281,7 @@ def _body(build: Build, body) -> None:
             f'{fmt(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])}"/>')
         return
     if inertia == 0:  # a point mass: above MuJoCo's mjMINVAL (1e-15) whatever the mass
-        radius = float(build.settings["point_mass_gyration"])
+        radius = float(build.cfg["point_mass_gyration"])
         inertia = max(mass * radius**2, POINT_MASS_INERTIA_FLOOR)
     build.inertial[body.name] = _inertial(mass, inertia)
 
@@ -318,7 +304,7 @@ def _massless_body(build: Build, body) -> None:
     # a loaded one is heavier: the notes of the two settings say why
     loaded = body.name in pair_element_bodies(build.mech)
     key = "massless_mass_ratio" if loaded else "link_mass_ratio"
-    mass = float(build.settings[key]) * build.m_min
+    mass = float(build.cfg[key]) * build.m_min
     build.substitutes[body.name] = (mass, mass * GYRATION**2)
     build.add_frame(body.name, gravcomp=True)
     build.inertial[body.name] = _inertial(mass, mass * GYRATION**2)
@@ -357,7 +343,7 @@ def _point_to_point(build: Build, f: PointToPoint) -> None:
     MuJoCo's tendon spring (stiffness >= 0, free length >= 0) and damper can hold is
     native, any other the passive callback's."""
     law = ForceLaw.of(f)
-    build.p2p.append(_P2P(f, f.name, law.tendon_spring if build.native else None, law.law))
+    build.p2p.append(_P2P(f, law.tendon_spring if build.native else None, law.law))
     for tag, body, point in (("a", f.body_a, f.point_a), ("b", f.body_b, f.point_b)):
         build.add_site(body, f"{f.name}:{tag}", _xyz(point))
 
@@ -366,10 +352,10 @@ def _coordinate_force(build: Build, f: CoordinateForce) -> None:
     """Joint stiffness/springref/damping where the law is linear and its argument is one
     engine joint value (`CoordinateMap.law_target`), otherwise the passive callback."""
     law, weights = ForceLaw.of(f), f.weights(build.mech.coordinates)
-    row = build.cmap.law_row(weights)
+    row = build.map.law_row(weights)
     j = build.mech.coordinates.index(f.coordinate)
     lin = law.linear if build.native else None
-    target = build.cmap.law_target(weights)
+    target = build.map.law_target(weights)
     spec = None
     if lin is not None and target is not None:
         j, r = target  # COORD = r v_j: F(COORD) on COORD is r F(r v_j) on v_j
@@ -393,13 +379,8 @@ _builds(COORDINATE_FORCE_LINEAR,
 _builds(COORDINATE_FORCE_CUSTOM,
         Expression(EXACT, "passive callback (set_mjcb_passive) at every integrator "
                           "stage"))(_coordinate_force)
-_FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "passive callback, evaluated at every RK4 stage at the "
-                                      "stage time"))
-def _time_load(build: Build, f) -> None:
-    _FORCES[type(f)](build, f)
+_BUILDERS.builds_time_load(Expression(EXACT, "passive callback, evaluated at every RK4 stage "
+                                             "at the stage time"))
 
 
 @_builds(POINT_ON_POINT, _soft_equality(SOFT, "connect equality between two sites"))
@@ -453,7 +434,7 @@ def _point_on_line(build: Build, c: PointOnLine) -> None:
         # diagonal, and a tiny slider mass makes the row along the slot dominate and soften
         # the row across it
         substitute = build.substitutes.get(c.body, (None,))[0]
-        split = slider_masses(build.mech, c.body, float(build.settings["slider_mass_ratio"]),
+        split = slider_masses(build.mech, c.body, float(build.cfg["slider_mass_ratio"]),
                               build.m_min, substitute)
         build.slider_mass.update(split.masses)
         if split.kept is not None:
@@ -494,7 +475,7 @@ def _linear_coupling(build: Build, c) -> None:
                                                  "over its coefficient, its violation the "
                                                  "slip; linearize uses the coupling"))
 def _rolling_contact(build: Build, c: RollingContact) -> None:
-    mech, s = build.mech, build.settings
+    mech, s = build.mech, build.cfg
     # the arm's hinge and the slide that frees its length go to the disc's MJCF body
     if c.arm not in build.foldable:
         raise ValueError(f"mujoco cannot build {c.name}: the arm {c.arm} must be a massless "
@@ -540,13 +521,8 @@ EXPRESSIONS = _BUILDERS.declared()
 def translate(mech: Mechanism, settings: dict, dt: float | None = None) -> Build:
     """The build of a numeric mechanism under the (resolved) settings; `dt`: the step the
     file is written for."""
-    cmap, jc = coordinate_map(mech), joint_chains(mech)
-    # the reference configuration of the MJCF: every engine joint value 0
-    frames = body_states(mech, cmap.T @ (-cmap.b), np.zeros(len(mech.joints)))
-    build = Build(mech, cmap, jc.carrier, jc.chains, jc.parent, settings, dt or 0.002,
-                  bool(settings["native_springs"]), jc.foldable, frames)
-    for kind, element in elements(mech):
-        _BUILDERS[kind](build, element)
+    build = Build(mech, settings, dt)
+    build.build(_BUILDERS)
     # a joint can carry one stiffness/springref/damping: the summed linear laws must be a
     # spring towards a reference (b < 0) or a pure damper; otherwise use the callback
     for i, (a, k, c) in build.joint_native.items():
@@ -556,10 +532,6 @@ def translate(mech: Mechanism, settings: dict, dt: float | None = None) -> Build
                     e.native = None
     build.xml = mjcf(build, dt)
     return build
-
-
-def _shape_geom(shape) -> str:
-    return _SHAPE_GEOMS.get(type(shape), lambda s: "")(shape)
 
 
 def _segment_geom(shape: Segment) -> str:
@@ -611,12 +583,12 @@ def mjcf(build: Build, dt: float | None = None) -> str:
                 lines += [f"<body {build.heads[child]}>"]
                 lines += indent(1, [jt.xml(law(jt.law)) for jt in build.joints[child]]
                                 + [build.inertial[child]]
-                                + [g for g in map(_shape_geom, mech.body(child).shapes) if g]
+                                + [_SHAPE_GEOMS[type(s)](s) for s in mech.body(child).shapes]
                                 + build.geoms.get(child, []) + inside(child))
                 lines += ["</body>"]
         return lines + [x for slider in build.sliders.get(name, []) for x in slider]
 
-    s = build.settings
+    s = build.cfg
     equalities = [cl for cl in build.closures if cl.kind != "contact"]
     option = (f'integrator="{s["integrator"]}" cone="{s["contact_cone"]}" '
               f'impratio="{fmt(s["impratio"])}" '
@@ -630,7 +602,7 @@ def mjcf(build: Build, dt: float | None = None) -> str:
     out = [
         '<mujoco model="mbfidelity">',
         '  <compiler angle="radian" inertiafromgeom="false"/>',
-        f'  <option {option} gravity="{fmt(*gravity_vector(mech))}">',
+        f'  <option {option} gravity="{fmt(*build.gravity_vector)}">',
         f'    <flag {" ".join(flags)}/>',
         "  </option>",
         '  <default><geom contype="0" conaffinity="0" rgba="0.4 0.6 0.8 1"/></default>',
@@ -647,7 +619,7 @@ def mjcf(build: Build, dt: float | None = None) -> str:
             out.append("    </fixed>")
         for e in build.p2p:
             k, l0, c = e.native if e.native is not None else (0.0, 0.0, 0.0)
-            out += [f'    <spatial name="{e.tendon}" stiffness="{fmt(k)}" '
+            out += [f'    <spatial name="{e.element.name}" stiffness="{fmt(k)}" '
                     f'springlength="{fmt(l0, l0)}" damping="{fmt(c)}">',
                     f'      <site site="{e.element.name}:a"/>',
                     f'      <site site="{e.element.name}:b"/>',
