@@ -967,9 +967,9 @@ class PyBulletBackend(Backend):
                 set_motors(body, links, torque_mode, forces=joint_forces(jv[:n], jvd[:n], t),
                            physicsClientId=cid)
             if n_pf:
-                ls = get_links(body, point_links, computeLinkVelocity=1,
-                               computeForwardKinematics=1, physicsClientId=cid)
-                ls = dict(zip(model.point_links, ls))
+                ls = dict(zip(model.point_links, get_links(
+                    body, point_links, computeLinkVelocity=1, computeForwardKinematics=1,
+                    physicsClientId=cid)))
                 forces = []
                 for pf in model.point_forces:
                     fx, fy, ax, ay, bx, by = pf.force(ls, t)
@@ -1128,7 +1128,7 @@ class PyBulletBackend(Backend):
             if use_sensor:
                 transmitted = {name: sensor[: steps + 1, r].copy()
                                for r, name in enumerate(reaction_joints)}
-                outside["pair_forces"] = {}
+                outside["pair_forces"] = {}  # the joint's own force: no pair element in it
             elif reaction_joints:
                 jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
                 transmitted = self._inverse_dynamics_forces(
