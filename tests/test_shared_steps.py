@@ -1,8 +1,8 @@
 """Shared steps of simulators/plan.py, base.py and reactions.py that an engine's
 translation calls (the sliders' masses, a semi-implicit Euler engine's free-vibration fit,
 modes with constraints held exactly, the geometric stiffness of constraint forces, the
-outside forces the reactions take out), each checked against an independent statement of
-what it computes."""
+outside forces the reactions take out, the builder of time loads), each checked against an
+independent statement of what it computes."""
 from __future__ import annotations
 
 import math
@@ -10,11 +10,15 @@ import math
 import numpy as np
 import pytest
 
-from mbfidelity.simulators.base import RELEASE_PERIODS, semi_implicit_euler_modes
+from mbfidelity.simulators.base import (EXACT, RELEASE_PERIODS, ElementBuilders, Expression,
+                                        semi_implicit_euler_modes)
 from mbfidelity.simulators.plan import (
+    COORDINATE_FORCE_CUSTOM,
     LINEAR_COUPLING,
     POINT_ON_LINE,
     POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    TIME_LOAD,
     constrained_modes,
     element_kind,
     geometric_stiffness,
@@ -157,3 +161,24 @@ def test_outside_forces_hand_pair_elements_and_couplings_apart():
             assert all(split[n] is given[n] for n in split), sid
         seen |= set(kinds.values())
     assert {POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING} <= seen
+
+
+def test_a_time_load_is_built_by_the_custom_law_builder_of_its_class():
+    """A force element whose law reads the time (kind `TIME_LOAD`) is built as the element
+    it is: a point-to-point element by the builder of point-to-point custom laws, a
+    coordinate force by the builder of coordinate custom laws."""
+    import sympy as sp
+
+    from mbfidelity.systems.model import TIME, CoordinateForce
+
+    builders, built = ElementBuilders(), []
+    for kind in (POINT_TO_POINT_CUSTOM, COORDINATE_FORCE_CUSTOM):
+        builders.builds(kind, Expression(EXACT, kind))(
+            lambda model, f, kind=kind: built.append((kind, f.name)))
+    builders.builds_time_loads(Expression(EXACT, "time load"))
+    loads = (PointToPoint("cable", "a", (0, 0), "b", (1, 0), tension=sp.sin(TIME)),
+             CoordinateForce("drive", "q", force=2 * TIME))
+    assert [element_kind(f) for f in loads] == [TIME_LOAD, TIME_LOAD]
+    for f in loads:
+        builders.of(f)(None, f)
+    assert built == [(POINT_TO_POINT_CUSTOM, "cable"), (COORDINATE_FORCE_CUSTOM, "drive")]

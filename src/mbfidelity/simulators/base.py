@@ -126,9 +126,9 @@ import numpy as np
 
 from ..systems import Expectation
 from ..systems._continua import Beam
-from ..systems.model import Mechanism
-from .plan import (ELEMENT_KINDS, CoordinateMap, description_reason, driven_start,
-                   element_kind, elements)
+from ..systems.model import CoordinateForce, Mechanism, PointToPoint
+from .plan import (COORDINATE_FORCE_CUSTOM, ELEMENT_KINDS, POINT_TO_POINT_CUSTOM, TIME_LOAD,
+                   CoordinateMap, description_reason, driven_start, element_kind, elements)
 from .reactions import joint_reactions
 
 EXACT, SOFT, SUBSTITUTE, UNSUPPORTED = "exact", "soft", "substitute", "unsupported"
@@ -238,6 +238,13 @@ class ElementBuilders(dict):
     def of(self, element) -> Callable:
         """The builder of an element of the description."""
         return self[element_kind(element)]
+
+    def builds_time_loads(self, *expressions: Expression) -> None:
+        """Register the builder of time loads (`plan.TIME_LOAD`) with its expressions: a
+        time load is built as the element it is, by the builder of its class's custom law
+        (a law that reads the time is never linear)."""
+        custom = {PointToPoint: POINT_TO_POINT_CUSTOM, CoordinateForce: COORDINATE_FORCE_CUSTOM}
+        self.builds(TIME_LOAD, *expressions)(lambda model, f: self[custom[type(f)]](model, f))
 
     def refuses(self, kind: str, how: str, engine: str) -> None:
         """Register `kind` as unsupported (`how`: why), with a builder that raises

@@ -34,14 +34,14 @@ from typing import Callable, Iterator, Mapping, Sequence
 import numpy as np
 
 from ..analytic.linear import quadratic_eigenvalues
-from ..systems.model import WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint
+from ..systems.model import WORLD, LinearCoupling, Mechanism
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
                    Linearization, Samples, Scheme, Setting, Stopwatch, central_differences)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
-                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
+                   REVOLUTE, ROLLING_CONTACT, EnginePlan, PairLoad, RollingGeometry,
                    SlotGeometry, carries_child, central_tensor, couples_two_engine_values,
                    coupling_row, element_kind, engine_coupling, held_by_closure, num,
                    one_joint_value, pair_load, parents_first, plane_point, point_distance,
@@ -387,14 +387,9 @@ def _coordinate_force(model: _Translation, f) -> None:
     """Nothing to build: the plan's coordinate laws are applied before every step."""
 
 
-#: a time load is built as the element it is
-_LOADS = {PointToPoint: _point_force, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "evaluated at the time of the start of each step, the "
-                                      "single stage of the semi-implicit Euler step"))
-def _time_load(model: _Translation, f) -> None:
-    _LOADS[type(f)](model, f)
+_BUILDERS.builds_time_loads(Expression(EXACT, "evaluated at the time of the start of each "
+                                              "step, the single stage of the semi-implicit "
+                                              "Euler step"))
 
 
 @_builds(POINT_ON_POINT, Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
