@@ -1,7 +1,8 @@
-"""Shared steps of simulators/plan.py and base.py that an engine's translation calls
-(the sliders' masses, a semi-implicit Euler engine's free-vibration fit, modes with
-constraints held exactly, the geometric stiffness of constraint forces), each checked
-against an independent statement of what it computes."""
+"""Shared steps of simulators/plan.py, base.py and reactions.py that an engine's
+translation calls (the sliders' masses, a semi-implicit Euler engine's free-vibration fit,
+modes with constraints held exactly, the geometric stiffness of constraint forces, the
+outside forces the reactions take out, the builder of time loads), each checked against an
+independent statement of what it computes."""
 from __future__ import annotations
 
 import math
@@ -9,16 +10,23 @@ import math
 import numpy as np
 import pytest
 
-from mbfidelity.simulators.base import RELEASE_PERIODS, semi_implicit_euler_modes
+from mbfidelity.simulators.base import (EXACT, RELEASE_PERIODS, ElementBuilders, Expression,
+                                        semi_implicit_euler_modes)
 from mbfidelity.simulators.plan import (
+    COORDINATE_FORCE_CUSTOM,
+    LINEAR_COUPLING,
     POINT_ON_LINE,
+    POINT_ON_POINT,
+    POINT_TO_POINT_CUSTOM,
+    TIME_LOAD,
     constrained_modes,
     element_kind,
     geometric_stiffness,
     num,
     slider_masses,
 )
-from mbfidelity.systems.model import WORLD
+from mbfidelity.simulators.reactions import outside_forces
+from mbfidelity.systems.model import WORLD, PointToPoint
 
 #: round-off bound: a few dozen operations on values of order 1-100
 TOL = 1e-10
@@ -132,10 +140,7 @@ def test_a_time_load_is_built_by_the_builder_of_its_custom_law():
     that of a coordinate custom law, and TIME_LOAD declares the expression given."""
     import sympy as sp
 
-    from mbfidelity.simulators.base import EXACT, ElementBuilders, Expression
-    from mbfidelity.simulators.plan import (COORDINATE_FORCE_CUSTOM, POINT_TO_POINT_CUSTOM,
-                                            TIME_LOAD)
-    from mbfidelity.systems.model import TIME, CoordinateForce, PointToPoint
+    from mbfidelity.systems.model import TIME, CoordinateForce
 
     builders, built = ElementBuilders(), []
     builders.builds(POINT_TO_POINT_CUSTOM)(lambda target, f: built.append((target, "point")))
@@ -149,3 +154,32 @@ def test_a_time_load_is_built_by_the_builder_of_its_custom_law():
         builders.of(load)(target, load)
     assert built == [(0, "point"), (1, "coord")]
     assert builders.declared()[TIME_LOAD] == (declared,)
+
+
+def test_outside_forces_hand_pair_elements_and_couplings_apart():
+    """The forces an engine's transmitted force holds, by the contract's sign convention
+    (simulators/reactions.py): the point-to-point elements' and the pin and slot
+    closures' (two opposite forces on two bodies) are pair forces, every other closure's
+    (a coupling's generalized force) a coupling force; each array is handed on as given.
+    Checked on every catalog mechanism, which together hold all three closure kinds."""
+    from mbfidelity.comparisons.runner import _engine_mechanism
+    from mbfidelity.systems import all_systems
+
+    seen: set[str] = set()
+    for sid, system in sorted(all_systems().items()):
+        mech = _engine_mechanism(system, system.parameter_values(None), None)
+        element_forces = {f.name: np.full((3, 2), float(i)) for i, f in enumerate(mech.forces)
+                          if isinstance(f, PointToPoint)}
+        constraint_forces = {c.name: np.full((3, 2), -float(i))
+                             for i, c in enumerate(mech.constraints)}
+        kinds = {c.name: element_kind(c) for c in mech.constraints}
+        out = outside_forces(mech, element_forces, constraint_forces)
+        pins_and_slots = {n for n, kind in kinds.items()
+                          if kind in (POINT_ON_POINT, POINT_ON_LINE)}
+        assert set(out["pair_forces"]) == set(element_forces) | pins_and_slots, sid
+        assert set(out["coupling_forces"]) == set(kinds) - pins_and_slots, sid
+        given = {**element_forces, **constraint_forces}
+        for split in out.values():
+            assert all(split[n] is given[n] for n in split), sid
+        seen |= set(kinds.values())
+    assert {POINT_ON_POINT, POINT_ON_LINE, LINEAR_COUPLING} <= seen

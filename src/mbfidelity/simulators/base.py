@@ -126,7 +126,7 @@ import numpy as np
 
 from ..systems import Expectation
 from ..systems._continua import Beam
-from ..systems.model import Mechanism, PointToPoint
+from ..systems.model import CoordinateForce, Mechanism, PointToPoint
 from .plan import (COORDINATE_FORCE_CUSTOM, ELEMENT_KINDS, POINT_TO_POINT_CUSTOM, TIME_LOAD,
                    CoordinateMap, description_reason, driven_start, element_kind, elements)
 from .reactions import joint_reactions
@@ -235,19 +235,17 @@ class ElementBuilders(dict):
             return builder
         return register
 
+    def of(self, element) -> Callable:
+        """The builder of an element of the description."""
+        return self[element_kind(element)]
+
     def builds_time_load(self, *expressions: Expression) -> None:
         """Register the builder of `plan.TIME_LOAD`, with its expressions: a load that
         depends on time is built as the element it is, by the builder registered for its
         custom law's kind (`POINT_TO_POINT_CUSTOM`, `COORDINATE_FORCE_CUSTOM`): a law of
         TIME is never linear, so no engine holds it as a native element."""
-        def build(target, load) -> None:
-            point = isinstance(load, PointToPoint)
-            self[POINT_TO_POINT_CUSTOM if point else COORDINATE_FORCE_CUSTOM](target, load)
-        self.builds(TIME_LOAD, *expressions)(build)
-
-    def of(self, element) -> Callable:
-        """The builder of an element of the description."""
-        return self[element_kind(element)]
+        custom = {PointToPoint: POINT_TO_POINT_CUSTOM, CoordinateForce: COORDINATE_FORCE_CUSTOM}
+        self.builds(TIME_LOAD, *expressions)(lambda model, f: self[custom[type(f)]](model, f))
 
     def refuses(self, kind: str, how: str, engine: str) -> None:
         """Register `kind` as unsupported (`how`: why), with a builder that raises

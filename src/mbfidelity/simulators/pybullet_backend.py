@@ -6,8 +6,8 @@ Translation (generic over the description, conventions 1-8 of `systems.model`): 
 element kind of the description (`plan.ELEMENT_KINDS`) has one builder, registered together
 with the expressions it builds (`_builds`; `EXPRESSIONS` is that registry's declarations),
 which puts the element into `_Translation`, the mechanism in PyBullet's terms; each closure
-is one class per PyBullet construct (`_Pin`, `_Slider`, `_Rotor`, `_Gear`) that creates its
-constraint, places its extra link, and turns the engine's constraint rows into the
+is one class per PyBullet construct (`_Pin`, `_Slider`, `_Rotor`, `_Gear`) that gives its
+constraint's frames, places its extra link, and turns the engine's constraint rows into the
 contract's force (signs measured, in each class) and violation.
 
 Closure constraints (``createConstraint``) are solved with the velocity-level projected
@@ -28,34 +28,32 @@ from __future__ import annotations
 
 import math
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
 from ..analytic.linear import quadratic_eigenvalues
-from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointToPoint,
-                             Prescribed)
+from ..systems.model import WORLD, LinearCoupling, Mechanism
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
                    Linearization, Samples, Scheme, Setting, Stopwatch, central_differences)
 from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE_CLOSURE,
                    LINEAR_COUPLING, MASSLESS_BODY, POINT_ON_LINE, POINT_ON_POINT,
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
-                   REVOLUTE, ROLLING_CONTACT, TIME_LOAD, EnginePlan, PairLoad, RollingGeometry,
+                   REVOLUTE, ROLLING_CONTACT, EnginePlan, PairLoad, RollingGeometry,
                    SlotGeometry, carries_child, central_tensor, couples_two_engine_values,
                    coupling_row, element_kind, engine_coupling, held_by_closure, num,
                    one_joint_value, pair_load, parents_first, plane_point, point_distance,
                    principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
-                   slide_axis, slot_geometry, spatial_tree_reason, turned, unit_axis)
+                   slide_axis, slot_geometry, spatial_tree_reason, turned, unit_axis, vec3)
+from .reactions import outside_forces
 
 _POINT_FORCE = ("applyExternalForce at both points every step, from the engine's link "
                 "states at the start of the step (the single stage of its semi-implicit "
                 "Euler)")
 _JOINT_FORCE = ("joint force through setJointMotorControlArray(TORQUE_CONTROL) every step, "
                 "tau = A^-T Q")
-_REACTION_METHODS = ("inverse_dynamics", "joint_sensor")
-_POINT_ON_LINE = ("prismatic", "slider")
 #: createMultiBody keeps the first 127 links and drops the rest without an error (measured)
 _MAX_LINKS = 127
 
@@ -63,16 +61,6 @@ _MAX_LINKS = 127
 def _quat_z(angle: float) -> list[float]:
     """Quaternion (x, y, z, w) of a rotation by `angle` about z."""
     return [0.0, 0.0, math.sin(angle / 2.0), math.cos(angle / 2.0)]
-
-
-def _xyz(point) -> list[float]:
-    """A planar point in PyBullet's 3-D terms."""
-    return [point[0], point[1], 0.0]
-
-
-def _engine(eidx: Sequence[int], link: int) -> int:
-    """The engine link index of a translation link (-1: the fixed base)."""
-    return eidx[link] if link >= 0 else -1
 
 
 def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
@@ -88,29 +76,25 @@ def _pose(ls, link: int) -> tuple[float, float, float, float, float, float]:
 
 @dataclass
 class _Link:
+    """A link of the multibody: one per description joint, then the extra links (a rotor,
+    a slider, the contact's radial slider), whose frame is aligned with the parent's and
+    whose centre of mass is at its origin (the defaults)."""
+
     name: str          # joint name
-    body: str          # child body
     parent: int        # translation link index of the parent body, -1 for the world
     revolute: bool
     mass: float
     inertia: float
     position: list[float]          # joint frame origin in the parent's link frame
-    orientation: list[float]       # joint frame orientation in the parent's link frame
-    inertial_position: list[float]  # centre of mass in the link frame
     axis: list[float]               # joint axis in the joint (= link) frame
+    body: str = ""     # child body of a description joint
+    #: joint frame orientation in the parent's link frame
+    orientation: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0, 1.0])
+    #: centre of mass in the link frame
+    inertial_position: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     #: a spatial body's principal moments and the quaternion of its principal axes in the
     #: link frame (None: the planar inertia on every axis, identity frame)
     principal: tuple[list[float], list[float]] | None = None
-
-
-def _extra_link(name: str, parent: int, revolute: bool, mass: float, inertia: float,
-                position: list[float], axis) -> _Link:
-    """A link beyond the description's (a rotor, a slider, the contact's radial slider):
-    its frame aligned with the parent's, its centre of mass at its origin."""
-    return _Link(name=name, body=name, parent=parent, revolute=revolute, mass=mass,
-                 inertia=inertia, position=position, orientation=[0.0, 0.0, 0.0, 1.0],
-                 inertial_position=[0.0, 0.0, 0.0], axis=[float(axis[0]), float(axis[1]),
-                                                          float(axis[2])])
 
 
 @dataclass
@@ -148,47 +132,49 @@ def _slider_row_normal(u: np.ndarray) -> tuple[float, float]:
 
 
 @dataclass
-class _Pin:
-    """PointOnPoint: JOINT_POINT2POINT, parent = body_a's link at point_a, child =
-    body_b's link at point_b (translation link indices, -1 = the fixed base; points in
-    centre-of-mass frames = the description's body frames). Its rows along world x, y, z
-    hold the force on the CHILD (a bar held at its tip by the base, bar = parent, reads
-    -m g / 2): the contract's force on body_a (the parent) is minus the rows."""
+class _Closure:
+    """A closure constraint: one PyBullet constraint (`frames`, `options`) from the link
+    `parent` to the link `child` (translation link indices, -1 = the fixed base)."""
 
     element: object
     parent: int
-    parent_point: tuple[float, float]
     child: int
-    child_point: tuple[float, float]
     #: its force acts between two bodies (reactions take it out where it crosses a cut)
     pair = True
     #: its child pivot is moved under the pin before every step
     follows_pin = False
 
-    def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
-        uid = p.createConstraint(body, _engine(eidx, self.parent), body,
-                                 _engine(eidx, self.child), *self.frames(p),
-                                 physicsClientId=cid)
-        p.changeConstraint(uid, maxForce=float(cfg["constraint_max_force"]),
-                           physicsClientId=cid)
-        return uid
-
-    def frames(self, p) -> tuple:
-        """createConstraint's joint type, axis and parent and child pivots."""
-        return (p.JOINT_POINT2POINT, [0, 0, 0], _xyz(self.parent_point),
-                _xyz(self.child_point))
+    def options(self, cfg: dict) -> dict:
+        """changeConstraint's keywords."""
+        return {"maxForce": float(cfg["constraint_max_force"])}
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
         """Set the state of its extra link from the description state (none here)."""
-
-    def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
-        """getConstraintState rows (N, 6) -> the contract's force (signs measured)."""
-        return -rows[:, :2]
 
     def violations(self, q: np.ndarray) -> np.ndarray:
         """Its violation at the samples q where it follows from q alone; otherwise an
         array that `violation` fills sample by sample from the engine's link states."""
         return np.empty(len(q))
+
+
+@dataclass
+class _Pin(_Closure):
+    """PointOnPoint: JOINT_POINT2POINT, parent = body_a's link at point_a, child =
+    body_b's link at point_b (points in centre-of-mass frames = the description's body
+    frames). Its rows along world x, y, z hold the force on the CHILD (a bar held at its
+    tip by the base, bar = parent, reads -m g / 2): the contract's force on body_a (the
+    parent) is minus the rows."""
+
+    parent_point: tuple[float, float]
+    child_point: tuple[float, float]
+
+    def frames(self, p) -> tuple:
+        """createConstraint's joint type, axis and parent and child pivots."""
+        return p.JOINT_POINT2POINT, [0, 0, 0], vec3(self.parent_point), vec3(self.child_point)
+
+    def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
+        """getConstraintState rows (N, 6) -> the contract's force (signs measured)."""
+        return -rows[:, :2]
 
     def violation(self, ls) -> float:
         """Distance of the two points (m)."""
@@ -201,10 +187,10 @@ class _Slot(_Pin):
     """PointOnLine: its geometry (`slot`), the links of the pin's body (`pin_link`) and
     of the slot body (`line_link`), and the extra link `aux`."""
 
-    slot: SlotGeometry | None = None
-    pin_link: int = -1
-    line_link: int = -1
-    aux: int = -1
+    slot: SlotGeometry
+    pin_link: int
+    line_link: int
+    aux: int
 
     def _states(self, ls) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """The frame states of the pin's body and of the slot body, from link states."""
@@ -240,14 +226,13 @@ class _Rotor(_Slot):
     follows_pin = True
 
     def frames(self, p) -> tuple:
-        return (p.JOINT_PRISMATIC, [self.slot.direction[0], self.slot.direction[1], 0.0],
-                [0.0, 0.0, 0.0], _xyz(self.child_point))
+        return (p.JOINT_PRISMATIC, [*self.slot.direction, 0.0], [0.0, 0.0, 0.0],
+                vec3(self.child_point))
 
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
         """The rotor turned to the slot body's angle, th_slot - th_pin, at the relative
         rate w_slot - w_pin."""
-        _, _, th_l, _, _, w_l = _pose(ls, self.line_link)
-        _, _, th_p, _, _, w_p = _pose(ls, self.pin_link)
+        (_, _, th_p, _, _, w_p), (_, _, th_l, _, _, w_l) = self._states(ls)
         rel = math.remainder(th_l - th_p, 2.0 * math.pi)
         p.resetJointState(body, eidx[self.aux], rel, w_l - w_p, physicsClientId=cid)
 
@@ -255,43 +240,36 @@ class _Rotor(_Slot):
         th = model.map.angle(self.slot.line_body, q)  # the world's: 0
         return rows[:, 1:2] * turned(th, *_slider_row_normal(self.slot.direction))
 
-    def pivot(self, ls, slot_of: Mapping[int, int]) -> list[float]:
+    def pivot(self, ls) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
         slot body's frame: L + ((P - L) . u) u (why: the setting point_on_line's note)."""
-        s, _ = self.slot.along(*self._states({lk: ls[m] for lk, m in slot_of.items()}))
+        s, _ = self.slot.along(*self._states(ls))
         return [*self.slot.line_point_at(s), 0.0]
 
 
 @dataclass
-class _Gear:
-    """LinearCoupling: JOINT_GEAR jv[a] + ratio jv[b] = target between engine joints a and
-    b. Its one row f gives the joint forces f (1, ratio) on (a, b) (checked against inverse
-    dynamics), i.e. (f / w_a) w = A^-T c f / w_a: the coupling's generalized force is
-    c f / w_a and -lambda = f / w_a (`scale` = w_a)."""
+class _Gear(_Closure):
+    """LinearCoupling: JOINT_GEAR jv[a] + ratio jv[b] = target between engine joints a =
+    `parent` and b = `child`. Its one row f gives the joint forces f (1, ratio) on (a, b)
+    (checked against inverse dynamics), i.e. (f / w_a) w = A^-T c f / w_a: the coupling's
+    generalized force is c f / w_a and -lambda = f / w_a (`scale` = w_a)."""
 
-    element: object
-    a: int
-    b: int
     ratio: float
     target: float
     scale: float
     weights: np.ndarray  # coupling coefficients c (description coordinates)
     constant: float
     pair = False
-    follows_pin = False
 
-    def create(self, p, cid: int, body: int, eidx: list[int], cfg: dict) -> int:
-        uid = p.createConstraint(body, eidx[self.a], body, eidx[self.b], p.JOINT_GEAR,
-                                 [0, 0, 1], [0, 0, 0], [0, 0, 0], physicsClientId=cid)
+    def frames(self, p) -> tuple:
+        return p.JOINT_GEAR, [0, 0, 1], [0, 0, 0], [0, 0, 0]
+
+    def options(self, cfg: dict) -> dict:
         kw = {"gearRatio": self.ratio, "maxForce": float(cfg["constraint_max_force"])}
         erp = float(cfg["gear_erp"])
         if erp:
             kw.update(erp=erp, relativePositionTarget=self.target)
-        p.changeConstraint(uid, physicsClientId=cid, **kw)
-        return uid
-
-    def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
-        """No extra link."""
+        return kw
 
     def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
         return rows[:, :1] / self.scale
@@ -301,31 +279,12 @@ class _Gear:
         return q @ self.weights - self.constant
 
 
-def _spatial_link(mech: Mechanism, i: int, parent: int, parent_anchor) -> _Link:
-    """The link of joint i of a spatial open tree: joint frame at the anchor, aligned with
-    the parent (no orientation offset, model convention 10), hinge about the
-    description's axis, the body's full tensor given by its principal moments and axes."""
-    j = mech.joints[i]
-    body = mech.body(j.child)
-    pa, ca = (np.array([num(v) for v in a] + [0.0] * (3 - len(a)))
-              for a in (j.parent_anchor, j.child_anchor))
-    tensor = central_tensor(mech, body)
-    return _Link(name=j.name, body=j.child, parent=parent, revolute=True,
-                 mass=num(body.mass), inertia=float(tensor[2, 2]),
-                 position=[float(v) for v in pa - np.array([*parent_anchor, 0.0][:3])],
-                 orientation=[0.0, 0.0, 0.0, 1.0],
-                 inertial_position=[float(v) for v in -ca],
-                 axis=list(unit_axis(j)),
-                 principal=principal_inertia(tensor))
-
-
 class _Translation(EnginePlan):
     """The mechanism in PyBullet's terms, built element by element by the builders
     registered per element kind (`_BUILDERS`) on the shared plan (`plan.EnginePlan`):
     `links`, one per description joint (the first `n`), then the extra links (the rolling
-    contact's radial slider, one rotor or slider per PointOnLine), with `creation_order`
-    putting parents first; the `closures`, the point-to-point elements (`point_forces`)
-    and the rolling `contact`."""
+    contact's radial slider, one rotor or slider per PointOnLine); the `closures`, the
+    point-to-point elements (`point_forces`) and the rolling `contact`."""
 
     def __init__(self, mech: Mechanism, cfg: Mapping) -> None:
         super().__init__(mech, cfg)
@@ -343,16 +302,10 @@ class _Translation(EnginePlan):
         self.point_links = sorted({lk for pf in self.point_forces
                                    for lk in (pf.link_a, pf.link_b) if lk >= 0})
 
-    def creation_order(self) -> list[int]:
-        """Link indices with every parent before its children (the link order unless a
-        link was re-parented onto a later one, e.g. the rolling contact's radial link)."""
-        return parents_first([lk.parent for lk in self.links])
-
 
 # --- the builders, registered per element kind with the expressions they build ---------
+# (contract point 5), each building an element of its kind into the `_Translation`
 
-#: per element kind of the description, the function that builds an element of it into
-#: the `_Translation` (contract point 5), and the expressions it builds
 _BUILDERS = ElementBuilders()
 _builds = _BUILDERS.builds
 
@@ -385,39 +338,40 @@ def _massless_body(model: _Translation, body) -> None:
     model.inertia_of[body.name] = (mass, inertia)
 
 
-def _joint_link(model: _Translation, j, revolute: bool, axis: list[float]) -> None:
+@_builds(REVOLUTE, Expression(EXACT, "revolute link about z, the joint frame turned by "
+                                     "angle_offset"))
+@_builds(PRISMATIC, Expression(EXACT, "prismatic link along the unit axis (its length in "
+                                      "v = A q + b)"))
+def _joint_link(model: _Translation, j) -> None:
     """The link of description joint j: its URDF frame at the joint's anchor on the
-    parent, turned by the angle offset; its inertial frame at -child_anchor, so that it is
-    the body frame (origin at the centre of mass)."""
-    i = model.mech.joints.index(j)
-    if model.mech.spatial:  # model convention 10; `translation_reason` bounds the cases
-        model.links.append(_spatial_link(model.mech, i, model.link_of[j.parent],
-                                         model.anchor_of[j.parent]))
+    parent, turned by the angle offset (a slide's axis in the x-y plane of that frame,
+    `plan.slide_axis`); its inertial frame at -child_anchor, so that it is the body frame
+    (origin at the centre of mass). In a spatial open tree (model convention 10;
+    `translation_reason` bounds the cases) the joint frame is aligned with the parent (no
+    orientation offset), the hinge turns about the description's axis and the body's full
+    tensor is given by its principal moments and axes."""
+    parent, panchor = model.link_of[j.parent], model.anchor_of[j.parent]
+    if model.mech.spatial:
+        body = model.mech.body(j.child)
+        pa, ca = np.array(vec3(j.parent_anchor)), np.array(vec3(j.child_anchor))
+        tensor = central_tensor(model.mech, body)
+        model.links.append(_Link(
+            name=j.name, body=j.child, parent=parent, revolute=True, mass=num(body.mass),
+            inertia=float(tensor[2, 2]), axis=list(unit_axis(j)),
+            position=[float(v) for v in pa - np.array([*panchor, 0.0][:3])],
+            inertial_position=[float(v) for v in -ca], principal=principal_inertia(tensor)))
         model.anchor_of[j.child] = tuple(-v for v in model.links[-1].inertial_position)
     else:
         pa, ca = plane_point(j.parent_anchor), plane_point(j.child_anchor)
-        panchor = model.anchor_of[j.parent]
         mass, inertia = model.inertia_of[j.child]
+        revolute = element_kind(j) == REVOLUTE
         model.links.append(_Link(
-            name=j.name, body=j.child, parent=model.link_of[j.parent], revolute=revolute,
-            mass=mass, inertia=inertia, position=[pa[0] - panchor[0], pa[1] - panchor[1], 0.0],
+            name=j.name, body=j.child, parent=parent, revolute=revolute, mass=mass,
+            inertia=inertia, position=[pa[0] - panchor[0], pa[1] - panchor[1], 0.0],
             orientation=_quat_z(num(j.angle_offset)), inertial_position=[-ca[0], -ca[1], 0.0],
-            axis=axis))
+            axis=[0.0, 0.0, 1.0] if revolute else [*slide_axis(j), 0.0]))
         model.anchor_of[j.child] = ca
-    model.link_of[j.child] = i
-
-
-@_builds(REVOLUTE, Expression(EXACT, "revolute link about z, the joint frame turned by "
-                                     "angle_offset"))
-def _hinge(model: _Translation, j) -> None:
-    _joint_link(model, j, True, [0.0, 0.0, 1.0])
-
-
-@_builds(PRISMATIC, Expression(EXACT, "prismatic link along the unit axis (its length in "
-                                      "v = A q + b)"))
-def _slide(model: _Translation, j) -> None:
-    """The axis in the x-y plane of the joint frame (`plan.slide_axis`)."""
-    _joint_link(model, j, False, [*slide_axis(j), 0.0])
+    model.link_of[j.child] = model.mech.joints.index(j)
 
 
 @_builds(POINT_TO_POINT_LINEAR, Expression(EXACT, _POINT_FORCE))
@@ -433,22 +387,17 @@ def _coordinate_force(model: _Translation, f) -> None:
     """Nothing to build: the plan's coordinate laws are applied before every step."""
 
 
-#: a time load is built as the element it is
-_LOADS = {PointToPoint: _point_force, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "evaluated at the time of the start of each step, the "
-                                      "single stage of the semi-implicit Euler step"))
-def _time_load(model: _Translation, f) -> None:
-    _LOADS[type(f)](model, f)
+_BUILDERS.builds_time_load(Expression(EXACT, "evaluated at the time of the start of each "
+                                              "step, the single stage of the semi-implicit "
+                                              "Euler step"))
 
 
 @_builds(POINT_ON_POINT, Expression(EXACT, "JOINT_POINT2POINT, solved at velocity level with "
                                            "erp 1 (no regularisation; the position error of "
                                            "a step is removed in the next)"))
 def _point_on_point(model: _Translation, c) -> None:
-    model.closures.append(_Pin(c, model.link_of[c.body_a], plane_point(c.point_a),
-                               model.link_of[c.body_b], plane_point(c.point_b)))
+    model.closures.append(_Pin(c, model.link_of[c.body_a], model.link_of[c.body_b],
+                               plane_point(c.point_a), plane_point(c.point_b)))
 
 
 @_builds(POINT_ON_LINE, Expression(SUBSTITUTE, "a rotor link on the pin (revolute, no mass, "
@@ -459,24 +408,23 @@ def _point_on_point(model: _Translation, c) -> None:
                                                "a slider link of small mass)"))
 def _point_on_line(model: _Translation, c) -> None:
     slot = slot_geometry(c)
-    lp, pp, u = slot.line_point, slot.pin_point, slot.direction
+    lp, pp = slot.line_point, slot.pin_point
     lpin, lline = model.link_of[c.body], model.link_of[c.line_body]
     k = len(model.links)
     geo = dict(slot=slot, pin_link=lpin, line_link=lline, aux=k)
     if model.cfg["point_on_line"] == "slider":
         anchor = model.anchor_of[c.line_body]
         mass = float(model.cfg["slider_mass_ratio"]) * model.m_min
-        model.links.append(_extra_link(f"{c.name}:slider", lline, False, mass, 0.0,
-                                       [lp[0] - anchor[0], lp[1] - anchor[1], 0.0],
-                                       (u[0], u[1], 0.0)))
-        model.closures.append(_Slider(c, lpin, pp, k, (0.0, 0.0), **geo))
+        model.links.append(_Link(f"{c.name}:slider", lline, False, mass, 0.0,
+                                 [lp[0] - anchor[0], lp[1] - anchor[1], 0.0],
+                                 [*slot.direction, 0.0]))
+        model.closures.append(_Slider(c, lpin, k, pp, (0.0, 0.0), **geo))
     else:
         anchor = model.anchor_of[c.body]
         inertia = float(model.cfg["rotor_inertia_ratio"]) * model.i_min
-        model.links.append(_extra_link(f"{c.name}:rotor", lpin, True, 0.0, inertia,
-                                       [pp[0] - anchor[0], pp[1] - anchor[1], 0.0],
-                                       (0.0, 0.0, 1.0)))
-        model.closures.append(_Rotor(c, k, (0.0, 0.0), lline, lp, **geo))
+        model.links.append(_Link(f"{c.name}:rotor", lpin, True, 0.0, inertia,
+                                 [pp[0] - anchor[0], pp[1] - anchor[1], 0.0], [0.0, 0.0, 1.0]))
+        model.closures.append(_Rotor(c, k, lline, (0.0, 0.0), lp, **geo))
 
 
 @_builds(LINEAR_COUPLING,
@@ -514,9 +462,8 @@ def _rolling_contact(model: _Translation, c) -> None:
     model.contact, model.coupling = rolling_geometry(model.mech, c), c.coupling
     hub = model.links[model.contact.hub]
     k = len(model.links)
-    u = model.contact.radial
-    model.links.append(_extra_link(f"{model.contact.coupling}:radial", hub.parent, False,
-                                   0.0, 0.0, list(hub.position), (u[0], u[1], 0.0)))
+    model.links.append(_Link(f"{model.contact.coupling}:radial", hub.parent, False, 0.0, 0.0,
+                             list(hub.position), [*model.contact.radial, 0.0]))
     hub.parent, hub.position = k, [0.0, 0.0, 0.0]
     model.radial_link = k
 
@@ -601,18 +548,16 @@ def _contact_force(points, ring: set[int], disc: int) -> tuple[float, float, flo
     return fx, fy, float(count)
 
 
-@_builds(PRESCRIBED,
-         Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
-                           "force that never saturates (prescribed_motion): the coordinate "
-                           "lands on q(t+h) at every step; actuator force from getJointState",
-                    when="the coordinate is one engine joint value", applies=one_joint_value),
-         Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an absolute "
-                                 "angle on a turning parent): one joint motor cannot impose "
-                                 "it without the parent's angle at t+h before the step",
-                    when="otherwise"))
-def _prescribed(model: _Translation, prescribed: Prescribed) -> None:
-    """Nothing to build: the plan's motion (`EnginePlan.driven`) drives the joint's motor
-    before every step."""
+_builds(PRESCRIBED,
+        Expression(EXACT, "the joint's VELOCITY_CONTROL motor driven to (q(t+h) - q)/h with a "
+                          "force that never saturates (prescribed_motion): the coordinate "
+                          "lands on q(t+h) at every step; actuator force from getJointState",
+                   when="the coordinate is one engine joint value", applies=one_joint_value),
+        Expression(UNSUPPORTED, "the coordinate is a sum of engine joint values (an absolute "
+                                "angle on a turning parent): one joint motor cannot impose "
+                                "it without the parent's angle at t+h before the step",
+                   when="otherwise"))(
+    lambda model, prescribed: None)  # the plan's motion (`EnginePlan.driven`) drives its motor
 
 
 _BUILDERS.refuses(HINGE_CLOSURE, "the spatial build closes no loop: a spatial closed loop "
@@ -684,7 +629,7 @@ class PyBulletBackend(Backend):
             "(MASSLESS_BODY's expression); a positive value is a substitute whose effect "
             "shows in the error."),
         "reaction_method": Setting(
-            "inverse_dynamics", _REACTION_METHODS,
+            "inverse_dynamics", ("inverse_dynamics", "joint_sensor"),
             "'inverse_dynamics' (default): calculateInverseDynamics on a copy with two "
             "massless prismatic joints in front of each reaction joint, at the engine's "
             "state and acceleration of the same step ((v_k+1 - v_k)/dt, exact for "
@@ -735,7 +680,7 @@ class PyBulletBackend(Backend):
             "'default value is 1e-7'.",
             engine_default=1e-7),
         "point_on_line": Setting(
-            "prismatic", _POINT_ON_LINE,
+            "prismatic", ("prismatic", "slider"),
             "'prismatic' (default; the build of POINT_ON_LINE's expression): the "
             "JOINT_PRISMATIC's child pivot is moved under the pin before every step "
             "(changeConstraint(jointChildPivot)): the engine evaluates the Jacobian at its "
@@ -835,7 +780,9 @@ class PyBulletBackend(Backend):
             rows.append((mass, shape, pos, orn, ipos, list(iorn), parent + 1, jtype, axis))
             return len(rows) - 1
 
-        for i in model.creation_order():
+        # parents first: the link order unless a link was re-parented onto a later one
+        # (the rolling contact's radial link)
+        for i in parents_first([lk.parent for lk in model.links]):
             lk = model.links[i]
             parent = engine_index[lk.parent] if lk.parent >= 0 else -1
             pos = lk.position
@@ -849,12 +796,9 @@ class PyBulletBackend(Backend):
             engine_index[i] = add(lk.mass, pos, lk.orientation, lk.inertial_position,
                                   parent, jtype, lk.axis, collision.get(i, -1),
                                   *([lk.principal[1]] if lk.principal else []))
-        fixed: list[int] = []
-        if fixed_shapes is not None:
-            host, host_shapes = fixed_shapes
-            for shape in host_shapes:
-                fixed.append(add(0.0, [0.0, 0.0, 0.0], [0, 0, 0, 1], [0.0, 0.0, 0.0],
-                                 engine_index[host], p.JOINT_FIXED, [0, 0, 1], shape))
+        host, host_shapes = fixed_shapes or (-1, ())
+        fixed = [add(0.0, [0.0, 0.0, 0.0], [0, 0, 0, 1], [0.0, 0.0, 0.0], engine_index[host],
+                     p.JOINT_FIXED, [0, 0, 1], shape) for shape in host_shapes]
         nl = len(rows)
         masses, shapes, positions, orientations, inertial, inertial_orientations, parents, \
             types, axes = map(list, zip(*rows))
@@ -889,14 +833,12 @@ class PyBulletBackend(Backend):
                 ("activationState", p.ACTIVATION_STATE_ENABLE_SLEEPING if settings["sleeping"]
                  else p.ACTIVATION_STATE_DISABLE_SLEEPING)):
             p.changeDynamics(body, -1, **{key: value}, physicsClientId=cid)
-        for i, lk in enumerate(model.links):
+        for i, lk in enumerate(model.links if settings["explicit_inertia"] else ()):
             diagonal = lk.principal[0] if lk.principal else [lk.inertia] * 3
-            if settings["explicit_inertia"]:
-                p.changeDynamics(body, engine_index[i], mass=float(lk.mass),
-                                 localInertiaDiagonal=diagonal, physicsClientId=cid)
+            p.changeDynamics(body, engine_index[i], mass=float(lk.mass),
+                             localInertiaDiagonal=diagonal, physicsClientId=cid)
             info = p.getDynamicsInfo(body, engine_index[i], physicsClientId=cid)
-            if settings["explicit_inertia"] and (
-                    abs(info[0] - lk.mass) > 1e-12 * max(1.0, lk.mass)
+            if (abs(info[0] - lk.mass) > 1e-12 * max(1.0, lk.mass)
                     or abs(info[2][2] - diagonal[2]) > 1e-12 * max(1.0, diagonal[2])):
                 raise RuntimeError(f"pybullet did not take the inertia of link {lk.name}: {info}")
         if not settings["joint_velocity_motors"]:
@@ -963,9 +905,12 @@ class PyBulletBackend(Backend):
                     c.place(p, cid, body, eidx, ls)
             cids = []  # one per closure, its frames relative to the body frames
             for c in model.closures:
-                cids.append(c.create(p, cid, body, eidx, cfg))
+                cids.append(p.createConstraint(
+                    body, eidx[c.parent] if c.parent >= 0 else -1, body,
+                    eidx[c.child] if c.child >= 0 else -1, *c.frames(p), physicsClientId=cid))
                 if cids[-1] < 0:
                     raise RuntimeError(f"pybullet createConstraint failed for {c.element.name}")
+                p.changeConstraint(cids[-1], **c.options(cfg), physicsClientId=cid)
             if model.contact is not None:
                 _contact_dynamics(p, cid, body, eidx, model, cfg)
             for i in sensor_joints:
@@ -1001,12 +946,10 @@ class PyBulletBackend(Backend):
         velocity_mode = p.VELOCITY_CONTROL
         links = eidx[:n]
         point_links = [eidx[k] for k in model.point_links]
-        pos_of = {k: m for m, k in enumerate(model.point_links)}
         A, bvec = model.map.A, model.map.b
         moving_links = sorted({lk for _, c in moving for lk in (c.pin_link, c.line_link)
                                if lk >= 0})
         moving_eidx = [eidx[lk] for lk in moving_links]
-        slot_of = {lk: m for m, lk in enumerate(moving_links)}
         driven_links = [eidx[m.index] for m in driven]
         drives = [(float(A[m.index, m.index]), m.position, float(bvec[m.index]), m.index)
                   for m in driven]
@@ -1019,12 +962,12 @@ class PyBulletBackend(Backend):
                 set_motors(body, links, torque_mode, forces=joint_forces(jv[:n], jvd[:n], t),
                            physicsClientId=cid)
             if n_pf:
-                ls = get_links(body, point_links, computeLinkVelocity=1,
-                               computeForwardKinematics=1, physicsClientId=cid)
-                ls_by_link = {lk: ls[pos_of[lk]] for lk in model.point_links}
+                ls = dict(zip(model.point_links, get_links(
+                    body, point_links, computeLinkVelocity=1, computeForwardKinematics=1,
+                    physicsClientId=cid)))
                 forces = []
                 for pf in model.point_forces:
-                    fx, fy, ax, ay, bx, by = pf.force(ls_by_link, t)
+                    fx, fy, ax, ay, bx, by = pf.force(ls, t)
                     forces.append((fx, fy))
                     if pf.link_b >= 0:
                         apply_force(body, eidx[pf.link_b], [fx, fy, 0.0], [bx, by, 0.0],
@@ -1033,9 +976,9 @@ class PyBulletBackend(Backend):
                         apply_force(body, eidx[pf.link_a], [-fx, -fy, 0.0], [ax, ay, 0.0],
                                     world_frame, physicsClientId=cid)
             if moving:
-                ls = get_links(body, moving_eidx, physicsClientId=cid)
+                ls = dict(zip(moving_links, get_links(body, moving_eidx, physicsClientId=cid)))
                 for uid, c in moving:
-                    change(uid, jointChildPivot=c.pivot(ls, slot_of), physicsClientId=cid)
+                    change(uid, jointChildPivot=c.pivot(ls), physicsClientId=cid)
             if driven:
                 t_next = (k + 1) * dt
                 target = [(a * q(t_next) + c - jv[i]) / dt for a, q, c, i in drives]
@@ -1056,14 +999,12 @@ class PyBulletBackend(Backend):
             get_states, body, links = p.getJointStates, world.body, world.eidx[:world.model.n]
             jv = jvd = []
             with Stopwatch() as clock:
-                if apply is None:
-                    for _ in range(steps):
-                        step(physicsClientId=cid)
-                for k in range(steps if apply is not None else 0):
+                for k in range(steps):
                     if reads:
                         js = get_states(body, links, physicsClientId=cid)
                         jv, jvd = [s[0] for s in js], [s[1] for s in js]
-                    apply(k, jv, jvd)
+                    if apply is not None:
+                        apply(k, jv, jvd)
                     step(physicsClientId=cid)
             js = get_states(body, links, physicsClientId=cid)
             return BareLoop.mapped(clock.cpu, world.model.map, [s[0] for s in js],
@@ -1115,8 +1056,7 @@ class PyBulletBackend(Backend):
         use_sensor = bool(reaction_joints) and cfg["reaction_method"] == "joint_sensor"
         with self._open(p, mechanism, q0, qd0, dt, cfg,
                         sensor_joints=joint_ids if use_sensor else ()) as world:
-            cid, body, eidx, model, cids = (world.cid, world.body, world.eidx, world.model,
-                                            world.cids)
+            cid, body, eidx, model = world.cid, world.body, world.eidx, world.model
             contact, closures, n = model.contact, model.closures, model.n
             # one extra step gives the reaction/acceleration (and the constraint forces)
             # of the last sample
@@ -1134,9 +1074,8 @@ class PyBulletBackend(Backend):
             get_cstate, get_contacts = p.getConstraintState, p.getContactPoints
             sensor_slots = [eidx[i] for i in joint_ids]
             apply, _ = self._inputs(p, world, dt, cfg)
-            driven = [(model.map.A[m.index, m.index], m.element.name) for m in model.driven]
             driven_slots = [m.index for m in model.driven]
-            motor = np.full((total + 1, len(driven)), np.nan)
+            motor = np.full((total + 1, len(driven_slots)), np.nan)
             if contact is not None:
                 ring_links = set(model.fixed_links)
                 disc_link = eidx[model.link_of[contact.inner]]
@@ -1146,16 +1085,14 @@ class PyBulletBackend(Backend):
                 for k in range(total):
                     JV[k] = jv = [s[0] for s in js]
                     JVD[k] = jvd = [s[1] for s in js]
-                    forces = apply(k, jv, jvd) if apply is not None else None
-                    if forces is not None:
+                    if apply is not None and (forces := apply(k, jv, jvd)) is not None:
                         f_point[k] = forces
                     step(physicsClientId=cid)
                     js = get_states(body, eidx, physicsClientId=cid)
                     # what is read after a step (the motors', constraints', contacts' and
                     # sensors' forces) belongs to the state before it
-                    for r, slot in enumerate(driven_slots):
-                        motor[k, r] = js[slot][3]
-                    for r, uid in enumerate(cids):
+                    motor[k] = [js[slot][3] for slot in driven_slots]
+                    for r, uid in enumerate(world.cids):
                         st = get_cstate(uid, physicsClientId=cid)
                         CF[k, r, : len(st)] = st
                     if contact is not None:
@@ -1163,9 +1100,7 @@ class PyBulletBackend(Backend):
                             get_contacts(bodyA=body, bodyB=body, physicsClientId=cid),
                             ring_links, disc_link)
                     if use_sensor:
-                        for r, slot in enumerate(sensor_slots):
-                            rf = js[slot][2]
-                            sensor[k, r] = rf[0], rf[1]
+                        sensor[k] = [js[slot][2][:2] for slot in sensor_slots]
             JV[total] = [s[0] for s in js]
             JVD[total] = [s[1] for s in js]
             jv, jvd = JV[: steps + 1], JVD[: steps + 1]  # the samples
@@ -1174,48 +1109,42 @@ class PyBulletBackend(Backend):
             # getConstraintState rows -> the contract's physical terms (signs measured)
             forces = {c.element.name: c.force(CF[: steps + 1, r], q, model)
                       for r, c in enumerate(closures)}
-            # a gear is a joint force: both routes see it
-            gears = {c.element.name: forces[c.element.name] for c in closures if not c.pair}
-            pairs: dict[str, np.ndarray] = {}
+            # inverse dynamics applies no element: the point-to-point and the closure
+            # forces across the cut are in its force (on body_a: minus the force recorded
+            # on point b); a gear is a joint force, which both routes see. Rolling by
+            # contact: the contact carries what the description's arm and coupling
+            # carried, so it counts as transmitted through the joints (contract point 6).
+            # Checked by Newton's law on the scotch yoke's disc and the slotted bar
+            # (3e-14 N)
+            outside = outside_forces(mechanism, {pf.pair.name: -f_point[: steps + 1, e]
+                                                 for e, pf in enumerate(model.point_forces)},
+                                     forces)
+            transmitted = {}
             if use_sensor:
                 transmitted = {name: sensor[: steps + 1, r].copy()
                                for r, name in enumerate(reaction_joints)}
+                outside["pair_forces"] = {}  # the joint's own force: no pair element in it
             elif reaction_joints:
                 jvdd = (JVD[1: total + 1] - JVD[:total]) / dt
                 transmitted = self._inverse_dynamics_forces(
                     p, cid, model, cfg, joint_ids, list(reaction_joints), jv, jvd,
                     jvdd[: steps + 1], q)
-                # inverse dynamics applies no element: the point-to-point and the closure
-                # forces across the cut are in its force (on body_a: minus the force
-                # recorded on point b). Rolling by contact: the contact carries what the
-                # description's arm and coupling carried, so it counts as transmitted
-                # through the joints (contract point 6). Checked by Newton's law on the
-                # scotch yoke's disc and the slotted bar (3e-14 N)
-                pairs = {pf.pair.name: -f_point[: steps + 1, e]
-                         for e, pf in enumerate(model.point_forces)}
-                pairs.update({c.element.name: forces[c.element.name] for c in closures
-                              if c.pair})
-            else:
-                transmitted = {}
             violation = self._violations(p, cid, body, eidx, model, jv, q)
 
-        contact_report = None
+        # the substitutes' own error: each closure's violation at every sample
+        extras = {"constraint_violation": violation}
         if contact is not None:
-            contact_report = rolling_contact_report(
+            extras["contact"] = report = rolling_contact_report(
                 mechanism, model.coupling, contact, model.map, q, qd,
                 jv[:, model.radial_link],  # the penetration: the radial slider's value
                 FC[: steps + 1, :2], FC[: steps + 1, 2])
-            forces[contact.coupling] = contact_report.pop("friction")[:, None]
-            violation[contact.coupling] = contact_report.pop("slip")
+            forces[contact.coupling] = report.pop("friction")[:, None]
+            violation[contact.coupling] = report.pop("slip")
         # the motor acts on its own joint only: Q = A^T tau is A[i, i] tau
-        actuators = {name: a * motor[: steps + 1, r] for r, (a, name) in enumerate(driven)}
-        # the substitutes' own error: each closure's violation at every sample
-        extras = {"constraint_violation": violation}
-        if contact_report is not None:
-            extras["contact"] = contact_report
+        actuators = {m.element.name: model.map.A[m.index, m.index] * motor[: steps + 1, r]
+                     for r, m in enumerate(model.driven)}
         return Samples(q, qd, clock, constraint_forces=forces, actuator_forces=actuators,
-                       extras=extras, transmitted=transmitted, pair_forces=pairs,
-                       coupling_forces=gears)
+                       extras=extras, transmitted=transmitted, **outside)
 
     def _inverse_dynamics_forces(self, p, cid: int, model: _Translation, cfg: dict,
                                  joint_ids: list[int], names: list[str], JV: np.ndarray,
@@ -1240,8 +1169,7 @@ class PyBulletBackend(Backend):
         for k in range(N):
             tau = inv_dyn(body, pos[k].tolist(), vel[k].tolist(), acc[k].tolist(),
                           physicsClientId=cid)
-            for r, (vx, vy) in enumerate(vslots):
-                out[k, r] = tau[vx], tau[vy]
+            out[k] = [(tau[vx], tau[vy]) for vx, vy in vslots]
         return {name: turned(model.map.angle(model.mech.joints[i].parent, q),
                               out[:, r, 0], out[:, r, 1])
                 for r, (i, name) in enumerate(zip(joint_ids, names))}
@@ -1273,7 +1201,6 @@ class PyBulletBackend(Backend):
         import pybullet as p
 
         cfg, autonomous = frame
-        h_rel = float(cfg["linearize_step"])
         q_eq = np.asarray(q_eq, dtype=float)
         with self._open(p, autonomous, q_eq, np.zeros(len(q_eq)), dt, cfg) as world:
             cid, body, eidx, model = world.cid, world.body, world.eidx, world.model
@@ -1290,9 +1217,7 @@ class PyBulletBackend(Backend):
 
             def applied(jv: np.ndarray, jvd: np.ndarray) -> np.ndarray:
                 """Engine joint forces of the (autonomous) force elements at (jv, jvd)."""
-                q = model.map.coordinates(jv)
-                qd = model.map.rates(jvd)
-                tau = model.joint_forces(q, qd, 0.0)
+                tau = model.joint_forces(model.map.coordinates(jv), model.map.rates(jvd), 0.0)
                 if not model.point_forces:
                     return tau
                 for i in range(n):
@@ -1324,7 +1249,7 @@ class PyBulletBackend(Backend):
 
             M = np.atleast_2d(np.array(p.calculateMassMatrix(
                 body, engine(jv_eq), physicsClientId=cid)))[np.ix_(perm, perm)]
-            K, C = central_differences(residual, jv_eq, h_rel)
+            K, C = central_differences(residual, jv_eq, float(cfg["linearize_step"]))
         eig = quadratic_eigenvalues(M, C, K)
         return Linearization(
             eigenvalues=eig,
@@ -1333,7 +1258,6 @@ class PyBulletBackend(Backend):
                     "forces through calculateJacobian), which inverse dynamics omits"),
             extra={"M": M.tolist(), "K": K.tolist(), "C": C.tolist(),
                    "coordinates": "engine joint values"})
-
 
     # --- flexible elements (contract point 12) ----------------------------------------------
     BEAM_ELEMENTS = {

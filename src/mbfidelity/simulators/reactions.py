@@ -103,11 +103,21 @@ def subtree_newton(mech: Mechanism, joints: Sequence[str], t: np.ndarray,
     (`subtree_force`) as `transmitted`, and the forces from outside that it holds, by the
     module's sign convention: the point-to-point elements' (`element_forces`) and the
     pair closures' among `constraint_forces` as `pair_forces`, the couplings' (the other
-    closures) as `coupling_forces`."""
-    pairs = pair_element_names(mech)
+    closures) as `coupling_forces` (`outside_forces`)."""
     return {"transmitted": {name: subtree_force(mech, name, t, accelerations)
                             for name in joints},
-            "pair_forces": {**element_forces, **{name: f for name, f in
+            **outside_forces(mech, element_forces, constraint_forces)}
+
+
+def outside_forces(mech: Mechanism, element_forces: Mapping[str, np.ndarray],
+                   constraint_forces: Mapping[str, np.ndarray]) -> dict[str, dict]:
+    """The forces from outside that an engine's transmitted force holds, as `base.Samples`
+    takes them (`joint_reaction` takes them out): the point-to-point elements'
+    (`element_forces`) and the pair closures' among the closures' `constraint_forces` as
+    `pair_forces`, the couplings' (the other closures) as `coupling_forces`, each by the
+    module's sign convention."""
+    pairs = pair_element_names(mech)
+    return {"pair_forces": {**element_forces, **{name: f for name, f in
                                                  constraint_forces.items() if name in pairs}},
             "coupling_forces": {name: f for name, f in constraint_forces.items()
                                 if name not in pairs}}
