@@ -887,6 +887,8 @@ def joint_chains(mech: Mechanism) -> JointChains:
 
 def _module(*values):
     """The functions for the kind of the values: NumPy, SymPy or `math`."""
+    if all(type(v) is float for v in values):  # one step's numbers: the common case
+        return math
     if any(isinstance(v, np.ndarray) for v in values):
         return np
     if any(isinstance(v, sp.Basic) for v in values):
