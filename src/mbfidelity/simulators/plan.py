@@ -51,7 +51,7 @@ them and lives here:
 - what every translation starts from (`EnginePlan`), more conditions of an expression
   that follow from the description alone (`carries_child`, `held_by_closure`,
   `couples_two_engine_values`), and the elements between two bodies read from their
-  frame states (`PairLoad`, `point_distance`, `SlotGeometry`).
+  frame states (`PairLoad`, `SlotGeometry`).
 """
 from __future__ import annotations
 
@@ -2126,14 +2126,6 @@ def pair_load(mech: Mechanism, f: PointToPoint) -> PairLoad:
                     element_loads(mech, f), ForceLaw.of(f).time_dependent)
 
 
-def point_distance(state_a: tuple, point_a, state_b: tuple, point_b) -> float:
-    """Distance between a point of one body and a point of another (body frames): a
-    PointOnPoint's violation."""
-    ax, ay, _, _ = point_state(state_a, point_a)
-    bx, by, _, _ = point_state(state_b, point_b)
-    return math.hypot(ax - bx, ay - by)
-
-
 @dataclass(frozen=True)
 class SlotGeometry:
     """A PointOnLine in numbers (body frames): the pin's body and point, the slot body,
@@ -2160,12 +2152,6 @@ class SlotGeometry:
         the rotation of u adds nothing)."""
         (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self.frame(pin, line)
         return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
-
-    def gap(self, pin: tuple, line: tuple) -> float:
-        """Signed distance n . (P - L) of the pin from the slot line (the violation),
-        n = (-u_y, u_x)."""
-        (px, py, _, _), (lx, ly, _, _), (ux, uy) = self.frame(pin, line)
-        return -uy * (px - lx) + ux * (py - ly)
 
     def line_point_at(self, s: float) -> tuple[float, float]:
         """The slot body's point of its line at s along it: L + s u (body frame)."""

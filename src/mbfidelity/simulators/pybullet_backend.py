@@ -8,7 +8,7 @@ with the expressions it builds (`_builds`; `EXPRESSIONS` is that registry's decl
 which puts the element into `_Translation`, the mechanism in PyBullet's terms; each closure
 is one class per PyBullet construct (`_Pin`, `_Slider`, `_Rotor`, `_Gear`) that gives its
 constraint's frames, places its extra link, and turns the engine's constraint rows into the
-contract's force (signs measured, in each class) and violation.
+contract's force (signs measured, in each class).
 
 Closure constraints (``createConstraint``) are solved with the velocity-level projected
 Gauss-Seidel of the multibody solver (setting constraint_erp), then q_{k+1} = q_k + dt
@@ -43,8 +43,8 @@ from .plan import (BODY, COORDINATE_FORCE_CUSTOM, COORDINATE_FORCE_LINEAR, HINGE
                    POINT_TO_POINT_CUSTOM, POINT_TO_POINT_LINEAR, PRESCRIBED, PRISMATIC,
                    REVOLUTE, ROLLING_CONTACT, EnginePlan, PairLoad, RollingGeometry,
                    SlotGeometry, carries_child, central_tensor, couples_two_engine_values,
-                   coupling_row, element_kind, engine_coupling, held_by_closure, num,
-                   one_joint_value, pair_load, parents_first, plane_point, point_distance,
+                   element_kind, engine_coupling, held_by_closure, num,
+                   one_joint_value, pair_load, parents_first, plane_point,
                    principal_inertia, ring_of_boxes, rolling_contact_report, rolling_geometry,
                    slide_axis, slot_geometry, spatial_tree_reason, turned, unit_axis, vec3)
 from .reactions import outside_forces
@@ -151,11 +151,6 @@ class _Closure:
     def place(self, p, cid: int, body: int, eidx: list[int], ls) -> None:
         """Set the state of its extra link from the description state (none here)."""
 
-    def violations(self, q: np.ndarray) -> np.ndarray:
-        """Its violation at the samples q where it follows from q alone; otherwise an
-        array that `violation` fills sample by sample from the engine's link states."""
-        return np.empty(len(q))
-
 
 @dataclass
 class _Pin(_Closure):
@@ -176,11 +171,6 @@ class _Pin(_Closure):
         """getConstraintState rows (N, 6) -> the contract's force (signs measured)."""
         return -rows[:, :2]
 
-    def violation(self, ls) -> float:
-        """Distance of the two points (m)."""
-        return point_distance(_pose(ls, self.parent), self.parent_point,
-                              _pose(ls, self.child), self.child_point)
-
 
 @dataclass
 class _Slot(_Pin):
@@ -195,10 +185,6 @@ class _Slot(_Pin):
     def _states(self, ls) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """The frame states of the pin's body and of the slot body, from link states."""
         return _pose(ls, self.pin_link), _pose(ls, self.line_link)
-
-    def violation(self, ls) -> float:
-        """Signed distance n . (P - L) of the pin from the slot line (m)."""
-        return self.slot.gap(*self._states(ls))
 
 
 @dataclass
@@ -257,8 +243,6 @@ class _Gear(_Closure):
     ratio: float
     target: float
     scale: float
-    weights: np.ndarray  # coupling coefficients c (description coordinates)
-    constant: float
     pair = False
 
     def frames(self, p) -> tuple:
@@ -273,10 +257,6 @@ class _Gear(_Closure):
 
     def force(self, rows: np.ndarray, q: np.ndarray, model: _Translation) -> np.ndarray:
         return rows[:, :1] / self.scale
-
-    def violations(self, q: np.ndarray) -> np.ndarray:
-        """Phi = c . q - constant."""
-        return q @ self.weights - self.constant
 
 
 class _Translation(EnginePlan):
@@ -437,15 +417,13 @@ def _point_on_line(model: _Translation, c) -> None:
                                  "constraint, and a one-joint coupling would be a lock",
                     when="one, or three or more, engine joint values"))
 def _linear_coupling(model: _Translation, c) -> None:
-    cvec, const = coupling_row(model.mech, c)
     w, rhs = engine_coupling(model.mech, c)
     nz = np.flatnonzero(w)
     if len(nz) != 2:  # guarded by support()
         raise ValueError(f"coupling {c.name}: {len(nz)} engine joints")
     ia, ib = sorted(nz, key=lambda i: -abs(w[i]))
     model.closures.append(_Gear(c, int(ia), int(ib), ratio=float(w[ib] / w[ia]),
-                                target=float(rhs / w[ia]), scale=float(w[ia]), weights=cvec,
-                                constant=const))
+                                target=float(rhs / w[ia]), scale=float(w[ia])))
 
 
 # --- rolling by friction contact (a variant's stand-in for a rolling coupling) ---------
@@ -848,23 +826,6 @@ class PyBulletBackend(Backend):
                                         forces=[0.0] * len(moving), physicsClientId=cid)
         return body, engine_index, virtual
 
-    # --- closure constraints -------------------------------------------------------------
-    @staticmethod
-    def _violations(p, cid: int, body: int, eidx: list[int], model: _Translation,
-                    JV: np.ndarray, q: np.ndarray) -> dict[str, np.ndarray]:
-        """Each closure's violation at the samples (engine joint values JV, coordinates
-        q): `violations`, or `violation` from the engine's own forward kinematics."""
-        out = {c.element.name: c.violations(q) for c in model.closures}
-        geo = [c for c in model.closures if c.pair]
-        n_all = len(eidx)
-        for k in range(len(JV) if geo else 0):
-            p.resetJointStatesMultiDof(body, eidx, [[v] for v in JV[k]], [[0.0]] * n_all,
-                                       physicsClientId=cid)
-            ls = p.getLinkStates(body, eidx, computeForwardKinematics=1, physicsClientId=cid)
-            for c in geo:
-                out[c.element.name][k] = c.violation(ls)
-        return out
-
     # --- contract points 6 and 9 ---------------------------------------------------------
     @contextmanager
     def _open(self, p, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray, dt: float,
@@ -1129,17 +1090,14 @@ class PyBulletBackend(Backend):
                 transmitted = self._inverse_dynamics_forces(
                     p, cid, model, cfg, joint_ids, list(reaction_joints), jv, jvd,
                     jvdd[: steps + 1], q)
-            violation = self._violations(p, cid, body, eidx, model, jv, q)
 
-        # the substitutes' own error: each closure's violation at every sample
-        extras = {"constraint_violation": violation}
+        extras = {}
         if contact is not None:
             extras["contact"] = report = rolling_contact_report(
                 mechanism, model.coupling, contact, model.map, q, qd,
                 jv[:, model.radial_link],  # the penetration: the radial slider's value
                 FC[: steps + 1, :2], FC[: steps + 1, 2])
             forces[contact.coupling] = report.pop("friction")[:, None]
-            violation[contact.coupling] = report.pop("slip")
         # the motor acts on its own joint only: Q = A^T tau is A[i, i] tau
         actuators = {m.element.name: model.map.A[m.index, m.index] * motor[: steps + 1, r]
                      for r, m in enumerate(model.driven)}
