@@ -512,64 +512,75 @@ class MujocoBackend(Backend):
         "constraint_timeconst_steps": Setting(
             2.0, float,
             "Closure equalities: solref time constant in time steps (solref[0] = steps * "
-            "dt) instead of MuJoCo's 0.02 s, which gave ~1 mm loop errors. MuJoCo clamps "
-            "it to 2 dt unless refsafe is off; measured on the scotch yoke with RK4: 2 is "
-            "best (1: same trajectory, 20x the force error; 0.5: 15x worse; 0.3: "
-            "unstable). Engine default: MuJoCo XML reference, equality/solref "
-            "'\"0.02 1\"' (0.02 s, i.e. 0.02/dt steps).",
+            "dt) instead of the engine default, a fixed duration of many steps: a "
+            "constraint that relaxes that slowly lets the loops open under load (the "
+            "out-of-the-box study measures by how much). MuJoCo clamps it to 2 dt unless "
+            "refsafe is off, so 2 is the stiffest it takes by default; on the scotch yoke "
+            "with RK4 a shorter constant (refsafe off) kept the trajectory but raised the "
+            "force error, and a much shorter one was unstable. Engine default: MuJoCo XML "
+            "reference, equality/solref '\"0.02 1\"' (seconds: over dt in steps).",
             engine_default=0.02, engine_default_in_seconds=True),
         "constraint_dampratio": Setting(
             1.0, float,
             "solref[1] of the closure equalities (1 = critical; below 1 MuJoCo also "
-            "stiffens the constraint: 0.25 was 3x worse, 0.1 unstable with RK4)."),
+            "stiffens the constraint, which worsens the errors and, far enough below, "
+            "makes RK4 unstable)."),
         "constraint_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
             "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
-            "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), so a "
-            "closure force lags the exact one by ~1e-4 relative; 0.999 made the "
-            "trajectory error 10x larger. Engine default: MuJoCo XML reference, "
-            "equality/solimp '\"0.9 0.95 0.001 0.5 2\"'.",
+            "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), and a "
+            "closure force lags the exact one by one minus the impedance (relative), so "
+            "every lower impedance lets the loop's force, and with it the trajectory, lag "
+            "further. Engine default: MuJoCo XML reference, equality/solimp '\"0.9 0.95 "
+            "0.001 0.5 2\"'.",
             engine_default=[0.9, 0.95, 0.001, 0.5, 2.0]),
         "refsafe": Setting(
             True, bool,
             "MuJoCo's default (on): solref time constants below 2 dt are raised to 2 dt. "
-            "Off lets constraint_timeconst_steps < 2 act (measured: no gain)."),
+            "Off lets constraint_timeconst_steps < 2 act (no gain: see "
+            "constraint_timeconst_steps)."),
         "diagexact": Setting(
             True, bool,
             "true (MuJoCo default false): mjENBL_DIAGEXACT, the constraint regularisation "
             "uses the exact diagonal of J M^-1 J^T instead of the body_invweight0 "
-            "estimate; with the estimate the scotch yoke's slot force was 6 % low at t = "
-            "0 and its violation 3e-6 m (5e-9 m exact). Engine default: MuJoCo XML "
+            "estimate (taken once, at the reference configuration); with the estimate a "
+            "constraint's softness is wrong wherever the true diagonal departs from it, "
+            "so the scotch yoke's slot force starts low and its violation grows (the "
+            "out-of-the-box study measures by how much). Engine default: MuJoCo XML "
             "reference, option/flag/diagexact '\"disable\"'.",
             engine_default=False),
         "slider_mass_ratio": Setting(
             0.3, float,
             "Mass of each point-on-line slider as a fraction of the largest point mass "
             "its pin body can give up (the rest keeps a positive inertia); it is taken "
-            "out of the pin body (exact while the constraint holds). Lighter sliders pass "
-            "less inertial force through the soft connect but condition it worse across "
-            "rotating slots; 0.3 measured best (0.02-0.9: within 5x)."),
+            "out of the pin body (exact while the constraint holds). Lighter sliders "
+            "pass less inertial force through the soft connect but condition it worse "
+            "across rotating slots; the harness's value sits between the two effects, "
+            "where the results depend least on it."),
         "massless_mass_ratio": Setting(
             3e-4, float,
             "Substitute mass of a massless body that a constraint or point force loads "
             "(e.g. a massless pin in a slot), times the lightest body's mass; weight "
-            "cancelled. Not compensated: it adds inertia, while a lighter one softens the "
-            "constraints through it (their stiffness scales with the mass they move). "
-            "Measured on the slotted link of Fig. 34: 3e-4 and 1e-3 give similar "
-            "trajectories (~5e-3), 1e-3 three times the frequency error (6e-4), 1e-2 and "
-            "1e-4 2x-8x worse trajectories."),
+            "cancelled. Not compensated: it adds inertia, while a lighter one softens "
+            "the constraints through it (their stiffness scales with the mass they "
+            "move). The harness's value balances the two on the slotted link of Fig. 34, "
+            "where both act: heavier or lighter substitutes worsen its trajectory and "
+            "frequency errors."),
         "point_mass_gyration": Setting(
             POINT_MASS_GYRATION, float,
-            "Radius of gyration (m) of the inertia given to a point mass (central inertia "
-            "0), which MuJoCo rejects below mjMINVAL (1e-15; the substitute is at least "
-            "1e-14 kg m^2). The body's moment about a pivot at d grows by the relative "
-            "(r/d)^2 (1e-12 at d = 1 m): a pendulum's period by (r/d)^2/2."),
+            "Radius of gyration (m) of the inertia given to a point mass (central "
+            "inertia 0), which MuJoCo rejects below mjMINVAL (MuJoCo API reference, "
+            "types: '#define mjMINVAL 1E-15 // minimum value in any denominator'; the "
+            "substitute is at least POINT_MASS_INERTIA_FLOOR, above it). The body's "
+            "moment about a pivot at d grows by the relative (r/d)^2, and a pendulum's "
+            "period by (r/d)^2/2: negligible while r is far below the mechanism's "
+            "lengths."),
         "link_mass_ratio": Setting(
             1e-9, float,
             "Substitute mass of a massless kinematic link that cannot be folded (several "
-            "child joints, no constraint on it), times the lightest body's mass; its tree "
-            "children carry the inertia, so it can be tiny (belt arm: 1e-3 gave 3e-6 "
-            "trajectory error, 1e-9 gives 8e-10)."),
+            "child joints, no constraint on it), times the lightest body's mass; its "
+            "tree children carry the inertia, so it can be tiny: the trajectory error it "
+            "adds shrinks with it (belt arm)."),
         "substitute_gravcomp": Setting(
             True, bool,
             "Cancel the weight of substitute bodies whose mass is not taken from a body "
@@ -613,8 +624,8 @@ class MujocoBackend(Backend):
             "with the matrix the step solves (first order in the free coordinates, the "
             "prescribed one on q(t) at every step). The applied force is the actuator "
             "force. MuJoCo has no exact imposed motion: joint equalities with a moving "
-            "reference and mocap welds are soft (1e-2 rad errors), position actuators "
-            "lag."),
+            "reference and mocap welds are soft (they lag the reference by their "
+            "constraint's relaxation), position actuators lag."),
     }
 
     ENGINE_MODULES = ('mujoco',)

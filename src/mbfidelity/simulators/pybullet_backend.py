@@ -567,8 +567,9 @@ class PyBulletBackend(Backend):
             engine_default=True),
         "linear_damping": Setting(
             0.0, float,
-            "Replaces the engine default 0.04 (a velocity-proportional plus quadratic "
-            "drag on every link: -15 % period on a 2 rad swing). Set with its own "
+            "Replaces the engine default (a velocity-proportional plus quadratic drag on "
+            "every link: it takes energy out of every motion and lengthens the period of "
+            "every swing; the out-of-the-box study measures by how much). Set with its own "
             "changeDynamics call: PyBullet's body-level setters (linearDamping, "
             "angularDamping, maxJointVelocity) reset the link index to -1, so "
             "mass/inertia passed in the same call land on the base (it becomes a floating "
@@ -577,13 +578,14 @@ class PyBulletBackend(Backend):
             engine_default=0.04),
         "angular_damping": Setting(
             0.0, float,
-            "Replaces the engine default 0.04 (see linear_damping). Engine default: "
+            "Replaces the engine default (see linear_damping). Engine default: "
             "PyBullet Quickstart Guide, changeDynamics: angularDamping 'angular damping of "
             "the link (0.04 by default)'.",
             engine_default=0.04),
         "max_joint_velocity": Setting(
             1.0e6, float,
-            "Replaces the engine clamp of 100 rad/s (or m/s) on every joint rate. Engine "
+            "Replaces the engine default clamp on every joint rate (rad/s or m/s), which "
+            "silently caps a fast run's rates. Engine "
             "default: PyBullet Quickstart Guide, changeDynamics: maxJointVelocity, "
             "'default maximum joint velocity is 100 units'.",
             engine_default=100.0),
@@ -591,7 +593,8 @@ class PyBulletBackend(Backend):
             True, bool,
             "True: the description's mass and central inertia are set on every link with "
             "changeDynamics(mass, localInertiaDiagonal). Without it a link without a "
-            "collision shape gets inertia 0 (a point mass; -13 % period on the pendulum). "
+            "collision shape gets inertia 0 (a point mass, which shortens a compound "
+            "pendulum's period; the out-of-the-box study measures by how much). "
             "Engine default (False): PyBullet Quickstart Guide, loadURDF flags: without "
             "URDF_USE_INERTIA_FROM_FILE 'Bullet recomputed the inertia tensor based on "
             "mass and volume of the collision shape'; createMultiBody does the same.",
@@ -599,8 +602,11 @@ class PyBulletBackend(Backend):
         "sleeping": Setting(
             False, bool,
             "False: deactivation disabled. PyBullet multibodies created without "
-            "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared joint "
-            "rates stay below 0.05 for 2 s freezes (the small-amplitude scenarios)."),
+            "URDF_ENABLE_SLEEPING do not sleep; when enabled a body whose squared rates "
+            "stay below a threshold for a timeout freezes (the small-amplitude scenarios): "
+            "bullet3 btMultiBody.h, 'INITIAL_SLEEP_EPSILON = btScalar(0.05);  // this is a "
+            "squared velocity (m^2 s^-2)', 'INITIAL_SLEEP_TIMEOUT = btScalar(2);  // in "
+            "seconds'."),
         "massless_link_mass": Setting(
             0.0, float,
             "Mass given to the description's massless link bodies; 0 (default) is exact "
@@ -615,8 +621,9 @@ class PyBulletBackend(Backend):
             "(world-space feedback); its second constraint pass of the articulated-body "
             "algorithm runs with the already updated velocities and the links' Coriolis "
             "accelerations but without the matching m w x v terms: exact on a single link "
-            "(the spurious part vanishes), wrong on chains in motion (1.7 N on the double "
-            "pendulum after 0.15 s)."),
+            "(the spurious part vanishes), wrong on chains in motion (by the missing "
+            "terms, which grow with the links' rates: the double pendulum's reactions "
+            "leave the reference as soon as it swings)."),
         "linearize_step": Setting(
             1e-6, float,
             "Central-difference step (scaled by max(1, |x|)) for dK and dC of "
@@ -626,20 +633,21 @@ class PyBulletBackend(Backend):
             "Global erp (setPhysicsEngineParameter; the only one POINT2POINT and "
             "PRISMATIC constraints obey). The constraint solve is velocity-level, J(q_k) "
             "v_k+1 = -erp Phi(q_k) / dt: 1.0 removes each step's position error and "
-            "leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; erp "
-            "0.2 gave 5x the violation and larger trajectory errors (scotch yoke, "
-            "eccentric cam). Set only for constrained mechanisms."),
+            "leaves a violation of O(dt^2 v^2 curvature) that does not accumulate; a "
+            "smaller erp carries part of each step's error into the next, so the "
+            "violation builds up to a multiple of it and the trajectory errors grow with "
+            "it (scotch yoke, eccentric cam). Set only for constrained mechanisms."),
         "gear_erp": Setting(
             0.0, float,
             "changeConstraint(erp) of the JOINT_GEAR constraints (0: off). A linear "
             "coupling solved at velocity level keeps its initial value exactly once the "
             "solver converges (q_k+1 = q_k + dt v_k+1 and J is constant); the 'GEAR "
-            "drifts' of the engine defaults (1e-5 m of slip in 10 s) came from the "
+            "drifts' of the engine defaults (a slow slip) came from the "
             "solver's early exit (solver_residual_threshold), not from a missing erp. "
             "When > 0, relativePositionTarget is set to the coupling's constant."),
         "constraint_max_force": Setting(
             1.0e12, float,
-            "maxForce of every constraint; the engine default 500 N would clip the "
+            "maxForce of every constraint; the engine default would clip the "
             "constraint forces (e.g. the start of a fast run). Engine default: bullet3 "
             "examples/SharedMemory/SharedMemoryPublic.h, b3UserConstraint: "
             "m_maxAppliedForce = 500.",
@@ -647,13 +655,15 @@ class PyBulletBackend(Backend):
         "solver_iterations": Setting(
             50, int,
             "numSolverIterations (engine default 50): the projected Gauss-Seidel sweeps "
-            "over all constraint rows; 10 gave the same results here, 200 cost 2x time."),
+            "over all constraint rows; fewer sweeps already gave the same results on the "
+            "mechanisms here and more only cost time, so the default is kept as a margin."),
         "solver_residual_threshold": Setting(
             0.0, float,
-            "solverResidualThreshold; the engine default 1e-7 ends the sweeps early (that "
-            "is why the iteration count 'had no effect'): it left a 1e-5 m drift of the "
-            "rolling coupling and 5e-7 of the belt over 10 s; 0 runs every sweep (belt "
-            "and rolling couplings then hold to 1e-15; same wall time). Engine default: "
+            "solverResidualThreshold; the engine default ends the sweeps early (that is "
+            "why the iteration count 'had no effect'), with a residual left in every "
+            "step's solve, so the velocity-level couplings (rolling, belt) slip a little "
+            "at each step and drift; 0 runs every sweep (the couplings then hold to "
+            "round-off, at the same wall time). Engine default: "
             "PyBullet Quickstart Guide, setPhysicsEngineParameter: solverResidualThreshold "
             "'default value is 1e-7'.",
             engine_default=1e-7),
@@ -675,7 +685,8 @@ class PyBulletBackend(Backend):
             1e-6, float,
             "Inertia of the rotor links of point_on_line='prismatic', relative to the "
             "smallest body inertia. The rotor turns with the slot body, so its inertia is "
-            "the substitute's only error; results were identical from 1e-3 to 1e-12."),
+            "the substitute's only error, which shrinks with it; the results do not "
+            "depend on it over a wide range of decades."),
         "slider_mass_ratio": Setting(
             1e-6, float,
             "Mass of the slider links of point_on_line='slider', relative to the smallest "
@@ -685,8 +696,9 @@ class PyBulletBackend(Backend):
             "Mass (and, on a revolute joint, inertia) given to a massless body that "
             "carries nothing but is held by a closure constraint (e.g. a pin on its own "
             "guide): zero would make the articulated-body algorithm singular. Relative to "
-            "the smallest body mass/inertia; results are the same from 1e-3 to 1e-7, 1e-8 "
-            "diverged (slotted link)."),
+            "the smallest body mass/inertia: too light a leaf leaves the solve so badly "
+            "conditioned that it diverges (slotted link); above that the results do not "
+            "depend on it."),
         "contact_friction": Setting(
             1.0, float,
             "Friction coefficient of the ring (the disc has 1; Bullet multiplies them). "
@@ -711,8 +723,8 @@ class PyBulletBackend(Backend):
             "the free coordinates keep the scheme's first order; the actuator force is the "
             "motor's applied force (getJointState()[3]) of the step that starts at the "
             "sample. Replaces resetJointState each step (the free bodies would never feel "
-            "the acceleration: 0.40 rad on a driven pendulum) and the default motor gains "
-            "(1.2e-2)."),
+            "the acceleration, and a driven pendulum swings wrong) and the default motor "
+            "gains (a soft motor lags the imposed motion)."),
         "prescribed_motor_force": Setting(
             1.0e9, float,
             "Maximum force/torque of a prescribed coordinate's velocity motor: large enough "
