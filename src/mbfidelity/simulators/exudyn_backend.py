@@ -452,14 +452,15 @@ class ExudynBackend(Backend):
             "as is: no alternation once the start is consistent). GeneralizedAlpha (index 3, "
             "constrained_spectral_radius: q(t) to round-off, free coordinates order 2, but "
             "its multiplier belongs to the algorithmic time, so the actuator force is only "
-            "first order; measured on an inertial shaker: 8.8e-3 relative at dt 1e-3, "
-            "8.8e-4 at 1e-4, against 8.5e-6 / 8.5e-8 with TrapezoidalIndex2)."),
+            "first order, against second order with TrapezoidalIndex2, as an inertial "
+            "shaker's actuator force shows)."),
         "constrained_spectral_radius": Setting(
             0.9, float,
             "GeneralizedAlpha on constrained mechanisms: Exudyn's default 0.9 kept; rho = "
-            "1 (no numerical damping) lets the index-3 multipliers oscillate (measured: "
-            "scotch yoke slot force error 1e4, slotted bar arctan damper failed Newton); "
-            "0.8-0.99 changed trajectory errors by < 10 %."),
+            "1 (no numerical damping) lets the index-3 multipliers oscillate undamped (the "
+            "scotch yoke's slot force is swamped by the oscillation, the slotted bar's "
+            "arctan damper fails Newton); values near the default change the trajectory "
+            "errors little."),
         "automatic_step_size": Setting(
             False, bool,
             "Exudyn default True lets error-controlled explicit solvers change the step; "
@@ -513,15 +514,18 @@ class ExudynBackend(Backend):
             "sends every law through Python user functions (same model, slower)."),
         "write_solution_file": Setting(
             False, bool,
-            "Exudyn default True writes coordinatesSolution.txt every 0.01 s (disk I/O "
-            "inside the timed loop); the backend samples with in-memory sensors at every "
-            "step instead (sensor write period dt replaces the 0.01 s default)."),
+            "Exudyn default True writes coordinatesSolution.txt at every solution write "
+            "period (disk I/O inside the timed loop); the backend samples with in-memory "
+            "sensors at every step instead (sensor write period dt replaces the engine's "
+            "default period)."),
         "linearization_relative_epsilon": Setting(
             1e-4, float,
             "linearize(): relative step of Exudyn's numerical Jacobian (K, D), a forward "
-            "difference. Exudyn default 1e-7 balances truncation and round-off at "
-            "~1e-7..1e-6 absolute error in K and D; with linearization_richardson, 1e-4 "
-            "gives ~1e-10 relative."),
+            "difference. Exudyn's default step, near the square root of the machine "
+            "epsilon u, balances a forward difference's truncation O(eps) against its "
+            "round-off O(u/eps), each then about sqrt(u); with linearization_richardson "
+            "the truncation is O(eps^2), so the harness's larger step cuts the round-off "
+            "while the truncation stays below it."),
         "linearization_richardson": Setting(
             True, bool,
             "linearize(): True evaluates Exudyn's Jacobian at eps and eps/2 and "
