@@ -602,7 +602,8 @@ class DrakeBackend(Backend):
         "linearization_step": Setting(
             1e-6, float,
             "linearize() with a Python force system: step of the central differences of "
-            "the diagram's time derivatives (truncation ~1e-12, round-off ~1e-10); without "
+            "the diagram's time derivatives (truncation O(h^2), round-off O(u/h) with u the "
+            "machine epsilon: both small at the default step); without "
             "one Drake's Linearize differentiates automatically and this is unused."),
     }
 

@@ -566,36 +566,37 @@ class PymunkBackend(Backend):
         "point_mass_gyration": Setting(
             POINT_MASS_GYRATION, float,
             "Radius of gyration r (m) of the moment m r^2 given to a point mass (central "
-            "inertia 0; Chipmunk needs a moment > 0): its moment about a pivot at d grows "
-            "by the relative (r/d)^2 (1e-12 at d = 1 m)."),
+            "inertia 0; Chipmunk needs a moment > 0): its moment about a pivot at d "
+            "grows by the relative (r/d)^2, negligible while r is far below the "
+            "mechanism's lengths."),
         "error_bias": Setting(
             0.0, float,
             "Fraction of a joint's position error left after 1 s, on every constraint. 0 "
-            "removes the whole error in the next step (bias velocity -error/h). Pymunk's "
-            "default (1-0.1)^60 = 1.8e-3 removes only part of it per step, and its "
-            "correction velocity enters the real velocity: measured on the 2 rad compound "
-            "pendulum, 10 s at h = 1e-3, joint gap 1.2e-3 m (O(h)), 0.64 rad trajectory "
-            "error and 5 % energy drift, against 1e-5 m (O(h^2)) and 3.6e-3 rad with 0. "
-            "Engine default: Pymunk API reference, Constraint.error_bias 'Defaults to "
-            "pow(1.0 - 0.1, 60.0)'.",
+            "removes the whole error in the next step (bias velocity -error/h). The "
+            "engine default (a tenth of the error removed per sixtieth of a second, by "
+            "the formula quoted below) removes only part of it per step, and its "
+            "correction velocity enters the real velocity: the joint gap stays O(h) "
+            "instead of O(h^2), and the correction's velocity feeds the trajectory and "
+            "the energy (the out-of-the-box study measures by how much). Engine default: "
+            "Pymunk API reference, Constraint.error_bias 'Defaults to pow(1.0 - 0.1, "
+            "60.0)'.",
             engine_default=0.9 ** 60),
         "iterations": Setting(
             50, int,
             "Gauss-Seidel velocity iterations per step (space.iterations). A single joint "
-            "is solved in one iteration, a chain is not: the small double-pendulum swing's "
-            "reaction error was 65 % with 1, 1.8e-3 (relative) with 10 and 1.4e-4 with 20, "
-            "30, 50 or 100 (trajectories identical from 10 on); the scotch yoke with slider "
-            "substitutes diverged with 10 at slider_mass_fraction 0.1. 50 keeps a margin at "
-            "negligible cost. Engine default: Pymunk API reference, Space.iterations "
-            "'Defaults to 10'.",
+            "is solved in one iteration, a chain is not: a double pendulum's reactions "
+            "keep converging with the iterations after its trajectory has, and a scotch "
+            "yoke with light slider substitutes diverged with the engine default. 50 "
+            "keeps a margin at negligible cost. Engine default: Pymunk API reference, "
+            "Space.iterations 'Defaults to 10'.",
             engine_default=10),
         "start_iterations": Setting(
             1000, int,
             "Gauss-Seidel iterations of the first step only, which has no previous "
-            "impulses to warm-start from: with 50, a closed loop or a slider substitute is "
-            "left unconverged (the rhombus's slot force at samples 1-3 0.07 N off, 9e-3 of "
-            "its scale; 1e-5 with 1000). Later steps converge from the warm start; tree "
-            "mechanisms were already converged (bit-identical results)."),
+            "impulses to warm-start from: with only the per-step iterations, a closed "
+            "loop or a slider substitute is left unconverged (the rhombus's slot force "
+            "is off at the first samples). Later steps converge from the warm start; "
+            "tree mechanisms were already converged (bit-identical results)."),
         "damping": Setting(
             1.0, float,
             "space.damping, the fraction of velocity kept after 1 s: Pymunk's default 1 (no "
@@ -609,12 +610,13 @@ class PymunkBackend(Backend):
             "When force elements are evaluated in a step. Chipmunk moves positions (x += "
             "h v) before it applies body.force, so a force from the state sampled before "
             "space.step() ('step_start', what user code usually does) makes the step "
-            "explicit Euler for it: energy grew by 114 % (elastic pendulum) and 90 % "
-            "(sliding block) in 10 s at h = 1e-3. 'position_updated' evaluates the laws at "
-            "x + h v and t + h, where Chipmunk pre-steps its constraints and its own "
-            "DampedSpring: a consistent semi-implicit Euler step (energy drift 0.4-0.5 %). "
-            "Pymunk has no hook for laws of length rate or time, so the backend applies "
-            "body forces and torques (no engine default is replaced)."),
+            "explicit Euler for it, which pumps energy into every oscillation (elastic "
+            "pendulum, sliding block). 'position_updated' evaluates the laws at x + h v "
+            "and t + h, where Chipmunk pre-steps its constraints and its own "
+            "DampedSpring: a consistent semi-implicit Euler step (symplectic: on "
+            "conservative laws its energy error stays bounded, O(h)). Pymunk has no hook for laws of length rate or "
+            "time, so the backend applies body forces and torques (no engine default is "
+            "replaced)."),
         "groove_half_length": Setting(
             1000.0, float,
             "Extent (m) of a Chipmunk groove (a finite segment whose ends act as stops) on "
@@ -626,40 +628,36 @@ class PymunkBackend(Backend):
             "exact: the POINT_ON_LINE expression) as this fraction of the host body's "
             "effective mass at its point, m I / (I + m d^2); must stay below 1 (the host "
             "keeps a positive moment). With slider_compensation it does not enter the "
-            "dynamics (scotch yoke, large: trajectory error 3.93e-3 at 0.1, 0.3 and 0.5), "
-            "only the convergence of the Gauss-Seidel solve, slow for a light body between "
-            "heavy ones: from the cold start the slot force at samples 1-3 was 0.23 off at "
-            "0.1 and 6.6e-3 at 0.5 with 50 iterations; the rhombus loop diverged at 0.05 "
-            "with 50 iterations (exact with 500)."),
+            "dynamics (the scotch yoke's trajectory is the same at every fraction), only "
+            "the convergence of the Gauss-Seidel solve, slow for a light body between "
+            "heavy ones: from the cold start a lighter slider leaves the slot force "
+            "further off at the first samples, and a very light one made the rhombus "
+            "loop diverge unless the iterations were raised."),
         "slider_compensation": Setting(
             True, bool,
             "true: the substitute's mass (and a slot carrier's moment) is taken out of "
             "its host (mass, centre of gravity via body.center_of_gravity, moment), so "
             "host + substitute have exactly the described inertia; false: the substitute "
-            "adds its mass to the mechanism (teaching mode: shows the dynamic effect of a "
-            "slider mass; measured with fraction 0.05, 10 s: trajectory error 0.33-1.9 of "
-            "the amplitude on the scotch yoke, 0.37-140 on the slotted link, against "
-            "3-10e-3 compensated)."),
+            "adds its mass to the mechanism (teaching mode: shows the dynamic effect of "
+            "a slider mass, the error that the compensation removes; the scotch yoke and "
+            "the slotted link show it)."),
         "prescribed_motion": Setting(
             _DRIVE_ROUTES[0], _DRIVE_ROUTES,
-            "How a Prescribed coordinate q(t) is imposed (Pymunk has no driven joint; the "
-            "PRESCRIBED expression says how each route builds it). 'kinematic_on_world' "
-            "(default): a joint on the world makes its child a Body.KINEMATIC driver (its "
-            "centre of gravity on the hinge); a joint on a free body (a rotor on a frame, "
-            "an inner mass in a frame) is a moving constraint, so the frame feels the "
-            "driven body's inertia. 'moving_constraint': the constraint on the world too "
-            "(a light driven body between the world and a heavy child makes the "
-            "Gauss-Seidel solve diverge: a block running out of the slot of a disc turned "
-            "at 10.5 rad/s, 2 s, 0.79 of the amplitude off at 50 iterations, 1.3e-2 with "
-            "5000). Either way the coordinate starts with the rate (q(h) - q0)/h. "
-            "Measured with the default, dt 1e-3 -> 1e-4 (max error; force relative to its "
-            "max; 2 s): a block on a base moved at its natural frequency, free 1.4e-4 -> "
-            "1.4e-5 m, force 3.0e-3 -> 3.0e-4; a block on a spring in the slot of a disc "
-            "turned at 5, 9.5, 10.5 rad/s, free 3.0e-4 -> 3.1e-5, 2.2e-3 -> 2.3e-4, 0.43 "
-            "-> 0.041 m (of 34 m), force 2.9e-3 -> 3.0e-4, 4.5e-3 -> 4.5e-4, 2.8e-2 -> "
-            "2.7e-3; a frame on a spring shaken by an unbalanced rotor (kept turning "
-            "relative to it) at the natural frequency, free 1.1e-4 -> 8.8e-6 m, force "
-            "3.7e-2 -> 3.7e-3; prescribed coordinate error 0 (round-off) in all."),
+            "How a Prescribed coordinate q(t) is imposed (Pymunk has no driven joint; "
+            "the PRESCRIBED expression says how each route builds it). "
+            "'kinematic_on_world' (default): a joint on the world makes its child a "
+            "Body.KINEMATIC driver (its centre of gravity on the hinge); a joint on a "
+            "free body (a rotor on a frame, an inner mass in a frame) is a moving "
+            "constraint, so the frame feels the driven body's inertia. "
+            "'moving_constraint': the constraint on the world too (a light driven body "
+            "between the world and a heavy child makes the Gauss-Seidel solve diverge, "
+            "or converge only with far more iterations: a block running out of the slot "
+            "of a turning disc). Either way the coordinate starts with the rate (q(h) - "
+            "q0)/h. With the default, the free coordinates and the actuator force "
+            "converge at the scheme's first order in the step, and the prescribed "
+            "coordinate is exact to round-off (a block on a base moved at its natural "
+            "frequency, a block on a spring in the slot of a turning disc, a frame on a "
+            "spring shaken by an unbalanced rotor)."),
         "contact_friction": Setting(
             10.0, float,
             "Friction coefficient of a RollingContact (Chipmunk multiplies the two shapes' "
