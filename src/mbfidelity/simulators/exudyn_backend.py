@@ -469,7 +469,7 @@ class ExudynBackend(Backend):
             engine_default=True),
         "ga_spectral_radius": Setting(
             1.0, float,
-            "GeneralizedAlpha as 'solver' (unconstrained mechanisms). Exudyn default 0.9 "
+            "GeneralizedAlpha as 'solver' (unconstrained mechanisms). The engine default "
             "adds numerical damping (energy decays); 1.0 removes it (no constraints, so "
             "rho = 1 is stable). Constrained: constrained_spectral_radius. Engine default: "
             "Exudyn documentation, SimulationSettings "
@@ -484,13 +484,13 @@ class ExudynBackend(Backend):
             engine_default=True),
         "newton_relative_tolerance": Setting(
             1e-13, float,
-            "Implicit solvers only. Exudyn default 1e-8 limits the accuracy of small "
+            "Implicit solvers only. The engine default limits the accuracy of small "
             "motions; tightened. Engine default: Exudyn documentation, SimulationSettings "
             "timeIntegration.newton.relativeTolerance = 1e-8.",
             engine_default=1e-8),
         "newton_absolute_tolerance": Setting(
             1e-14, float,
-            "Implicit solvers only. Exudyn default 1e-10; tightened for small amplitudes. "
+            "Implicit solvers only. The engine default, tightened for small amplitudes. "
             "Engine default: Exudyn documentation, SimulationSettings "
             "timeIntegration.newton.absoluteTolerance = 1e-10.",
             engine_default=1e-10),

@@ -527,7 +527,7 @@ class MujocoBackend(Backend):
             "makes RK4 unstable)."),
         "constraint_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
-            "solimp of the closure equalities instead of '0.9 0.95 0.001 0.5 2': the "
+            "solimp of the closure equalities instead of the engine default: the "
             "impedance 0.9999 is MuJoCo's ceiling (higher values are clamped), and a "
             "closure force lags the exact one by one minus the impedance (relative), so "
             "every lower impedance lets the loop's force, and with it the trajectory, lag "
@@ -588,14 +588,14 @@ class MujocoBackend(Backend):
         "contact_timeconst_steps": Setting(
             2.0, float,
             "RollingContact: solref[0] of the contacts in steps. Engine default: MuJoCo "
-            "XML reference, geom/solref '\"0.02 1\"' (0.02 s, i.e. 0.02/dt steps).",
+            "XML reference, geom/solref '\"0.02 1\"' (seconds: over dt in steps).",
             engine_default=0.02, engine_default_in_seconds=True),
         "contact_dampratio": Setting(
             1.0, float,
             "RollingContact: solref[1] of the contacts."),
         "contact_solimp": Setting(
             [0.9999, 0.9999, 0.001, 0.5, 2.0], list,
-            "RollingContact: solimp of the contacts (MuJoCo's default 0.9 0.95 lets the "
+            "RollingContact: solimp of the contacts (the engine default lets the "
             "rolling contact slip and lose energy). Engine default: MuJoCo XML "
             "reference, geom/solimp '\"0.9 0.95 0.001 0.5 2\"'.",
             engine_default=[0.9, 0.95, 0.001, 0.5, 2.0]),
