@@ -524,8 +524,8 @@ class ExudynBackend(Backend):
             "difference. Exudyn's default step, near the square root of the machine "
             "epsilon u, balances a forward difference's truncation O(eps) against its "
             "round-off O(u/eps), each then about sqrt(u); with linearization_richardson "
-            "the truncation is O(eps^2), so the harness's larger step cuts the round-off "
-            "while the truncation stays below it."),
+            "the truncation is O(eps^2), so a larger step (the harness's) cuts the "
+            "round-off u/eps while the truncation stays small."),
         "linearization_richardson": Setting(
             True, bool,
             "linearize(): True evaluates Exudyn's Jacobian at eps and eps/2 and "
