@@ -835,8 +835,8 @@ class ExudynBackend(Backend):
         (`constraint_manifold_eigenvalues`) from the tree's M, K, D (`_tree_mkd`) and
         Exudyn's forces f and constraint Jacobian C (n x m, ``ComputeJacobianAE``): the
         null-space projection ``ComputeODE2Eigenvalues`` uses, with the constraint stiffness
-        d(C lam)/du it leaves out (without it the loaded slot of the eccentric cam came out
-        2.7 % low)."""
+        d(C lam)/du it leaves out (without it a loaded slot's frequency, the eccentric cam's,
+        comes out low)."""
         cfg, cmap = system.cfg, system.geo.cmap
         u_eq = np.linalg.solve(cmap.T, q_eq - cmap.c)
 

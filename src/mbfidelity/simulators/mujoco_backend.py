@@ -938,10 +938,9 @@ class MujocoBackend(Backend):
         matrix: the engine's linearization, kept as a cross-check), at the amplitude
         `RELEASE_AMPLITUDE` l, and integrated with MuJoCo's Euler (semi-implicit; its
         implicit integrators do not run flex). The fit's own error (`resolution`, its
-        distance to the linearization, which bounds it):
-        measured 1e-12..5e-8 (the linear prediction's residual is ~1e-14 of the record, so
-        most of that distance is the linearization's round-off), far below the element's
-        error (>= 8e-4 at N = 32)."""
+        distance to the linearization, which bounds it, is reported with each frequency; the
+        linear prediction's residual is at round-off of the record, so most of that
+        distance is the linearization's own round-off."""
         self.check_beam_request(beam, kind, elements, settings,
                                 "the flex route (its integrator and step are fixed)")
         import mujoco

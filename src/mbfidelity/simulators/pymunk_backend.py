@@ -1043,7 +1043,7 @@ class PymunkBackend(Backend):
         `reactions.motion_forces`): in a tree, on the joint child's subtree; with closure
         constraints, the balance of every description body, made of its engine parts
         (`_parts`). Chipmunk computes that impulse at the position-updated configuration
-        x(n+1), so it is given to sample n+1 (measured on the pendulums: 3.5-40x closer to
+        x(n+1), so it is given to sample n+1 (on the pendulums it is several times closer to
         the model's reaction at that sample than at sample n); sample 0 has no step before
         it and is NaN. A start with angular velocity shows an O(1) transient at sample 1
         of a tree's reactions: the first step also builds the steady O(h^2) joint gap of
