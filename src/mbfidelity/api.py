@@ -176,8 +176,8 @@ def _analyze_here(system_id: str, params: Mapping[str, float] | None = None) -> 
     import numpy as np
 
     from .analytic.errata import errata
-    from .analytic.linear import (find_equilibria, operating_equilibrium,
-                                  oscillatory_instability)
+    from .analytic.linear import find_equilibria, operating_equilibrium
+    from .analytic.modes import oscillatory_instability
 
     system = _system(system_id)
     try:

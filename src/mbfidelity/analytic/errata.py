@@ -688,7 +688,7 @@ def printed_model_frequencies(system: System, pf: PrintedFormula,
                               values: Mapping[str, float]) -> np.ndarray | None:
     """|s| of the modes (rad/s) when the printed M, K, C, kinetic or potential energy or
     frequency replaces the derived one at the equilibrium it refers to."""
-    from .linear import quadratic_eigenvalues
+    from .modes import quadratic_eigenvalues
 
     values = _with_relations(system, dict(values), pf)
     model = numeric_model(system.id, values)

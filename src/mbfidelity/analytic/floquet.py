@@ -154,7 +154,8 @@ def driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
 
 
 def _driven_floquet(system, values) -> list[tuple[np.ndarray, FloquetResult]]:
-    from .linear import companion_matrix, driven_coefficients, driven_rest_states
+    from .linear import driven_coefficients, driven_rest_states
+    from .modes import companion_matrix
     from .numeric import numeric_model
 
     model = numeric_model(system.id, dict(values))

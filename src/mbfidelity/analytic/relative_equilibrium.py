@@ -39,7 +39,7 @@ import sympy as sp
 
 from ..systems import System
 from .derivation import derivation_of
-from .linear import Equilibrium, Mode, is_stable, modes_from_eigenvalues, quadratic_eigenvalues
+from .modes import Equilibrium, Mode, is_stable, modes_from_eigenvalues, quadratic_eigenvalues
 from .numeric import NumericModel, numeric_model
 
 #: relative size of K r, C r (and of the change of the coefficients at a shifted, moving

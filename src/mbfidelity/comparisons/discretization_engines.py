@@ -13,7 +13,8 @@ from __future__ import annotations
 from typing import Mapping, Sequence
 
 from ..analytic.discretization import DiscretizationStudy, structural_parameter
-from ..analytic.linear import modes_from_eigenvalues, operating_equilibrium
+from ..analytic.linear import operating_equilibrium
+from ..analytic.modes import modes_from_eigenvalues
 from ..simulators import get_backend
 from ..systems import System
 from . import tolerances

@@ -17,9 +17,9 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from .. import __version__
-from ..analytic.linear import (ZERO_REAL_PART, companion_matrix, find_equilibria,
-                               operating_equilibrium, oscillatory_instability,
-                               unexcited_values, wrap_angles)
+from ..analytic.linear import (find_equilibria, operating_equilibrium, unexcited_values,
+                               wrap_angles)
+from ..analytic.modes import ZERO_REAL_PART, companion_matrix, oscillatory_instability
 from ..analytic.numeric import contact_forces, numeric_model
 from ..analytic.reference import reference, sensitivity
 from ..analytic.steady_state import (excitation_frequencies, observable_functions,
@@ -1043,7 +1043,7 @@ def _compare_frequencies(system, backend, values, dt, t_end, settings, result, k
     with contained(result, "frequency", "linearization"):
         lin = backend.linearize(mech, eq.q, settings, dt)
     if lin is not None:
-        from ..analytic.linear import modes_from_eigenvalues
+        from ..analytic.modes import modes_from_eigenvalues
 
         got = [m for m in modes_from_eigenvalues(lin.eigenvalues) if m.frequency_hz > 0]
         discrete_order = lin.extra.get("discrete_order")

@@ -29,7 +29,7 @@ from ..analytic.errata import (Erratum, SingularPrintedModel, _equilibrium_at, _
                                _one_equation_each, _term_scale, _with_relations, errata,
                                printed_model_frequencies, printed_model_trajectory,
                                printed_multiplier_trajectory)
-from ..analytic.linear import modes_from_eigenvalues
+from ..analytic.modes import modes_from_eigenvalues
 from ..analytic.numeric import numeric_model
 from ..analytic.reference import reference
 from ..simulators import all_backends

@@ -547,7 +547,7 @@ def constraint_manifold_eigenvalues(
     structurally zero eigenvalue, which the projection's round-off would turn into a tiny
     frequency. The facts: the step, the multipliers, the equilibrium's residual
     max |C lam - f| and the rank of C."""
-    from ..analytic.linear import quadratic_eigenvalues
+    from ..analytic.modes import quadratic_eigenvalues
 
     n = len(u_eq)
     f, C = forces_and_jacobian(u_eq)

@@ -37,7 +37,7 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..analytic.linear import quadratic_eigenvalues
+from ..analytic.modes import quadratic_eigenvalues
 from ..systems._continua import Beam
 from ..systems.model import (WORLD, Body, CoordinateForce, LinearCoupling, Mechanism,
                              PointOnLine, PointOnPoint, PointToPoint, Prescribed, Prismatic,

@@ -14,7 +14,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from ..analytic.linear import quadratic_eigenvalues
+from ..analytic.modes import quadratic_eigenvalues
 from ..systems._continua import Beam
 from ..systems.model import Mechanism
 from . import mujoco_mjcf

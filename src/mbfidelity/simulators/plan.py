@@ -64,7 +64,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ..analytic.linear import quadratic_eigenvalues
+from ..analytic.modes import quadratic_eigenvalues
 from ..systems.model import (
     COORD,
     COORD_RATE,

@@ -33,7 +33,7 @@ from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from ..analytic.linear import quadratic_eigenvalues
+from ..analytic.modes import quadratic_eigenvalues
 from ..systems.model import WORLD, LinearCoupling, Mechanism
 from .base import (EXACT, NO_BEAM_ELEMENT, SEMI_IMPLICIT_EULER_STABILITY, SUBSTITUTE,
                    UNSUPPORTED, Backend, BareLoop, BeamElement, ElementBuilders, Expression,
