@@ -70,14 +70,13 @@ at a fixed step (`CONVERGENCE_SETTINGS`), and the discrete plant at its step.
 from __future__ import annotations
 
 import inspect
-from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Mapping, Sequence
 
 import numpy as np
 
 from ..systems.model import (WORLD, CoordinateForce, LinearCoupling, Mechanism, PointOnLine,
-                             PointOnPoint, PointToPoint, Revolute)
+                             PointOnPoint, PointToPoint)
 from .base import (
     ElementBuilders,
     EXACT,
@@ -114,15 +113,20 @@ from .plan import (
     ROLLING_CONTACT,
     TIME_LOAD,
     CoordinateMap,
+    EnginePlan,
     ForceLaw,
-    coordinate_map,
+    couples_two_engine_values,
     engine_coupling,
     element_kind,
     elements,
     motions,
     num,
     massive_below,
+    unit_axis,
+    vec3,
 )
+from .reactions import outside_forces
+from .script_export import literal
 
 #: order of the solution each integrator propagates (Drake's documentation of each class)
 _ORDER = {"runge_kutta5": 5, "runge_kutta3": 3, "bogacki_shampine3": 3, "radau3": 3,
@@ -237,47 +241,42 @@ def _discrete(mech: Mechanism, cfg: Mapping) -> bool:
                    and _jumps(ForceLaw.of(f).expr) for f in mech.forces))
 
 
-def _coupler(mech: Mechanism, coupling: LinearCoupling
-             ) -> tuple[int, int, float, float] | None:
-    """(joint i0, joint i1, ratio, offset) with v_i0 = ratio v_i1 + offset: the coupling
-    written on the engine joint values (`CoordinateMap.on_engine_values`); None unless it
-    relates exactly two of them."""
-    row, constant = engine_coupling(mech, coupling)
-    nonzero = np.flatnonzero(row)
-    if len(nonzero) != 2:
-        return None
-    i0, i1 = (int(i) for i in nonzero)
-    return i0, i1, float(-row[i1] / row[i0]), constant / float(row[i0])
+class _Built(EnginePlan):
+    """A diagram built from a mechanism on its shared plan (`plan.EnginePlan`: the
+    mechanism, the settings, the coordinate map): what each element's builder adds to
+    (every plant call through the recorder, which `export` writes), then what the force
+    system and the read-out need."""
 
-
-@dataclass
-class _Built:
-    """A diagram built from a mechanism: what each element's builder adds to (every
-    plant call through the recorder, which `export` writes), then what the force system
-    and the read-out need."""
-
-    mech: Mechanism
-    rec: "_Recorder"
-    plant: object
-    cmap: CoordinateMap
-    #: laws as Drake's own elements where they express them (`native_elements`)
-    native: bool
-    bodies: dict                      # description body (and WORLD) -> Drake body
-    #: per description joint: the viscous damping its native coordinate laws give it
-    damping: list
-    #: per native coordinate law (by name): (its joint, stiffness, nominal value, damping)
-    springs: dict
-    joints: list = field(default_factory=list)        # Drake joints, in description order
-    python_laws: list = field(default_factory=list)   # CoordinateForce laws of the LeafSystem
-    python_p2p: list = field(default_factory=list)    # PointToPoint laws of the LeafSystem
-    driven: list = field(default_factory=list)        # motions the LeafSystem imposes
-    #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
-    #: slot's unit direction), for the slider's initial state (`_place_slider`)
-    slots: list = field(default_factory=list)
-    diagram: object = None
-    positions: np.ndarray | None = None   # plant position index of each joint
-    velocities: np.ndarray | None = None  # plant velocity index of each joint
-    forces: object = None             # the Python force system, when there is one
+    def __init__(self, mech: Mechanism, cfg: Mapping, rec: "_Recorder", plant,
+                 discrete: bool) -> None:
+        super().__init__(mech, cfg)
+        self.rec, self.plant = rec, plant
+        rec("", plant.mutable_gravity_field().set_gravity_vector,
+            "plant.mutable_gravity_field().set_gravity_vector", list(self.gravity_vector))
+        #: laws as Drake's own elements where they express them (`native_elements`); on
+        #: the discrete plant every law is explicit, as semi-implicit Euler's gates assume:
+        #: its solver would take the joints' damping implicitly
+        self.native = bool(cfg["native_elements"]) and not discrete
+        #: per native coordinate law (by name): (its joint, stiffness, nominal value, damping)
+        self.springs = _native_coordinate_laws(mech, self.map) if self.native else {}
+        #: per description joint: the viscous damping its native coordinate laws give it
+        self.damping = [0.0] * self.n
+        for j, _, _, d in self.springs.values():
+            self.damping[j] += d
+        #: description body (and WORLD) -> Drake body
+        self.bodies = {WORLD: rec("world", plant.world_body, "plant.world_body")}
+        self.joints: list = []       # Drake joints, in description order
+        self.python_laws: list = []  # CoordinateForce laws of the LeafSystem
+        self.python_p2p: list = []   # PointToPoint laws of the LeafSystem
+        self.driven: list = []       # motions the LeafSystem imposes (their builders')
+        #: per slot: (its slider joint, the pin's body, the pin point, the slot's frame, the
+        #: slot's unit direction), for the slider's initial state (`_place_slider`)
+        self.slots: list = []
+        self.build(_BUILDERS)
+        self.diagram = None
+        self.positions: np.ndarray | None = None   # plant position index of each joint
+        self.velocities: np.ndarray | None = None  # plant velocity index of each joint
+        self.forces = None                         # the Python force system, if any
 
     @property
     def python_forces(self) -> bool:
@@ -290,36 +289,32 @@ class _Built:
         from pydrake.multibody.tree import FixedOffsetFrame
 
         rec = self.rec
-        point = [num(anchor[0]), num(anchor[1]), 0.0]
         pose = rec(None, RigidTransform, "RigidTransform",
                    rec(None, RotationMatrix.MakeZRotation, "RotationMatrix.MakeZRotation",
-                       angle), point)
+                       angle), vec3(anchor))
         parent = rec(None, self.bodies[body].body_frame,
                      f"{rec.code(self.bodies[body])}.body_frame")
         return rec(f"frame_{name}", self.plant.AddFrame, "plant.AddFrame",
                    rec(None, FixedOffsetFrame, "FixedOffsetFrame", name, parent, pose))
 
 
-def _native_coordinate_laws(mech: Mechanism, cmap: CoordinateMap, native: bool
+def _native_coordinate_laws(mech: Mechanism, cmap: CoordinateMap
                             ) -> dict[str, tuple[int, float, float, float]]:
     """Per coordinate law that Drake's own elements hold (by name): (joint, stiffness,
-    nominal value, damping). A law goes to them when its coordinate is r v_j, one engine
-    joint value (COORD = sum sign q_i = (sum sign T_i) v + sum sign c_i): then
-    tau_j = r F(r v_j, r v_j') = r a + r^2 b v_j + r^2 c v_j', a spring of stiffness
-    k = -r^2 b >= 0 and nominal value r a / k, and a damper -r^2 c >= 0. The joints take
+    nominal value, damping). A law goes to them when it is linear on one engine joint
+    value v_j (`CoordinateMap.joint_spring`: tau_j = force - k v_j - d v_j'), a spring of
+    stiffness k >= 0 and nominal value force / k, and a damper d >= 0. The joints take
     the damping when they are built, so it is known before the laws' own builders run."""
     held = {}
     for kind, f in elements(mech):
-        if kind != COORDINATE_FORCE_LINEAR or not native:
+        if kind != COORDINATE_FORCE_LINEAR:
             continue
-        target = cmap.law_target(f.weights(mech.coordinates))
-        if target is None:
+        spring = cmap.joint_spring(f.weights(mech.coordinates), ForceLaw.of(f).linear)
+        if spring is None:
             continue
-        j, r = target
-        a, b, c = ForceLaw.of(f).linear
-        k, d = -r * r * b, -r * r * c
-        if k >= 0 and d >= 0 and (k > 0 or a == 0):
-            held[f.name] = (j, k, r * a / k if k > 0 else 0.0, d)
+        j, force, k, d = spring
+        if k >= 0 and d >= 0 and (k > 0 or force == 0):
+            held[f.name] = (j, k, force / k if k > 0 else 0.0, d)
     return held
 
 
@@ -328,6 +323,16 @@ _BUILDERS = ElementBuilders()
 _builds = _BUILDERS.builds
 
 
+@_builds(BODY, Expression(EXACT, "a rigid body with its mass and central inertia (zero "
+                                 "central inertia accepted: point masses are exact)"))
+@_builds(
+    MASSLESS_BODY,
+    Expression(EXACT, "a zero-mass body: the articulated inertia stays regular while a "
+                      "massive descendant carries its coordinates",
+               when="a massive body below it", applies=massive_below),
+    Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the plant's "
+                            "mass matrix would be singular",
+               when="only massless bodies below it"))
 def _body(build: _Built, body) -> None:
     from pydrake.multibody.tree import SpatialInertia, UnitInertia
 
@@ -339,49 +344,26 @@ def _body(build: _Built, body) -> None:
                        rec(None, UnitInertia, "UnitInertia", *unit)))
 
 
-_builds(BODY, Expression(EXACT, "a rigid body with its mass and central inertia (zero "
-                                "central inertia accepted: point masses are exact)"))(_body)
-_builds(
-    MASSLESS_BODY,
-    Expression(EXACT, "a zero-mass body: the articulated inertia stays regular while a "
-                      "massive descendant carries its coordinates",
-               when="a massive body below it", applies=massive_below),
-    Expression(UNSUPPORTED, "it carries no mass and no massive body below it: the plant's "
-                            "mass matrix would be singular",
-               when="only massless bodies below it"))(_body)
-
-
-def _add_joint(build: _Built, made) -> None:
-    """A description joint into the plant (the joints come in description order)."""
-    rec = build.rec
-    build.joints.append(rec(f"joint_{len(build.joints)}", build.plant.AddJoint,
-                            "plant.AddJoint", made))
-
-
 @_builds(REVOLUTE, Expression(EXACT, "RevoluteJoint about z between frames at the anchors "
                                      "(the parent's turned by the angle offset)"))
-def _revolute(build: _Built, joint: Revolute) -> None:
-    from pydrake.multibody.tree import RevoluteJoint
-
-    jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor,
-                     num(joint.angle_offset))
-    jc = build.frame(joint.child, f"{joint.name}_on_child", joint.child_anchor, 0.0)
-    _add_joint(build, build.rec(
-        None, RevoluteJoint, "RevoluteJoint", joint.name, jp, jc, [0.0, 0.0, 1.0],
-        damping=build.damping[len(build.joints)]))
-
-
 @_builds(PRISMATIC, Expression(EXACT, "PrismaticJoint along the unit axis"))
-def _prismatic(build: _Built, joint) -> None:
-    from pydrake.multibody.tree import PrismaticJoint
+def _joint(build: _Built, joint) -> None:
+    """A description joint into the plant (the joints come in description order): a
+    hinge's frame on the parent turned by the angle offset, a slide's frame on the child
+    by minus it."""
+    from pydrake.multibody.tree import PrismaticJoint, RevoluteJoint
 
-    axis = np.array([num(joint.axis[0]), num(joint.axis[1]), 0.0])
-    jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor, 0.0)
+    hinge, offset = element_kind(joint) == REVOLUTE, num(joint.angle_offset)
+    jp = build.frame(joint.parent, f"{joint.name}_on_parent", joint.parent_anchor,
+                     offset if hinge else 0.0)
     jc = build.frame(joint.child, f"{joint.name}_on_child", joint.child_anchor,
-                     -num(joint.angle_offset))
-    _add_joint(build, build.rec(
-        None, PrismaticJoint, "PrismaticJoint", joint.name, jp, jc,
-        axis / np.linalg.norm(axis), damping=build.damping[len(build.joints)]))
+                     0.0 if hinge else -offset)
+    kind, axis = ((RevoluteJoint, [0.0, 0.0, 1.0]) if hinge
+                  else (PrismaticJoint, np.array(unit_axis(joint))))
+    build.joints.append(build.rec(
+        f"joint_{len(build.joints)}", build.plant.AddJoint, "plant.AddJoint",
+        build.rec(None, kind, kind.__name__, joint.name, jp, jc, axis,
+                  damping=build.damping[len(build.joints)])))
 
 
 def _point_to_point(build: _Built, f: PointToPoint) -> None:
@@ -407,9 +389,8 @@ def _point_to_point(build: _Built, f: PointToPoint) -> None:
                       [0.0] * 3, [0.0] * 3, [stiffness] * 3, [0.0] * 3)
     else:
         element = rec(None, LinearSpringDamper, "LinearSpringDamper",
-                      build.bodies[f.body_a], [num(f.point_a[0]), num(f.point_a[1]), 0.0],
-                      build.bodies[f.body_b], [num(f.point_b[0]), num(f.point_b[1]), 0.0],
-                      free_length, stiffness, damper)
+                      build.bodies[f.body_a], vec3(f.point_a), build.bodies[f.body_b],
+                      vec3(f.point_b), free_length, stiffness, damper)
     rec("", build.plant.AddForceElement, "plant.AddForceElement", element)
 
 
@@ -454,13 +435,8 @@ _builds(COORDINATE_FORCE_CUSTOM,
                           "evaluated at the start of each step of the discrete plant (the "
                           "error control cannot cross a jump: it has no event location)",
                    when="the law jumps (dry friction)"))(_coordinate_force)
-_FORCES = {PointToPoint: _point_to_point, CoordinateForce: _coordinate_force}
-
-
-@_builds(TIME_LOAD, Expression(EXACT, "a LeafSystem evaluated at every integrator stage with "
-                                      "the stage time"))
-def _time_load(build: _Built, f) -> None:
-    _FORCES[type(f)](build, f)  # a law of TIME is never a native element's
+_BUILDERS.builds_time_load(Expression(EXACT, "a LeafSystem evaluated at every integrator stage "
+                                             "with the stage time"))
 
 
 @_builds(POINT_ON_POINT, Expression(SOFT, "AddBallConstraint between the two points on the "
@@ -470,8 +446,7 @@ def _time_load(build: _Built, f) -> None:
                                     reason=SAP_CONSTRAINT))
 def _point_on_point(build: _Built, c: PointOnPoint) -> None:
     build.rec("", build.plant.AddBallConstraint, "plant.AddBallConstraint",
-              build.bodies[c.body_a], [num(c.point_a[0]), num(c.point_a[1]), 0.0],
-              build.bodies[c.body_b], [num(c.point_b[0]), num(c.point_b[1]), 0.0])
+              build.bodies[c.body_a], vec3(c.point_a), build.bodies[c.body_b], vec3(c.point_b))
 
 
 @_builds(
@@ -516,15 +491,19 @@ def _point_on_line(build: _Built, c: PointOnLine) -> None:
     Expression(SOFT, "AddCouplerConstraint v0 = rho v1 + offset on the discrete plant, the "
                      "coupling written on the engine joint values",
                when="it relates two joint values",
-               applies=lambda mech, coupling: _coupler(mech, coupling) is not None,
+               applies=couples_two_engine_values,
                expected_failures=SAP_CONSTRAINT_METRICS, reason=SAP_CONSTRAINT),
     Expression(UNSUPPORTED, "Drake's coupler constraint relates two joints; this coupling "
                             "involves one or more than two joint values",
                when="it relates one or more than two joint values"))
 def _linear_coupling(build: _Built, c: LinearCoupling) -> None:
-    i0, i1, ratio, offset = _coupler(build.mech, c)
+    """v_i0 = ratio v_i1 + offset from the coupling written on the engine joint values,
+    row . v = constant (`plan.engine_coupling`)."""
+    row, constant = engine_coupling(build.mech, c)
+    i0, i1 = (int(i) for i in np.flatnonzero(row))
     build.rec("", build.plant.AddCouplerConstraint, "plant.AddCouplerConstraint",
-              build.joints[i0], build.joints[i1], ratio, offset)
+              build.joints[i0], build.joints[i1], float(-row[i1] / row[i0]),
+              constant / float(row[i0]))
 
 
 _BUILDERS.refuses(ROLLING_CONTACT, "no contact geometry is built: the continuous plant's "
@@ -662,23 +641,7 @@ class DrakeBackend(Backend):
                 "plant.set_discrete_contact_approximation", DiscreteContactApproximation.kSap)
             rec("", plant.set_sap_near_rigid_threshold, "plant.set_sap_near_rigid_threshold",
                 float(cfg["sap_near_rigid_threshold"]))
-        rec("", plant.mutable_gravity_field().set_gravity_vector,
-            "plant.mutable_gravity_field().set_gravity_vector", [0.0, -num(mech.gravity), 0.0])
-        cmap = coordinate_map(mech)
-        # on the discrete plant every law is explicit, as semi-implicit Euler's gates
-        # assume: its solver would take the joints' damping implicitly
-        native = bool(cfg["native_elements"]) and not discrete
-        springs = _native_coordinate_laws(mech, cmap, native)
-        damping = [0.0] * len(mech.joints)
-        for j, _, _, d in springs.values():
-            damping[j] += d
-        built = _Built(mech, rec, plant, cmap, native,
-                       {WORLD: rec("world", plant.world_body, "plant.world_body")},
-                       damping, springs)
-        for kind, element in elements(mech):
-            _BUILDERS[kind](built, element)
-        rec.python_forces = [f.name for f in mech.forces
-                             if any(f is w for w in built.python_p2p + built.python_laws)]
+        built = _Built(mech, cfg, rec, plant, discrete)
         plant.Finalize()
         built.positions = np.array([j.position_start() for j in built.joints], dtype=int)
         built.velocities = np.array([j.velocity_start() for j in built.joints], dtype=int)
@@ -704,7 +667,6 @@ class DrakeBackend(Backend):
         cfg = self.resolve_settings(settings)
         recorder = _Recorder()
         built = self._build(mechanism, cfg, dt, recorder)
-        cmap = built.cmap
         accuracy = ("integrator.set_fixed_step_mode(True)" if cfg["fixed_step"] else
                     f"integrator.set_target_accuracy({float(cfg['target_accuracy'])!r})")
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
@@ -731,8 +693,8 @@ class DrakeBackend(Backend):
             "simulator = Simulator(diagram)",
             "context = plant.GetMyMutableContextFromRoot(simulator.get_mutable_context())",
             "joints = [" + ", ".join(f"joint_{i}" for i in range(len(built.joints))) + "]",
-            f"v0 = {[float(v) for v in cmap.engine_values(q0)]!r}",
-            f"vd0 = {[float(v) for v in cmap.A @ np.asarray(qd0, dtype=float)]!r}",
+            f"v0 = {[float(v) for v in built.map.engine_values(q0)]!r}",
+            f"vd0 = {[float(v) for v in built.map.A @ np.asarray(qd0, dtype=float)]!r}",
             "positions, velocities = np.zeros(plant.num_positions()), "
             "np.zeros(plant.num_velocities())",
             "for joint, value, rate in zip(joints, v0, vd0):  # the engine's joint values",
@@ -752,12 +714,14 @@ class DrakeBackend(Backend):
             "for k in range(1, int(round(1.0 / dt)) + 1):",
             "    simulator.AdvanceTo(k * dt)",
             "v = np.array([plant.GetPositions(context)[j.position_start()] for j in joints])",
-            f"T = np.array({cmap.T.tolist()!r})",
-            f"c = np.array({cmap.c.tolist()!r})",
+            f"T = np.array({built.map.T.tolist()!r})",
+            f"c = np.array({built.map.c.tolist()!r})",
             f"print(dict(zip({list(coordinates)!r}, (T @ v + c).tolist())))",
             ""])
+        python = [f.name for f in mechanism.forces
+                  if any(f is w for w in built.python_p2p + built.python_laws)]
         outside = ([f"the force laws computed by the Python force system: "
-                    f"{', '.join(recorder.python_forces)}"] if recorder.python_forces else [])
+                    f"{', '.join(python)}"] if python else [])
         return text, outside
 
     # --- running -----------------------------------------------------------------------------
@@ -769,8 +733,8 @@ class DrakeBackend(Backend):
         plant_context = built.plant.GetMyMutableContextFromRoot(context)
         v0 = np.zeros(built.plant.num_positions())
         vd0 = np.zeros(built.plant.num_velocities())
-        v0[built.positions] = built.cmap.engine_values(q0)
-        vd0[built.velocities] = built.cmap.A @ np.asarray(qd0, dtype=float)
+        v0[built.positions] = built.map.engine_values(q0)
+        vd0[built.velocities] = built.map.A @ np.asarray(qd0, dtype=float)
         built.plant.SetPositions(plant_context, v0)
         built.plant.SetVelocities(plant_context, vd0)
         for slide, body, pin, line, axis in built.slots:
@@ -834,8 +798,8 @@ class DrakeBackend(Backend):
             read(steps + 1)
         state, actuators = state[:steps + 1], actuators[:steps + 1]
         forces = {name: f[:steps + 1] for name, f in forces.items()}
-        q = built.cmap.coordinates(state[:, :n])
-        qd = built.cmap.rates(state[:, n:])
+        q = built.map.coordinates(state[:, :n])
+        qd = built.map.rates(state[:, n:])
         actuator_forces = {name: actuators[:, k] for k, name in enumerate(driven)}
         control = None if cfg["fixed_step"] or discrete else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
@@ -845,11 +809,10 @@ class DrakeBackend(Backend):
         # Drake books the generalized forces on a joint's own coordinate (its laws, a
         # coupler constraint: unknown, so NaN on a slide it involves) as transmitted
         # through it; the ball constraints and point-to-point forces act on the bodies
-        couplings = {c.name: closures[c.name] for c in mechanism.constraints
-                     if element_kind(c) == LINEAR_COUPLING}
         return Samples(q, qd, clock, constraint_forces=closures,
                        actuator_forces=actuator_forces, error_control=control,
-                       transmitted=forces, coupling_forces=couplings)
+                       transmitted=forces, coupling_forces=outside_forces(
+                           mechanism, {}, closures)["coupling_forces"])
 
     def _bare_loop_impl(self, mechanism: Mechanism, q0: np.ndarray, qd0: np.ndarray,
                         steps: int, dt: float, cfg: dict) -> BareLoop:
@@ -861,7 +824,7 @@ class DrakeBackend(Backend):
                 simulator.AdvanceTo(k * dt)
         x = built.plant.GetPositionsAndVelocities(plant_context)[self._state_index(built)]
         n = len(mechanism.joints)
-        return BareLoop.mapped(clock.cpu, built.cmap, x[:n], x[n:])
+        return BareLoop.mapped(clock.cpu, built.map, x[:n], x[n:])
 
     @staticmethod
     def _state_index(built: _Built) -> np.ndarray:
@@ -871,18 +834,16 @@ class DrakeBackend(Backend):
     # --- linearization -------------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
                   settings: Mapping | None = None, dt: float = 1e-3) -> Linearization | None:
-        cfg = self.resolve_settings(settings)
-        # a driven mechanism moves about a motion, not an equilibrium; a discrete plant's
-        # constraints are SAP's, whose solve is not differentiated here
-        if not self.support(mechanism).ok or mechanism.prescribed or _discrete(mechanism, cfg):
+        frame = self.linearization_frame(mechanism, settings)
+        # a discrete plant's constraints are SAP's, whose solve is not differentiated here
+        if frame is None or _discrete(mechanism, frame[0]):
             return None
-        # the autonomous system: the excitation e(t) does not belong to the equilibrium
-        mech = mechanism.without_time_loads()
+        cfg, mech = frame
         built = self._build(mech, cfg, dt)
         context = built.diagram.CreateDefaultContext()
         plant_context = built.plant.GetMyMutableContextFromRoot(context)
         v_eq = np.zeros(built.plant.num_positions())
-        v_eq[built.positions] = built.cmap.engine_values(q_eq)
+        v_eq[built.positions] = built.map.engine_values(q_eq)
         built.plant.SetPositions(plant_context, v_eq)
         built.plant.SetVelocities(plant_context, np.zeros(built.plant.num_velocities()))
         if not built.python_forces:
@@ -941,16 +902,10 @@ class _Recorder:
         self.lines: list[str] = []
         self.names: dict[int, str] = {}
         self.kept: list = []
-        self.python_forces: list[str] = []
 
     def code(self, value) -> str:
-        if id(value) in self.names:
-            return self.names[id(value)]
-        if isinstance(value, np.ndarray):
-            return repr([float(v) for v in value])
-        if isinstance(value, (list, tuple)):
-            return "[" + ", ".join(self.code(v) for v in value) + "]"
-        return repr(float(value)) if isinstance(value, (float, np.floating)) else repr(value)
+        """A recorded object by its name, a value as a literal (`script_export.literal`)."""
+        return self.names[id(value)] if id(value) in self.names else literal(value)
 
     def __call__(self, var: str | None, fn, text: str, *args, **kwargs):
         out = fn(*args, **kwargs)
@@ -967,16 +922,14 @@ class _Recorder:
 
 def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
     """(free length, stiffness, damping) of a point-to-point law that Drake's own elements
-    express exactly: tension = k (L - L0) + c L' with k > 0, L0 > 0, c >= 0
-    (LinearSpringDamper), or k L (L0 = 0, c = 0: LinearBushingRollPitchYaw); else None."""
-    if law.linear is None:
+    express exactly: tension = k (L - L0) + c L' (`ForceLaw.tendon_spring`) with k > 0,
+    L0 > 0 (LinearSpringDamper) or L0 = 0 and c = 0 (LinearBushingRollPitchYaw); else
+    None."""
+    spring = law.tendon_spring
+    if spring is None or spring[0] == 0 or (spring[1] == 0 and spring[2] != 0):
         return None
-    a, b, c = law.linear
-    if b > 0 and a == 0 and c == 0:
-        return 0.0, b, 0.0
-    if not (b > 0 and c >= 0 and -a / b > 0):
-        return None
-    return -a / b, b, c
+    stiffness, free_length, damping = spring
+    return free_length, stiffness, damping
 
 
 def _force_system(built: _Built):
@@ -1005,7 +958,7 @@ def _force_system(built: _Built):
     points = [(f, ForceLaw.of(f).law, np.array([num(f.point_a[0]), num(f.point_a[1]), 0.0]),
                np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in built.python_p2p]
     kinematics = plant.CreateDefaultContext()
-    T, c = built.cmap.T, built.cmap.c
+    T, c = built.map.T, built.map.c
     driven = built.driven
     select = np.zeros((n, nv))  # joint values' rates from the plant's velocities
     select[np.arange(n), velocities] = 1.0
