@@ -3,32 +3,28 @@
 
 Translation (generic over the description, conventions 1-8 of `systems.model`): each
 element kind (`plan.ELEMENT_KINDS`) has one builder, registered with `_builds` together
-with the `Expression`(s) it declares (contract point 5), so that the declaration and the
-code that builds the element are one thing; the build runs them over the description's
-elements in order, each adding its plant calls to a `_Built`:
+with the `Expression`(s) it declares (contract point 5: the Drake construct of each case
+and why it is exact or not), so that the declaration and the code that builds the
+element are one thing; the build runs them over the description's elements in order,
+each adding its plant calls to a `_Built` (on the shared plan, `plan.EnginePlan`):
 
 - every description body becomes a rigid body whose frame is the description's
   centre-of-mass frame, with its mass and central inertia (the planar moment on z, a
   lamina's half of it on x and y so that the tensor is physical; they cannot act in planar
-  motion). Drake accepts zero central inertia, so point masses are exact; a massless body
-  is a zero-mass body, regular while a massive descendant carries its coordinates;
-- `Revolute` -> ``RevoluteJoint`` about z between a frame on the parent (at the parent
-  anchor, turned by the angle offset) and a frame on the child (at the child anchor);
-  `Prismatic` -> ``PrismaticJoint`` along the unit axis, the child's joint frame turned by
-  minus the angle offset. The joint values are the engine values of `plan.CoordinateMap`
-  (relative angles, slides along the unit axis), so q = T v + c maps them back;
+  motion);
+- the joint values are the engine values of `plan.CoordinateMap` (relative angles,
+  slides along the unit axis), so q = T v + c maps them back;
 - gravity is the plant's gravity field;
-- a `CoordinateForce` whose law is affine (no TIME) on one engine joint value, with a
-  non-negative stiffness and damping, is Drake's own ``RevoluteSpring`` /
-  ``PrismaticSpring`` plus the joint's viscous damping; a `PointToPoint` element whose
-  law is a spring of positive free length and stiffness with a non-negative damper is
-  Drake's ``LinearSpringDamper``, a spring of zero free length without damper an
-  isotropic ``LinearBushingRollPitchYaw`` without torque. Every other law (custom, time
-  loads e(t), springs Drake's elements cannot hold) is evaluated by one Python
-  ``LeafSystem`` from the plan's compiled laws at every integrator stage (the stage's
-  time and state): coordinate laws as the plant's applied generalized force
+- the laws that Drake's own force elements express exactly are those elements (springs,
+  dampers, a bushing: `_point_to_point`, `_native_coordinate_laws`). Every other law
+  (custom, time loads e(t), springs Drake's elements cannot hold) is evaluated by one
+  Python ``LeafSystem`` from the plan's compiled laws at every integrator stage (the
+  stage's time and state): coordinate laws as the plant's applied generalized force
   (tau = T^T Q), point-to-point laws as externally applied spatial forces on the two
-  bodies (so that they are not booked as forces through the joints);
+  bodies (so that they are not booked as forces through the joints). The same system
+  imposes the prescribed motions (convention 9), which start on q(0), q'(0), through
+  their acceleration (`_force_system`): the coordinates follow q(t) to the integrator's
+  accuracy;
 - the run is sampled at t = k dt by ``Simulator.AdvanceTo`` (the integrator's own steps
   are error-controlled between samples and end on them);
 - reactions: the plant's reaction forces output (the force on the child at its joint
@@ -45,27 +41,18 @@ elements in order, each adding its plant calls to a `_Built`:
 `export` writes the plant calls of the build, recorded as they are made, as a standalone
 pydrake script.
 
-Prescribed motions (convention 9) start on q(0), q'(0) and are imposed through their
-acceleration by the same LeafSystem, at every integrator stage: from the plant's mass
-matrix and its other generalized forces (force elements, gravity, bias, the Python laws)
-it solves for the generalized force that gives q''(t), the actuator force; the
-coordinates then follow q(t) to the integrator's accuracy.
-
 A continuous-time plant refuses constraints, and its error control has no event location
 for a law that jumps (dry friction). A mechanism with a closure, a coupling or a jumping
 law is built on the discrete plant instead (time step dt, Drake's SAP solver): a
 first-order step whose velocity update is implicit in the constraint impulses and
 explicit in the forces (every law then goes through the LeafSystem, evaluated at the
 step's start), whose positions follow the new velocities (semi-implicit Euler). Its
-constraints are compliant (declared soft in `EXPRESSIONS`) and their forces are not
-reported (NaN): `PointOnPoint` -> ``AddBallConstraint`` (the out-of-plane row is void);
-a `LinearCoupling` of two engine joint values -> ``AddCouplerConstraint``; `PointOnLine`
-(Drake has no point-on-line constraint) -> a slider body on a ``PrismaticJoint`` along
-the slot held to the pin by a ball constraint, carrying a point mass that the pin's body
-lends at the pin (exact while the constraints hold). A discrete step's reactions are
-those of the step that starts at the sample. The convergence study sweeps the target
-accuracy of the continuous plant (`ACCURACY_SETTING`); its step study runs Runge-Kutta 3
-at a fixed step (`CONVERGENCE_SETTINGS`), and the discrete plant at its step.
+constraints are compliant (declared soft in `EXPRESSIONS`, with the construct of each;
+a slot, for which Drake has no constraint, is a slider substitute) and their forces are
+not reported (NaN). A discrete step's reactions are those of the step that starts at the
+sample. The convergence study sweeps the target accuracy of the continuous plant
+(`ACCURACY_SETTING`); its step study runs Runge-Kutta 3 at a fixed step
+(`CONVERGENCE_SETTINGS`), and the discrete plant at its step.
 """
 from __future__ import annotations
 
@@ -260,9 +247,8 @@ class _Built(EnginePlan):
         #: per native coordinate law (by name): (its joint, stiffness, nominal value, damping)
         self.springs = _native_coordinate_laws(mech, self.map) if self.native else {}
         #: per description joint: the viscous damping its native coordinate laws give it
-        self.damping = [0.0] * self.n
-        for j, _, _, d in self.springs.values():
-            self.damping[j] += d
+        self.damping = [sum((d for j, _, _, d in self.springs.values() if j == i), 0.0)
+                        for i in range(self.n)]
         #: description body (and WORLD) -> Drake body
         self.bodies = {WORLD: rec("world", plant.world_body, "plant.world_body")}
         self.joints: list = []       # Drake joints, in description order
@@ -273,15 +259,12 @@ class _Built(EnginePlan):
         #: slot's unit direction), for the slider's initial state (`_place_slider`)
         self.slots: list = []
         self.build(_BUILDERS)
+        #: whether a Python LeafSystem computes forces
+        self.python_forces = bool(self.python_laws or self.python_p2p or self.driven)
         self.diagram = None
         self.positions: np.ndarray | None = None   # plant position index of each joint
         self.velocities: np.ndarray | None = None  # plant velocity index of each joint
         self.forces = None                         # the Python force system, if any
-
-    @property
-    def python_forces(self) -> bool:
-        """Whether a Python LeafSystem computes forces."""
-        return bool(self.python_laws or self.python_p2p or self.driven)
 
     def frame(self, body: str, name: str, anchor, angle: float):
         """A frame on `body` at `anchor` (its frame's coordinates), turned by `angle`."""
@@ -367,18 +350,20 @@ def _joint(build: _Built, joint) -> None:
 
 
 def _point_to_point(build: _Built, f: PointToPoint) -> None:
-    """Drake's own spring element where it expresses the law (`_native_spring`), else
-    the law in the LeafSystem; a force between two points of one body is internal."""
+    """Drake's own spring element where it expresses the law exactly, a spring of
+    tension k (L - L0) + c L' (`ForceLaw.tendon_spring`) with k > 0 and L0 > 0
+    (LinearSpringDamper) or L0 = 0 and c = 0 (LinearBushingRollPitchYaw), else the law
+    in the LeafSystem; a force between two points of one body is internal."""
     from pydrake.multibody.tree import LinearBushingRollPitchYaw, LinearSpringDamper
 
     if f.body_a == f.body_b:
         return
-    spring = _native_spring(ForceLaw.of(f)) if build.native else None
-    if spring is None:
+    spring = ForceLaw.of(f).tendon_spring if build.native else None
+    if spring is None or spring[0] == 0 or (spring[1] == 0 and spring[2] != 0):
         build.python_p2p.append(f)
         return
     rec = build.rec
-    free_length, stiffness, damper = spring
+    stiffness, free_length, damper = spring
     if free_length == 0:
         # a spring of zero free length pulls each point towards the other with k times
         # their separation: a bushing with isotropic force stiffness and no torque, whose
@@ -620,16 +605,15 @@ class DrakeBackend(Backend):
                       _ORDER[name], None)
 
     # --- building ----------------------------------------------------------------------------
-    def _build(self, mech: Mechanism, cfg: dict, dt: float,
-               recorder: "_Recorder | None" = None) -> _Built:
+    def _build(self, mech: Mechanism, cfg: dict, dt: float) -> _Built:
         """The diagram (a discrete plant of step `dt` where `_discrete`): each element
-        built by the builder registered for its kind; every plant call goes through
-        `recorder` (`export` writes them)."""
+        built by the builder registered for its kind; every plant call goes through the
+        build's recorder (`export` writes them)."""
         from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant
         from pydrake.systems.framework import DiagramBuilder
 
         self.check_support(mech)
-        rec = recorder or _Recorder()
+        rec = _Recorder()
         builder = DiagramBuilder()
         discrete = _discrete(mech, cfg)
         plant = rec("plant", builder.AddSystem, "builder.AddSystem",
@@ -665,8 +649,8 @@ class DrakeBackend(Backend):
         hold) cannot be written out: its laws are listed."""
         name, q0, qd0 = self.export_start(initial_states)
         cfg = self.resolve_settings(settings)
-        recorder = _Recorder()
-        built = self._build(mechanism, cfg, dt, recorder)
+        built = self._build(mechanism, cfg, dt)
+        recorder = built.rec
         accuracy = ("integrator.set_fixed_step_mode(True)" if cfg["fixed_step"] else
                     f"integrator.set_target_accuracy({float(cfg['target_accuracy'])!r})")
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
@@ -823,8 +807,7 @@ class DrakeBackend(Backend):
             for k in range(1, steps + 1):
                 simulator.AdvanceTo(k * dt)
         x = built.plant.GetPositionsAndVelocities(plant_context)[self._state_index(built)]
-        n = len(mechanism.joints)
-        return BareLoop.mapped(clock.cpu, built.map, x[:n], x[n:])
+        return BareLoop.mapped(clock.cpu, built.map, x[:built.n], x[built.n:])
 
     @staticmethod
     def _state_index(built: _Built) -> np.ndarray:
@@ -918,18 +901,6 @@ class _Recorder:
             if var:
                 self.names[id(out)] = var
         return out
-
-
-def _native_spring(law: ForceLaw) -> tuple[float, float, float] | None:
-    """(free length, stiffness, damping) of a point-to-point law that Drake's own elements
-    express exactly: tension = k (L - L0) + c L' (`ForceLaw.tendon_spring`) with k > 0,
-    L0 > 0 (LinearSpringDamper) or L0 = 0 and c = 0 (LinearBushingRollPitchYaw); else
-    None."""
-    spring = law.tendon_spring
-    if spring is None or spring[0] == 0 or (spring[1] == 0 and spring[2] != 0):
-        return None
-    stiffness, free_length, damping = spring
-    return free_length, stiffness, damping
 
 
 def _force_system(built: _Built):
