@@ -1,8 +1,8 @@
 """Shared steps of simulators/plan.py, base.py and reactions.py that an engine's
 translation calls (the sliders' masses, a semi-implicit Euler engine's free-vibration fit,
 modes with constraints held exactly, the geometric stiffness of constraint forces, the
-outside forces the reactions take out, the builder of time loads), each checked against an
-independent statement of what it computes."""
+outside forces the reactions take out, the builder of time loads, a Jacobian by central
+differences), each checked against an independent statement of what it computes."""
 from __future__ import annotations
 
 import math
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mbfidelity.simulators.base import (EXACT, RELEASE_PERIODS, ElementBuilders, Expression,
-                                        semi_implicit_euler_modes)
+                                        central_jacobian, semi_implicit_euler_modes)
 from mbfidelity.simulators.plan import (
     COORDINATE_FORCE_CUSTOM,
     LINEAR_COUPLING,
@@ -132,6 +132,26 @@ def test_geometric_stiffness_of_a_circle_constraint():
     G = geometric_stiffness(jacobian_at, np.array([f]), 3, 1e-6)
     # round-off: eps |J^T f| / step = 1e-16 * 10 / 1e-6, i.e. ~1e-9
     assert np.allclose(G, 2 * f * np.eye(3), rtol=0, atol=1e-8)
+
+
+def test_central_jacobian_of_a_known_function():
+    """f(x) = (x_0^2 x_1, sin x_1, 3 x_0 - x_1): the polynomial rows are quadratic or
+    linear in each entry, where central differences are exact up to round-off (eps |f| /
+    step, ~1e-12 here); on sin x_1 they give (sin(x_1 + h) - sin(x_1 - h)) / (2 h) =
+    cos x_1 sin(h) / h in closed form (a one-sided difference would be off by h/2 sin x_1,
+    ~5e-5). `f` hands back one buffer that it overwrites: every value is kept apart."""
+    x, h = np.array([0.7, -1.3]), 1e-4
+    buffer = np.empty(3)
+
+    def f(y: np.ndarray) -> np.ndarray:
+        buffer[:] = y[0] ** 2 * y[1], math.sin(y[1]), 3 * y[0] - y[1]
+        return buffer
+
+    J = central_jacobian(f, x, h)
+    assert J.shape == (3, 2)
+    exact = np.array([[2 * x[0] * x[1], x[0] ** 2], [0.0, math.cos(x[1]) * math.sin(h) / h],
+                      [3.0, -1.0]])
+    assert np.allclose(J, exact, rtol=0, atol=1e-10)
 
 
 def test_a_time_load_is_built_by_the_builder_of_its_custom_law():

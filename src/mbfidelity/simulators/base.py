@@ -327,6 +327,22 @@ def central_differences(residual: Callable[[np.ndarray, np.ndarray], np.ndarray]
     return K, C
 
 
+def central_jacobian(f: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, step: float
+                     ) -> np.ndarray:
+    """df/dx at x0 by central differences (contract point 7): column k is (f(x0 + step
+    e_k) - f(x0 - step e_k)) / (2 step), exact for a quadratic f up to round-off (about
+    eps |f| / step); `f` may reuse its output's storage (each value is copied)."""
+    columns = []
+    for k in range(len(x0)):
+        ends = []
+        for sign in (1.0, -1.0):
+            x = np.array(x0, dtype=float)
+            x[k] += sign * step
+            ends.append(np.array(f(x), dtype=float))
+        columns.append((ends[0] - ends[1]) / (2 * step))
+    return np.column_stack(columns)
+
+
 def step_count(t_end: float, dt: float) -> int:
     """The number of fixed steps of a run of `t_end` seconds (contract point 6)."""
     return int(round(t_end / dt))

@@ -81,6 +81,7 @@ from .base import (
     Stopwatch,
     Scheme,
     Setting,
+    central_jacobian,
 )
 from .plan import (
     CoordinateLaws,
@@ -655,10 +656,7 @@ class DrakeBackend(Backend):
                     f"integrator.set_target_accuracy({float(cfg['target_accuracy'])!r})")
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
         text = "\n".join([
-            f'"""The mechanism as mbfidelity builds it in Drake {self.version()}, from the',
-            f"initial state of scenario {name!r}; backend settings:",
-            *[f"  {k} = {v!r}" for k, v in cfg.items()],
-            '"""',
+            f'"""{self.script_title("Drake", name, cfg)}\n"""',
             "import numpy as np",
             "from pydrake.math import RigidTransform, RotationMatrix",
             "from pydrake.multibody.plant import DiscreteContactApproximation, MultibodyPlant",
@@ -840,20 +838,15 @@ class DrakeBackend(Backend):
             A = np.asarray(linear.A())
             how = "drake Linearize of the MultibodyPlant (automatic differentiation)"
         else:
-            step = float(cfg["linearization_step"])
-            x0 = context.get_continuous_state_vector().CopyToVector()
             derivatives = built.diagram.AllocateTimeDerivatives()
-            A = np.zeros((len(x0), len(x0)))
-            for k in range(len(x0)):
-                columns = []
-                for sign in (1.0, -1.0):
-                    x = x0.copy()
-                    x[k] += sign * step
-                    context.SetContinuousState(x)
-                    built.diagram.CalcTimeDerivatives(context, derivatives)
-                    columns.append(derivatives.CopyToVector())
-                A[:, k] = (columns[0] - columns[1]) / (2 * step)
-            context.SetContinuousState(x0)
+
+            def rates(x: np.ndarray) -> np.ndarray:
+                context.SetContinuousState(x)
+                built.diagram.CalcTimeDerivatives(context, derivatives)
+                return derivatives.CopyToVector()
+
+            A = central_jacobian(rates, context.get_continuous_state_vector().CopyToVector(),
+                                 float(cfg["linearization_step"]))
             how = ("central differences of the Drake diagram's time derivatives "
                    "(CalcTimeDerivatives; a Python force system has no automatic "
                    "differentiation)")
@@ -921,18 +914,17 @@ def _force_system(built: _Built):
     from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
     from pydrake.systems.framework import BasicVector, LeafSystem
 
-    mech, plant, bodies = built.mech, built.plant, built.bodies
+    plant, bodies = built.plant, built.bodies
     positions, velocities = built.positions, built.velocities
     nq, nv = plant.num_positions(), plant.num_velocities()
-    n = len(mech.joints)
-    laws = CoordinateLaws(mech, built.python_laws)
-    points = [(f, ForceLaw.of(f).law, np.array([num(f.point_a[0]), num(f.point_a[1]), 0.0]),
-               np.array([num(f.point_b[0]), num(f.point_b[1]), 0.0])) for f in built.python_p2p]
+    laws = CoordinateLaws(built.mech, built.python_laws)
+    points = [(f, ForceLaw.of(f).law, np.array(vec3(f.point_a)), np.array(vec3(f.point_b)))
+              for f in built.python_p2p]
     kinematics = plant.CreateDefaultContext()
     T, c = built.map.T, built.map.c
     driven = built.driven
-    select = np.zeros((n, nv))  # joint values' rates from the plant's velocities
-    select[np.arange(n), velocities] = 1.0
+    select = np.zeros((built.n, nv))  # joint values' rates from the plant's velocities
+    select[np.arange(built.n), velocities] = 1.0
     G = T[[m.index for m in driven]] @ select
 
     class _Forces(LeafSystem):
