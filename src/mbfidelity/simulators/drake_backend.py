@@ -147,9 +147,8 @@ def _jumps(expr) -> bool:
         return True
     for piecewise in expr.atoms(sp.Piecewise):
         for _, condition in piecewise.args:
-            relations = [condition] if condition.is_Relational else list(
-                condition.atoms(sp.core.relational.Relational))
-            for relation in relations:
+            # a condition's relations (a relation's atoms include itself)
+            for relation in condition.atoms(sp.core.relational.Relational):
                 boundary = relation.lhs - relation.rhs
                 for x in boundary.free_symbols:
                     others = {y: 0 for y in expr.free_symbols - {x}}
@@ -265,6 +264,8 @@ class _Built(EnginePlan):
         self.diagram = None
         self.positions: np.ndarray | None = None   # plant position index of each joint
         self.velocities: np.ndarray | None = None  # plant velocity index of each joint
+        #: where the description's joints sit in the plant's state vector (q, then v)
+        self.state_index: np.ndarray | None = None
         self.forces = None                         # the Python force system, if any
 
     def frame(self, body: str, name: str, anchor, angle: float):
@@ -483,8 +484,7 @@ def _point_on_line(build: _Built, c: PointOnLine) -> None:
                             "involves one or more than two joint values",
                when="it relates one or more than two joint values"))
 def _linear_coupling(build: _Built, c: LinearCoupling) -> None:
-    """v_i0 = ratio v_i1 + offset from the coupling written on the engine joint values,
-    row . v = constant (`plan.engine_coupling`)."""
+    """v_i0 = ratio v_i1 + offset: the coupling on the engine joint values (`engine_coupling`)."""
     row, constant = engine_coupling(build.mech, c)
     i0, i1 = (int(i) for i in np.flatnonzero(row))
     build.rec("", build.plant.AddCouplerConstraint, "plant.AddCouplerConstraint",
@@ -512,7 +512,6 @@ _BUILDERS.refuses(HINGE_CLOSURE, "the build is planar: a spatial closed loop has
 
 #: per element kind, the expression(s) its registered builder makes, in the kinds' order
 EXPRESSIONS = _BUILDERS.declared()
-
 
 
 class DrakeBackend(Backend):
@@ -630,6 +629,8 @@ class DrakeBackend(Backend):
         plant.Finalize()
         built.positions = np.array([j.position_start() for j in built.joints], dtype=int)
         built.velocities = np.array([j.velocity_start() for j in built.joints], dtype=int)
+        built.state_index = np.concatenate([built.positions,
+                                            plant.num_positions() + built.velocities])
         if built.python_forces:
             built.forces = builder.AddSystem(_force_system(built))
             builder.Connect(plant.get_state_output_port(), built.forces.get_input_port(0))
@@ -738,9 +739,7 @@ class DrakeBackend(Backend):
         built = self._build(mechanism, cfg, dt)
         simulator, integrator, plant_context = self._simulator(built, q0, qd0, dt, cfg)
         plant = built.plant
-        n = len(mechanism.joints)
-        state = np.empty((steps + 2, 2 * n))
-        index = self._state_index(built)
+        state = np.empty((steps + 2, 2 * built.n))
         discrete = _discrete(mechanism, cfg)
         wanted = [(name, mechanism.joints.index(mechanism.joint(name))) for name in reaction_joints]
         forces = {name: np.empty((steps + 2, 2)) for name, _ in wanted}
@@ -749,7 +748,7 @@ class DrakeBackend(Backend):
 
         def read(k: int) -> None:
             x = plant.GetPositionsAndVelocities(plant_context)
-            state[k] = x[index]
+            state[k] = x[built.state_index]
             if driven:
                 actuators[k] = built.forces.actuators(x, k * dt, built.forces._laws(x, k * dt))
             if wanted:
@@ -780,8 +779,8 @@ class DrakeBackend(Backend):
             read(steps + 1)
         state, actuators = state[:steps + 1], actuators[:steps + 1]
         forces = {name: f[:steps + 1] for name, f in forces.items()}
-        q = built.map.coordinates(state[:, :n])
-        qd = built.map.rates(state[:, n:])
+        q = built.map.coordinates(state[:, :built.n])
+        qd = built.map.rates(state[:, built.n:])
         actuator_forces = {name: actuators[:, k] for k, name in enumerate(driven)}
         control = None if cfg["fixed_step"] or discrete else ErrorControl(
             float(integrator.get_target_accuracy()), int(integrator.get_num_steps_taken()))
@@ -804,13 +803,8 @@ class DrakeBackend(Backend):
         with Stopwatch() as clock:
             for k in range(1, steps + 1):
                 simulator.AdvanceTo(k * dt)
-        x = built.plant.GetPositionsAndVelocities(plant_context)[self._state_index(built)]
+        x = built.plant.GetPositionsAndVelocities(plant_context)[built.state_index]
         return BareLoop.mapped(clock.cpu, built.map, x[:built.n], x[built.n:])
-
-    @staticmethod
-    def _state_index(built: _Built) -> np.ndarray:
-        """Where the description's joints sit in the plant's state vector (q, then v)."""
-        return np.concatenate([built.positions, built.plant.num_positions() + built.velocities])
 
     # --- linearization -------------------------------------------------------------------------
     def linearize(self, mechanism: Mechanism, q_eq: np.ndarray,
@@ -828,9 +822,8 @@ class DrakeBackend(Backend):
         built.plant.SetPositions(plant_context, v_eq)
         built.plant.SetVelocities(plant_context, np.zeros(built.plant.num_velocities()))
         if not built.python_forces:
-            from pydrake.systems.primitives import Linearize
-
             from pydrake.systems.framework import InputPortSelection, OutputPortSelection
+            from pydrake.systems.primitives import Linearize
 
             linear = Linearize(built.plant, plant_context,
                                input_port_index=InputPortSelection.kNoInput,
