@@ -333,9 +333,8 @@ def _body(build: _Built, body) -> None:
                                      "(the parent's turned by the angle offset)"))
 @_builds(PRISMATIC, Expression(EXACT, "PrismaticJoint along the unit axis"))
 def _joint(build: _Built, joint) -> None:
-    """A description joint into the plant (the joints come in description order): a
-    hinge's frame on the parent turned by the angle offset, a slide's frame on the child
-    by minus it."""
+    """A description joint into the plant, in description order (a hinge's frame on the
+    parent turned by the angle offset, a slide's frame on the child by minus it)."""
     from pydrake.multibody.tree import PrismaticJoint, RevoluteJoint
 
     hinge, offset = element_kind(joint) == REVOLUTE, num(joint.angle_offset)
@@ -452,8 +451,7 @@ def _point_on_point(build: _Built, c: PointOnPoint) -> None:
                             "slider without mass makes the plant's mass matrix singular",
                when="the pin's body cannot lend it"))
 def _point_on_line(build: _Built, c: PointOnLine) -> None:
-    """A slider along the slot, held to the pin, carrying a point mass lent by the pin's
-    body (`_slider_mass`)."""
+    """The slot's slider, held to the pin, with the point mass its body lends (`_slider_mass`)."""
     from pydrake.multibody.tree import PrismaticJoint, SpatialInertia, UnitInertia
 
     rec, plant = build.rec, build.plant
@@ -714,12 +712,10 @@ class DrakeBackend(Backend):
         simulator = Simulator(built.diagram)
         context = simulator.get_mutable_context()
         plant_context = built.plant.GetMyMutableContextFromRoot(context)
-        v0 = np.zeros(built.plant.num_positions())
-        vd0 = np.zeros(built.plant.num_velocities())
-        v0[built.positions] = built.map.engine_values(q0)
-        vd0[built.velocities] = built.map.A @ np.asarray(qd0, dtype=float)
-        built.plant.SetPositions(plant_context, v0)
-        built.plant.SetVelocities(plant_context, vd0)
+        x0 = np.zeros(built.plant.num_positions() + built.plant.num_velocities())
+        x0[built.state_index] = np.concatenate([built.map.engine_values(q0),
+                                                built.map.A @ np.asarray(qd0, dtype=float)])
+        built.plant.SetPositionsAndVelocities(plant_context, x0)
         for slide, body, pin, line, axis in built.slots:
             _place_slider(built.plant, plant_context, slide, body, pin, line, axis)
         max_step = dt if cfg["max_step"] is None else min(dt, float(cfg["max_step"]))
@@ -817,10 +813,9 @@ class DrakeBackend(Backend):
         built = self._build(mech, cfg, dt)
         context = built.diagram.CreateDefaultContext()
         plant_context = built.plant.GetMyMutableContextFromRoot(context)
-        v_eq = np.zeros(built.plant.num_positions())
-        v_eq[built.positions] = built.map.engine_values(q_eq)
-        built.plant.SetPositions(plant_context, v_eq)
-        built.plant.SetVelocities(plant_context, np.zeros(built.plant.num_velocities()))
+        x_eq = np.zeros(built.plant.num_positions() + built.plant.num_velocities())
+        x_eq[built.positions] = built.map.engine_values(q_eq)  # at rest
+        built.plant.SetPositionsAndVelocities(plant_context, x_eq)
         if not built.python_forces:
             from pydrake.systems.framework import InputPortSelection, OutputPortSelection
             from pydrake.systems.primitives import Linearize
