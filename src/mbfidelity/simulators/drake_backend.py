@@ -482,7 +482,6 @@ def _point_on_line(build: _Built, c: PointOnLine) -> None:
                             "involves one or more than two joint values",
                when="it relates one or more than two joint values"))
 def _linear_coupling(build: _Built, c: LinearCoupling) -> None:
-    """v_i0 = ratio v_i1 + offset: the coupling on the engine joint values (`engine_coupling`)."""
     row, constant = engine_coupling(build.mech, c)
     i0, i1 = (int(i) for i in np.flatnonzero(row))
     build.rec("", build.plant.AddCouplerConstraint, "plant.AddCouplerConstraint",
@@ -701,9 +700,8 @@ class DrakeBackend(Backend):
             ""])
         python = [f.name for f in mechanism.forces
                   if any(f is w for w in built.python_p2p + built.python_laws)]
-        outside = ([f"the force laws computed by the Python force system: "
-                    f"{', '.join(python)}"] if python else [])
-        return text, outside
+        return text, ([f"the force laws computed by the Python force system: "
+                       f"{', '.join(python)}"] if python else [])
 
     # --- running -----------------------------------------------------------------------------
     def _simulator(self, built: _Built, q0: np.ndarray, qd0: np.ndarray, dt: float, cfg: dict):
