@@ -525,8 +525,9 @@ class DrakeBackend(Backend):
         "target_accuracy": Setting(
             1e-10, float,
             "Drake's default target accuracy replaced by 1e-10: the local error the "
-            "integrator keeps each step below (unit weights: rad, m, rad/s, m/s); tight "
-            "enough that Drake is the most accurate engine on smooth trees. The run records "
+            "integrator keeps each step below (unit weights: rad, m, rad/s, m/s); tight, so "
+            "that the comparison sees Drake's model of the mechanism more than its "
+            "integration error. The run records "
             "it with the number of steps taken (the error-controlled trajectory gate follows "
             "from both). Engine default: Drake's SimulatorConfig "
             "(systems/analysis/simulator_config.h), accuracy 1e-4.",
