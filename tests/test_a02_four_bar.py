@@ -204,7 +204,7 @@ def test_analyze_reports_the_points_at_the_end_of_each_scenario():
 
 
 def test_engine_points_take_the_shared_kinematics_of_the_coordinates():
-    """The engines' route (plan.py's planar forward kinematics of the coordinates) gives
+    """The engines' route (the plan's planar forward kinematics of the coordinates) gives
     the derivation's points along the reference's states, to round-off."""
     from mbfidelity.comparisons.points import engine_points
 

@@ -1,4 +1,4 @@
-"""The shared numeric kinematics of simulators/plan.py, checked against its forward
+"""The shared numeric kinematics of simulators/plan, checked against its forward
 kinematics (`body_states`, `point_state`) on every planar catalog mechanism, and the
 elimination of massless links (`plan.EliminatedFrames`; in Pymunk, its description frames
 and the virtual power of its loads) against the same."""
@@ -128,7 +128,7 @@ def test_traced_step_function_is_the_numeric_one():
 
 
 def _body_states_on_symbols(mech, q, qd) -> dict:
-    """body_states on symbols: the planar tree by `point_state` (plan.py)."""
+    """body_states on symbols: the planar tree by `point_state` (simulators/plan)."""
     from mbfidelity.simulators.plan import cos_sin, point_state, num
     from mbfidelity.systems.model import WORLD, Revolute
 

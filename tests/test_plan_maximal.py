@@ -1,4 +1,4 @@
-"""The shared geometry an engine in maximal coordinates is placed by (plan.py), without an
+"""The shared geometry an engine in maximal coordinates is placed by (the plan), without an
 engine: each against the forward kinematics (`plan.body_states`, written independently)
 or a closed form (parallel axes, the chord of a circle)."""
 import math

@@ -1,4 +1,4 @@
-"""The engine-neutral helpers of simulators/plan.py and base.py that a backend calls in
+"""The engine-neutral helpers of simulators/plan and base.py that a backend calls in
 place of its own geometry and numerics: the pin and slot geometry from the bodies' frame
 states, a point-to-point element's pair force, a slide's unit axis, the coordinate laws
 on engine joint values, a parents-first link order and the linearization's central

@@ -1,4 +1,4 @@
-"""Shared steps of simulators/plan.py, base.py and reactions.py that an engine's
+"""Shared steps of simulators/plan, base.py and reactions.py that an engine's
 translation calls (the sliders' masses, a semi-implicit Euler engine's free-vibration fit,
 modes with constraints held exactly, the geometric stiffness of constraint forces, the
 outside forces the reactions take out, the builder of time loads, a Jacobian by central

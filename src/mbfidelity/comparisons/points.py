@@ -2,7 +2,7 @@
 
 An engine reports its coordinates (mapped to the description's); every engine's points
 come from them by one shared route, the planar forward kinematics of
-simulators/plan.py (`body_states`, `point_state`), so that no backend needs an output of
+simulators/plan (`body_states`, `point_state`), so that no backend needs an output of
 its own. The reference's points come from the derivation (analytic/numeric.py
 `point_states`): two independent routes of the same kinematics.
 
@@ -36,8 +36,8 @@ from .tolerances import Gate
 def engine_points(system: System, values: Mapping[str, float], mech: Mechanism,
                   q: np.ndarray, qd: np.ndarray) -> dict[str, np.ndarray]:
     """Each named point's world position and velocity, (N, 4), along an engine's
-    coordinates (planar forward kinematics, simulators/plan.py). A spatial mechanism's
-    points come from the derivation's kinematics instead (plan.py's is planar)."""
+    coordinates (planar forward kinematics, simulators/plan). A spatial mechanism's
+    points come from the derivation's kinematics instead (the plan's is planar)."""
     points = system.points(system.symbols)
     if mech.spatial:
         return numeric_model(system.id, values).point_states(q, qd)
