@@ -1,8 +1,5 @@
-"""Equilibria, their stability, the linearized M, C, K and the modes (docs/user-guide.md):
-
-eigenvalues s of M s^2 + C s + K = 0;
-frequency_hz = |s|/(2 pi), damping_ratio = -Re(s)/|s|, damped_frequency_hz = |Im s|/(2 pi).
-One mode per complex-conjugate pair (the member with Im s > 0), one per real eigenvalue.
+"""Equilibria, their stability, the linearized M, C, K and the modes (docs/user-guide.md;
+the modes from the eigenvalues of M s^2 + C s + K = 0 as analytic/modes.py defines them).
 
 A floating system (no ground, `System.rigid_directions`) has no static equilibrium under
 a load with a non-zero resultant: its equilibria are relative ones (Italian notes

@@ -139,8 +139,6 @@ class _Closure:
     element: object
     parent: int
     child: int
-    #: its force acts between two bodies (reactions take it out where it crosses a cut)
-    pair = True
     #: its child pivot is moved under the pin before every step
     follows_pin = False
 
@@ -243,7 +241,6 @@ class _Gear(_Closure):
     ratio: float
     target: float
     scale: float
-    pair = False
 
     def frames(self, p) -> tuple:
         return p.JOINT_GEAR, [0, 0, 1], [0, 0, 0], [0, 0, 0]
