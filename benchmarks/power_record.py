@@ -1,15 +1,19 @@
-"""The power study's record from the power.json that `mbfidelity power --out DIR` writes.
+"""The power study's records from the power.json that `mbfidelity power --out DIR` writes.
 
     mbfidelity power --workers 2 --out DIR
-    python benchmarks/power_record.py DIR --record benchmarks/records/power.json
+    python benchmarks/power_record.py DIR --record benchmarks/records/power.json \
+        --study benchmarks/records/power_study.json.gz
 
-Per system x engine only the smallest rejected eps of each error kind, the runs per kind,
-the verdict at the probe (1 %) and each default's verdict with why; the summary (median
-smallest rejected eps per engine and kind, defaults rejected and acting) and the cost as
-the command wrote them. The command's power.json holds the rest (every trial)."""
+`--record`: per system x engine only the smallest rejected eps of each error kind, the runs
+per kind, the verdict at the probe (1 %) and each default's verdict with why; the summary
+(median smallest rejected eps per engine and kind, defaults rejected and acting) and the
+cost as the command wrote them. `--study`: the command's power.json itself (every trial),
+gzip-compressed with no time stamp, which `mbfidelity power --record` lends readings from
+(`make report` does)."""
 from __future__ import annotations
 
 import argparse
+import gzip
 import json
 from pathlib import Path
 
@@ -40,6 +44,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", type=Path, help="the --out folder of mbfidelity power")
     parser.add_argument("--record", type=Path, required=True)
+    parser.add_argument("--study", type=Path, help="also the whole power.json, gzipped")
     parser.add_argument("--command", default="mbfidelity power --workers 2 --out DIR")
     parser.add_argument("--note", default="")
     args = parser.parse_args()
@@ -50,6 +55,11 @@ def main() -> None:
               "entries": [entry_record(e) for e in power["entries"]]}
     args.record.write_text(json.dumps(record, indent=1) + "\n")
     print(f"{len(record['entries'])} entries -> {args.record}")
+    if args.study is not None:
+        raw = (args.folder / "power.json").read_bytes()
+        with gzip.GzipFile(args.study, "wb", compresslevel=9, mtime=0) as f:
+            f.write(raw)
+        print(f"{len(raw)} bytes -> {args.study} ({args.study.stat().st_size} compressed)")
 
 
 if __name__ == "__main__":

@@ -336,3 +336,111 @@ def test_search_from_the_predicted_decade_finds_the_first_rejected(threshold, st
     assert len(calls) == len(set(calls)) and len(calls) <= 5
     if start in (threshold, threshold - 1):
         assert len(calls) <= 2
+
+
+def _record(tmp_path, study, describe: str, kinds):
+    """A recorded study as `mbfidelity power --out` saves it (its power.json), gzipped."""
+    import gzip
+    import json
+
+    doc = power.power_document([e.as_dict() for e in study.entries],
+                               {**study.provenance, "git_describe": describe})
+    doc["error_kinds"] = {k: list(power.ERROR_KINDS[k]) for k in kinds}
+    path = tmp_path / "power.json.gz"
+    path.write_bytes(gzip.compress(json.dumps(doc).encode()))
+    return path
+
+
+def test_a_recorded_study_lends_the_readings_of_the_installed_engines_only(
+        tmp_path, monkeypatch):
+    """`out_of_the_box_study(record=)`: a reading the record made with the installed
+    engine's version at the same step is taken from it as it was made (marked with the
+    state of the package that made it, no comparison counted); with another engine
+    version, or at another step, the study makes it. The pages say where a reading
+    came from."""
+    import json
+
+    from mbfidelity.reports.power_page import POWER, write_power_pages
+
+    _installed("pymunk")
+    monkeypatch.setenv("MBFIDELITY_NO_CACHE", "1")
+    kinds = ("mass",)
+    made = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
+                                               kinds=kinds)
+    record = out_of_the_box.read_record(_record(tmp_path, made, "v0-recorded", kinds))
+
+    measured = []
+    real = out_of_the_box.defaults_entry
+    monkeypatch.setattr(out_of_the_box, "defaults_entry",
+                        lambda *a, **k: measured.append(a) or real(*a, **k))
+    lent = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
+                                               kinds=kinds, record=record)
+    assert measured == []
+    (entry,) = lent.entries
+    assert entry.recorded == "v0-recorded"
+    assert {**entry.as_dict(), "recorded": ""} == made.entries[0].as_dict()
+    assert lent.cost()["comparisons"] == 0 and lent.cost()["recorded_entries"] == 1
+    assert lent.provenance["record"]["git_describe"] == "v0-recorded"
+    (tmp_path / POWER).write_text(json.dumps(lent.power_document()))
+    (tmp_path / "out_of_the_box.json").write_text(json.dumps(lent.as_dict()))
+    for page in write_power_pages(tmp_path):
+        assert "recorded at v0-recorded" in page.read_text()
+
+    # another step: made by the study
+    again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
+                                                dt=made.entries[0].dt / 2, kinds=kinds,
+                                                record=record)
+    assert len(measured) == 1 and not again.entries[0].recorded
+    # another version of the engine: made by the study
+    monkeypatch.setattr(get_backend("pymunk"), "version", lambda: "another version")
+    again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
+                                                kinds=kinds, record=record)
+    assert len(measured) == 2 and not again.entries[0].recorded
+    assert again.cost()["comparisons"] > 0 and again.cost()["recorded_entries"] == 0
+
+
+def test_a_record_that_is_not_a_power_study_is_refused(tmp_path):
+    """`read_record` and `recorded_readings` refuse a missing file, a file that is not
+    JSON, a JSON document that is not a power study, and a study of other error kinds;
+    the command says why and stops."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from mbfidelity.cli import app
+
+    with pytest.raises(ValueError, match="no recorded power study"):
+        out_of_the_box.read_record(tmp_path / "missing.json")
+    (tmp_path / "bad.json").write_text("not json")
+    with pytest.raises(ValueError, match="is not a recorded power study"):
+        out_of_the_box.read_record(tmp_path / "bad.json")
+    (tmp_path / "other.json").write_text(json.dumps({"entries": []}))
+    with pytest.raises(ValueError, match="no provenance, error_kinds"):
+        out_of_the_box.read_record(tmp_path / "other.json")
+    doc = {"provenance": {}, "error_kinds": {"mass": ["kg"]}, "entries": []}
+    with pytest.raises(ValueError, match="injected mass"):
+        out_of_the_box.recorded_readings(doc, tuple(power.ERROR_KINDS))
+    res = CliRunner().invoke(app, ["power", "--systems", "compound_pendulum", "--record",
+                                   str(tmp_path / "missing.json")])
+    assert res.exit_code != 0 and "no recorded power study" in res.output
+
+
+def test_the_committed_record_reads_back_as_power_entries():
+    """benchmarks/records/power_study.json.gz (what `make report` lends readings from):
+    a power study of every error kind whose every entry this version reads back
+    (`PowerEntry.from_dict` refuses a field it does not know), each made at its system's
+    own step."""
+    from pathlib import Path
+
+    from mbfidelity.comparisons.runner import own_step
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks/records/power_study.json.gz"
+    if not path.exists():
+        pytest.skip("not in this checkout")
+    doc = out_of_the_box.read_record(path)
+    readings = out_of_the_box.recorded_readings(doc, tuple(power.ERROR_KINDS))
+    assert readings
+    for (system, sim), reading in readings.items():
+        entry = power.PowerEntry.from_dict(reading)
+        assert entry.recorded and (entry.system, entry.simulator) == (system, sim)
+        assert entry.dt == own_step(system, None)

@@ -800,12 +800,15 @@ def export(system_id: str, simulator: str = "mujoco", params: Mapping[str, float
 
 def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = None,
           out: str | Path | None = None, *, dt: float | None = None,
-          workers: int | None = None, progress=None):
+          workers: int | None = None, progress=None, record: str | Path | None = None):
     """The power study (comparisons/power.py) of systems x engines (default: all systems,
     every installed engine): per injected model error the smallest relative error the
     gates reject, per neutralised default whether they reject it, both from one
     neutralised run per system x engine (comparisons/out_of_the_box.py); one job per
     system in a pool of `workers` processes (default: up to 2), the longest first. With
+    `record` (the power.json of an earlier study, plain or gzip-compressed), each reading
+    it holds made with the installed engine's version at the same step is taken from it
+    (marked with the state of the package that made it) and only the others are made. With
     `out`, power.json and out_of_the_box.json and their pages (power.html,
     out_of_the_box.html) are written there; where the folder holds a run's results, its
     site is written again (as `out_of_the_box`). Returns the `OutOfTheBoxStudy`, whose
@@ -813,16 +816,18 @@ def power(systems: Iterable[str] | None = None, sims: Iterable[str] | None = Non
     import json
 
     from .comparisons.matrix import schedule
-    from .comparisons.out_of_the_box import out_of_the_box_study
+    from .comparisons.out_of_the_box import out_of_the_box_study, read_record
     from .comparisons.power import ERROR_KINDS
     from .comparisons.results_folder import load_job_costs
 
     sys_ids, sim_ids = _matrix(systems, sims, installed_only=True)
     checked_duration("dt", dt)
     folder = checked_output_folder(out) if out is not None else None
+    recorded = read_record(record) if record is not None else None
     order = schedule(sys_ids, load_job_costs(folder) if folder is not None else None)
     study = out_of_the_box_study(sys_ids, sim_ids, dt, workers=workers, order=order,
-                                 progress=progress, kinds=tuple(ERROR_KINDS))
+                                 progress=progress, kinds=tuple(ERROR_KINDS),
+                                 record=recorded)
     if folder is not None:
         from .reports.power_page import OUT_OF_THE_BOX, POWER, write_power_pages
 

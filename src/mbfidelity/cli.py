@@ -850,6 +850,11 @@ def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
                        "(and the site again, when the folder holds a run)"),
               workers: Optional[int] = typer.Option(
                   None, "--workers", min=1, help="processes (default: up to 2)"),
+              record: Optional[Path] = typer.Option(
+                  None, "--record",
+                  help="a recorded study (the power.json of an earlier --out, plain or "
+                       ".gz): its readings made with the installed engines' versions at "
+                       "the same step are taken from it, the others made"),
               as_json: bool = typer.Option(False, "--json"),
               ) -> None:
     """What the gates catch: per system x engine, the smallest relative error of a mass,
@@ -866,7 +871,8 @@ def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
                           else f"{p.kind} {'not rejected' if p.applicable else 'n/a'}"
                           for p in entry.errors)
         typer.echo(f"{entry.system:28s} {entry.simulator:9s} "
-                   + (found if entry.supported else f"unsupported: {entry.reason}"))
+                   + (found if entry.supported else f"unsupported: {entry.reason}")
+                   + (f" (recorded at {entry.recorded})" if entry.recorded else ""))
         for p in entry.errors:
             if p.applicable and p.verdict != "rejected":
                 typer.echo(f"    {p.kind} at 1 %: {p.verdict}: {p.why}")
@@ -875,7 +881,7 @@ def power_cmd(systems: Optional[List[str]] = typer.Option(None, "--systems", hel
 
     try:
         study = api.power(_split(systems) or None, _split(sims) or None, out, dt=dt,
-                          workers=workers, progress=progress)
+                          workers=workers, progress=progress, record=record)
     except ValueError as exc:
         _fail(str(exc))
     if as_json:

@@ -33,11 +33,16 @@ process.
 Each system x engine's reading is kept in the persistent cache under the content it
 depends on (`cached_entry`): a report made again with the same code, engines and
 libraries takes the readings from there, and an engine's upgrade makes its readings alone
-again.
+again. A recorded study (the power.json a study wrote, `recorded_readings`) lends its
+readings the same way, but matched by the engine's version and the step only: a reading
+from it is marked with the state of the package that made it (`PowerEntry.recorded`), and
+the readings it lacks, or made with another version of the engine, are made by the study.
 """
 from __future__ import annotations
 
+import gzip
 import hashlib
+import json
 import os
 import pickle
 import resource
@@ -244,7 +249,7 @@ def _cpu_seconds() -> float:
 #: the cache folder of the readings (`cached_entry`)
 CACHE_FOLDER = "power"
 #: bump when the layout or the meaning of a cached reading changes
-CACHE_FORMAT = "1"
+CACHE_FORMAT = "2"
 
 
 @lru_cache(maxsize=1)
@@ -303,13 +308,62 @@ def cached_entry(system_id: str, simulator: str, dt: float, only, kinds=()) -> P
     return entry
 
 
-def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=()
+def read_record(path: str | Path) -> dict:
+    """A recorded power study: the power.json that `mbfidelity power --out` wrote, plain or
+    gzip-compressed. `ValueError` when the file is missing or is not such a document."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"no recorded power study at {path}")
+    raw = path.read_bytes()
+    try:
+        doc = json.loads(gzip.decompress(raw) if raw[:2] == b"\x1f\x8b" else raw)
+    except (OSError, EOFError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path} is not a recorded power study: {exc}") from None
+    missing = [k for k in ("provenance", "error_kinds", "entries") if not (
+        isinstance(doc, dict) and k in doc)]
+    if missing:
+        raise ValueError(f"{path} is not a recorded power study (the power.json of "
+                         f"`mbfidelity power --out`): no {', '.join(missing)}")
+    return doc
+
+
+def recorded_readings(doc: Mapping, kinds: Iterable[str]) -> dict[tuple[str, str], dict]:
+    """(system, engine) -> the reading of a recorded study (`read_record`), each marked
+    with the state of the package that made it (`PowerEntry.recorded`: its own mark where
+    it was itself lent by an older record). `ValueError` when the record injected other
+    error kinds than `kinds`."""
+    if set(doc["error_kinds"]) != set(kinds):
+        raise ValueError(f"the recorded study injected {', '.join(doc['error_kinds'])}; "
+                         f"this study injects {', '.join(kinds)}")
+    made_by = str(doc["provenance"].get("git_describe", "unknown"))
+    return {(e["system"], e["simulator"]): {**e, "recorded": e.get("recorded") or made_by}
+            for e in doc["entries"]}
+
+
+def _lent(reading: Mapping | None, simulator: str, dt: float) -> PowerEntry | None:
+    """A recorded reading where it was made with the installed version of the engine at
+    step `dt`; None where the study must make it."""
+    if reading is None:
+        return None
+    backend = get_backend(simulator)
+    if not backend.available()[0] or reading.get("engine_version") != backend.version() \
+            or reading.get("dt") != dt:
+        return None
+    return PowerEntry.from_dict({**reading, "from_cache": False})
+
+
+def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=(),
+                recorded: Mapping[str, dict] | None = None
                 ) -> tuple[list[PowerEntry], float]:
-    """Every engine's reading of one system (`cached_entry`; `dt` None: the system's own
-    step), and the job's CPU seconds."""
+    """Every engine's reading of one system (`dt` None: the system's own step): lent by
+    `recorded` (engine -> a recorded reading, `_lent`) or `cached_entry`; and the job's
+    CPU seconds."""
     dt = own_step(system_id, dt)
     start = _cpu_seconds()
-    entries = [cached_entry(system_id, sim, dt, only, kinds) for sim in sims]
+    recorded = recorded or {}
+    entries = [_lent(recorded.get(sim), sim, dt) or cached_entry(system_id, sim, dt, only,
+                                                                   kinds)
+               for sim in sims]
     return entries, _cpu_seconds() - start
 
 
@@ -338,8 +392,12 @@ class OutOfTheBoxStudy:
     job_cpu_s: dict = field(default_factory=dict)
 
     def cost(self) -> dict:
+        """What this study spent: its wall time and CPU, the comparisons of the readings it
+        made (not of those a record lent), and each reading's wall time (a lent one's, as
+        recorded)."""
         return {"wall_time_s": self.wall_time_s, "workers": self.workers,
-                "comparisons": sum(e.comparisons for e in self.entries),
+                "comparisons": sum(e.comparisons for e in self.entries if not e.recorded),
+                "recorded_entries": sum(bool(e.recorded) for e in self.entries),
                 "cpu_s": sum(self.job_cpu_s.values()), "job_cpu_s": self.job_cpu_s,
                 "per_entry_wall_time_s": {f"{e.system}/{e.simulator}": e.wall_time_s
                                           for e in self.entries}}
@@ -365,16 +423,25 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                          dt: float | None = None, workers: int | None = None,
                          order: Iterable[str] | None = None,
                          progress: Callable[[PowerEntry], None] | None = None,
-                         only: Iterable[str] | None = None, kinds: Iterable[str] = ()
-                         ) -> OutOfTheBoxStudy:
+                         only: Iterable[str] | None = None, kinds: Iterable[str] = (),
+                         record: Mapping | None = None) -> OutOfTheBoxStudy:
     """`defaults_entry` for every system x engine, in `systems` x `sims` order; one job
     per system in a pool of `workers` processes (default: up to 2), dispatched in `order`
     (default: `systems`; the longest first keeps the pool busy to the end). `only`
     names the defaults switched on (each engine those of them it neutralises); `kinds`
-    adds the power study's model errors of those kinds (`defaults_entry`)."""
+    adds the power study's model errors of those kinds (`defaults_entry`). `record` (a
+    recorded power study, `read_record`; with every default and `kinds` only) lends the
+    readings it made with the installed engines at the same step (`_lent`)."""
     kinds = tuple(kinds)
     only = None if only is None else tuple(only)
     from .runner import provenance
+
+    lent: dict[str, dict[str, dict]] = {}
+    if record is not None:
+        if only is not None:
+            raise ValueError("a recorded study lends whole readings: every default")
+        for (system_id, sim), reading in recorded_readings(record, kinds).items():
+            lent.setdefault(system_id, {})[sim] = reading
 
     started = time.perf_counter()
     systems, sims = list(systems), list(sims)
@@ -393,11 +460,12 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
     crashed = []
     if workers == 1:
         for s in order:
-            collect(s, _system_job(s, sims, dt, only, kinds))
+            collect(s, _system_job(s, sims, dt, only, kinds, lent.get(s)))
     else:
         with ProcessPoolExecutor(max_workers=workers, initializer=become_worker,
                                  initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(_system_job, s, sims, dt, only, kinds): s for s in order}
+            futures = {pool.submit(_system_job, s, sims, dt, only, kinds, lent.get(s)): s
+                       for s in order}
             for fut in as_completed(futures):
                 try:
                     collect(futures[fut], fut.result())
@@ -410,8 +478,13 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                         for sim in sims], 0.0))
     for s in crashed:
         start = _cpu_seconds()
-        entries = [_isolated_entry(s, sim, own_step(s, dt), only, kinds) for sim in sims]
+        step = own_step(s, dt)
+        entries = [_lent(lent.get(s, {}).get(sim), sim, step)
+                   or _isolated_entry(s, sim, step, only, kinds) for sim in sims]
         collect(s, (entries, _cpu_seconds() - start))
     entries = [e for s in systems for e in found[s]]
-    return OutOfTheBoxStudy(entries, provenance(), time.perf_counter() - started, workers,
+    made = provenance()
+    if record is not None:
+        made["record"] = {k: record["provenance"].get(k) for k in ("git_describe", "date")}
+    return OutOfTheBoxStudy(entries, made, time.perf_counter() - started, workers,
                             {s: cpu[s] for s in systems})

@@ -204,9 +204,21 @@ class PowerEntry:
     #: taken from the persistent cache (comparisons/out_of_the_box.py, `cached_entry`):
     #: its timings are those of the run that made it
     from_cache: bool = False
+    #: taken from a recorded study (`recorded_readings`): the state of the package that
+    #: made it (its `git describe`); empty for a reading made by this study
+    recorded: str = ""
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: Mapping) -> "PowerEntry":
+        """The entry `as_dict` gave (a key this version does not know is an error)."""
+        d = dict(d)
+        d["errors"] = [ErrorPower(**{**p, "trials": [Trial(**t) for t in p.get("trials", [])]})
+                       for p in d.get("errors", [])]
+        d["defaults"] = [DefaultPower(**x) for x in d.get("defaults", [])]
+        return cls(**d)
 
 
 #: marks a metric that rejects a run by exceeding the baseline's own failing value by
@@ -638,6 +650,7 @@ def out_of_the_box_document(power: dict) -> dict:
     doc = {"provenance": power["provenance"], "entries": [
         {**{k: e[k] for k in ("system", "simulator", "engine_version", "scenario",
                               "defaults_scenarios", "dt", "supported", "reason")},
+         "recorded": e.get("recorded", ""),
          "defaults": [{k: d.get(k) for k in keep} for d in e["defaults"]]}
         for e in power["entries"]]}
     if "cost" in power:

@@ -20,6 +20,15 @@ table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #ccc;p
 th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.weak{background:#fbeec8}
 .na{background:#e6e6e6;color:#666}small{color:#555}"""
 
+#: where a recorded study lent readings (comparisons/out_of_the_box.py, `_lent`)
+RECORD_NOTE = """{% if doc.provenance.record %}<p><b>{{ doc.cost.recorded_entries }} of the {{ doc.entries|length }}
+readings were taken from the recorded study made at {{ doc.provenance.record.git_describe }}
+({{ doc.provenance.record.date }})</b>, each where it was made with the engine version
+installed now at the same step (marked "recorded at" with the state of the package that made
+it); this study made the others. A recorded reading does not see a change of the gates or of
+the builds made since its mark: <code>make power</code> makes every reading again.</p>{% endif %}
+"""
+
 _ENV = jinja2.Environment(autoescape=True)
 _ENV.filters["eps"] = lambda x: "-" if x is None else (x if isinstance(x, str) else f"{x:.0e}")
 _ENV.filters["num"] = lambda x: "-" if x is None else (x if isinstance(x, str) else f"{x:.3g}")
@@ -46,14 +55,14 @@ a judged quantity moves beyond its gate and no gate catches it, a defect). A def
 switched on is classified the same way from the engine's runs with and without it: it
 acts when it moves a judged quantity by more than its gate; one that moves it toward the
 reference (a smaller error with it) is "closer to the reference".</p>
-<h2>Summary: median smallest rejected eps</h2>
+""" + RECORD_NOTE + """<h2>Summary: median smallest rejected eps</h2>
 <table><tr><th>engine</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults that act: rejected</th></tr>
 {% for sim, row in doc.summary.items() %}<tr><td>{{ sim }}</td>
 {% for k in kinds %}<td>{{ row[k].median_smallest_rejected|eps }} <small>({{ row[k].systems }} systems{% if row[k].not_rejected_at_largest %}, {{ row[k].not_rejected_at_largest }} not rejected at {{ doc.epsilons[-1]|eps }}{% endif %}{% if row[k].at_probe %}; at {{ doc.probe|eps }}: {{ row[k].at_probe['rejected'] }} rejected, {{ row[k].at_probe['below the gates'] }} below the gates{% if row[k].at_probe['not rejected'] %}, <b>{{ row[k].at_probe['not rejected'] }} not rejected</b>{% endif %}{% endif %})</small></td>{% endfor %}
 <td>{{ row.defaults.rejected }} / {{ row.defaults.acting }}{% if row.defaults.not_rejected %} <small><b>not rejected: {{ row.defaults.not_rejected|join(', ') }}</b></small>{% endif %}{% if row.defaults.closer_to_reference %} <small>closer to the reference: {{ row.defaults.closer_to_reference|join(', ') }}</small>{% endif %}{% if row.defaults.on_failed_run %} <small>on a failed run: {{ row.defaults.on_failed_run|join(', ') }}</small>{% endif %}{% if row.defaults.below_gates %} <small>({{ row.defaults.below_gates|length }} below the gates)</small>{% endif %}</td></tr>{% endfor %}</table>
 <h2>Per system and engine</h2>
 <table><tr><th>system</th><th>engine</th><th>baseline</th>{% for k in kinds %}<th>{{ k }}</th>{% endfor %}<th>defaults switched on</th></tr>
-{% for e in doc.entries %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}</td>
+{% for e in doc.entries %}<tr><td>{{ e.system }}</td><td>{{ e.simulator }}{% if e.recorded %} <small>recorded at {{ e.recorded }}</small>{% endif %}</td>
 {% if not e.supported %}<td class="na" colspan="{{ kinds|length + 2 }}">unsupported: {{ e.reason }}</td>
 {% else %}<td class="{{ 'pass' if e.baseline_passed else 'fail' }}" title="{{ e.baseline_not_holding|join(', ') }}">{{ 'passes' if e.baseline_passed else 'fails' }}</td>
 {% for p in e.errors %}{% if not p.applicable %}<td class="na" title="{{ p.reason }}">n/a</td>
@@ -90,11 +99,11 @@ change of the exact model's energy along the run, relative to the largest kineti
 Damping ratio: what the free-vibration fit of mode 1 finds added to the exact one. Verdict:
 rejected when a gate that holds with the harness's setting fails with the default (a run that
 does not complete counts as rejected: timed out, crashed); "no effect" when no metric moved.</p>
-{% if left %}<h2>Left out</h2><p>What the study could not measure, with the reason: an
+""" + RECORD_NOTE + """{% if left %}<h2>Left out</h2><p>What the study could not measure, with the reason: an
 engine that cannot build the mechanism, a run with a default that did not complete (its
 verdict counts it as rejected; its effect is not measured).</p><ul>
 {% for anchor, what, why in left %}<li><a href="#{{ anchor }}">{{ what }}</a>: {{ why }}</li>{% endfor %}</ul>{% endif %}
-{% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{% if e.system in links.pages %}<a href="{{ links.pages[e.system] }}">{{ e.system }}</a>{% else %}{{ e.system }}{% endif %} · {{ e.simulator }} {{ e.engine_version }}</h2>
+{% for e in doc.entries %}<h2 id="{{ e.system }}-{{ e.simulator }}">{% if e.system in links.pages %}<a href="{{ links.pages[e.system] }}">{{ e.system }}</a>{% else %}{{ e.system }}{% endif %} · {{ e.simulator }} {{ e.engine_version }}{% if e.recorded %} <small>(recorded at {{ e.recorded }})</small>{% endif %}</h2>
 {% if not e.supported %}<p>left out: {{ e.reason }}</p>{% elif not e.defaults %}<p>no neutralised default declared by its backend (<code>Setting.engine_default</code>).</p>{% else %}
 <table><tr><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate)</th><th>energy drift: harness → default</th><th>damping ratio added (mode 1)</th><th>frequency error (mode 1)</th></tr>
 {% for d in e.defaults %}{% set damp = d.effect.get('damping.fit_mode1') %}{% set freq = d.effect.get('frequency.fit_mode1') %}
