@@ -360,6 +360,7 @@ def test_a_recorded_study_lends_the_readings_of_the_installed_engines_only(
     came from."""
     import json
 
+    from mbfidelity.reports.html import _out_of_the_box_rows
     from mbfidelity.reports.power_page import POWER, write_power_pages
 
     _installed("pymunk")
@@ -385,6 +386,8 @@ def test_a_recorded_study_lends_the_readings_of_the_installed_engines_only(
     (tmp_path / "out_of_the_box.json").write_text(json.dumps(lent.as_dict()))
     for page in write_power_pages(tmp_path):
         assert "recorded at v0-recorded" in page.read_text()
+    (row,) = _out_of_the_box_rows(tmp_path)["compound_pendulum"]  # the mechanism page's
+    assert row["recorded"] == "v0-recorded"
 
     # another step: made by the study
     again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],

@@ -281,7 +281,7 @@ def _out_of_the_box_rows(out: Path) -> dict[str, list[dict]]:
         rows.setdefault(e["system"], []).append({
             "simulator": e["simulator"], "supported": e["supported"],
             "reason": e.get("reason", ""), "anchor": f"{e['system']}-{e['simulator']}",
-            "defaults": defaults})
+            "recorded": e.get("recorded", ""), "defaults": defaults})
     return rows
 
 

@@ -179,7 +179,7 @@ conservative mechanism). Each as harness &#x2192; default.</p>
 <table><tr><th>engine</th><th>default</th><th>engine value</th><th>harness value</th><th>verdict</th><th>motion change (gate, scenario)</th><th>energy drift (scenario)</th><th>damping ratio error, mode 1</th></tr>
 {% for e in out_of_the_box %}{% if not e.supported %}<tr><td><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td><td colspan="7" class="unsupported">left out: {{ e.reason|e }}</td></tr>
 {% elif not e.defaults %}<tr><td><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td><td colspan="7">no neutralised default declared by its backend</td></tr>
-{% else %}{% for d in e.defaults %}<tr>{% if loop.first %}<td rowspan="{{ e.defaults|length }}"><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a></td>{% endif %}
+{% else %}{% for d in e.defaults %}<tr>{% if loop.first %}<td rowspan="{{ e.defaults|length }}"><a href="out_of_the_box.html#{{ e.anchor }}">{{ e.simulator }}</a>{% if e.recorded %}<br><small>recorded at {{ e.recorded|e }}</small>{% endif %}</td>{% endif %}
 <td title="{{ d.note|e }}">{{ d.setting|e }}</td><td><code>{{ d.engine_value|e }}</code></td><td><code>{{ d.harness_value|e }}</code></td>
 <td class="{{ d.cls }}" title="{{ d.rejected_by|e }}">{{ d.verdict }}{% for i in d.incidents %} ({{ i|e }}){% endfor %}</td>
 <td>{% if d.motion.get("error") %}{{ d.motion.error|e }}{% elif d.motion.change is not none %}{{ "%.3g"|format(d.motion.change) }}{% if d.motion.gate is not none %} <small>({{ "%.2g"|format(d.motion.gate) }}, {{ d.motion.scenario|e }})</small>{% endif %}{% else %}-{% endif %}</td>
