@@ -124,3 +124,47 @@ def test_every_neutralised_default_is_cited():
                 (engine, key)
             cited += 1
     assert cited >= 4
+
+
+def test_a_default_the_step_cannot_hold_is_recorded_as_refused():
+    """MuJoCo's default integrator, semi-implicit Euler, is stable for w h < 2 only; the
+    harness's RK4 up to w h = 2.78. On the mass-spring-damper (Fig. 1: w = sqrt(k / m),
+    the modulus of its eigenvalues) at w h = 2.4 the neutralised run goes, and the harness
+    refuses the Euler run before it starts (`runner.UnstableStep`): the study records the
+    refusal as that default's run (rejected, with the incident) instead of raising out of
+    the system's whole job."""
+    from mbfidelity.comparisons import out_of_the_box
+
+    ok, why = get_backend("mujoco").available()
+    if not ok:
+        pytest.skip(why)
+    system = get_system("mass_spring_damper")
+    v = system.parameter_values(None, scenario=system.scenarios[0])
+    w = math.sqrt(v["k"] / v["m"])
+    entry = out_of_the_box.defaults_entry("mass_spring_damper", "mujoco", 2.4 / w,
+                                          only=["integrator"])
+    (d,) = entry.defaults
+    assert entry.supported and d.setting == "integrator" and d.engine_value == "Euler"
+    assert d.rejected and d.verdict == "rejected"
+    (incident,) = d.incidents
+    assert incident["outcome"] == "refused"
+    assert "cannot be stable" in incident["message"] and "w h = 2.4" in incident["message"]
+
+
+def test_one_engine_that_fails_leaves_the_systems_other_engines_measured(monkeypatch):
+    """A reading that raises (here an injected error on PyBullet's) becomes that engine's
+    entry, not measured and saying why; the system's other engines are measured."""
+    from mbfidelity.comparisons import out_of_the_box
+    from mbfidelity.comparisons.power import PowerEntry
+
+    def reading(system_id, simulator, dt, only, kinds):
+        if simulator == "pybullet":
+            raise RuntimeError("injected failure")
+        return PowerEntry(system_id, simulator, dt=dt)
+
+    monkeypatch.setattr(out_of_the_box, "cached_entry", reading)
+    entries, _ = out_of_the_box._system_job("mass_spring_damper",
+                                            ["mujoco", "pybullet", "pymunk"], None, None)
+    assert [e.simulator for e in entries] == ["mujoco", "pybullet", "pymunk"]
+    assert [e.supported for e in entries] == [True, False, True]
+    assert entries[1].reason == "not measured: RuntimeError: injected failure"

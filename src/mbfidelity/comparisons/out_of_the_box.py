@@ -67,7 +67,8 @@ from .power import (ERROR_KINDS, RUN_TIMEOUT_FACTOR, RUN_TIMEOUT_FLOOR, DefaultP
                     classify_default, effect_against, engine_defaults, error_powers,
                     free_coordinates, largest_change, metric_named, out_of_the_box_document,
                     power_document, rejecting_metrics, same_metrics, worst_scenario)
-from .runner import Comparison, compare, failed_comparison, isolated_compare, own_step
+from .runner import (Comparison, UnstableStep, compare, failed_comparison, isolated_compare,
+                     own_step)
 
 #: wall-clock budget of one default's run: this many times the neutralised run's wall
 #: time, at least RUN_BUDGET_FLOOR s. A default can make a run much longer than the
@@ -211,6 +212,10 @@ def defaults_entry(system_id: str, simulator: str, dt: float | None = None,
         try:
             run, motion = isolated(_switched_on, system.id, simulator, dt, declared, settings,
                                    series, free, held, timeout=budget)
+        except UnstableStep as exc:  # the engine's own default cannot run at this step
+            run = failed_comparison(system.id, simulator, None, dt, "", "step", exc,
+                                    "refused")
+            motion = {}
         except (ValueError, KeyError):
             raise
         except Exception as exc:  # crashed or past its budget: the run's incident
@@ -361,25 +366,37 @@ def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=(
     dt = own_step(system_id, dt)
     start = _cpu_seconds()
     recorded = recorded or {}
-    entries = [_lent(recorded.get(sim), sim, dt) or cached_entry(system_id, sim, dt, only,
-                                                                   kinds)
+    entries = [_lent(recorded.get(sim), sim, dt) or _contained_entry(system_id, sim, dt, only,
+                                                                       kinds)
                for sim in sims]
     return entries, _cpu_seconds() - start
 
 
+def _contained_entry(system_id: str, simulator: str, dt: float, only, kinds) -> PowerEntry:
+    """`cached_entry`, or where it raises, an entry that says why it was not measured:
+    one engine's failure leaves the system's other engines measured (and nothing cached,
+    so that the next study tries again)."""
+    try:
+        return cached_entry(system_id, simulator, dt, only, kinds)
+    except Exception as exc:
+        return PowerEntry(system_id, simulator, supported=False, dt=dt,
+                          reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
+
+
 def _isolated_entry(system_id: str, simulator: str, dt: float, only, kinds=()
                     ) -> PowerEntry:
-    """`defaults_entry` in a worker of its own: a process that dies gives an entry that
-    says so, with every default unmeasured."""
+    """`defaults_entry` in a worker of its own: a process that dies, or a reading that
+    raises, gives an entry that says so, with every default unmeasured."""
     try:
         return isolated(defaults_entry, system_id, simulator, dt, only, kinds,
                         timeout=ENTRY_TIMEOUT)
-    except (ValueError, KeyError):
-        raise
-    except Exception as exc:
+    except (WorkerCrashed, WorkerTimedOut) as exc:
         return PowerEntry(system_id, simulator, supported=False, dt=dt,
                           reason=f"the neutralised run did not complete "
                                  f"({type(exc).__name__}: {exc})"[:500])
+    except Exception as exc:
+        return PowerEntry(system_id, simulator, supported=False, dt=dt,
+                          reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
 
 
 @dataclass

@@ -393,8 +393,15 @@ def _compare_stored_inertia(system, backend, mech, settings, result) -> None:
         result.metrics.append(metric)
 
 
+class UnstableStep(ValueError):
+    """The engine's scheme, with these settings, cannot be stable at this step on the
+    mechanism's fastest mode (`tolerances.stability_refusal`): bad input where a user chose
+    the settings and the step, a property of the engine where its own defaults did (the
+    out-of-the-box study records it as that default's run)."""
+
+
 def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) -> None:
-    """ValueError (one line) when the engine's scheme cannot be stable at this step on the
+    """`UnstableStep` (a ValueError, one line) when the engine's scheme cannot be stable at this step on the
     fastest mode of the operating point's linearization (before any reference solve,
     which a stiff system would make endless). Where the equilibrium cannot be found the
     comparison's own stages record why."""
@@ -409,7 +416,7 @@ def _refuse_unstable_step(system, backend, mech, settings, values, dt: float) ->
     refusal = tolerances.stability_refusal(w, dt, f"{backend.id}'s {scheme.name}",
                                            scheme.stability_limit)
     if refusal:
-        raise ValueError(refusal)
+        raise UnstableStep(refusal)
 
 
 def isolated_compare(system_id: str, simulator: str,
