@@ -438,8 +438,6 @@ def test_the_committed_record_reads_back_as_power_entries():
     from mbfidelity.comparisons.runner import own_step
 
     path = Path(__file__).resolve().parent.parent / "benchmarks/records/power_study.json.gz"
-    if not path.exists():
-        pytest.skip("not in this checkout")
     doc = out_of_the_box.read_record(path)
     readings = out_of_the_box.recorded_readings(doc, tuple(power.ERROR_KINDS))
     assert readings
