@@ -356,8 +356,8 @@ def test_a_recorded_study_lends_the_readings_of_the_installed_engines_only(
     """`out_of_the_box_study(record=)`: a reading the record made with the installed
     engine's version at the same step is taken from it as it was made (marked with the
     state of the package that made it, no comparison counted); with another engine
-    version, or at another step, the study makes it. The pages say where a reading
-    came from."""
+    version, at another step, or in a layout this version does not read, the study makes
+    it. The pages say where a reading came from."""
     import json
 
     from mbfidelity.reports.html import _out_of_the_box_rows
@@ -389,16 +389,21 @@ def test_a_recorded_study_lends_the_readings_of_the_installed_engines_only(
     (row,) = _out_of_the_box_rows(tmp_path)["compound_pendulum"]  # the mechanism page's
     assert row["recorded"] == "v0-recorded"
 
+    # a reading of a layout this version does not read: made by the study
+    later = {**record, "entries": [{**e, "a_later_field": 1} for e in record["entries"]]}
+    again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
+                                                kinds=kinds, record=later)
+    assert len(measured) == 1 and not again.entries[0].recorded
     # another step: made by the study
     again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
                                                 dt=made.entries[0].dt / 2, kinds=kinds,
                                                 record=record)
-    assert len(measured) == 1 and not again.entries[0].recorded
+    assert len(measured) == 2 and not again.entries[0].recorded
     # another version of the engine: made by the study
     monkeypatch.setattr(get_backend("pymunk"), "version", lambda: "another version")
     again = out_of_the_box.out_of_the_box_study(["compound_pendulum"], ["pymunk"],
                                                 kinds=kinds, record=record)
-    assert len(measured) == 2 and not again.entries[0].recorded
+    assert len(measured) == 3 and not again.entries[0].recorded
     assert again.cost()["comparisons"] > 0 and again.cost()["recorded_entries"] == 0
 
 

@@ -347,14 +347,18 @@ def recorded_readings(doc: Mapping, kinds: Iterable[str]) -> dict[tuple[str, str
 
 def _lent(reading: Mapping | None, simulator: str, dt: float) -> PowerEntry | None:
     """A recorded reading where it was made with the installed version of the engine at
-    step `dt`; None where the study must make it."""
+    step `dt`; None where the study must make it (a reading of a layout this version does
+    not read, too)."""
     if reading is None:
         return None
     backend = get_backend(simulator)
     if not backend.available()[0] or reading.get("engine_version") != backend.version() \
             or reading.get("dt") != dt:
         return None
-    return PowerEntry.from_dict({**reading, "from_cache": False})
+    try:
+        return PowerEntry.from_dict({**reading, "from_cache": False})
+    except (TypeError, KeyError, AttributeError):
+        return None
 
 
 def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=(),
