@@ -280,6 +280,34 @@ def test_a_default_on_a_run_the_engine_fails_without_it_is_told_apart_from_a_bli
     finite = _reading(0.1, [], beyond)
     power.classify_default(finite, baseline)
     assert finite.verdict == power.NOT_REJECTED
+    # no metric moved: whatever the motion change says, the default acts on nothing
+    still = _reading(0.1, [], beyond)
+    still.moved = False
+    power.classify_default(still, baseline)
+    assert not still.acts and still.verdict == power.NO_EFFECT
+
+
+def test_a_motion_not_finite_in_both_runs_is_no_change():
+    """`_motion_change`: the largest |q_on - q_off| over the amplitude, where a sample
+    not finite in one run only is an infinite change and one not finite in both runs (the
+    engine's run fails there with or without the default) is none."""
+    from types import SimpleNamespace
+
+    nan = float("nan")
+    off = np.array([[0.0, 5.0], [0.1, 5.0], [nan, 5.0], [nan, 5.0]])
+    scale = np.array([0.5, 1.0])
+    neutral = {"s": (off, scale)}
+    same_failure = off.copy()
+    same_failure[1, 0] = 0.2  # 0.1 away, at amplitude 0.5
+    on = SimpleNamespace(series={"s": {"q": same_failure}})
+    change = out_of_the_box._motion_change(neutral, on, [0])["s"]["trajectory_change"]
+    assert change == pytest.approx(0.2)
+    its_own = off.copy()
+    its_own[2, 0] = 0.3  # finite where the neutralised run is not
+    on = SimpleNamespace(series={"s": {"q": its_own}})
+    assert out_of_the_box._motion_change(neutral, on, [0])["s"]["trajectory_change"] == math.inf
+    on = SimpleNamespace(series={"s": {"q": off.copy()}})  # the same failing run
+    assert out_of_the_box._motion_change(neutral, on, [0, 1])["s"]["trajectory_change"] == 0.0
 
 
 def test_a_reading_is_kept_by_its_content_and_made_again_for_another_engine_version(

@@ -85,7 +85,9 @@ ALL = "all"
 
 def _motion_change(neutral: Mapping[str, tuple], on: Comparison, free: list[int]) -> dict:
     """Per scenario, the largest |q_on - q_off| over the free coordinates relative to
-    their amplitude (the trajectory gate's scale), from the two comparisons' series."""
+    their amplitude (the trajectory gate's scale), from the two comparisons' series: a
+    sample not finite in one run only is an infinite change, one not finite in both (a
+    run that fails there either way) none."""
     out = {}
     for name, series in on.series.items():
         if name not in neutral:
@@ -93,10 +95,12 @@ def _motion_change(neutral: Mapping[str, tuple], on: Comparison, free: list[int]
         q_off, scale = neutral[name]
         q_on = np.asarray(series["q"], dtype=float)
         n = min(len(q_off), len(q_on))
+        a, b = q_on[:n][:, free], q_off[:n][:, free]
         with np.errstate(invalid="ignore"):
-            change = (float(np.max(np.abs(q_on[:n, free] - q_off[:n, free]) / scale[free]))
-                      if n else float("nan"))
-        out[name] = {"trajectory_change": change if np.isfinite(change) else float("inf")}
+            change = np.abs(a - b) / scale[free]
+        change[~np.isfinite(change)] = np.inf
+        change[~np.isfinite(a) & ~np.isfinite(b)] = 0.0
+        out[name] = {"trajectory_change": float(change.max()) if change.size else np.inf}
     return out
 
 

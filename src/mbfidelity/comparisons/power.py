@@ -283,10 +283,11 @@ def classify_default(d: DefaultPower, baseline: Comparison) -> None:
     without it: the engine's run stops or diverges there); not rejected (a judged quantity
     moved beyond its gate, away from the reference or unjudged, and no gate caught it: the
     metric that judges it, named, and its status in the baseline). An incident of the run
-    acts only where the baseline does not have it too."""
+    acts only where the baseline does not have it too; a change where no metric moved is
+    none."""
     c = d.change
     shared = {(i["scenario"], i["stage"]) for i in baseline.incidents}
-    d.acts = bool(c and c["ratio"] > 1.0) or any(
+    d.acts = bool(c and c["ratio"] > 1.0) and d.moved or any(
         (i["scenario"], i["stage"]) not in shared for i in d.incidents)
     if d.rejected:
         d.verdict = REJECTED
