@@ -168,3 +168,27 @@ def test_one_engine_that_fails_leaves_the_systems_other_engines_measured(monkeyp
     assert [e.simulator for e in entries] == ["mujoco", "pybullet", "pymunk"]
     assert [e.supported for e in entries] == [True, False, True]
     assert entries[1].reason == "not measured: RuntimeError: injected failure"
+
+
+def test_a_row_whose_neutralised_run_has_no_energy_drift_renders(tmp_path):
+    """A scenario where the neutralised run measured no energy drift and the default's run
+    did (IFToMM A02 on Exudyn, its published scenario): the mechanism page's row shows
+    "-" for the missing value beside the measured one."""
+    from mbfidelity.reports import site
+    from mbfidelity.reports.html import _out_of_the_box_rows
+
+    default = {"setting": "a_default", "engine_value": 1.0, "harness_value": 0.0,
+               "acts": True, "moved": True, "verdict": "below the gates", "why": "",
+               "rejected": False, "rejected_by": [], "effect": {}, "incidents": [],
+               "motion": {"scenarios": {"published": {"energy_drift_neutralised": None,
+                                                      "energy_drift_switched_on": 2e-6}}}}
+    doc = {"provenance": {}, "entries": [
+        {"system": "s", "simulator": "exudyn", "supported": True, "reason": "",
+         "defaults": [default]}]}
+    (tmp_path / "out_of_the_box.json").write_text(json.dumps(doc))
+    rows = _out_of_the_box_rows(tmp_path)["s"]
+    page = site.MECHANISM.render(
+        style="", title="t", source="", drawing="", script="", convergence="", errata=[],
+        published=[], errata_page=False, system="s", sections=[], model={},
+        out_of_the_box=rows)
+    assert "- &#x2192; 2e-06 <small>(published)</small>" in page

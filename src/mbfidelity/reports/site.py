@@ -183,7 +183,7 @@ conservative mechanism). Each as harness &#x2192; default.</p>
 <td title="{{ d.note|e }}">{{ d.setting|e }}</td><td><code>{{ d.engine_value|e }}</code></td><td><code>{{ d.harness_value|e }}</code></td>
 <td class="{{ d.cls }}" title="{{ d.rejected_by|e }}">{{ d.verdict }}{% for i in d.incidents %} ({{ i|e }}){% endfor %}</td>
 <td>{% if d.motion.get("error") %}{{ d.motion.error|e }}{% elif d.motion.change is not none %}{{ "%.3g"|format(d.motion.change) }}{% if d.motion.gate is not none %} <small>({{ "%.2g"|format(d.motion.gate) }}, {{ d.motion.scenario|e }})</small>{% endif %}{% else %}-{% endif %}</td>
-<td>{% if d.energy %}{{ "%.3g"|format(d.energy.neutralised) }} &#x2192; {{ "%.3g"|format(d.energy.switched_on) }} <small>({{ d.energy.scenario|e }})</small>{% else %}-{% endif %}</td>
+<td>{% if d.energy %}{{ "%.3g"|format(d.energy.neutralised) if d.energy.neutralised is not none else "-" }} &#x2192; {{ "%.3g"|format(d.energy.switched_on) }} <small>({{ d.energy.scenario|e }})</small>{% else %}-{% endif %}</td>
 <td>{% if d.damping %}{{ "%.3g"|format(d.damping.neutralised) if d.damping.neutralised is not none else "-" }} &#x2192; {{ "%.3g"|format(d.damping.switched_on) }}{% else %}-{% endif %}</td></tr>{% endfor %}{% endif %}{% endfor %}
 </table>{% endif %}
 {% if convergence %}<h2>Convergence and work-precision</h2><img src="{{ convergence|url }}" alt="convergence of {{ system|e }}">{% endif %}
