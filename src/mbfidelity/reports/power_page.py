@@ -22,10 +22,10 @@ th{background:#f0f0f0}.pass{background:#dff5df}.fail{background:#f8d0d0}.weak{ba
 
 #: where a recorded study lent readings (comparisons/out_of_the_box.py, `_lent`)
 RECORD_NOTE = """{% if doc.provenance.record %}<p><b>{{ doc.cost.recorded_entries }} of the {{ doc.entries|length }}
-readings were taken from the recorded study made at {{ doc.provenance.record.git_describe }}
-({{ doc.provenance.record.date }})</b>, each where it was made with the engine version
-installed now at the same step (marked "recorded at" with the state of the package that made
-it); this study made the others. A recorded reading does not see a change of the gates or of
+readings were taken from a recorded study (written at {{ doc.provenance.record.git_describe }},
+{{ doc.provenance.record.date }})</b>, each where it was made with the engine version
+installed now at the same step, and each marked "recorded at" with the state of the package
+that made it; this study made the others. A recorded reading does not see a change of the gates or of
 the builds made since its mark: <code>make power</code> makes every reading again.</p>{% endif %}
 """
 
