@@ -312,7 +312,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
+
+if TYPE_CHECKING:  # annotations only: a rule that needs NumPy imports it itself
+    import numpy as np
 
 FD_FREQUENCY = 1e-6
 FIT_RESOLUTION = 1e-5
@@ -404,8 +407,8 @@ def error_controlled_gate(tolerance: float) -> Gate:
     return Gate(tolerance)
 
 
-def modal_trajectory_tolerance(amplitudes: "np.ndarray", omegas: "np.ndarray",
-                               zetas: "np.ndarray", scale: "np.ndarray", h: float, order: int,
+def modal_trajectory_tolerance(amplitudes: np.ndarray, omegas: np.ndarray,
+                               zetas: np.ndarray, scale: np.ndarray, h: float, order: int,
                                t_end: float) -> float:
     """max_c sum_j amplitudes[c, j] e_j / scale[c] (module docstring: mode by mode), e_j
     the trajectory bound at omegas[j] inside the bound's range of w h, twice the mode's
