@@ -52,6 +52,7 @@ def test_slot_geometry_reads_where_the_pin_is_placed():
                      0.9, (lvx + r * u[0] + w * n[0], lvy + r * u[1] + w * n[1]))
         along, rate = geo.along(pin, line)
         assert along == pytest.approx(s, abs=TOL) and rate == pytest.approx(r, abs=TOL)
+        assert geo.position_along(pin, line) == along  # the same arithmetic: bitwise
         assert geo.line_point_at(s) == pytest.approx((0.5 + 0.6 * s, 0.1 + 0.8 * s), abs=TOL)
     assert geo.direction == pytest.approx((0.6, 0.8), abs=TOL)
 

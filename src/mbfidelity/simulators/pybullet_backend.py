@@ -227,8 +227,7 @@ class _Rotor(_Slot):
     def pivot(self, ls) -> list[float]:
         """The slot body's point under the pin (its projection on the slot line), in the
         slot body's frame: L + ((P - L) . u) u (why: the setting point_on_line's note)."""
-        s, _ = self.slot.along(*self._states(ls))
-        return [*self.slot.line_point_at(s), 0.0]
+        return [*self.slot.line_point_at(self.slot.position_along(*self._states(ls))), 0.0]
 
 
 @dataclass

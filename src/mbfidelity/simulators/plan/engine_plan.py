@@ -128,10 +128,26 @@ class SlotGeometry:
         (px, py, pvx, pvy), (lx, ly, lvx, lvy), (ux, uy) = self.frame(pin, line)
         return (px - lx) * ux + (py - ly) * uy, (pvx - lvx) * ux + (pvy - lvy) * uy
 
+    def position_along(self, pin: tuple, line: tuple) -> float:
+        """`along`'s position s alone, by the same arithmetic on one step's floats (what
+        an engine that moves the slot's pivot every step needs)."""
+        c, s = math.cos(line[2]), math.sin(line[2])
+        ux = c * self.direction[0] - s * self.direction[1]
+        uy = s * self.direction[0] + c * self.direction[1]
+        (px, py), (lx, ly) = _position(pin, self.pin_point), _position(line, self.line_point)
+        return (px - lx) * ux + (py - ly) * uy
+
     def line_point_at(self, s: float) -> tuple[float, float]:
         """The slot body's point of its line at s along it: L + s u (body frame)."""
         ux, uy = self.direction
         return self.line_point[0] + s * ux, self.line_point[1] + s * uy
+
+
+def _position(state: tuple, local) -> tuple[float, float]:
+    """World position of a body point from the body frame's state (x, y, theta, ...) of
+    floats: `point_state`'s position, term by term."""
+    c, s = math.cos(state[2]), math.sin(state[2])
+    return state[0] + (c * local[0] - s * local[1]), state[1] + (s * local[0] + c * local[1])
 
 
 def slot_geometry(c: PointOnLine) -> SlotGeometry:
