@@ -91,54 +91,20 @@ def _(element: Body) -> str:
     return MASSLESS_BODY if element.massless else BODY
 
 
-@element_kind.register
-def _(element: Revolute) -> str:
-    return REVOLUTE
-
-
-@element_kind.register
-def _(element: Prismatic) -> str:
-    return PRISMATIC
-
-
-@element_kind.register
-def _(element: PointToPoint) -> str:
+def _force_kind(element) -> str:
     return ForceLaw.of(element).kind
 
 
-@element_kind.register
-def _(element: CoordinateForce) -> str:
-    return ForceLaw.of(element).kind
-
-
-@element_kind.register
-def _(element: PointOnPoint) -> str:
-    return POINT_ON_POINT
-
-
-@element_kind.register
-def _(element: PointOnLine) -> str:
-    return POINT_ON_LINE
-
-
-@element_kind.register
-def _(element: LinearCoupling) -> str:
-    return LINEAR_COUPLING
-
-
-@element_kind.register
-def _(element: RollingContact) -> str:
-    return ROLLING_CONTACT
-
-
-@element_kind.register
-def _(element: Prescribed) -> str:
-    return PRESCRIBED
-
-
-@element_kind.register
-def _(element: HingeClosure) -> str:
-    return HINGE_CLOSURE
+element_kind.register(PointToPoint, _force_kind)
+element_kind.register(CoordinateForce, _force_kind)
+#: the element types whose kind does not depend on the element
+_FIXED_KINDS = {Revolute: REVOLUTE, Prismatic: PRISMATIC, PointOnPoint: POINT_ON_POINT,
+                PointOnLine: POINT_ON_LINE, LinearCoupling: LINEAR_COUPLING,
+                RollingContact: ROLLING_CONTACT, Prescribed: PRESCRIBED,
+                HingeClosure: HINGE_CLOSURE}
+for _type, _kind in _FIXED_KINDS.items():
+    element_kind.register(_type, lambda element, kind=_kind: kind)
+del _type, _kind
 
 
 def rigid_body(mech: Mechanism, body: Body) -> bool:
@@ -156,13 +122,13 @@ def massive_below(mech: Mechanism, body: Body) -> bool:
     return any(not mech.body(b).massless for b in mech.subtree(body.name))
 
 
-
 def held_below(mech: Mechanism, body: Body) -> bool:
     """Some body of the subtree from `body` (itself included) has mass or is acted on by a
     closure constraint (`constrained_bodies`): what keeps a massless link's coordinates
     determined in a tree of relative joints (an `Expression.applies` condition)."""
     return massive_below(mech, body) or bool(
         constrained_bodies(mech) & set(mech.subtree(body.name)))
+
 
 def elements(mech: Mechanism) -> Iterator[tuple[str, object]]:
     """(kind, element) for every element of the description, in description order."""
