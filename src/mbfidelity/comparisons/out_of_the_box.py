@@ -380,6 +380,11 @@ def _system_job(system_id: str, sims: list[str], dt: float | None, only, kinds=(
     return entries, _cpu_seconds() - start
 
 
+def _not_measured(system_id: str, simulator: str, dt: float, why: str) -> PowerEntry:
+    """The entry of a reading that could not be made, saying why."""
+    return PowerEntry(system_id, simulator, supported=False, dt=dt, reason=why[:500])
+
+
 def _contained_entry(system_id: str, simulator: str, dt: float, only, kinds) -> PowerEntry:
     """`cached_entry`, or where it raises, an entry that says why it was not measured:
     one engine's failure leaves the system's other engines measured (and nothing cached,
@@ -387,8 +392,8 @@ def _contained_entry(system_id: str, simulator: str, dt: float, only, kinds) -> 
     try:
         return cached_entry(system_id, simulator, dt, only, kinds)
     except Exception as exc:
-        return PowerEntry(system_id, simulator, supported=False, dt=dt,
-                          reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
+        return _not_measured(system_id, simulator, dt,
+                             f"not measured: {type(exc).__name__}: {exc}")
 
 
 def _isolated_entry(system_id: str, simulator: str, dt: float, only, kinds=()
@@ -399,12 +404,11 @@ def _isolated_entry(system_id: str, simulator: str, dt: float, only, kinds=()
         return isolated(defaults_entry, system_id, simulator, dt, only, kinds,
                         timeout=ENTRY_TIMEOUT)
     except (WorkerCrashed, WorkerTimedOut) as exc:
-        return PowerEntry(system_id, simulator, supported=False, dt=dt,
-                          reason=f"the neutralised run did not complete "
-                                 f"({type(exc).__name__}: {exc})"[:500])
+        return _not_measured(system_id, simulator, dt, f"the neutralised run did not "
+                                                       f"complete ({type(exc).__name__}: {exc})")
     except Exception as exc:
-        return PowerEntry(system_id, simulator, supported=False, dt=dt,
-                          reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
+        return _not_measured(system_id, simulator, dt,
+                             f"not measured: {type(exc).__name__}: {exc}")
 
 
 @dataclass
@@ -497,10 +501,10 @@ def out_of_the_box_study(systems: Iterable[str], sims: Iterable[str],
                 except BrokenProcessPool:
                     crashed.append(futures[fut])
                 except Exception as exc:  # the job could not come back: its entries say so
-                    collect(futures[fut], ([PowerEntry(
-                        futures[fut], sim, supported=False, dt=own_step(futures[fut], dt),
-                        reason=f"not measured: {type(exc).__name__}: {exc}"[:500])
-                        for sim in sims], 0.0))
+                    why = f"not measured: {type(exc).__name__}: {exc}"
+                    collect(futures[fut], ([_not_measured(futures[fut], sim,
+                                                          own_step(futures[fut], dt), why)
+                                            for sim in sims], 0.0))
     for s in crashed:
         start = _cpu_seconds()
         step = own_step(s, dt)
