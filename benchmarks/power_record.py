@@ -48,7 +48,8 @@ def main() -> None:
     parser.add_argument("--command", default="mbfidelity power --workers 2 --out DIR")
     parser.add_argument("--note", default="")
     args = parser.parse_args()
-    power = json.loads((args.folder / "power.json").read_text())
+    raw = (args.folder / "power.json").read_bytes()
+    power = json.loads(raw)
     record = {"benchmark": "power", "command": args.command, "note": args.note,
               "provenance": power["provenance"], "cost": power.get("cost"),
               "summary": power["summary"],
@@ -56,7 +57,6 @@ def main() -> None:
     args.record.write_text(json.dumps(record, indent=1) + "\n")
     print(f"{len(record['entries'])} entries -> {args.record}")
     if args.study is not None:
-        raw = (args.folder / "power.json").read_bytes()
         with gzip.GzipFile(args.study, "wb", compresslevel=9, mtime=0) as f:
             f.write(raw)
         print(f"{len(raw)} bytes -> {args.study} ({args.study.stat().st_size} compressed)")
